@@ -1,0 +1,277 @@
+/*
+ * jetfit.h -- the one public header of libjetfit.
+ *
+ * jetfit estimates, at every sample of a point cloud or mesh, the normal, the
+ * principal curvatures and directions and the 3rd/4th-order Monge
+ * coefficients by fitting osculating jets (Cazals & Pouget, "Estimating
+ * Differential Quantities Using Polynomial Fitting of Osculating Jets",
+ * SGP 2003; section numbers below are the paper's).
+ *
+ * Conventions of the whole API
+ *  - Every fallible call returns a jf_status (JF_OK == 0); jf_strerror() names
+ *    it.  The library never prints, exits or aborts.  Calls that read files
+ *    also fill a caller-owned jf_error with one line naming the file, the
+ *    place (line or element) and the reason.
+ *  - Per-point failure is data, not an error: jf_result.status holds
+ *    JF_PT_* flags (0 = full fit at the requested degree).
+ *  - Points are `const double *xyz` with 3 doubles per point, caller-owned.
+ *    Element i of every output array belongs to input point i.
+ *  - Handles (jf_fitter, jf_index, ...) are opaque, created once and reused;
+ *    jf_*_free(NULL) is a no-op; a failed create frees what it made.
+ *  - Thread safety: functions taking a const handle are safe to call from
+ *    several threads at once; a jf_fitter is a per-thread workspace.
+ */
+#ifndef JETFIT_H
+#define JETFIT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define JF_VERSION_MAJOR 0
+#define JF_VERSION_MINOR 1
+#define JF_VERSION_PATCH 0
+#define JF_VERSION_STRING "0.1.0"
+
+/* Run-time version string ("0.1.0"). */
+const char *jf_version(void);
+
+/* ------------------------------------------------------------------ */
+/* Status codes (stable: values never change once released).          */
+/* ------------------------------------------------------------------ */
+typedef enum {
+    JF_OK = 0,
+    JF_ERR_INVALID = 1,     /* bad argument or parameter                 */
+    JF_ERR_NOMEM = 2,       /* allocation failed                         */
+    JF_ERR_IO = 3,          /* open/read/write/rename failed             */
+    JF_ERR_FORMAT = 4,      /* malformed or unsupported file content     */
+    JF_ERR_TOO_LARGE = 5,   /* more points/neighbours than the handle or
+                               the file can hold                          */
+    JF_ERR_NUMERIC = 6,     /* a numerical routine failed                */
+    JF_ERR_UNSUPPORTED = 7, /* feature not built in (e.g. no CGAL)       */
+    JF_ERR_INTERNAL = 8     /* a bug: please report                      */
+} jf_status;
+
+/* Static English name of a status; never NULL. */
+const char *jf_strerror(jf_status s);
+
+/* One-line message filled by calls that touch files (caller-owned). */
+typedef struct {
+    char msg[512];
+} jf_error;
+
+/* ------------------------------------------------------------------ */
+/* Per-point status flags (jf_result.status, the output column).      */
+/* 0 means: fitted at the requested degree, nothing to report.        */
+/* ------------------------------------------------------------------ */
+enum {
+    JF_PT_LOWERED_COND = 1u << 0,  /* degree lowered: kappa > max_cond  */
+    JF_PT_LOWERED_RANK = 1u << 1,  /* degree lowered: M' rank deficient */
+    JF_PT_LOWERED_FEW = 1u << 2,   /* degree lowered: N < N_n           */
+    JF_PT_UMBILIC = 1u << 3,       /* k1 == k2 (relative 1e-10):
+                                      d1, d2 an arbitrary orthonormal
+                                      tangent pair (never NaN)          */
+    JF_PT_FAILED = 1u << 4,        /* no fit even at degree 1 (fewer than
+                                      3 usable points, collinear...):
+                                      quantities are NaN                */
+    JF_PT_NONFINITE = 1u << 5,     /* the input point is NaN/Inf; it is
+                                      nobody's neighbour; row is NaN    */
+    JF_PT_FEW_NEIGHBORS = 1u << 6, /* neighbourhood smaller than asked  */
+    JF_PT_NORMAL_POLES = 1u << 7,  /* natural: tangent plane from pole  */
+    JF_PT_NORMAL_MINCIRC = 1u << 8,/* natural: min-circumradius normal  */
+    JF_PT_NORMAL_FALLBACK = 1u << 9,/* natural: pole unreliable, the
+                                      fallback normal was used          */
+    JF_PT_ROBUST_NOCONV = 1u << 10,/* robust reweighting did not converge */
+    JF_PT_ORIENT_UNKNOWN = 1u << 11,/* orientation could not be decided
+                                      (e.g. mst: isolated point)        */
+    JF_PT_NORMAL_INPUT = 1u << 12, /* natural: tangent plane from the
+                                      normal read from the file         */
+    JF_PT_SCALE_SELECTED = 1u << 13 /* scale selection chose a K other
+                                      than the largest candidate        */
+};
+
+/* Writes a '|'-separated list of flag names of `status` into buf
+ * ("ok" for 0).  Returns buf.  Thread-safe. */
+char *jf_point_status_str(unsigned status, char *buf, size_t len);
+
+/* ------------------------------------------------------------------ */
+/* Parameters                                                          */
+/* ------------------------------------------------------------------ */
+#define JF_MAX_DEGREE 9         /* largest jet degree (N_9 = 55)       */
+#define JF_MAX_MONGE_DEGREE 4
+
+typedef enum { JF_FIT_APPROX = 0, JF_FIT_INTERP = 1 } jf_fit_mode;
+typedef enum { JF_FRAME_PCA = 0, JF_FRAME_AXIS = 1 } jf_frame_mode;
+typedef enum {
+    JF_ROBUST_NONE = 0,
+    JF_ROBUST_HUBER = 1,
+    JF_ROBUST_TUKEY = 2
+} jf_robust_mode;
+
+typedef struct {
+    int degree;              /* jet degree n, 1..JF_MAX_DEGREE (default 2) */
+    int monge_degree;        /* 2..4 and <= degree; 3 gives b0..b3,
+                                4 also c0..c4 (default 2)                  */
+    jf_fit_mode fit;         /* approximation (N > N_n) or interpolation
+                                (the N_n nearest points)  (default approx) */
+    jf_frame_mode frame;     /* fitting frame, §5.2 (default pca)          */
+    double max_cond;         /* adaptive degree: lower the degree while
+                                kappa(M') > max_cond (default: see README) */
+    size_t max_neighbors;    /* largest N a fitter accepts (default 256)   */
+    jf_robust_mode robust;   /* IRLS weights on residuals (default none)   */
+    int robust_iters;        /* IRLS iteration cap (default 10)            */
+} jf_params;
+
+/* Fills defaults.  Never fails. */
+void jf_params_init(jf_params *p);
+
+/* Checks every field.  Returns JF_ERR_INVALID and, if `bad_field` is not
+ * NULL, sets it to the name of the first bad field (static string). */
+jf_status jf_params_validate(const jf_params *p, const char **bad_field);
+
+/* Number of coefficients of an n-jet of a surface: (n+1)(n+2)/2. */
+size_t jf_jet_size(int degree);
+
+/* ------------------------------------------------------------------ */
+/* Result of one fit                                                   */
+/* ------------------------------------------------------------------ */
+typedef struct {
+    unsigned status;      /* JF_PT_* flags                              */
+    int degree;           /* degree actually used (0 when FAILED)       */
+    int n_used;           /* number of points in the fit                */
+    double cond;          /* kappa(M') = sigma_max/sigma_min of the
+                             preconditioned Vandermonde matrix (§2.3)   */
+    double residual;      /* RMS of the fit residuals, in length units  */
+    double pca_eval[3];   /* covariance eigenvalues, ascending          */
+    double normal[3];     /* unit normal                                */
+    double k1, k2;        /* principal curvatures, k1 >= k2, signed
+                             w.r.t. `normal`                            */
+    double d1[3], d2[3];  /* principal directions (unit, d1 x d2 = n)   */
+    double b[4];          /* Monge b0..b3 (monge_degree >= 3, else 0)   */
+    double c[5];          /* Monge c0..c4 (monge_degree >= 4, else 0)   */
+} jf_result;
+
+/* Flips the orientation of a result in place: normal -> -normal, every
+ * Monge coefficient negated, k1<->k2, d1<->d2, b0<->b3, b1<->b2,
+ * c0<->c4, c1<->c3 (DESIGN.md; the convention of CGAL's
+ * Monge_via_jet_fitting).  d1 x d2 = n is kept. */
+void jf_result_flip(jf_result *r);
+
+/* Flips `r` if its normal points away from `dir` (n . dir < 0). */
+void jf_result_orient(jf_result *r, const double dir[3]);
+
+/* ------------------------------------------------------------------ */
+/* Fitter: a per-thread workspace                                      */
+/* ------------------------------------------------------------------ */
+typedef struct jf_fitter jf_fitter;
+
+/* Creates a workspace for the parameters `p` (validated; copied).  All
+ * memory a fit needs is allocated here: jf_fit_point never allocates. */
+jf_status jf_fitter_create(const jf_params *p, jf_fitter **out);
+void jf_fitter_free(jf_fitter *f);
+
+/* Fits the osculating jet at point p from its n neighbours nbr[3*i..]
+ * (p itself may be one of them; it is the origin of the fit).  Always
+ * fills *out (status flags say what happened) and returns JF_OK, or
+ * JF_ERR_INVALID / JF_ERR_TOO_LARGE (n > max_neighbors) for bad
+ * arguments.  With interpolation the N_n nearest points are used.
+ * Not thread-safe on one fitter; use one fitter per thread. */
+jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr,
+                       size_t n, jf_result *out);
+
+/* Same, with one weight per neighbour (>= 0) multiplying its equation. */
+jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3],
+                                const double *nbr, const double *w,
+                                size_t n, jf_result *out);
+
+/* Fits every point i of a cloud from the neighbour lists
+ * idx[off[i] .. off[i+1]-1] (CSR; off has n+1 entries).  Non-finite
+ * points get JF_PT_NONFINITE.  threads <= 0 means all cores.  Results
+ * are identical for any thread count. */
+jf_status jf_fit_cloud(const jf_params *p, const double *xyz, size_t n,
+                       const size_t *off, const uint32_t *idx, int threads,
+                       jf_result *out);
+
+/* ------------------------------------------------------------------ */
+/* Plane curves (§4): 2D samples, jet y = f(x) of degree n             */
+/* ------------------------------------------------------------------ */
+typedef struct {
+    unsigned status;     /* JF_PT_* flags                              */
+    int degree;          /* degree used                                */
+    double cond;         /* kappa of the preconditioned system         */
+    double coef[JF_MAX_DEGREE + 1]; /* B0..Bn in the fitting frame     */
+    double normal[2];    /* unit normal                                */
+    double tangent[2];   /* unit tangent                               */
+    double k;            /* curvature 2B2/(1+B1^2)^(3/2), signed w.r.t.
+                            normal                                      */
+    double dk;           /* dk/ds (n >= 3), else 0                     */
+} jf_curve_result;
+
+/* Fits a curve jet at p from n 2D samples xy[2*i..].  The frame: PCA of
+ * the samples (x along the tangent estimate).  Uses the fitter's
+ * workspace (the fitter's degree bounds `degree`). */
+jf_status jf_fit_curve(jf_fitter *f, const double p[2], const double *xy,
+                       size_t n, int degree, jf_fit_mode mode,
+                       jf_curve_result *out);
+
+/* ------------------------------------------------------------------ */
+/* Spatial index (k-d tree): exact k-NN and radius queries             */
+/* ------------------------------------------------------------------ */
+typedef struct jf_index jf_index;
+
+/* Builds an index over the finite points of xyz (non-finite points are
+ * left out: nobody's neighbour).  xyz must outlive the index. */
+jf_status jf_index_build(const double *xyz, size_t n, jf_index **out);
+void jf_index_free(jf_index *ix);
+
+/* The k nearest indexed points to q (a query at a data point finds that
+ * point first), nearest first; ties broken by smaller index.  Writes
+ * *found <= k indices (and squared distances if d2 != NULL).
+ * Thread-safe. */
+jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,
+                       uint32_t *idx, double *d2, size_t *found);
+
+/* The nearest points within distance r of q (inclusive), nearest first,
+ * at most `max` of them; *found is their number. Thread-safe. */
+jf_status jf_index_radius(const jf_index *ix, const double q[3], double r,
+                          size_t max, uint32_t *idx, double *d2,
+                          size_t *found);
+
+/* A cache-friendly processing order (Morton / Z-order of the points):
+ * fills order[0..n-1] with a permutation of 0..n-1. */
+jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order);
+
+/* ------------------------------------------------------------------ */
+/* Clouds, meshes and files                                            */
+/* ------------------------------------------------------------------ */
+typedef struct {
+    size_t n;            /* number of points                           */
+    double *xyz;         /* 3n coordinates                             */
+    double *nrm;         /* 3n normals read from the file, or NULL     */
+    size_t nfaces;       /* mesh faces (0 for a cloud)                 */
+    size_t *face_off;    /* nfaces+1 offsets into face_idx, or NULL    */
+    uint32_t *face_idx;  /* polygon vertex indices, or NULL            */
+} jf_cloud;
+
+typedef struct {
+    int columns[6];      /* xyz/txt: 0-based column of x,y,z[,nx,ny,nz];
+                            -1 = default (x y z [nx ny nz] first)      */
+} jf_read_opts;
+
+void jf_read_opts_init(jf_read_opts *o);
+
+/* Reads a cloud or mesh; format from the extension (.ply, .xyz, .pts,
+ * .txt, .csv, .off).  On failure returns the status, fills err with
+ * "FILE:LINE: reason" (or "FILE: element vertex 12: reason") and leaves
+ * *c empty. */
+jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
+                        jf_cloud *c, jf_error *err);
+void jf_cloud_free(jf_cloud *c);   /* frees the arrays; c may be zeroed */
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JETFIT_H */
