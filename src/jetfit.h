@@ -123,6 +123,9 @@ typedef struct {
     size_t max_neighbors;    /* largest N a fitter accepts (default 256)   */
     jf_robust_mode robust;   /* IRLS weights on residuals (default none)   */
     int robust_iters;        /* IRLS iteration cap (default 10)            */
+    int nscales;             /* scale selection: number of candidate K in
+                                scales[] (0 = off, default)               */
+    size_t scales[8];        /* candidate neighbourhood sizes, ascending  */
 } jf_params;
 
 /* Fills defaults.  Never fails. */
@@ -186,6 +189,23 @@ jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr,
 jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3],
                                 const double *nbr, const double *w,
                                 size_t n, jf_result *out);
+
+/* Signed residuals z_i - J(x_i, y_i) of each of the n neighbours given to
+ * the last fit on this fitter (in the fitting frame, in the order given;
+ * interpolation: points not used also get their residual).  res has n
+ * entries.  JF_ERR_INVALID if n differs from the last fit's n. */
+jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n);
+
+/* The parameters the fitter was created with. */
+const jf_params *jf_fitter_params(const jf_fitter *f);
+
+/* The full per-point fit used by the command (src/robust.c): honours
+ * params.robust (iteratively reweighted least squares on the residuals,
+ * scale from the median absolute residual) and params.scales (per-point
+ * choice of K among scales[], the first K of nbr, which must be sorted
+ * nearest first).  With neither set it is exactly jf_fit_point. */
+jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
+                            const double *nbr, size_t n, jf_result *out);
 
 /* Fits every point i of a cloud from the neighbour lists
  * idx[off[i] .. off[i+1]-1] (CSR; off has n+1 entries).  Non-finite

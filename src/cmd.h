@@ -1,0 +1,11 @@
+/* cmd.h -- the subcommands of the jetfit command (src/cmd_*.c).  Each takes
+ * its own argv (argv[0] is the subcommand name), prints its own errors to
+ * stderr and returns the process exit status. */
+#ifndef JF_CMD_H
+#define JF_CMD_H
+int jf_cmd_estimate(int argc, char **argv);    /* cmd_estimate.c    */
+int jf_cmd_generate(int argc, char **argv);    /* cmd_generate.c    */
+int jf_cmd_convergence(int argc, char **argv); /* cmd_convergence.c */
+int jf_cmd_render(int argc, char **argv);      /* cmd_render.c      */
+int jf_cmd_eval(int argc, char **argv);        /* cmd_eval.c        */
+#endif

@@ -1,0 +1,47 @@
+/* main.c -- `jetfit SUBCOMMAND ...`: dispatch to src/cmd_*.c. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cmd.h"
+#include "jetfit.h"
+
+static const struct {
+    const char *name;
+    int (*run)(int, char **);
+    const char *what;
+} cmds[] = {
+    {"estimate", jf_cmd_estimate, "normals, curvatures, Monge coefficients"},
+    {"generate", jf_cmd_generate, "the paper's surfaces with exact truth"},
+    {"convergence", jf_cmd_convergence, "the paper's §6.1 experiment"},
+    {"render", jf_cmd_render, "a PNG of a result coloured by curvature"},
+    {"eval", jf_cmd_eval, "errors of a result against ground truth"},
+};
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: jetfit COMMAND [options]   (jetfit COMMAND --help)\n\n");
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)
+        fprintf(out, "  %-12s %s\n", cmds[i].name, cmds[i].what);
+    fprintf(out, "\n  --help       this list\n  --version    print the version\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("jetfit %s\n", jf_version());
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)
+        if (!strcmp(argv[1], cmds[i].name))
+            return cmds[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "jetfit: unknown command '%s' (jetfit --help lists them)\n", argv[1]);
+    return 2;
+}
