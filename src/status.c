@@ -1,0 +1,48 @@
+/* status.c -- version, status names, per-point flag names. */
+#include <stdio.h>
+#include <string.h>
+
+#include "jetfit.h"
+
+const char *jf_version(void) { return JF_VERSION_STRING; }
+
+const char *jf_strerror(jf_status s)
+{
+    switch (s) {
+    case JF_OK: return "success";
+    case JF_ERR_INVALID: return "invalid argument";
+    case JF_ERR_NOMEM: return "out of memory";
+    case JF_ERR_IO: return "input/output error";
+    case JF_ERR_FORMAT: return "malformed or unsupported file";
+    case JF_ERR_TOO_LARGE: return "too large";
+    case JF_ERR_NUMERIC: return "numerical failure";
+    case JF_ERR_UNSUPPORTED: return "not supported by this build";
+    case JF_ERR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
+}
+
+static const char *const flag_names[] = {
+    "lowered_cond", "lowered_rank", "lowered_few", "umbilic",
+    "failed", "nonfinite", "few_neighbors", "normal_poles",
+    "normal_mincirc", "normal_fallback", "robust_noconv", "orient_unknown",
+    "normal_input", "scale_selected",
+};
+
+char *jf_point_status_str(unsigned status, char *buf, size_t len)
+{
+    size_t used = 0;
+    if (!buf || !len) return buf;
+    buf[0] = '\0';
+    if (status == 0) {
+        snprintf(buf, len, "ok");
+        return buf;
+    }
+    for (unsigned b = 0; b < sizeof flag_names / sizeof flag_names[0]; b++) {
+        if (!(status & (1u << b))) continue;
+        int w = snprintf(buf + used, len - used, "%s%s", used ? "|" : "", flag_names[b]);
+        if (w < 0 || (size_t)w >= len - used) break;
+        used += (size_t)w;
+    }
+    return buf;
+}
