@@ -277,19 +277,168 @@ typedef struct {
 } jf_cloud;
 
 typedef struct {
-    int columns[6];      /* xyz/txt: 0-based column of x,y,z[,nx,ny,nz];
-                            -1 = default (x y z [nx ny nz] first)      */
+    int columns[6];      /* .xyz/.pts/.txt/.csv: 0-based column of x,y,z
+                            [,nx,ny,nz]; -1 = default.  Defaults: xyz/txt
+                            x y z first, and nx ny nz in columns 3..5
+                            when rows have exactly 6 columns and the
+                            first row's (3..5) has length 0.9..1.1 (so
+                            "x y z r g b" is not read as normals); .pts
+                            never takes default normals; .csv finds the
+                            header names x,y,z[,nx,ny,nz] (any case).
+                            x,y,z must be all set or all -1; normals
+                            likewise.                                  */
 } jf_read_opts;
 
+/* Sets every column to -1 (the defaults above).  Never fails. */
 void jf_read_opts_init(jf_read_opts *o);
 
-/* Reads a cloud or mesh; format from the extension (.ply, .xyz, .pts,
- * .txt, .csv, .off).  On failure returns the status, fills err with
- * "FILE:LINE: reason" (or "FILE: element vertex 12: reason") and leaves
- * *c empty. */
+/* Reads a cloud or mesh; format from the extension, any case (.ply,
+ * .xyz, .pts, .txt, .csv, .off).
+ *  - PLY: ascii, binary_little_endian, binary_big_endian; vertex x y z
+ *    (any numeric type), nx ny nz when all present; other properties,
+ *    elements and lists are skipped; a `face` element (list
+ *    vertex_indices or vertex_index) fills the face arrays.
+ *  - XYZ/PTS/TXT: whitespace (or ',' ';') separated, 3 or more columns,
+ *    '#' and '//' comments, blank lines skipped; a line holding one
+ *    integer (a point count, as PTS files start) is skipped.
+ *  - CSV: comma separated; a header line naming the columns, or no header
+ *    (all-numeric first line: x y z first).
+ *  - OFF (also COFF/NOFF/STOFF variants; NOFF normals are read): polygons
+ *    of any size >= 3; indices are checked against the vertex count.
+ * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
+ * o may be NULL (defaults).  c is overwritten (not freed first).
+ * On failure returns the status (JF_ERR_IO, JF_ERR_FORMAT,
+ * JF_ERR_TOO_LARGE, JF_ERR_NOMEM, JF_ERR_INVALID, JF_ERR_UNSUPPORTED),
+ * fills err (may be NULL) with one line "FILE:LINE: reason" (text) or
+ * "FILE: element vertex 12: reason" (binary PLY), and leaves *c zeroed
+ * with nothing allocated.  Thread-safe (no shared state). */
 jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
                         jf_cloud *c, jf_error *err);
-void jf_cloud_free(jf_cloud *c);   /* frees the arrays; c may be zeroed */
+
+/* Frees the arrays and zeroes *c; c may be NULL or already zeroed. */
+void jf_cloud_free(jf_cloud *c);
+
+/* ------------------------------------------------------------------ */
+/* Writing tables and meshes                                           */
+/* ------------------------------------------------------------------ */
+/* A table: one row per point, named columns; format from the extension:
+ *  .ply  binary little endian (or ascii), element `vertex` with one
+ *        property per column named as the column (CloudCompare/MeshLab
+ *        show them as scalar fields); F64 -> double, F32 -> float,
+ *        I32 -> int.
+ *  .csv  one header line "x,y,z,...", then comma separated rows.
+ *  .xyz/.txt  one header line "# x y z ...", then space separated rows.
+ * Text is exact: F64 with %.17g, F32 with %.9g (both read back bit for
+ * bit); NaN is written "nan", infinities "inf"/"-inf".  I32 values are
+ * rounded to nearest; NaN or out-of-range values become INT32_MIN.
+ * The file is written to a temporary ".NAME.tmp.PID" in the same folder
+ * and renamed onto NAME only by a successful jf_writer_commit: after a
+ * failure or jf_writer_abort no file with the final name is created (an
+ * existing one is left untouched).  A writer is used by one thread. */
+typedef enum { JF_COL_F64 = 0, JF_COL_F32 = 1, JF_COL_I32 = 2 } jf_col_type;
+
+typedef struct {
+    const char *name;    /* column / property name (copied at open)    */
+    jf_col_type type;
+} jf_column;
+
+typedef struct jf_writer jf_writer;
+
+/* Opens a table of ncols columns and exactly nrows rows (the PLY header
+ * needs the count; commit fails if a different number was written).
+ * ascii != 0 asks for ascii PLY (ignored for text formats).  Names must
+ * be non-empty without whitespace or ','.  On failure *w is NULL, err
+ * (may be NULL) says why, nothing is left on disk. */
+jf_status jf_writer_open(const char *path, const jf_column *cols,
+                         size_t ncols, size_t nrows, int ascii,
+                         jf_writer **w, jf_error *err);
+
+/* PLY only (ignored by text formats): also write a `face` element
+ * (list uchar int vertex_indices) from nfaces polygons
+ * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the
+ * first row; the arrays are read at commit and must stay valid until
+ * then.  JF_ERR_INVALID if rows were already written or a face has more
+ * than 255 vertices. */
+jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
+                          const uint32_t *idx);
+
+/* Appends one row: vals[0..ncols-1], in column order.  Buffered (no
+ * system call per row).  After the first failure every call returns it
+ * and commit reports it. */
+jf_status jf_writer_row(jf_writer *w, const double *vals);
+
+/* Flushes, closes, checks the row count and renames the temporary onto
+ * the final name.  Frees w whatever happens (w may be NULL: invalid).
+ * On failure the temporary is removed and err says why. */
+jf_status jf_writer_commit(jf_writer *w, jf_error *err);
+
+/* Removes the temporary and frees w.  NULL is a no-op. */
+void jf_writer_abort(jf_writer *w);
+
+/* Writes a cloud or mesh (vertices, normals if c->nrm, faces if
+ * c->nfaces) with the same temporary-then-rename rule; format from the
+ * extension: .off (NOFF when normals are present), .ply (binary little
+ * endian, or ascii if ascii != 0; x y z [nx ny nz] as double, face
+ * element list uchar int vertex_indices), .xyz/.txt/.csv (vertices and
+ * normals only; faces are not written).  Thread-safe. */
+jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
+                         jf_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Evaluation (src/eval.c): error measures against ground truth        */
+/* ------------------------------------------------------------------ */
+
+/* Unoriented angle between two directions in degrees, in [0, 90]:
+ * acos(|a.b| / (|a||b|)) (PCPNet's measure).  NaN if either is zero or
+ * non-finite.  Thread-safe. */
+double jf_normal_angle_deg(const double a[3], const double b[3]);
+
+/* PCPNet's curvature error |k - k_true| / max(|k_true|, 1). */
+double jf_curv_error_rel(double k, double k_true);
+
+/* Errors of estimated curvatures (k1 >= k2 w.r.t. n) against the truth
+ * (k1_true >= k2_true w.r.t. n_true): the estimate is first oriented along
+ * n_true (flip: k1, k2 -> -k2, -k1).  Fills err_abs[2] |k - k_true| and
+ * err_rel[2] (jf_curv_error_rel) for k1 and k2; either may be NULL. */
+void jf_curv_compare(const double n[3], double k1, double k2,
+                     const double n_true[3], double k1_true, double k2_true,
+                     double err_abs[2], double err_rel[2]);
+
+/* Summary of a sample of errors. */
+typedef struct {
+    size_t n;          /* finite values summarised                      */
+    size_t nonfinite;  /* NaN/Inf values left out                       */
+    double rms, mean, median, p95, max; /* quantiles interpolate
+                          linearly between order statistics (numpy's
+                          default); NaN when n == 0                     */
+} jf_err_stats;
+
+/* Summarises v[0..n-1].  Reorders v in place (finite values first,
+ * sorted).  JF_ERR_INVALID on NULL.  Thread-safe on distinct arrays. */
+jf_status jf_err_stats_compute(double *v, size_t n, jf_err_stats *s);
+
+/* A table of numbers with named columns, row-major. */
+typedef struct {
+    size_t nrows, ncols;
+    char (*names)[32];   /* ncols names ("" when unknown)              */
+    double *v;           /* nrows * ncols values                       */
+} jf_eval_table;
+
+/* Reads a whole table; columns are named by: .csv a header line; .xyz,
+ * .txt, .pts the last "# name name ..." comment before the data (jetfit's
+ * and generate's outputs); .ply the vertex element's properties (ascii or
+ * binary_little_endian; other elements must come after it and are
+ * ignored); headerless files by extension: .normals nx ny nz, .curv k1 k2
+ * (PCPNet's column order, not re-sorted), .pidx index, otherwise
+ * x y z nx ny nz k1 k2.  On failure fills err ("FILE:LINE: reason") and
+ * leaves *t empty.  The table is owned by the caller: jf_eval_table_free. */
+jf_status jf_eval_table_read(const char *path, jf_eval_table *t,
+                             jf_error *err);
+
+/* Index of the column named `name`, or -1. */
+int jf_eval_table_col(const jf_eval_table *t, const char *name);
+
+void jf_eval_table_free(jf_eval_table *t); /* NULL or zeroed: no-op */
 
 #ifdef __cplusplus
 }
