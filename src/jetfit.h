@@ -440,6 +440,39 @@ int jf_eval_table_col(const jf_eval_table *t, const char *name);
 
 void jf_eval_table_free(jf_eval_table *t); /* NULL or zeroed: no-op */
 
+/* ------------------------------------------------------------------ */
+/* Orientation (src/orient.c)                                          */
+/* ------------------------------------------------------------------ */
+/* Each call flips whole results (jf_result_flip: curvature signs, k1/k2,
+ * d1/d2 and Monge coefficients follow the normal).  Results with
+ * JF_PT_FAILED or JF_PT_NONFINITE, or a non-finite normal, are left
+ * alone; a point whose side cannot be decided (n.dir == 0, isolated point)
+ * gets JF_PT_ORIENT_UNKNOWN.  Not thread-safe on one res array. */
+typedef enum {
+    JF_ORIENT_NONE = 0,      /* as fitted                                */
+    JF_ORIENT_INPUT = 1,     /* agree with the normals read from the file */
+    JF_ORIENT_VIEWPOINT = 2, /* point towards a scanner position          */
+    JF_ORIENT_MST = 3        /* propagate along a k-NN minimum spanning
+                                tree (Hoppe et al. 1992)                 */
+} jf_orient_mode;
+
+/* res[i] agrees with nrm[3i..3i+2] (n_i . nrm_i >= 0).  nrm is caller-owned. */
+jf_status jf_orient_input(jf_result *res, size_t n, const double *nrm);
+
+/* res[i] points towards vp: n_i . (vp - p_i) >= 0. */
+jf_status jf_orient_viewpoint(jf_result *res, const double *xyz, size_t n,
+                              const double vp[3]);
+
+/* Consistent orientation by Prim's algorithm on the graph of the k nearest
+ * neighbours (ix built over xyz), weights 1 - |ni.nj|: each newly reached
+ * normal is flipped to agree with its tree parent.  Components are
+ * handled separately: each starts at its point of largest z, oriented
+ * towards +z (outward on a closed surface).  Memory O(n) (about 24 bytes
+ * per point; neighbours are queried again, not stored), single-threaded,
+ * deterministic.  k in 1..1024 (8 is a good default). */
+jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
+                        const jf_index *ix, size_t k);
+
 #ifdef __cplusplus
 }
 #endif
