@@ -1,0 +1,73 @@
+// cgalref_svd.hpp -- the SVD CGAL's Monge_via_jet_fitting uses in
+// test_cgal_reference and bench_fit.
+//
+// CGAL's default is Eigen's JacobiSVD (CGAL::Eigen_svd), enabled when the
+// target links CGAL::Eigen3_support (tests/cgalref.cmake does that when
+// libeigen3-dev is installed).  Without Eigen, Monge_via_jet_fitting has no
+// default SvdTraits, so this header supplies a model of CGAL's SvdTraits
+// concept on GSL's Golub-Kahan SVD: same least-squares solution for the
+// full-rank systems the reference test compares (bench_fit says which SVD
+// the CGAL side used).
+#ifndef JF_CGALREF_SVD_HPP
+#define JF_CGALREF_SVD_HPP
+
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Monge_via_jet_fitting.h>
+#include <gsl/gsl_linalg.h>
+#include <vector>
+
+namespace jf_cgalref {
+
+struct Gsl_svd {
+    typedef double FT;
+    struct Vector {
+        std::vector<double> v;
+        explicit Vector(std::size_t n) : v(n, 0.0) {}
+        void set(std::size_t i, double x) { v[i] = x; }
+        double operator()(std::size_t i) const { return v[i]; }
+        double *vector() { return v.data(); }
+        std::size_t size() const { return v.size(); }
+    };
+    struct Matrix {
+        std::size_t r, c;
+        std::vector<double> m;
+        Matrix(std::size_t rows, std::size_t cols)
+            : r(rows), c(cols), m(rows * cols, 0.0) {}
+        void set(std::size_t i, std::size_t j, double x) { m[i * c + j] = x; }
+        double operator()(std::size_t i, std::size_t j) const
+        { return m[i * c + j]; }
+    };
+    // Least-squares solution of M X = B stored in B; returns
+    // sigma_max / sigma_min as CGAL::Eigen_svd does.  rows >= cols (CGAL's
+    // precondition N >= N_n).
+    static FT solve(const Matrix &M, Vector &B)
+    {
+        std::vector<double> a(M.m), vv(M.c * M.c), s(M.c), w(M.c), x(M.c);
+        gsl_matrix_view A = gsl_matrix_view_array(a.data(), M.r, M.c);
+        gsl_matrix_view V = gsl_matrix_view_array(vv.data(), M.c, M.c);
+        gsl_vector_view S = gsl_vector_view_array(s.data(), M.c);
+        gsl_vector_view W = gsl_vector_view_array(w.data(), M.c);
+        gsl_vector_view X = gsl_vector_view_array(x.data(), M.c);
+        gsl_vector_view b = gsl_vector_view_array(B.v.data(), M.r);
+        gsl_linalg_SV_decomp(&A.matrix, &V.matrix, &S.vector, &W.vector);
+        gsl_linalg_SV_solve(&A.matrix, &V.matrix, &S.vector, &b.vector,
+                            &X.vector);
+        for (std::size_t i = 0; i < M.c; i++) B.v[i] = x[i];
+        return s[0] / s[M.c - 1];
+    }
+};
+
+typedef CGAL::Simple_cartesian<double> Kernel;
+typedef Kernel::Point_3 Point;
+#ifdef CGAL_EIGEN3_ENABLED
+typedef CGAL::Monge_via_jet_fitting<Kernel> Monge_fitting;
+static const char *const cgal_svd_name = "Eigen JacobiSVD (CGAL default)";
+#else
+typedef CGAL::Monge_via_jet_fitting<Kernel, Kernel, Gsl_svd> Monge_fitting;
+static const char *const cgal_svd_name = "GSL SV_decomp (no Eigen found)";
+#endif
+typedef Monge_fitting::Monge_form Monge_form;
+
+} // namespace jf_cgalref
+
+#endif
