@@ -1,0 +1,142 @@
+/* frame.c -- the fitting frame of §5.2: PCA of the neighbourhood or the
+ * world axis closest to the PCA normal.
+ *
+ * design: the points arrive already translated to p (so coordinates of
+ * 1e6 lose nothing); the covariance is accumulated in two passes about the
+ * weighted centroid (CGAL 5.5.1 sums in one pass in world coordinates and
+ * loses all precision at large offsets, see CGAL_NOTES.md); a cyclic Jacobi
+ * eigen-solver gives orthonormal eigenvectors whose signs are pinned so the
+ * frame, hence every result, is reproducible. */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "fitter_internal.h"
+
+/* Pins the sign of v: its largest-|component| (first on ties) positive. */
+static void pin_sign(double *v)
+{
+    int k = 0;
+    for (int i = 1; i < 3; i++)
+        if (fabs(v[i]) > fabs(v[k])) k = i;
+    if (v[k] < 0) {
+        v[0] = -v[0];
+        v[1] = -v[1];
+        v[2] = -v[2];
+    }
+}
+
+void jf__eig3(const double a_in[9], double eval[3], double evec[9])
+{
+    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
+
+    /* Cyclic Jacobi (Golub & Van Loan §8.5): each rotation zeroes a[p][q];
+     * converges quadratically, 50 sweeps is far beyond what doubles need. */
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
+        double diag = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
+        if (off == 0.0 || off <= DBL_EPSILON * DBL_EPSILON * diag) break;
+        for (int p = 0; p < 2; p++) {
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0.0) continue;
+                double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                /* t = tan of the rotation angle, the smaller root */
+                /* theta^2 would overflow: t ~ 1/(2 theta) */
+                double t = fabs(theta) > 1e150
+                               ? 1.0 / (2.0 * theta)
+                               : (theta >= 0 ? 1.0 : -1.0) /
+                                     (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; k++) { /* A <- A J */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) { /* A <- J^T A */
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                a[p][q] = a[q][p] = 0.0;
+                for (int k = 0; k < 3; k++) { /* V <- V J */
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    /* sort ascending (stable on ties, deterministic) */
+    int idx[3] = {0, 1, 2};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && a[idx[j]][idx[j]] < a[idx[j - 1]][idx[j - 1]]; j--) {
+            int t = idx[j];
+            idx[j] = idx[j - 1];
+            idx[j - 1] = t;
+        }
+    for (int k = 0; k < 3; k++) {
+        eval[k] = a[idx[k]][idx[k]];
+        for (int i = 0; i < 3; i++) evec[3 * k + i] = v[i][idx[k]];
+        pin_sign(evec + 3 * k);
+    }
+}
+
+static void cross(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
+              double r[9], double eval[3])
+{
+    /* pass 1: weighted centroid */
+    double sw = 0, c[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        if (!(w[i] > 0)) continue;
+        sw += w[i];
+        for (int k = 0; k < 3; k++) c[k] += w[i] * q[3 * i + k];
+    }
+    if (!(sw > 0) || !isfinite(sw)) return -1;
+    for (int k = 0; k < 3; k++) c[k] /= sw;
+    /* pass 2: covariance about the centroid */
+    double cov[9] = {0};
+    for (size_t i = 0; i < n; i++) {
+        if (!(w[i] > 0)) continue;
+        double d[3] = {q[3 * i] - c[0], q[3 * i + 1] - c[1], q[3 * i + 2] - c[2]};
+        for (int a = 0; a < 3; a++)
+            for (int b = a; b < 3; b++) cov[3 * a + b] += w[i] * d[a] * d[b];
+    }
+    for (int a = 0; a < 3; a++)
+        for (int b = a; b < 3; b++) {
+            cov[3 * a + b] /= sw;
+            cov[3 * b + a] = cov[3 * a + b];
+        }
+    for (int k = 0; k < 9; k++)
+        if (!isfinite(cov[k])) return -1;
+
+    double evec[9];
+    jf__eig3(cov, eval, evec);
+    if (mode == JF_FRAME_AXIS) {
+        /* §5.2: z is the world axis closest to the rough (PCA) normal; its
+         * positive direction, since the pinned normal's largest component
+         * is positive.  x, y cyclic so the frame is right-handed. */
+        const double *nrm = evec;
+        int k = 0;
+        for (int i = 1; i < 3; i++)
+            if (fabs(nrm[i]) > fabs(nrm[k])) k = i;
+        memset(r, 0, 9 * sizeof r[0]);
+        r[0 + (k + 1) % 3] = 1.0; /* ex */
+        r[3 + (k + 2) % 3] = 1.0; /* ey */
+        r[6 + k] = 1.0;           /* ez */
+    } else {
+        /* z = smallest-eigenvalue eigenvector, x = largest, y = z cross x */
+        memcpy(r + 0, evec + 6, 3 * sizeof r[0]);
+        memcpy(r + 6, evec + 0, 3 * sizeof r[0]);
+        cross(r + 6, r + 0, r + 3);
+    }
+    return 0;
+}
