@@ -243,26 +243,174 @@ jf_status jf_fit_curve(jf_fitter *f, const double p[2], const double *xy,
 typedef struct jf_index jf_index;
 
 /* Builds an index over the finite points of xyz (non-finite points are
- * left out: nobody's neighbour).  xyz must outlive the index. */
+ * left out: nobody's neighbour).  The finite points are copied (the index
+ * takes about 34 bytes per point), so xyz may change or go after the
+ * call.  n must be < UINT32_MAX (else JF_ERR_TOO_LARGE).  O(n log n).
+ * Returns JF_OK, JF_ERR_INVALID (NULL out, or NULL xyz with n > 0) or
+ * JF_ERR_NOMEM.  Free with jf_index_free (NULL is a no-op). */
 jf_status jf_index_build(const double *xyz, size_t n, jf_index **out);
 void jf_index_free(jf_index *ix);
 
-/* The k nearest indexed points to q (a query at a data point finds that
- * point first), nearest first; ties broken by smaller index.  Writes
- * *found <= k indices (and squared distances if d2 != NULL).
- * Thread-safe. */
+/* Number of (finite) points indexed; bytes the index holds. */
+size_t jf_index_size(const jf_index *ix);
+size_t jf_index_memory(const jf_index *ix);
+
+/* The k nearest indexed points to q, nearest first, in the exact order of
+ * (squared distance, index): ties go to the smaller index, so results are
+ * deterministic.  A query at a data point finds it first (distance 0;
+ * among exact duplicates the smallest index comes first).  Writes
+ * *found = min(k, jf_index_size) indices to idx (caller-owned, k entries)
+ * and their squared distances to d2 (k entries) unless d2 is NULL.
+ * Distances are computed as dx*dx + dy*dy + dz*dz, in that order.
+ * Allocation-free, except when d2 == NULL and k > 1024 (a scratch buffer
+ * is then allocated for the call).  Returns JF_ERR_INVALID for a
+ * non-finite q or NULL pointers.  Thread-safe. */
 jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,
                        uint32_t *idx, double *d2, size_t *found);
 
-/* The nearest points within distance r of q (inclusive), nearest first,
- * at most `max` of them; *found is their number. Thread-safe. */
+/* The points within distance r >= 0 of q (inclusive: d2 <= r*r), nearest
+ * first in the same (d2, index) order, at most `max` of them (the `max`
+ * nearest when more lie within r); *found is their number.  Same buffers,
+ * allocation rule and errors as jf_index_knn; a negative or non-finite r
+ * is JF_ERR_INVALID.  Thread-safe. */
 jf_status jf_index_radius(const jf_index *ix, const double q[3], double r,
                           size_t max, uint32_t *idx, double *d2,
                           size_t *found);
 
-/* A cache-friendly processing order (Morton / Z-order of the points):
- * fills order[0..n-1] with a permutation of 0..n-1. */
+/* A cache-friendly processing order: the Morton (Z-order) permutation of
+ * the points (63-bit keys: 21 bits per axis over the cubic bounding box of
+ * the finite points; equal keys in index order; non-finite points last,
+ * in index order).  Fills order[0..n-1] (caller-owned) with a permutation
+ * of 0..n-1; deterministic.  Allocates 20 bytes per point during the call.
+ * Returns JF_OK, JF_ERR_INVALID, JF_ERR_TOO_LARGE (n >= UINT32_MAX) or
+ * JF_ERR_NOMEM.  Thread-safe. */
 jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order);
+
+/* ------------------------------------------------------------------ */
+/* Neighbourhoods (--neighbors): parse a spec, query it                */
+/* ------------------------------------------------------------------ */
+typedef enum {
+    JF_NB_KNN,        /* knn:K       the K nearest points               */
+    JF_NB_RADIUS,     /* radius:R    the points within R (inclusive)    */
+    JF_NB_KNN_RADIUS, /* knn:K,radius:R  up to K nearest within R, with
+                         a minimum-count fallback (jf_nb_query)         */
+    JF_NB_RINGS,      /* rings[:N]   mesh rings (jf_nb_query_mesh)      */
+    JF_NB_NATURAL     /* natural[:N] §5.1 natural neighbours (the CGAL
+                         bridge); n = 0 means its default              */
+} jf_nb_kind;
+
+typedef struct {
+    jf_nb_kind kind;
+    size_t k;         /* knn, knn_radius: K >= 1                         */
+    double r;         /* radius, knn_radius: R > 0, finite              */
+    size_t n;         /* rings, natural: N >= 1, or 0 for the default   */
+} jf_nb_spec;
+
+/* Parses "knn:K", "radius:R", "knn:K,radius:R" (either order), "rings",
+ * "rings:N", "natural", "natural:N" (no spaces; K, N positive decimal
+ * integers; R a positive finite decimal number).  On error returns
+ * JF_ERR_INVALID, leaves *spec unchanged and sets *why (if why != NULL)
+ * to a static English reason.  Thread-safe. */
+jf_status jf_nb_parse(const char *text, jf_nb_spec *spec, const char **why);
+
+/* Writes the canonical text of a spec (what jf_nb_parse reads) into buf;
+ * returns buf. */
+char *jf_nb_format(const jf_nb_spec *s, char *buf, size_t len);
+
+/* The neighbourhood of q for a point-cloud spec, nearest first in
+ * (squared distance, index) order, into caller-owned idx (and d2 unless
+ * NULL), `cap` entries each; *found is the count.  A query at a data
+ * point returns it first.
+ *  - knn:K          the min(K, cap) nearest.
+ *  - radius:R       the points within R, capped by `cap` (the cap
+ *                   nearest when more lie within R).
+ *  - knn:K,radius:R the points within R, at most min(K, cap); if fewer
+ *                   than M = min(min_count, K, cap) lie within R, the M
+ *                   nearest regardless of R (min_count: what the fit
+ *                   needs, e.g. N_n for the degree; K always bounds).
+ * rings and natural: JF_ERR_INVALID (use jf_nb_query_mesh / the bridge).
+ * Allocation-free when d2 != NULL.  Thread-safe. */
+jf_status jf_nb_query(const jf_index *ix, const jf_nb_spec *s,
+                      size_t min_count, const double q[3], uint32_t *idx,
+                      double *d2, size_t cap, size_t *found);
+
+/* ------------------------------------------------------------------ */
+/* Meshes (§5.1 mesh case): vertex adjacency and rings                 */
+/* ------------------------------------------------------------------ */
+typedef struct jf_mesh jf_mesh;
+
+enum {                      /* per-vertex flags, jf_mesh_vertex_flags  */
+    JF_MESH_ISOLATED = 1,   /* in no valid face: no neighbours         */
+    JF_MESH_NONMANIFOLD = 2,/* on an edge shared by more than 2 faces  */
+    JF_MESH_BOUNDARY = 4    /* on an edge of only one face             */
+};
+
+typedef struct {
+    size_t degenerate_faces;    /* < 3 vertices or a repeated vertex:
+                                   skipped                              */
+    size_t nonmanifold_edges;   /* edges in more than 2 faces           */
+    size_t nonmanifold_vertices;/* vertices on such an edge             */
+    size_t boundary_edges;      /* edges in exactly one face            */
+    size_t isolated_vertices;   /* vertices in no valid face            */
+} jf_mesh_stats;
+
+/* Builds the vertex adjacency of a polygon mesh of n vertices whose face f
+ * has vertices face_idx[face_off[f] .. face_off[f+1]-1] (jf_cloud's
+ * layout).  Degenerate faces are skipped and counted; non-manifold edges
+ * and isolated vertices are reported (jf_mesh_get_stats, per-vertex
+ * flags), never an error.  A vertex index >= n or decreasing offsets give
+ * JF_ERR_FORMAT with err->msg = "face F: vertex index I out of range (n
+ * vertices)" (err may be NULL).  Other returns: JF_OK, JF_ERR_INVALID,
+ * JF_ERR_TOO_LARGE (n or nfaces >= UINT32_MAX), JF_ERR_NOMEM.  The arrays
+ * are not kept.  Free with jf_mesh_free (NULL is a no-op). */
+jf_status jf_mesh_build(size_t n, size_t nfaces, const size_t *face_off,
+                        const uint32_t *face_idx, jf_mesh **out,
+                        jf_error *err);
+void jf_mesh_free(jf_mesh *m);
+
+size_t jf_mesh_vertex_count(const jf_mesh *m);
+/* n flags (JF_MESH_*), owned by the mesh. */
+const uint8_t *jf_mesh_vertex_flags(const jf_mesh *m);
+void jf_mesh_get_stats(const jf_mesh *m, jf_mesh_stats *s);
+/* The distinct neighbours of v, ascending (owned by the mesh); returns
+ * their number (0 for v out of range). */
+size_t jf_mesh_neighbors(const jf_mesh *m, uint32_t v, const uint32_t **nbr);
+
+/* The §5.1 mesh neighbourhood of vertex v: v first, then ring 1 (the
+ * vertices one edge away), ring 2, ... each ring nearest to v first in
+ * (squared distance, index) order; every vertex of the first k-1 rings,
+ * then the nearest vertices of the k-th ring, until N points in all (or
+ * cap: idx has cap entries, caller-owned).  *found < min(N, cap) when v's
+ * connected component is smaller.  Vertices with non-finite coordinates
+ * are left out (and not walked through).  JF_ERR_INVALID for N == 0, v out
+ * of range or non-finite.  Allocation-free; thread-safe. */
+jf_status jf_mesh_rings(const jf_mesh *m, const double *xyz, uint32_t v,
+                        size_t N, uint32_t *idx, size_t cap, size_t *found);
+
+/* Same order, but whole rings only: the fewest full rings holding at
+ * least min_count points (v included); only `cap` can cut the last ring
+ * (to its nearest vertices). */
+jf_status jf_mesh_rings_full(const jf_mesh *m, const double *xyz, uint32_t v,
+                             size_t min_count, uint32_t *idx, size_t cap,
+                             size_t *found);
+
+/* The neighbourhood of mesh vertex v for a rings spec:
+ *  - rings:N   jf_mesh_rings(N).
+ *  - rings     (n == 0, the default) interpolation: jf_mesh_rings(min_count)
+ *              (min_count = N_n: interpolation uses exactly N_n points);
+ *              approximation: jf_mesh_rings_full(2 * min_count), whole
+ *              rings with at least 2 N_n points (degree 2 on a regular
+ *              triangulation: 2 rings, 19 points; degree 4: 3 rings, 37).
+ *              Why: whole rings keep the neighbourhood symmetric about v,
+ *              and twice the unknowns keeps least squares well
+ *              overdetermined -- the paper (§6.1) reports its degree-7
+ *              approximation worse than expected because the rings gave
+ *              only one point more than interpolation.
+ * Other kinds: JF_ERR_INVALID.  Thread-safe. */
+jf_status jf_nb_query_mesh(const jf_mesh *m, const double *xyz,
+                           const jf_nb_spec *s, size_t min_count,
+                           jf_fit_mode fit, uint32_t v, uint32_t *idx,
+                           size_t cap, size_t *found);
 
 /* ------------------------------------------------------------------ */
 /* Clouds, meshes and files                                            */
@@ -472,6 +620,94 @@ jf_status jf_orient_viewpoint(jf_result *res, const double *xyz, size_t n,
  * deterministic.  k in 1..1024 (8 is a good default). */
 jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
                         const jf_index *ix, size_t k);
+
+/* ------------------------------------------------------------------ */
+/* Natural neighbourhoods (§5.1, point clouds; src/natural.c over the  */
+/* CGAL bridge)                                                        */
+/* ------------------------------------------------------------------ */
+typedef enum {
+    JF_NORMAL_POLES = 0,   /* Amenta-Bern pole, mincirc where unreliable */
+    JF_NORMAL_MINCIRC = 1, /* minimum-circumradius triangle (§5.1)       */
+    JF_NORMAL_PCA = 2,     /* the caller's (not computed here)           */
+    JF_NORMAL_INPUT = 3    /* the caller's (not computed here)           */
+} jf_normal_source;
+
+/* A pole whose reliability (pole distance / nearest-neighbour distance)
+ * is below this is replaced by the mincirc normal (chosen by measurement,
+ * see README "Natural neighbourhoods"). */
+#define JF_NATURAL_MIN_RELIABILITY 4.0
+
+/* The 3D Delaunay triangulation of a cloud, kept as plain arrays (vertex
+ * map, adjacency, poles, a copy of the coordinates): xyz may be freed
+ * after create.  About 100 bytes per point. */
+typedef struct jf_natural jf_natural;
+
+/* Builds it over the finite points of xyz[3n] (non-finite points are left
+ * out: nobody's neighbour, no normal); identical points are merged into
+ * one vertex (jf_natural_kept).  Coplanar, collinear or fewer than 4
+ * points are accepted (jf_natural_stats says the dimension).  Returns
+ * JF_OK, JF_ERR_INVALID (NULL args), JF_ERR_TOO_LARGE (n >= 2^32 - 1),
+ * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Not parallel. */
+jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
+void jf_natural_free(jf_natural *nt);
+
+typedef struct {
+    int dimension;       /* 3; 2 = all coplanar (no poles: mincirc);
+                            1 = collinear; 0 = one point; -1 = none     */
+    size_t nvertices;    /* distinct finite points                      */
+    size_t nduplicates;  /* finite points identical to a kept one       */
+    size_t nnonfinite;   /* points with a NaN/Inf coordinate            */
+} jf_natural_stats;
+
+/* Fills *st.  Thread-safe. */
+void jf_natural_get_stats(const jf_natural *nt, jf_natural_stats *st);
+
+/* The input index carrying point i's vertex: i itself, or the smallest
+ * index of a point identical to i; SIZE_MAX if i is non-finite or out of
+ * range.  i is a merged duplicate iff the result differs from i. */
+size_t jf_natural_kept(const jf_natural *nt, size_t i);
+
+/* Tangent-plane normals of every point for src = POLES (mincirc fallback
+ * where the pole is unreliable) or MINCIRC (JF_ERR_INVALID for the
+ * others): nrm[3n] (unit, unoriented), flags[n] |= JF_PT_NORMAL_POLES /
+ * JF_PT_NORMAL_MINCIRC / JF_PT_NORMAL_FALLBACK (flags are or-ed in, not
+ * cleared), reliability[n] (may be NULL) gets the pole figure in both
+ * modes (0 where there is no usable pole).  Points that get no normal
+ * (collinear neighbourhood, non-finite) get NaN and JF_PT_FAILED (plus
+ * JF_PT_NONFINITE).  threads <= 0: all cores; output independent of it. */
+jf_status jf_natural_normals(const jf_natural *nt, jf_normal_source src,
+                             int threads, double *nrm, unsigned *flags,
+                             double *reliability);
+
+/* Per-thread workspace for the neighbour queries (about 4 bytes per
+ * point plus buffers; allocated once, grown only on rare huge rings). */
+typedef struct jf_natural_ws jf_natural_ws;
+jf_status jf_natural_ws_create(const jf_natural *nt, jf_natural_ws **out);
+void jf_natural_ws_free(jf_natural_ws *ws);
+
+/* The natural neighbours of point i in the plane through it with normal
+ * nrm (need not be unit): the samples whose power cells are adjacent in
+ * the power diagram of the samples projected on that plane with weights
+ * -(distance to the plane)^2 (the trace of the 3D Voronoi diagram, exact
+ * up to floating-point rounding); grown ring by ring (neighbours of
+ * neighbours) until N points, each ring sorted nearest first, the last
+ * one cut.  idx[0] = i; *found <= min(N, cap) (smaller when the cloud
+ * runs out; JF_PT_FEW_NEIGHBORS is the caller's).  A non-finite point
+ * gets *found = 0.  Returns JF_OK, or JF_ERR_INVALID (bad i, NULL, nrm
+ * zero or non-finite), JF_ERR_NOMEM.  Thread-safe on a const nt with one
+ * ws per thread. */
+jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws,
+                               size_t i, const double nrm[3], size_t N,
+                               uint32_t *idx, size_t cap, size_t *found);
+
+/* Same neighbourhood by whole rings: idx gets i then planar rings
+ * 1..nrings complete (each nearest first); ring_end[r] (may be NULL;
+ * nrings+1 entries) is the end of ring r in idx.  JF_ERR_TOO_LARGE if
+ * cap is too small. */
+jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
+                           size_t i, const double nrm[3], int nrings,
+                           uint32_t *idx, size_t cap, size_t *found,
+                           size_t *ring_end);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,468 @@
+/*
+ * natural.c -- natural neighbourhoods of a point cloud (§5.1): tangent-plane
+ * normals from Voronoi poles or minimum-circumradius triangles, then the
+ * natural neighbours of p in the power diagram of the samples restricted to
+ * p's tangent plane (Boissonnat & Flototto, ref. 3), grown ring by ring.
+ *
+ * design:
+ *  - The CGAL bridge builds the 3D Delaunay triangulation once and hands
+ *    back plain arrays (cgal_bridge.h): vertex map, CSR adjacency, poles.
+ *    Everything per point happens here, in C, without allocation.
+ *  - Why the planar cells are exact: project the samples on the plane H
+ *    through p with weight w_q = -h_q^2 (h_q the distance of q to H).  For
+ *    x in H the power distance |x - q'|^2 - w_q = |x - q'|^2 + h_q^2 is the
+ *    3D squared distance |x - q|^2, so the planar power cell of q is
+ *    H ∩ Vor3(q), and Vor3(q) is the intersection of the half-spaces of
+ *    q's 3D Delaunay neighbours only.  Clipping a polygon of H by those
+ *    half-planes therefore gives q's planar cell exactly (up to rounding),
+ *    and the labels of its edges are q's planar natural neighbours.
+ *    Planar ring r+1 = the planar neighbours of ring r, each found from
+ *    its own 3D adjacency: no candidate set can be too small.
+ *  - Unbounded planar cells are clipped by a box 1e3 times the reach of
+ *    the vertex's 3D neighbours: an adjacency farther out than that is
+ *    missed (only at the rim of an open scan).
+ */
+#include <math.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#include <stdlib.h>
+#include <string.h>
+
+#include "../cgal_bridge/cgal_bridge.h"
+#include "jetfit.h"
+
+#define NONE UINT32_MAX
+#define BOX_SCALE 1e3      /* box half-size / farthest 3D neighbour     */
+#define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
+#define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
+
+struct jf_natural {
+    jfb_delaunay d;
+    double *vxyz; /* [3nv] coordinates of each vertex                  */
+    double *nn;   /* [nv] distance to the nearest Delaunay neighbour    */
+    size_t max_deg;
+};
+
+struct jf_natural_ws {
+    const jf_natural *nt;
+    uint32_t *stamp; /* [nv] == gen: vertex already collected          */
+    uint32_t gen;
+    uint32_t *list;  /* collected vertices, in ring order              */
+    double *dist;    /* their squared distance to p                    */
+    size_t listcap;
+    double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
+    uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
+    double *sx, *sy, *sr;      /* projected neighbours of the cell     */
+};
+
+static jf_status from_bridge(int rc) {
+    switch (rc) {
+    case 0: return JF_OK;
+    case 1: return JF_ERR_INVALID;
+    case 2: return JF_ERR_NOMEM;
+    case 5: return JF_ERR_TOO_LARGE;
+    default: return JF_ERR_INTERNAL;
+    }
+}
+
+jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out) {
+    if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
+    *out = NULL;
+    jf_natural *nt = calloc(1, sizeof *nt);
+    if (!nt) return JF_ERR_NOMEM;
+    jf_status st = from_bridge(jfb_delaunay_build(xyz, n, &nt->d));
+    if (st != JF_OK) {
+        free(nt);
+        return st;
+    }
+    size_t nv = nt->d.nv;
+    nt->vxyz = malloc((3 * nv + 1) * sizeof(double));
+    nt->nn = malloc((nv + 1) * sizeof(double));
+    if (!nt->vxyz || !nt->nn) {
+        jf_natural_free(nt);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t v = 0; v < nv; v++) {
+        const double *p = xyz + 3 * (size_t)nt->d.rep[v];
+        memcpy(nt->vxyz + 3 * v, p, 3 * sizeof(double));
+    }
+    /* the nearest neighbour is always a Delaunay neighbour */
+    for (size_t v = 0; v < nv; v++) {
+        const double *p = nt->vxyz + 3 * v;
+        double best = INFINITY;
+        size_t b = nt->d.adj_off[v], e = nt->d.adj_off[v + 1];
+        if (e - b > nt->max_deg) nt->max_deg = e - b;
+        for (size_t k = b; k < e; k++) {
+            const double *q = nt->vxyz + 3 * (size_t)nt->d.adj[k];
+            double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+            double d2 = dx * dx + dy * dy + dz * dz;
+            if (d2 < best) best = d2;
+        }
+        nt->nn[v] = sqrt(best);
+    }
+    *out = nt;
+    return JF_OK;
+}
+
+void jf_natural_free(jf_natural *nt) {
+    if (!nt) return;
+    jfb_delaunay_release(&nt->d);
+    free(nt->vxyz);
+    free(nt->nn);
+    free(nt);
+}
+
+void jf_natural_get_stats(const jf_natural *nt, jf_natural_stats *st) {
+    if (!st) return;
+    memset(st, 0, sizeof *st);
+    st->dimension = -1;
+    if (!nt) return;
+    st->dimension = nt->d.dimension;
+    st->nvertices = nt->d.nv;
+    st->nduplicates = nt->d.nduplicates;
+    st->nnonfinite = nt->d.nnonfinite;
+}
+
+size_t jf_natural_kept(const jf_natural *nt, size_t i) {
+    if (!nt || i >= nt->d.n || nt->d.vertex_of[i] == NONE) return SIZE_MAX;
+    return nt->d.rep[nt->d.vertex_of[i]];
+}
+
+/* ---- normals ------------------------------------------------------- */
+
+/* §5.1: q = nearest neighbour of p, r = the sample minimising the
+ * circumradius of pqr, normal of pqr.  The minimiser is a Delaunay
+ * neighbour of p: pq is a Gabriel edge (q nearest), so the smallest sphere
+ * through p, q, r is empty (a point inside it on the far side of pq would
+ * give a smaller circle), i.e. pqr is a Delaunay face.  Returns 0 when
+ * every candidate is collinear with p and q. */
+static int mincirc_normal(const jf_natural *nt, size_t v, double n[3]) {
+    const double *p = nt->vxyz + 3 * v;
+    size_t b = nt->d.adj_off[v], e = nt->d.adj_off[v + 1];
+    double a[3] = {0, 0, 0}, best = INFINITY;
+    for (size_t k = b; k < e; k++) {
+        const double *q = nt->vxyz + 3 * (size_t)nt->d.adj[k];
+        double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (d2 < best) {
+            best = d2;
+            memcpy(a, d, sizeof a);
+        }
+    }
+    if (!(best < INFINITY)) return 0;
+    double la = best, bestr = INFINITY;
+    for (size_t k = b; k < e; k++) {
+        const double *r = nt->vxyz + 3 * (size_t)nt->d.adj[k];
+        double c[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double x[3] = {a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                       a[0] * c[1] - a[1] * c[0]};
+        double lx = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        /* collinear (or q itself): no triangle.  The relative bound keeps
+         * nearly collinear triples, whose circle is huge, from winning by
+         * rounding. */
+        double lc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        if (!(lx > 1e-24 * la * lc)) continue;
+        double ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        /* R^2 = |a|^2 |c|^2 |c - a|^2 / (4 |a x c|^2) */
+        double r2 = la * lc * (ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]) / (4 * lx);
+        if (r2 < bestr) {
+            bestr = r2;
+            double l = sqrt(lx);
+            n[0] = x[0] / l;
+            n[1] = x[1] / l;
+            n[2] = x[2] / l;
+        }
+    }
+    return bestr < INFINITY;
+}
+
+/* Amenta & Bern pole normal of vertex v and its reliability (pole
+ * distance / nearest-neighbour distance; 0 when there is no usable pole).
+ * A hull sample's pole must lie opposite its hull direction, and the two
+ * must roughly agree, else the cell is open in an unknown direction (rim
+ * of an open scan). */
+static double pole_normal(const jf_natural *nt, size_t v, double n[3]) {
+    const double *pl = nt->d.pole + 3 * v, *h = nt->d.hull + 3 * v;
+    double lp = sqrt(pl[0] * pl[0] + pl[1] * pl[1] + pl[2] * pl[2]);
+    if (!(lp > 0) || !isfinite(lp)) return 0.0;
+    for (int k = 0; k < 3; k++) n[k] = pl[k] / lp;
+    double lh = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    if (lh > 0 && -(n[0] * h[0] + n[1] * h[1] + n[2] * h[2]) < HULL_AGREE * lh) return 0.0;
+    double nn = nt->nn[v];
+    return nn > 0 ? lp / nn : 0.0;
+}
+
+jf_status jf_natural_normals(const jf_natural *nt, jf_normal_source src, int threads,
+                             double *nrm, unsigned *flags, double *reliability) {
+    if (!nt || !nrm || !flags) return JF_ERR_INVALID;
+    if (src != JF_NORMAL_POLES && src != JF_NORMAL_MINCIRC) return JF_ERR_INVALID;
+    long n = (long)nt->d.n;
+#ifdef _OPENMP
+    int nthr = threads > 0 ? threads : omp_get_num_procs();
+#pragma omp parallel for schedule(static) num_threads(nthr)
+#else
+    (void)threads;
+#endif
+    for (long i = 0; i < n; i++) {
+        uint32_t v = nt->d.vertex_of[i];
+        double *o = nrm + 3 * i;
+        if (v == NONE) {
+            o[0] = o[1] = o[2] = NAN;
+            flags[i] |= JF_PT_FAILED | JF_PT_NONFINITE;
+            if (reliability) reliability[i] = 0.0;
+            continue;
+        }
+        double pn[3], rel = pole_normal(nt, v, pn);
+        if (reliability) reliability[i] = rel;
+        if (src == JF_NORMAL_POLES && rel >= JF_NATURAL_MIN_RELIABILITY) {
+            memcpy(o, pn, sizeof pn);
+            flags[i] |= JF_PT_NORMAL_POLES;
+        } else if (mincirc_normal(nt, v, o)) {
+            flags[i] |= JF_PT_NORMAL_MINCIRC |
+                        (src == JF_NORMAL_POLES ? JF_PT_NORMAL_FALLBACK : 0u);
+        } else {
+            o[0] = o[1] = o[2] = NAN;
+            flags[i] |= JF_PT_FAILED;
+        }
+    }
+    return JF_OK;
+}
+
+/* ---- neighbourhoods ---------------------------------------------- */
+
+jf_status jf_natural_ws_create(const jf_natural *nt, jf_natural_ws **out) {
+    if (!nt || !out) return JF_ERR_INVALID;
+    *out = NULL;
+    jf_natural_ws *ws = calloc(1, sizeof *ws);
+    if (!ws) return JF_ERR_NOMEM;
+    size_t m = nt->max_deg + 8;
+    ws->nt = nt;
+    ws->stamp = calloc(nt->d.nv + 1, sizeof *ws->stamp);
+    ws->listcap = 256;
+    ws->list = malloc(ws->listcap * sizeof *ws->list);
+    ws->dist = malloc(ws->listcap * sizeof *ws->dist);
+    double **bufs[] = {&ws->px, &ws->py, &ws->qx, &ws->qy, &ws->sx, &ws->sy, &ws->sr};
+    int ok = ws->stamp && ws->list && ws->dist;
+    for (size_t k = 0; k < sizeof bufs / sizeof *bufs; k++) ok &= (*bufs[k] = malloc(m * sizeof(double))) != NULL;
+    ok &= (ws->pl = malloc(m * sizeof(uint32_t))) != NULL;
+    ok &= (ws->ql = malloc(m * sizeof(uint32_t))) != NULL;
+    if (!ok) {
+        jf_natural_ws_free(ws);
+        return JF_ERR_NOMEM;
+    }
+    *out = ws;
+    return JF_OK;
+}
+
+void jf_natural_ws_free(jf_natural_ws *ws) {
+    if (!ws) return;
+    free(ws->stamp);
+    free(ws->list);
+    free(ws->dist);
+    free(ws->px), free(ws->py), free(ws->qx), free(ws->qy);
+    free(ws->sx), free(ws->sy), free(ws->sr);
+    free(ws->pl), free(ws->ql);
+    free(ws);
+}
+
+/* The tangent plane: orthonormal e1, e2 spanning it, n its unit normal. */
+typedef struct {
+    double o[3], e1[3], e2[3], n[3];
+} plane;
+
+static int make_plane(const double *o, const double nrm[3], plane *h) {
+    double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(l > 0) || !isfinite(l)) return 0;
+    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] / l, h->o[k] = o[k];
+    /* e1: the world axis least aligned with n, made orthogonal */
+    int ax = fabs(h->n[0]) < fabs(h->n[1]) ? (fabs(h->n[0]) < fabs(h->n[2]) ? 0 : 2)
+                                            : (fabs(h->n[1]) < fabs(h->n[2]) ? 1 : 2);
+    double t[3] = {0, 0, 0};
+    t[ax] = 1;
+    double d = t[0] * h->n[0] + t[1] * h->n[1] + t[2] * h->n[2];
+    for (int k = 0; k < 3; k++) t[k] -= d * h->n[k];
+    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int k = 0; k < 3; k++) h->e1[k] = t[k] / l;
+    h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
+    h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
+    h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
+    return 1;
+}
+
+static void project(const plane *h, const double *q, double *x, double *y, double *z) {
+    double d[3] = {q[0] - h->o[0], q[1] - h->o[1], q[2] - h->o[2]};
+    *x = d[0] * h->e1[0] + d[1] * h->e1[1] + d[2] * h->e1[2];
+    *y = d[0] * h->e2[0] + d[1] * h->e2[1] + d[2] * h->e2[2];
+    *z = d[0] * h->n[0] + d[1] * h->n[1] + d[2] * h->n[2];
+}
+
+/* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
+ * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
+ * the clip line gets label s. */
+static void clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
+    size_t n = *m, o = 0;
+    for (size_t k = 0; k < n; k++) {
+        size_t k1 = k + 1 == n ? 0 : k + 1;
+        double fu = ax * ws->px[k] + ay * ws->py[k] - b;
+        double fw = ax * ws->px[k1] + ay * ws->py[k1] - b;
+        if (fu <= 0) {
+            ws->qx[o] = ws->px[k], ws->qy[o] = ws->py[k], ws->ql[o++] = ws->pl[k];
+            if (fw > 0) {
+                double t = fu / (fu - fw);
+                ws->qx[o] = ws->px[k] + t * (ws->px[k1] - ws->px[k]);
+                ws->qy[o] = ws->py[k] + t * (ws->py[k1] - ws->py[k]);
+                ws->ql[o++] = s;
+            }
+        } else if (fw <= 0) {
+            double t = fu / (fu - fw);
+            ws->qx[o] = ws->px[k] + t * (ws->px[k1] - ws->px[k]);
+            ws->qy[o] = ws->py[k] + t * (ws->py[k1] - ws->py[k]);
+            ws->ql[o++] = ws->pl[k];
+        }
+    }
+    double *tx = ws->px, *ty = ws->py;
+    uint32_t *tl = ws->pl;
+    ws->px = ws->qx, ws->py = ws->qy, ws->pl = ws->ql;
+    ws->qx = tx, ws->qy = ty, ws->ql = tl;
+    *m = o;
+}
+
+static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
+    if (*len == ws->listcap) { /* rare: amortised growth, not per point */
+        size_t c = 2 * ws->listcap;
+        uint32_t *l = realloc(ws->list, c * sizeof *l);
+        if (!l) return 0;
+        ws->list = l;
+        double *d = realloc(ws->dist, c * sizeof *d);
+        if (!d) return 0;
+        ws->dist = d;
+        ws->listcap = c;
+    }
+    ws->list[*len] = v;
+    ws->dist[(*len)++] = d2;
+    return 1;
+}
+
+/* Appends to the list the planar natural neighbours of vertex u not yet
+ * collected (the edge labels of u's clipped power cell). */
+static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    size_t b = nt->d.adj_off[u], e = nt->d.adj_off[u + 1], m = 0;
+    double ux, uy, uz, reach = 0;
+    project(h, nt->vxyz + 3 * (size_t)u, &ux, &uy, &uz);
+    for (size_t k = b; k < e; k++, m++) {
+        double x, y, z;
+        project(h, nt->vxyz + 3 * (size_t)nt->d.adj[k], &x, &y, &z);
+        /* relative to u': the half-plane 2 d.X <= |d|^2 + h_s^2 - h_u^2 */
+        ws->sx[m] = x - ux, ws->sy[m] = y - uy;
+        ws->sr[m] = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z + uz);
+        double r = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z - uz);
+        if (r > reach) reach = r;
+    }
+    reach = sqrt(reach);
+    double B = BOX_SCALE * reach;
+    size_t np = 4;
+    double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
+    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
+    for (size_t k = 0; k < m && np > 0; k++) {
+        if (ws->sx[k] == 0 && ws->sy[k] == 0) {
+            if (ws->sr[k] < 0) np = 0; /* s straight above u, nearer H */
+            continue;
+        }
+        clip(ws, &np, 2 * ws->sx[k], 2 * ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
+    }
+    const double *p = h->o;
+    for (size_t k = 0; k < np; k++) {
+        uint32_t s = ws->pl[k];
+        if (s == NONE || ws->stamp[s] == ws->gen) continue;
+        size_t k1 = k + 1 == np ? 0 : k + 1;
+        double ex = ws->px[k1] - ws->px[k], ey = ws->py[k1] - ws->py[k];
+        if (ex * ex + ey * ey <= EDGE_EPS * EDGE_EPS * reach * reach) continue;
+        const double *q = nt->vxyz + 3 * (size_t)s;
+        double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                    (q[2] - p[2]) * (q[2] - p[2]);
+        ws->stamp[s] = ws->gen;
+        if (!push(ws, len, s, d2)) return 0;
+    }
+    return 1;
+}
+
+/* Sorts list[a..b) by distance, then vertex id (insertion sort: rings
+ * are short). */
+static void sort_ring(jf_natural_ws *ws, size_t a, size_t b) {
+    for (size_t k = a + 1; k < b; k++) {
+        uint32_t v = ws->list[k];
+        double d = ws->dist[k];
+        size_t j = k;
+        while (j > a && (ws->dist[j - 1] > d || (ws->dist[j - 1] == d && ws->list[j - 1] > v))) {
+            ws->list[j] = ws->list[j - 1], ws->dist[j] = ws->dist[j - 1];
+            j--;
+        }
+        ws->list[j] = v, ws->dist[j] = d;
+    }
+}
+
+/* Grows rings from input point i until `want` vertices (with i) or
+ * `maxrings` rings are collected.  ring_end[r] = end of ring r. */
+static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const double nrm[3],
+                      size_t want, int maxrings, size_t *len, size_t *ring_end) {
+    *len = 0;
+    if (!nt || !ws || ws->nt != nt || !nrm || i >= nt->d.n) return JF_ERR_INVALID;
+    uint32_t v0 = nt->d.vertex_of[i];
+    if (v0 == NONE) return JF_OK;
+    plane h;
+    if (!make_plane(nt->vxyz + 3 * (size_t)v0, nrm, &h)) return JF_ERR_INVALID;
+    if (++ws->gen == 0) { /* wrapped: clear the stamps once */
+        memset(ws->stamp, 0, nt->d.nv * sizeof *ws->stamp);
+        ws->gen = 1;
+    }
+    ws->stamp[v0] = ws->gen;
+    push(ws, len, v0, 0.0);
+    size_t a = 0, b = 1;
+    if (ring_end) ring_end[0] = 1;
+    for (int r = 1; r <= maxrings && *len < want; r++) {
+        for (size_t k = a; k < b; k++)
+            if (!cell_neighbors(ws, &h, ws->list[k], len)) return JF_ERR_NOMEM;
+        if (*len == b) break; /* the cloud ran out */
+        sort_ring(ws, b, *len);
+        a = b, b = *len;
+        if (ring_end) ring_end[r] = b;
+    }
+    return JF_OK;
+}
+
+jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i,
+                               const double nrm[3], size_t N, uint32_t *idx, size_t cap,
+                               size_t *found) {
+    if (!found || !idx) return JF_ERR_INVALID;
+    *found = 0;
+    size_t len, want = N < cap ? N : cap;
+    jf_status st = grow(nt, ws, i, nrm, want, INT32_MAX, &len, NULL);
+    if (st != JF_OK || len == 0) return st;
+    if (len > want) len = want;
+    idx[0] = (uint32_t)i;
+    for (size_t k = 1; k < len; k++) idx[k] = nt->d.rep[ws->list[k]];
+    *found = len;
+    return JF_OK;
+}
+
+jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws, size_t i,
+                           const double nrm[3], int nrings, uint32_t *idx, size_t cap,
+                           size_t *found, size_t *ring_end) {
+    if (!found || !idx || nrings < 0) return JF_ERR_INVALID;
+    *found = 0;
+    size_t len;
+    if (ring_end)
+        for (int r = 0; r <= nrings; r++) ring_end[r] = 0;
+    jf_status st = grow(nt, ws, i, nrm, SIZE_MAX, nrings, &len, ring_end);
+    if (st != JF_OK || len == 0) return st;
+    if (ring_end) /* rings past the end of the cloud are empty */
+        for (int r = 1; r <= nrings; r++)
+            if (ring_end[r] < ring_end[r - 1]) ring_end[r] = ring_end[r - 1];
+    if (len > cap) return JF_ERR_TOO_LARGE;
+    idx[0] = (uint32_t)i;
+    for (size_t k = 1; k < len; k++) idx[k] = nt->d.rep[ws->list[k]];
+    *found = len;
+    return JF_OK;
+}
