@@ -1,0 +1,123 @@
+/*
+ * io_internal.h -- shared pieces of the file readers and writers (not part
+ * of the public API).  Every reader parses a caller-owned byte buffer
+ * [buf, buf+len) and never reads outside it (no NUL terminator needed), so
+ * the file reader can map the file and the fuzzers can pass their bytes.
+ */
+#ifndef JF_IO_INTERNAL_H
+#define JF_IO_INTERNAL_H
+
+#include "jetfit.h"
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+typedef enum {
+    JF_FMT_UNKNOWN = 0,
+    JF_FMT_PLY,
+    JF_FMT_XYZ,   /* .xyz and .txt */
+    JF_FMT_PTS,
+    JF_FMT_CSV,
+    JF_FMT_OFF
+} jf_format;
+
+/* Format from the extension (any case); JF_FMT_UNKNOWN if none fits. */
+jf_format jf_format_from_path(const char *path);
+
+/* Parses a whole file image.  `name` is used in messages only.  Same
+ * contract as jf_cloud_read: on failure *c is zeroed, nothing allocated. */
+jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
+                            const char *name, const jf_read_opts *o,
+                            jf_cloud *c, jf_error *err);
+
+/* The per-format readers called by jf_cloud_read_mem (c zeroed on entry;
+ * on failure they may leave arrays in c: the caller frees them). */
+jf_status jf_read_ply(const char *buf, size_t len, const char *name,
+                      jf_cloud *c, jf_error *err);
+jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
+                      const char *name, const jf_read_opts *o, jf_cloud *c,
+                      jf_error *err);
+jf_status jf_read_off(const char *buf, size_t len, const char *name,
+                      jf_cloud *c, jf_error *err);
+
+/* Fills err (may be NULL) with "NAME:LINE: reason" (line > 0) or
+ * "NAME: reason" (line == 0); returns st. */
+jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
+                     size_t line, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+
+/* Parses the whole token [s, e) as a double (decimal, exponent, "nan",
+ * "inf", hex floats): 1 on success, 0 if the token is not one number.
+ * Exact: the fast path (<= 19 digits, mantissa <= 2^53, |exp| <= 22) is
+ * Clinger's one-rounding case; everything else goes to strtod. */
+int jf_parse_double(const char *s, const char *e, double *out);
+
+/* Parses [s, e) as an unsigned decimal integer <= max: 1 ok, 0 not. */
+int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out);
+
+/* Text cursor: line by line over [p, end), counting lines from 1. */
+typedef struct {
+    const char *p, *end;
+    size_t line;          /* number of the line last returned */
+} jf_text;
+
+/* Next line as [*ls, *le) without '\n' and a trailing '\r'.  0 at end. */
+static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
+{
+    if (t->p >= t->end)
+        return 0;
+    const char *s = t->p;
+    const char *nl = memchr(s, '\n', (size_t)(t->end - s));
+    const char *e = nl ? nl : t->end;
+    t->p = nl ? nl + 1 : t->end;
+    if (e > s && e[-1] == '\r')
+        e--;
+    t->line++;
+    *ls = s;
+    *le = e;
+    return 1;
+}
+
+/* Separator classes for jf_next_token. */
+static inline int jf_is_space(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+/* Next token of [*p, e) separated by whitespace (and ',' ';' when
+ * `commas`); sets [*ts, *te) and advances *p.  0 when none is left. */
+static inline int jf_next_token(const char **p, const char *e, int commas,
+                                const char **ts, const char **te)
+{
+    const char *q = *p;
+    while (q < e && (jf_is_space(*q) || (commas && (*q == ',' || *q == ';'))))
+        q++;
+    if (q >= e) {
+        *p = q;
+        return 0;
+    }
+    *ts = q;
+    while (q < e && !jf_is_space(*q) && !(commas && (*q == ',' || *q == ';')))
+        q++;
+    *te = q;
+    *p = q;
+    return 1;
+}
+
+/* Growable array of doubles / uint32 / size_t (amortised doubling: no
+ * allocation per element).  Return 0 on allocation failure. */
+typedef struct { double *v; size_t n, cap; } jf_dvec;
+typedef struct { uint32_t *v; size_t n, cap; } jf_uvec;
+int jf_dvec_reserve(jf_dvec *a, size_t cap);
+int jf_uvec_reserve(jf_uvec *a, size_t cap);
+int jf_zvec_reserve(size_t **v, size_t *cap, size_t want);
+
+/* Largest number of points a cloud may hold (indices are uint32). */
+#define JF_MAX_POINTS ((size_t)UINT32_MAX - 1)
+
+#endif /* JF_IO_INTERNAL_H */

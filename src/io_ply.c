@@ -1,0 +1,464 @@
+/*
+ * io_ply.c -- PLY reader (ascii, binary little and big endian).
+ *
+ * design: parse the header into elements and properties; then walk the
+ * elements in file order.  `vertex` gives x y z (and nx ny nz when all
+ * three exist), `face` its vertex_indices/vertex_index list; every other
+ * element, property and list is skipped (the Stanford range scans carry a
+ * range_grid element of lists).  Before allocating from a count the bytes
+ * left are checked: a binary row needs at least its fixed size, an ascii
+ * row two bytes per value.  Ascii rows are one line each.
+ */
+#include "io_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
+static const char *const type_names[][2] = {
+    {"", ""},          {"char", "int8"},   {"uchar", "uint8"},
+    {"short", "int16"}, {"ushort", "uint16"}, {"int", "int32"},
+    {"uint", "uint32"}, {"float", "float32"}, {"double", "float64"}};
+static const unsigned type_size[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+
+#define MAX_ELEMS 32
+#define MAX_PROPS 64
+#define NAME_LEN 64
+
+typedef struct {
+    char name[NAME_LEN];
+    int type;        /* scalar type, or list item type */
+    int count_type;  /* list count type, T_NONE for a scalar */
+} ply_prop;
+
+typedef struct {
+    char name[NAME_LEN];
+    uint64_t count;
+    int nprops;
+    ply_prop props[MAX_PROPS];
+} ply_elem;
+
+typedef struct {
+    const char *name;            /* file name, for messages */
+    jf_error *err;
+    int format;                  /* 0 ascii, 1 little, 2 big endian */
+    int nelems;
+    ply_elem elems[MAX_ELEMS];
+    jf_text tx;                  /* ascii body cursor */
+    const unsigned char *p, *end;/* binary body cursor */
+    size_t nverts_known;         /* vertex count once its element is read */
+    int have_verts;
+} ply;
+
+static int type_of(const char *s, const char *e)
+{
+    size_t n = (size_t)(e - s);
+    for (int t = T_I8; t <= T_F64; t++)
+        for (int k = 0; k < 2; k++)
+            if (strlen(type_names[t][k]) == n &&
+                !memcmp(type_names[t][k], s, n))
+                return t;
+    return T_NONE;
+}
+
+static int tok_is(const char *s, const char *e, const char *word)
+{
+    size_t n = strlen(word);
+    return (size_t)(e - s) == n && !memcmp(s, word, n);
+}
+
+static jf_status parse_header(ply *h, const char *buf, size_t len,
+                              size_t *body)
+{
+    jf_text t = {buf, buf + len, 0};
+    const char *ls, *le, *ts, *te, *q;
+    if (!jf_text_line(&t, &ls, &le) || !tok_is(ls, le, "ply"))
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, 1,
+                          "not a PLY file (first line is not \"ply\")");
+    h->format = -1;
+    while (jf_text_line(&t, &ls, &le)) {
+        q = ls;
+        if (!jf_next_token(&q, le, 0, &ts, &te))
+            continue; /* blank header line */
+        if (tok_is(ts, te, "comment") || tok_is(ts, te, "obj_info"))
+            continue;
+        if (tok_is(ts, te, "end_header")) {
+            if (h->format < 0)
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "no format line before end_header");
+            *body = (size_t)(t.p - buf);
+            h->tx = (jf_text){t.p, buf + len, t.line};
+            return JF_OK;
+        }
+        if (tok_is(ts, te, "format")) {
+            if (!jf_next_token(&q, le, 0, &ts, &te))
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "format line without a format");
+            if (tok_is(ts, te, "ascii"))
+                h->format = 0;
+            else if (tok_is(ts, te, "binary_little_endian"))
+                h->format = 1;
+            else if (tok_is(ts, te, "binary_big_endian"))
+                h->format = 2;
+            else
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "unsupported format '%.*s'",
+                                  (int)(te - ts > 40 ? 40 : te - ts), ts);
+            continue;
+        }
+        if (tok_is(ts, te, "element")) {
+            const char *ns, *ne, *cs, *ce;
+            uint64_t cnt;
+            if (!jf_next_token(&q, le, 0, &ns, &ne) ||
+                !jf_next_token(&q, le, 0, &cs, &ce) ||
+                !jf_parse_size(cs, ce, UINT64_MAX, &cnt))
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "malformed element line (expected "
+                                  "\"element NAME COUNT\")");
+            if (h->nelems == MAX_ELEMS || ne - ns >= NAME_LEN)
+                return jf_io_fail(h->err, JF_ERR_UNSUPPORTED, h->name, t.line,
+                                  "too many elements or name too long");
+            ply_elem *el = &h->elems[h->nelems++];
+            memcpy(el->name, ns, (size_t)(ne - ns));
+            el->name[ne - ns] = '\0';
+            el->count = cnt;
+            el->nprops = 0;
+            continue;
+        }
+        if (tok_is(ts, te, "property")) {
+            if (h->nelems == 0)
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "property before any element");
+            ply_elem *el = &h->elems[h->nelems - 1];
+            if (el->nprops == MAX_PROPS)
+                return jf_io_fail(h->err, JF_ERR_UNSUPPORTED, h->name, t.line,
+                                  "more than %d properties", MAX_PROPS);
+            ply_prop *pr = &el->props[el->nprops];
+            const char *a, *ae, *ns = NULL, *ne = NULL;
+            int ok = jf_next_token(&q, le, 0, &a, &ae);
+            pr->count_type = T_NONE;
+            if (ok && tok_is(a, ae, "list")) {
+                const char *c1, *c1e;
+                ok = jf_next_token(&q, le, 0, &c1, &c1e) &&
+                     jf_next_token(&q, le, 0, &a, &ae);
+                pr->count_type = ok ? type_of(c1, c1e) : T_NONE;
+                ok = ok && pr->count_type != T_NONE &&
+                     pr->count_type != T_F32 && pr->count_type != T_F64;
+            }
+            pr->type = ok ? type_of(a, ae) : T_NONE;
+            ok = ok && pr->type != T_NONE &&
+                 jf_next_token(&q, le, 0, &ns, &ne) && ne - ns < NAME_LEN;
+            if (!ok)
+                return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                  "malformed property line (expected "
+                                  "\"property TYPE NAME\" or \"property list "
+                                  "INTTYPE TYPE NAME\")");
+            memcpy(pr->name, ns, (size_t)(ne - ns));
+            pr->name[ne - ns] = '\0';
+            el->nprops++;
+            continue;
+        }
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                          "unknown header line '%.*s'",
+                          (int)(te - ts > 40 ? 40 : te - ts), ts);
+    }
+    return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                      "header has no end_header line");
+}
+
+/* One binary value at p as a double (byte order per h->format). */
+static double load(const unsigned char *p, int type, int swap)
+{
+    unsigned char b[8];
+    unsigned n = type_size[type];
+    if (swap)
+        for (unsigned i = 0; i < n; i++)
+            b[i] = p[n - 1 - i];
+    else
+        memcpy(b, p, n);
+    switch (type) {
+    case T_I8: { int8_t v; memcpy(&v, b, 1); return v; }
+    case T_U8: return b[0];
+    case T_I16: { int16_t v; memcpy(&v, b, 2); return v; }
+    case T_U16: { uint16_t v; memcpy(&v, b, 2); return v; }
+    case T_I32: { int32_t v; memcpy(&v, b, 4); return v; }
+    case T_U32: { uint32_t v; memcpy(&v, b, 4); return v; }
+    case T_F32: { float v; memcpy(&v, b, 4); return v; }
+    default: { double v; memcpy(&v, b, 8); return v; }
+    }
+}
+
+/* What to do with each property of the element being read. */
+typedef struct {
+    double *dst[MAX_PROPS]; /* scalar destination row pointer or NULL */
+    int face_list;          /* index of the face list property, or -1 */
+} ply_plan;
+
+/* Stores a face index (checked: integral, in range when known). */
+static jf_status face_index(ply *h, jf_uvec *fi, double v, size_t line,
+                            uint64_t row)
+{
+    if (!(v >= 0 && v < 4294967295.0) || v != (double)(uint32_t)v ||
+        (h->have_verts && v >= (double)h->nverts_known))
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                          "%sface %llu: vertex index %.17g out of range "
+                          "(%zu vertices)", line ? "" : "element ",
+                          (unsigned long long)row, v, h->nverts_known);
+    fi->v[fi->n++] = (uint32_t)v;
+    return JF_OK;
+}
+
+static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
+                           jf_cloud *c, jf_uvec *fi)
+{
+    int swap = 0;
+    if (h->format) {
+        const uint16_t one = 1;
+        int little = *(const unsigned char *)&one == 1;
+        swap = (h->format == 1) != little;
+    }
+    const char *tag = h->format ? "element " : "";
+    for (uint64_t r = 0; r < el->count; r++) {
+        const char *ls = NULL, *le = NULL, *q = NULL, *ts, *te;
+        size_t line = 0;
+        int found = 0; /* ascii: values taken so far on this line */
+        if (!h->format) {
+            do {
+                if (!jf_text_line(&h->tx, &ls, &le))
+                    return jf_io_fail(h->err, JF_ERR_FORMAT, h->name,
+                                      h->tx.line, "%s %llu: file ends "
+                                      "(header says %llu)", el->name,
+                                      (unsigned long long)r,
+                                      (unsigned long long)el->count);
+                q = ls;
+            } while (!jf_next_token(&q, le, 0, &ts, &te));
+            q = ls;
+            line = h->tx.line;
+        }
+        for (int k = 0; k < el->nprops; k++) {
+            const ply_prop *pr = &el->props[k];
+            uint64_t items = 1;
+            int list = pr->count_type != T_NONE;
+            double v = 0;
+            if (list) {
+                if (h->format) {
+                    if ((size_t)(h->end - h->p) < type_size[pr->count_type])
+                        goto truncated;
+                    v = load(h->p, pr->count_type, swap);
+                    h->p += type_size[pr->count_type];
+                } else {
+                    if (!jf_next_token(&q, le, 0, &ts, &te))
+                        goto short_row;
+                    found++;
+                    if (!jf_parse_double(ts, te, &v))
+                        goto not_number;
+                }
+                if (!(v >= 0 && v <= 4294967295.0) || v != (double)(uint64_t)v)
+                    return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                                      "%s%s %llu: bad list count %.17g", tag,
+                                      el->name, (unsigned long long)r, v);
+                items = (uint64_t)v;
+                if (k == pl->face_list) {
+                    if (items < 3)
+                        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name,
+                                          line, "%sface %llu: %llu vertices "
+                                          "(a face needs 3 or more)", tag,
+                                          (unsigned long long)r,
+                                          (unsigned long long)items);
+                    /* bounded by the bytes left before reserving */
+                    uint64_t room = h->format
+                        ? (uint64_t)(h->end - h->p) / type_size[pr->type]
+                        : (uint64_t)(le - q);
+                    if (items > room)
+                        goto truncated;
+                    if (!jf_uvec_reserve(fi, fi->n + items))
+                        return jf_io_fail(h->err, JF_ERR_NOMEM, h->name, 0,
+                                          "out of memory");
+                    c->face_off[r] = fi->n;
+                }
+            }
+            for (uint64_t i = 0; i < items; i++) {
+                if (h->format) {
+                    if ((size_t)(h->end - h->p) < type_size[pr->type])
+                        goto truncated;
+                    v = load(h->p, pr->type, swap);
+                    h->p += type_size[pr->type];
+                } else {
+                    if (!jf_next_token(&q, le, 0, &ts, &te))
+                        goto short_row;
+                    found++;
+                    if (!jf_parse_double(ts, te, &v))
+                        goto not_number;
+                }
+                if (list && k == pl->face_list) {
+                    jf_status st = face_index(h, fi, v, line, r);
+                    if (st != JF_OK)
+                        return st;
+                } else if (!list && pl->dst[k]) {
+                    pl->dst[k][3 * r] = v;
+                }
+            }
+        }
+        if (!h->format && jf_next_token(&q, le, 0, &ts, &te)) {
+            int n = found + 1;
+            while (jf_next_token(&q, le, 0, &ts, &te))
+                n++;
+            return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                              "%s %llu: expected %d values, found %d",
+                              el->name, (unsigned long long)r, found, n);
+        }
+        continue;
+    truncated:
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                          "%s%s %llu: truncated (the file ends or a list "
+                          "is longer than the file)", tag, el->name,
+                          (unsigned long long)r);
+    short_row: {
+        int lists = 0;
+        for (int k = 0; k < el->nprops; k++)
+            lists += el->props[k].count_type != T_NONE;
+        if (!lists)
+            return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                              "%s %llu: expected %d numbers, found %d",
+                              el->name, (unsigned long long)r, el->nprops,
+                              found);
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                          "%s %llu: expected more than %d numbers (lists "
+                          "included), found %d", el->name,
+                          (unsigned long long)r, found, found);
+    }
+    not_number:
+        return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
+                          "%s %llu: '%.*s' is not a number", el->name,
+                          (unsigned long long)r,
+                          (int)(te - ts > 40 ? 40 : te - ts), ts);
+    }
+    return JF_OK;
+}
+
+static int prop_index(const ply_elem *el, const char *name, int list)
+{
+    for (int k = 0; k < el->nprops; k++)
+        if (!strcmp(el->props[k].name, name) &&
+            (el->props[k].count_type != T_NONE) == list)
+            return k;
+    return -1;
+}
+
+jf_status jf_read_ply(const char *buf, size_t len, const char *name,
+                      jf_cloud *c, jf_error *err)
+{
+    ply *h = calloc(1, sizeof *h);
+    if (!h)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+    h->name = name;
+    h->err = err;
+    size_t body = 0;
+    jf_status st = parse_header(h, buf, len, &body);
+    jf_uvec fi = {0};
+    int seen_vertex = 0, seen_face = 0;
+    h->p = (const unsigned char *)buf + body;
+    h->end = (const unsigned char *)buf + len;
+    for (int e = 0; st == JF_OK && e < h->nelems; e++) {
+        const ply_elem *el = &h->elems[e];
+        ply_plan pl = {{0}, -1};
+        int is_vertex = !seen_vertex && !strcmp(el->name, "vertex");
+        int is_face = !seen_face && !strcmp(el->name, "face");
+        /* room check: bytes a row needs at least */
+        uint64_t need = 0;
+        for (int k = 0; k < el->nprops; k++) {
+            const ply_prop *pr = &el->props[k];
+            need += h->format ? type_size[pr->count_type != T_NONE
+                                              ? pr->count_type
+                                              : pr->type]
+                              : 2;
+        }
+        size_t left = h->format ? (size_t)(h->end - h->p)
+                                : (size_t)(h->tx.end - h->tx.p) + 1;
+        if (need == 0 && !is_vertex && !is_face)
+            continue; /* rows of no bytes: nothing to skip */
+        if (need && el->count > left / need) {
+            st = jf_io_fail(err, JF_ERR_TOO_LARGE, name,
+                            h->format ? 0 : h->tx.line,
+                            "element %s: %llu rows cannot fit in the %zu "
+                            "bytes left in the file", el->name,
+                            (unsigned long long)el->count, left);
+            break;
+        }
+        if (is_vertex) {
+            seen_vertex = 1;
+            int ix = prop_index(el, "x", 0), iy = prop_index(el, "y", 0),
+                iz = prop_index(el, "z", 0);
+            if (ix < 0 || iy < 0 || iz < 0) {
+                st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                "element vertex has no x, y, z properties");
+                break;
+            }
+            if (el->count > JF_MAX_POINTS) {
+                st = jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0,
+                                "%llu vertices: more than supported",
+                                (unsigned long long)el->count);
+                break;
+            }
+            size_t n = (size_t)el->count;
+            c->n = n;
+            c->xyz = malloc((n ? n : 1) * 3 * sizeof(double));
+            int inx = prop_index(el, "nx", 0), iny = prop_index(el, "ny", 0),
+                inz = prop_index(el, "nz", 0);
+            if (inx >= 0 && iny >= 0 && inz >= 0) {
+                c->nrm = malloc((n ? n : 1) * 3 * sizeof(double));
+                if (c->nrm) {
+                    pl.dst[inx] = c->nrm;
+                    pl.dst[iny] = c->nrm + 1;
+                    pl.dst[inz] = c->nrm + 2;
+                }
+            }
+            if (!c->xyz || (inx >= 0 && iny >= 0 && inz >= 0 && !c->nrm)) {
+                st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
+                                "out of memory for %zu vertices", n);
+                break;
+            }
+            pl.dst[ix] = c->xyz;
+            pl.dst[iy] = c->xyz + 1;
+            pl.dst[iz] = c->xyz + 2;
+        } else if (is_face) {
+            seen_face = 1;
+            pl.face_list = prop_index(el, "vertex_indices", 1);
+            if (pl.face_list < 0)
+                pl.face_list = prop_index(el, "vertex_index", 1);
+            if (pl.face_list >= 0) {
+                c->nfaces = (size_t)el->count;
+                c->face_off = malloc((c->nfaces + 1) * sizeof(size_t));
+                if (!c->face_off) {
+                    st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
+                                    "out of memory for faces");
+                    break;
+                }
+                c->face_off[0] = 0;
+            }
+        }
+        st = read_elem(h, el, &pl, c, &fi);
+        if (st == JF_OK && is_vertex) {
+            h->have_verts = 1;
+            h->nverts_known = c->n;
+        }
+        if (st == JF_OK && pl.face_list >= 0)
+            c->face_off[c->nfaces] = fi.n;
+    }
+    if (st == JF_OK && !seen_vertex)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no vertex element");
+    /* faces listed before the vertices: check their indices now */
+    for (size_t f = 0; st == JF_OK && f < c->nfaces; f++)
+        for (size_t k = c->face_off[f]; k < c->face_off[f + 1]; k++)
+            if (fi.v[k] >= c->n) {
+                st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                "face %zu: vertex index %u out of range "
+                                "(%zu vertices)", f, fi.v[k], c->n);
+                break;
+            }
+    c->face_idx = fi.v;
+    if (st == JF_OK && c->nfaces && !c->face_idx) /* all faces empty */
+        c->face_idx = malloc(sizeof(uint32_t));
+    free(h);
+    return st;
+}

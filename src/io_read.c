@@ -1,0 +1,333 @@
+/*
+ * io_read.c -- jf_cloud_read: picks the reader from the extension, maps the
+ * file, and holds the pieces every reader shares (messages, exact number
+ * parsing, growable arrays).
+ *
+ * design: the file is mapped (or read whole when it cannot be mapped) and
+ * the reader parses the byte range in place: no copy, no allocation per
+ * token, no reading past the end.  Counts read from headers are checked
+ * against the bytes left before anything is allocated from them.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "io_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+void jf_read_opts_init(jf_read_opts *o)
+{
+    if (!o)
+        return;
+    for (int i = 0; i < 6; i++)
+        o->columns[i] = -1;
+}
+
+void jf_cloud_free(jf_cloud *c)
+{
+    if (!c)
+        return;
+    free(c->xyz);
+    free(c->nrm);
+    free(c->face_off);
+    free(c->face_idx);
+    memset(c, 0, sizeof *c);
+}
+
+jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
+                     size_t line, const char *fmt, ...)
+{
+    if (!err)
+        return st;
+    int k = line ? snprintf(err->msg, sizeof err->msg, "%s:%zu: ", name, line)
+                 : snprintf(err->msg, sizeof err->msg, "%s: ", name);
+    if (k < 0 || (size_t)k >= sizeof err->msg)
+        return st;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg + k, sizeof err->msg - (size_t)k, fmt, ap);
+    va_end(ap);
+    /* one line: a control character from the file must not break it */
+    for (char *q = err->msg; *q; q++)
+        if ((unsigned char)*q < 0x20)
+            *q = ' ';
+    return st;
+}
+
+jf_format jf_format_from_path(const char *path)
+{
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    const char *slash = path ? strrchr(path, '/') : NULL;
+    if (!dot || (slash && dot < slash))
+        return JF_FMT_UNKNOWN;
+    char ext[8];
+    size_t n = strlen(dot + 1);
+    if (n == 0 || n >= sizeof ext)
+        return JF_FMT_UNKNOWN;
+    for (size_t i = 0; i <= n; i++) {
+        char ch = dot[1 + i];
+        ext[i] = (ch >= 'A' && ch <= 'Z') ? (char)(ch - 'A' + 'a') : ch;
+    }
+    if (!strcmp(ext, "ply"))
+        return JF_FMT_PLY;
+    if (!strcmp(ext, "xyz") || !strcmp(ext, "txt"))
+        return JF_FMT_XYZ;
+    if (!strcmp(ext, "pts"))
+        return JF_FMT_PTS;
+    if (!strcmp(ext, "csv"))
+        return JF_FMT_CSV;
+    if (!strcmp(ext, "off"))
+        return JF_FMT_OFF;
+    return JF_FMT_UNKNOWN;
+}
+
+/* ---- numbers ---------------------------------------------------------- */
+
+/* 10^0 .. 10^22 are exact doubles (Clinger's fast path). */
+static const double jf_pow10[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+static int slow_double(const char *s, const char *e, double *out)
+{
+    char tmp[512];
+    size_t n = (size_t)(e - s);
+    if (n == 0 || n >= sizeof tmp)
+        return 0;
+    memcpy(tmp, s, n);
+    tmp[n] = '\0';
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(tmp, &end);
+    if (end != tmp + n)
+        return 0;
+    /* ERANGE: overflow gives +-HUGE_VAL (= inf), underflow a denormal or
+     * 0 -- both the nearest double, which is what the file means. */
+    *out = v;
+    return 1;
+}
+
+int jf_parse_double(const char *s, const char *e, double *out)
+{
+    const char *p = s;
+    int neg = 0;
+    if (p < e && (*p == '-' || *p == '+'))
+        neg = (*p++ == '-');
+    uint64_t m = 0;
+    int nd = 0, exp10 = 0, digits = 0;
+    while (p < e && (unsigned)(*p - '0') < 10) {
+        if (nd < 19) {
+            m = m * 10 + (uint64_t)(*p - '0');
+            nd += (m != 0);
+        } else {
+            return slow_double(s, e, out);
+        }
+        p++;
+        if (++digits > 400)
+            return slow_double(s, e, out);
+    }
+    if (p < e && *p == '.') {
+        p++;
+        while (p < e && (unsigned)(*p - '0') < 10) {
+            if (nd < 19) {
+                m = m * 10 + (uint64_t)(*p - '0');
+                nd += (m != 0);
+                exp10--;
+            } else {
+                return slow_double(s, e, out);
+            }
+            p++;
+            if (++digits > 400) /* bounds exp10; strtod decides */
+                return slow_double(s, e, out);
+        }
+    }
+    if (!digits)
+        return slow_double(s, e, out); /* nan, inf, or not a number */
+    if (p < e && (*p == 'e' || *p == 'E')) {
+        p++;
+        int eneg = 0, ev = 0, ed = 0;
+        if (p < e && (*p == '-' || *p == '+'))
+            eneg = (*p++ == '-');
+        while (p < e && (unsigned)(*p - '0') < 10 && ed < 6) {
+            ev = ev * 10 + (*p++ - '0');
+            ed++;
+        }
+        if (!ed || (p < e && (unsigned)(*p - '0') < 10))
+            return slow_double(s, e, out);
+        exp10 += eneg ? -ev : ev;
+    }
+    if (p != e)
+        return slow_double(s, e, out); /* hex float, or not a number */
+    if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22)
+        return slow_double(s, e, out);
+    double v = (double)m;
+    v = exp10 >= 0 ? v * jf_pow10[exp10] : v / jf_pow10[-exp10];
+    *out = neg ? -v : v;
+    return 1;
+}
+
+int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out)
+{
+    if (s < e && *s == '+')
+        s++;
+    if (s >= e)
+        return 0;
+    uint64_t v = 0;
+    for (const char *p = s; p < e; p++) {
+        unsigned d = (unsigned)(*p - '0');
+        if (d >= 10 || v > (max - d) / 10)
+            return 0;
+        v = v * 10 + d;
+    }
+    *out = v;
+    return 1;
+}
+
+/* ---- growable arrays -------------------------------------------------- */
+
+static int grow(void **v, size_t *cap, size_t want, size_t elem)
+{
+    if (want <= *cap)
+        return 1;
+    size_t nc = *cap ? *cap : 64;
+    while (nc < want) {
+        if (nc > SIZE_MAX / 2 / elem)
+            return 0;
+        nc *= 2;
+    }
+    void *q = realloc(*v, nc * elem);
+    if (!q)
+        return 0;
+    *v = q;
+    *cap = nc;
+    return 1;
+}
+
+int jf_dvec_reserve(jf_dvec *a, size_t cap)
+{
+    return grow((void **)&a->v, &a->cap, cap, sizeof *a->v);
+}
+
+int jf_uvec_reserve(jf_uvec *a, size_t cap)
+{
+    return grow((void **)&a->v, &a->cap, cap, sizeof *a->v);
+}
+
+int jf_zvec_reserve(size_t **v, size_t *cap, size_t want)
+{
+    return grow((void **)v, cap, want, sizeof **v);
+}
+
+/* ---- entry points ----------------------------------------------------- */
+
+jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
+                            const char *name, const jf_read_opts *o,
+                            jf_cloud *c, jf_error *err)
+{
+    jf_read_opts def;
+    if (!o) {
+        jf_read_opts_init(&def);
+        o = &def;
+    }
+    if (!name)
+        name = "(memory)";
+    if (!c || (!buf && len))
+        return jf_io_fail(err, JF_ERR_INVALID, name, 0, "invalid argument");
+    memset(c, 0, sizeof *c);
+    if (err)
+        err->msg[0] = '\0';
+    if (len == 0)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "empty file");
+    jf_status st;
+    switch (fmt) {
+    case JF_FMT_PLY:
+        st = jf_read_ply(buf, len, name, c, err);
+        break;
+    case JF_FMT_XYZ:
+    case JF_FMT_PTS:
+    case JF_FMT_CSV:
+        st = jf_read_xyz(buf, len, fmt, name, o, c, err);
+        break;
+    case JF_FMT_OFF:
+        st = jf_read_off(buf, len, name, c, err);
+        break;
+    default:
+        st = jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                        "unknown file extension (expected .ply, .xyz, .pts, "
+                        ".txt, .csv or .off)");
+    }
+    if (st != JF_OK)
+        jf_cloud_free(c);
+    return st;
+}
+
+jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
+                        jf_cloud *c, jf_error *err)
+{
+    if (err)
+        err->msg[0] = '\0';
+    if (!c)
+        return jf_io_fail(err, JF_ERR_INVALID, path ? path : "(null)", 0,
+                          "invalid argument");
+    memset(c, 0, sizeof *c);
+    if (!path)
+        return jf_io_fail(err, JF_ERR_INVALID, "(null)", 0, "no file name");
+    jf_format fmt = jf_format_from_path(path);
+    if (fmt == JF_FMT_UNKNOWN)
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
+                          "unknown file extension (expected .ply, .xyz, "
+                          ".pts, .txt, .csv or .off)");
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return jf_io_fail(err, JF_ERR_IO, path, 0, "cannot open: %s",
+                          strerror(errno));
+    struct stat sb;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        close(fd);
+        return jf_io_fail(err, JF_ERR_IO, path, 0, "not a regular file");
+    }
+    size_t len = (size_t)sb.st_size;
+    if (len == 0) {
+        close(fd);
+        return jf_io_fail(err, JF_ERR_FORMAT, path, 0, "empty file");
+    }
+    char *buf = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
+    int mapped = buf != MAP_FAILED;
+    if (!mapped) {
+        /* e.g. a file system without mmap: read it whole */
+        buf = malloc(len);
+        if (!buf) {
+            close(fd);
+            return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
+                              "out of memory reading %zu bytes", len);
+        }
+        size_t got = 0;
+        while (got < len) {
+            ssize_t r = read(fd, buf + got, len - got);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0)
+                break;
+            got += (size_t)r;
+        }
+        if (got < len) {
+            free(buf);
+            close(fd);
+            return jf_io_fail(err, JF_ERR_IO, path, 0, "read failed");
+        }
+    } else {
+        posix_madvise(buf, len, POSIX_MADV_SEQUENTIAL);
+    }
+    close(fd);
+    jf_status st = jf_cloud_read_mem(buf, len, fmt, path, o, c, err);
+    if (mapped)
+        munmap(buf, len);
+    else
+        free(buf);
+    return st;
+}
