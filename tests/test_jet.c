@@ -46,6 +46,8 @@ static void sample_poly(const double *a, int deg, size_t n, double s, double *xy
     }
 }
 
+static const double origin[3] = {0, 0, 0};
+
 static jf_fitter *make_fitter(int degree, int monge, jf_fit_mode fit, jf_frame_mode frame)
 {
     jf_params p;
@@ -96,11 +98,294 @@ START_TEST(test_paraboloid)
 }
 END_TEST
 
+
+/* coefficients of P(a x + b y, c x + d y) (independent of monge.c) */
+static void compose_linear(const double *pa, int deg, double a, double b, double c,
+                           double d, double *out)
+{
+    static const double binom[10][10] = {
+        {1}, {1, 1}, {1, 2, 1}, {1, 3, 3, 1}, {1, 4, 6, 4, 1}, {1, 5, 10, 10, 5, 1},
+        {1, 6, 15, 20, 15, 6, 1}, {1, 7, 21, 35, 35, 21, 7, 1},
+        {1, 8, 28, 56, 70, 56, 28, 8, 1}, {1, 9, 36, 84, 126, 126, 84, 36, 9, 1}};
+    memset(out, 0, jf_jet_size(deg) * sizeof *out);
+    for (int k = 0; k <= deg; k++)
+        for (int j = 0; j <= k; j++) {
+            int i = k - j; /* (a x + b y)^i (c x + d y)^j */
+            for (int p = 0; p <= i; p++)
+                for (int q = 0; q <= j; q++) {
+                    double t = pa[IDX(i, j)] * binom[i][p] * pow(a, i - p) * pow(b, p) *
+                               binom[j][q] * pow(c, j - q) * pow(d, q);
+                    out[IDX(i - p + j - q, p + q)] += t;
+                }
+        }
+}
+
+static void random_poly(int deg, double scale, double *a)
+{
+    for (size_t c = 0; c < jf_jet_size(deg); c++) a[c] = scale * (2 * urand() - 1);
+    a[0] = 0.05 * (2 * urand() - 1);
+}
+
+static void check_coef(const jf_fitter *f, const double *want, int deg)
+{
+    double big = 0;
+    for (size_t c = 0; c < jf_jet_size(deg); c++) big = fmax(big, fabs(want[c]));
+    ck_assert_int_eq(f->last_deg, deg);
+    for (size_t c = 0; c < jf_jet_size(deg); c++)
+        ck_assert_msg(fabs(f->coef[c] - want[c]) <= 1e-9 * big,
+                      "deg %d coef %zu: got %.17g want %.17g", deg, c, f->coef[c], want[c]);
+}
+
+/* Exact recovery, axis frame: z = P(x,y) of degree <= n over the world xy
+ * plane is fitted exactly by an n-jet (interpolation with N_n points,
+ * approximation with 3 N_n); the frame is the identity. */
+START_TEST(test_exact_axis)
+{
+    rng_state = 42;
+    for (int n = 1; n <= JF_MAX_DEGREE; n++)
+        for (int pd = (n > 1 ? n - 1 : n); pd <= n; pd++)
+            for (int fi = 0; fi < 2; fi++) {
+                double a[55] = {0}, xyz[3 * 165];
+                random_poly(pd, 0.1, a);
+                size_t nn = fi ? jf_jet_size(n) : 3 * jf_jet_size(n);
+                sample_poly(a, pd, nn, 1.0, xyz);
+                jf_fitter *f = make_fitter(n, n >= 4 ? 4 : (n < 2 ? 2 : n),
+                                           fi ? JF_FIT_INTERP : JF_FIT_APPROX, JF_FRAME_AXIS);
+                jf_result r;
+                ck_assert_int_eq(jf_fit_point(f, origin, xyz, nn, &r), JF_OK);
+                ck_assert_msg((r.status & ~(unsigned)JF_PT_UMBILIC) == 0, "n %d status %u cond %g", n, r.status, r.cond);
+                ck_assert_int_eq(r.n_used, (int)nn);
+                static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+                for (int k = 0; k < 9; k++) ck_assert(f->frame[k] == id[k]);
+                check_coef(f, a, n);
+                jf_fitter_free(f);
+            }
+}
+END_TEST
+
+/* Exact recovery, PCA frame: the samples of z = P(x,y) are made to have
+ * cov(x,z) = cov(y,z) = 0 (by choosing A10, A01), so the PCA normal is the
+ * local z axis; the cloud is then rotated by a known Q and translated.  The
+ * reported frame R must be Q up to a rotation S about z (and a pinned sign),
+ * and the coefficients those of S33 P(S2^T (x,y)). */
+START_TEST(test_exact_pca)
+{
+    rng_state = 7;
+    const double ang[3] = {0.7, -0.4, 1.1};
+    double q[9]; /* Q = Rz(ang2) Ry(ang1) Rx(ang0): rows = local axes */
+    {
+        double cx = cos(ang[0]), sx = sin(ang[0]), cy = cos(ang[1]), sy = sin(ang[1]);
+        double cz = cos(ang[2]), sz = sin(ang[2]);
+        double m[9] = {cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
+                       sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx,
+                       -sy,     cy * sx,                cy * cx};
+        memcpy(q, m, sizeof m);
+    }
+    const double off[3] = {0.3, -0.2, 0.1};
+    for (int n = 2; n <= 7; n++)
+        for (int fi = 0; fi < 2; fi++) {
+            double a[55] = {0}, loc[3 * 108], xyz[3 * 108];
+            random_poly(n, 0.05, a);
+            size_t nn = fi ? jf_jet_size(n) : 3 * jf_jet_size(n);
+            sample_poly(a, n, nn, 1.0, loc);
+            /* choose A10, A01 so that the sample covariances (x,z), (y,z)
+             * vanish: a 2x2 linear system in (A10, A01) */
+            double mx = 0, my = 0;
+            for (size_t i = 0; i < nn; i++) {
+                mx += loc[3 * i] / nn;
+                my += loc[3 * i + 1] / nn;
+            }
+            double sxx = 0, sxy = 0, syy = 0, rx = 0, ry = 0;
+            a[1] = a[2] = 0;
+            for (size_t i = 0; i < nn; i++) {
+                double dx = loc[3 * i] - mx, dy = loc[3 * i + 1] - my;
+                double z = poly_eval(a, n, loc[3 * i], loc[3 * i + 1]);
+                sxx += dx * dx;
+                sxy += dx * dy;
+                syy += dy * dy;
+                rx -= dx * z;
+                ry -= dy * z;
+            }
+            double det = sxx * syy - sxy * sxy;
+            a[1] = (rx * syy - ry * sxy) / det;
+            a[2] = (sxx * ry - sxy * rx) / det;
+            for (size_t i = 0; i < nn; i++) {
+                loc[3 * i + 2] = poly_eval(a, n, loc[3 * i], loc[3 * i + 1]);
+                for (int k = 0; k < 3; k++) /* world = Q^T local + off */
+                    xyz[3 * i + k] = off[k] + q[k] * loc[3 * i] + q[3 + k] * loc[3 * i + 1] +
+                                     q[6 + k] * loc[3 * i + 2];
+            }
+            jf_fitter *f = make_fitter(n, n >= 4 ? 4 : n, fi ? JF_FIT_INTERP : JF_FIT_APPROX,
+                                       JF_FRAME_PCA);
+            jf_result r;
+            ck_assert_int_eq(jf_fit_point(f, off, xyz, nn, &r), JF_OK);
+            ck_assert_uint_eq(r.status, 0);
+            double s[9]; /* S = R Q^T */
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    s[3 * i + j] = f->frame[3 * i] * q[3 * j] + f->frame[3 * i + 1] * q[3 * j + 1] +
+                                   f->frame[3 * i + 2] * q[3 * j + 2];
+            ck_assert_double_eq_tol(s[2], 0, 1e-12);
+            ck_assert_double_eq_tol(s[5], 0, 1e-12);
+            ck_assert_double_eq_tol(fabs(s[8]), 1, 1e-12);
+            /* (x, y) = S2^T (X, Y): x = s0 X + s3 Y, y = s1 X + s4 Y */
+            double want[55];
+            compose_linear(a, n, s[0], s[3], s[1], s[4], want);
+            for (size_t c = 0; c < jf_jet_size(n); c++) want[c] *= s[8];
+            check_coef(f, want, n);
+            jf_fitter_free(f);
+        }
+}
+END_TEST
+
+/* Residuals: z_i - J(x_i, y_i) in the fitting frame; least squares makes
+ * them orthogonal to every monomial column; the result's residual is their
+ * RMS.  An outlier of weight 0 does not disturb an exact fit. */
+START_TEST(test_residuals_weights)
+{
+    rng_state = 3;
+    double a[10] = {0.01, 0.02, -0.03, 0.4, 0.1, -0.2, 0.05, 0.02, -0.01, 0.03};
+    double xyz[3 * 30], w[30], res[30];
+    sample_poly(a, 3, 30, 0.5, xyz);
+    xyz[3 * 7 + 2] += 0.01; /* one perturbed sample */
+    jf_fitter *f = make_fitter(3, 3, JF_FIT_APPROX, JF_FRAME_AXIS);
+    jf_result r;
+    ck_assert_int_eq(jf_fit_point(f, origin, xyz, 30, &r), JF_OK);
+    ck_assert_int_eq(jf_fitter_residuals(f, res, 29), JF_ERR_INVALID);
+    ck_assert_int_eq(jf_fitter_residuals(f, res, 30), JF_OK);
+    double ss = 0;
+    for (int k = 0; k <= 3; k++)
+        for (int j = 0; j <= k; j++) {
+            double dot = 0;
+            for (int i = 0; i < 30; i++)
+                dot += res[i] * pow(xyz[3 * i], k - j) * pow(xyz[3 * i + 1], j);
+            ck_assert_double_eq_tol(dot, 0, 1e-15);
+        }
+    for (int i = 0; i < 30; i++) {
+        double z = poly_eval(f->coef, 3, xyz[3 * i], xyz[3 * i + 1]);
+        ck_assert_double_eq_tol(res[i], xyz[3 * i + 2] - z, 1e-15);
+        ss += res[i] * res[i];
+    }
+    ck_assert(res[7] > 1e-3);
+    ck_assert_double_eq_tol(r.residual, sqrt(ss / 30), 1e-15);
+    for (int i = 0; i < 30; i++) w[i] = i == 7 ? 0.0 : 1.0;
+    ck_assert_int_eq(jf_fit_point_weighted(f, origin, xyz, w, 30, &r), JF_OK);
+    ck_assert_int_eq(r.n_used, 29);
+    check_coef(f, a, 3);
+    ck_assert(r.residual < 1e-15);
+    ck_assert_int_eq(jf_fitter_residuals(f, res, 30), JF_OK);
+    ck_assert_double_eq_tol(res[7], 0.01, 1e-12);
+    w[3] = -1;
+    ck_assert_int_eq(jf_fit_point_weighted(f, origin, xyz, w, 30, &r), JF_ERR_INVALID);
+    w[3] = NAN;
+    ck_assert_int_eq(jf_fit_point_weighted(f, origin, xyz, w, 30, &r), JF_ERR_INVALID);
+    jf_fitter_free(f);
+}
+END_TEST
+
+/* No hidden state: a fitter reused on other (and failing) neighbourhoods
+ * gives bit-identical results to a fresh one. */
+START_TEST(test_no_hidden_state)
+{
+    static const jf_fit_mode fits[2] = {JF_FIT_APPROX, JF_FIT_INTERP};
+    rng_state = 11;
+    double a[15], xyz[3 * 60], other[3 * 60];
+    random_poly(4, 0.3, a);
+    sample_poly(a, 4, 60, 0.3, xyz);
+    for (int fi = 0; fi < 2; fi++)
+        for (int fr = 0; fr < 2; fr++) {
+            jf_fitter *fresh = make_fitter(4, 4, fits[fi], (jf_frame_mode)fr);
+            jf_fitter *used = make_fitter(4, 4, fits[fi], (jf_frame_mode)fr);
+            jf_result r0, r1, junk;
+            double res0[60], res1[60];
+            for (int t = 0; t < 20; t++) {
+                for (int i = 0; i < 3 * 60; i++) other[i] = 2 * urand() - 1;
+                if (t % 3 == 0) other[5] = NAN;
+                if (t % 4 == 0)
+                    for (int i = 1; i < 60; i++) /* collinear: fails */
+                        other[3 * i] = other[3 * i + 1] = other[3 * i + 2] = i * 0.1;
+                jf_fit_point(used, other, other, 10 + (size_t)t * 2, &junk);
+            }
+            ck_assert_int_eq(jf_fit_point(fresh, xyz, xyz, 60, &r0), JF_OK);
+            ck_assert_int_eq(jf_fit_point(used, xyz, xyz, 60, &r1), JF_OK);
+            ck_assert(memcmp(&r0, &r1, sizeof r0) == 0);
+            jf_fitter_residuals(fresh, res0, 60);
+            jf_fitter_residuals(used, res1, 60);
+            ck_assert(memcmp(res0, res1, sizeof res0) == 0);
+            jf_fitter_free(fresh);
+            jf_fitter_free(used);
+        }
+}
+END_TEST
+
+START_TEST(test_params)
+{
+    jf_params p;
+    const char *bad = "x";
+    jf_params_init(&p);
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_OK);
+    ck_assert_ptr_null(bad);
+    ck_assert_int_eq(jf_jet_size(2), 6);
+    ck_assert_int_eq(jf_jet_size(9), 55);
+    p.degree = 0;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    ck_assert_str_eq(bad, "degree");
+    p.degree = 10;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    jf_params_init(&p);
+    p.monge_degree = 3; /* > degree 2 */
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    ck_assert_str_eq(bad, "monge_degree");
+    jf_params_init(&p);
+    p.degree = 1; /* degree 1 with the default monge_degree is valid */
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_OK);
+    jf_params_init(&p);
+    p.max_cond = NAN;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    ck_assert_str_eq(bad, "max_cond");
+    p.max_cond = 0.5;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    jf_params_init(&p);
+    p.max_neighbors = 0;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    ck_assert_str_eq(bad, "max_neighbors");
+    jf_params_init(&p);
+    p.nscales = 2;
+    p.scales[0] = 32;
+    p.scales[1] = 16;
+    ck_assert_int_eq(jf_params_validate(&p, &bad), JF_ERR_INVALID);
+    ck_assert_str_eq(bad, "scales");
+    ck_assert_int_eq(jf_params_validate(NULL, &bad), JF_ERR_INVALID);
+
+    jf_fitter *f = (jf_fitter *)&p; /* must be reset to NULL on failure */
+    p.nscales = 0;
+    p.degree = 0;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_ERR_INVALID);
+    ck_assert_ptr_null(f);
+    jf_fitter_free(NULL);
+    jf_params_init(&p);
+    p.max_neighbors = 8;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    ck_assert_int_eq(jf_fitter_params(f)->max_neighbors, 8);
+    double pts[3 * 9] = {0};
+    jf_result r;
+    ck_assert_int_eq(jf_fit_point(f, pts, pts, 9, &r), JF_ERR_TOO_LARGE);
+    ck_assert_int_eq(jf_fit_point(f, pts, NULL, 3, &r), JF_ERR_INVALID);
+    ck_assert_int_eq(jf_fit_point(f, NULL, pts, 3, &r), JF_ERR_INVALID);
+    jf_fitter_free(f);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("jet");
     TCase *tc = tcase_create("core");
     tcase_add_test(tc, test_paraboloid);
+    tcase_add_test(tc, test_exact_axis);
+    tcase_add_test(tc, test_exact_pca);
+    tcase_add_test(tc, test_residuals_weights);
+    tcase_add_test(tc, test_no_hidden_state);
+    tcase_add_test(tc, test_params);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
