@@ -1,0 +1,369 @@
+/* kdtree.c -- jf_index: a static k-d tree with exact k-NN and radius queries.
+ *
+ * design:
+ *  - build: the finite points are copied, permuted, into one contiguous array
+ *    (24 bytes/point) beside their original indices (4 bytes/point).  Each
+ *    node splits its range at the median of the axis of largest extent
+ *    (quickselect, Hoare partition: O(n log n) total); ranges of at most
+ *    KD_LEAF points are leaves.  An inner node keeps the largest coordinate
+ *    of its left half and the smallest of its right half along its axis
+ *    (as nanoflann does), so the gap between the halves prunes too.
+ *  - query: depth first, nearer child first; a bounded max-heap of
+ *    (d2, index) pairs lives in the caller's buffers.  Order is the
+ *    lexicographic (d2, original index), so ties go to the smaller index and
+ *    results never depend on the tree's shape.
+ *  - exactness: the lower bound of a cell is g0*g0 + g1*g1 + g2*g2 with
+ *    g_i <= |q_i - p_i| computed by the same rounded operations as a point's
+ *    distance, so (rounding being monotonic) it never exceeds the distance of
+ *    any point inside; a cell is skipped only if its bound is strictly
+ *    larger than the current worst, so ties are never lost.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "jetfit.h"
+
+#define KD_LEAF 12          /* largest leaf: 6..12 points per leaf        */
+#define KD_STACK_KEYS 1024  /* d2 scratch on the stack when d2 == NULL    */
+#define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
+
+typedef struct {
+    double lo;        /* inner: max coordinate of the left child          */
+    double hi;        /* inner: min coordinate of the right child         */
+    uint32_t first;   /* inner: index of the left child (right = +1);
+                         leaf: first point of the leaf                    */
+    uint32_t dim;     /* inner: split axis 0..2; leaf: KD_IS_LEAF | count<<2 */
+} kd_node;
+
+struct jf_index {
+    size_t n;          /* points given                                    */
+    size_t m;          /* finite points indexed                           */
+    double *pts;       /* 3m coordinates, in tree order                   */
+    uint32_t *id;      /* m original indices, in tree order               */
+    kd_node *nodes;
+    size_t nnodes;
+    double bbox[6];    /* lo x,y,z then hi x,y,z of the finite points     */
+};
+
+/* ---------------------------------------------------------------- build */
+
+static size_t count_nodes(size_t cnt)
+{
+    if (cnt <= KD_LEAF) return 1;
+    return 1 + count_nodes(cnt / 2) + count_nodes(cnt - cnt / 2);
+}
+
+static void swap_pt(double *pts, uint32_t *id, size_t a, size_t b)
+{
+    double t0 = pts[3 * a], t1 = pts[3 * a + 1], t2 = pts[3 * a + 2];
+    uint32_t ti = id[a];
+    pts[3 * a] = pts[3 * b];
+    pts[3 * a + 1] = pts[3 * b + 1];
+    pts[3 * a + 2] = pts[3 * b + 2];
+    id[a] = id[b];
+    pts[3 * b] = t0;
+    pts[3 * b + 1] = t1;
+    pts[3 * b + 2] = t2;
+    id[b] = ti;
+}
+
+/* Quickselect (median of three, Hoare partition: equal keys split evenly,
+ * so grids with many equal coordinates stay O(n)): afterwards every point
+ * in [lo, nth) has coordinate d <= that of nth <= those in (nth, hi). */
+static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
+                       size_t nth, int d)
+{
+    while (hi - lo > 2) {
+        size_t mid = lo + (hi - lo) / 2, last = hi - 1;
+        if (pts[3 * mid + d] < pts[3 * lo + d]) swap_pt(pts, id, mid, lo);
+        if (pts[3 * last + d] < pts[3 * lo + d]) swap_pt(pts, id, last, lo);
+        if (pts[3 * last + d] < pts[3 * mid + d]) swap_pt(pts, id, last, mid);
+        double pivot = pts[3 * mid + d];
+        size_t i = lo, j = last;
+        for (;;) {
+            while (pts[3 * i + d] < pivot) i++;
+            while (pts[3 * j + d] > pivot) j--;
+            if (i >= j) break;
+            swap_pt(pts, id, i, j);
+            i++;
+            j--;
+        }
+        /* [lo, j] <= pivot <= [j+1, hi) */
+        if (nth <= j) hi = j + 1;
+        else lo = j + 1;
+    }
+    if (hi - lo == 2 && pts[3 * (lo + 1) + d] < pts[3 * lo + d])
+        swap_pt(pts, id, lo, lo + 1);
+}
+
+typedef struct {
+    double *pts;
+    uint32_t *id;
+    kd_node *nodes;
+    size_t used;
+} kd_builder;
+
+static void build_node(kd_builder *b, size_t ni, size_t begin, size_t end)
+{
+    kd_node *nd = &b->nodes[ni];
+    size_t cnt = end - begin;
+    if (cnt <= KD_LEAF) {
+        nd->lo = nd->hi = 0.0;
+        nd->first = (uint32_t)begin;
+        nd->dim = KD_IS_LEAF | (uint32_t)(cnt << 2);
+        return;
+    }
+    double lo[3], hi[3];
+    const double *p = b->pts;
+    for (int d = 0; d < 3; d++) lo[d] = hi[d] = p[3 * begin + d];
+    for (size_t i = begin + 1; i < end; i++)
+        for (int d = 0; d < 3; d++) {
+            double v = p[3 * i + d];
+            if (v < lo[d]) lo[d] = v;
+            if (v > hi[d]) hi[d] = v;
+        }
+    int dim = 0;
+    for (int d = 1; d < 3; d++)
+        if (hi[d] - lo[d] > hi[dim] - lo[dim]) dim = d;
+    size_t mid = begin + cnt / 2;
+    select_nth(b->pts, b->id, begin, end, mid, dim);
+    double lmax = p[3 * begin + dim];
+    for (size_t i = begin + 1; i < mid; i++)
+        if (p[3 * i + dim] > lmax) lmax = p[3 * i + dim];
+    size_t child = b->used;
+    b->used += 2;
+    nd = &b->nodes[ni];
+    nd->lo = lmax;
+    nd->hi = p[3 * mid + dim]; /* the selected element is the right minimum */
+    nd->first = (uint32_t)child;
+    nd->dim = (uint32_t)dim;
+    build_node(b, child, begin, mid);
+    build_node(b, child + 1, mid, end);
+}
+
+static int finite3(const double *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+jf_status jf_index_build(const double *xyz, size_t n, jf_index **out)
+{
+    if (!out) return JF_ERR_INVALID;
+    *out = NULL;
+    if (!xyz && n) return JF_ERR_INVALID;
+    /* UINT32_MAX itself is the heap's "no point" sentinel */
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    jf_index *ix = calloc(1, sizeof *ix);
+    if (!ix) return JF_ERR_NOMEM;
+    ix->n = n;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) m += finite3(xyz + 3 * i) ? 1 : 0;
+    ix->m = m;
+    ix->nnodes = m ? count_nodes(m) : 0;
+    ix->pts = malloc((m ? m : 1) * 3 * sizeof *ix->pts);
+    ix->id = malloc((m ? m : 1) * sizeof *ix->id);
+    ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);
+    if (!ix->pts || !ix->id || !ix->nodes) {
+        jf_index_free(ix);
+        return JF_ERR_NOMEM;
+    }
+    size_t j = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!finite3(xyz + 3 * i)) continue;
+        memcpy(ix->pts + 3 * j, xyz + 3 * i, 3 * sizeof(double));
+        ix->id[j++] = (uint32_t)i;
+    }
+    for (int d = 0; d < 3; d++) {
+        ix->bbox[d] = m ? ix->pts[d] : 0.0;
+        ix->bbox[3 + d] = m ? ix->pts[d] : 0.0;
+    }
+    for (size_t i = 1; i < m; i++)
+        for (int d = 0; d < 3; d++) {
+            double v = ix->pts[3 * i + d];
+            if (v < ix->bbox[d]) ix->bbox[d] = v;
+            if (v > ix->bbox[3 + d]) ix->bbox[3 + d] = v;
+        }
+    if (m) {
+        kd_builder b = {ix->pts, ix->id, ix->nodes, 1};
+        build_node(&b, 0, 0, m);
+        if (b.used != ix->nnodes) {
+            jf_index_free(ix);
+            return JF_ERR_INTERNAL;
+        }
+    }
+    *out = ix;
+    return JF_OK;
+}
+
+void jf_index_free(jf_index *ix)
+{
+    if (!ix) return;
+    free(ix->pts);
+    free(ix->id);
+    free(ix->nodes);
+    free(ix);
+}
+
+size_t jf_index_size(const jf_index *ix) { return ix ? ix->m : 0; }
+
+size_t jf_index_memory(const jf_index *ix)
+{
+    if (!ix) return 0;
+    return sizeof *ix + ix->m * (3 * sizeof(double) + sizeof(uint32_t)) +
+           ix->nnodes * sizeof(kd_node);
+}
+
+/* ---------------------------------------------------------------- query */
+
+typedef struct {
+    const jf_index *ix;
+    double q[3];
+    double *hd;       /* heap keys: squared distances                     */
+    uint32_t *hi;     /* heap values: original indices                    */
+    size_t cap, cnt;
+    double worst_d;   /* (worst_d, worst_i): the pair a candidate must beat */
+    uint32_t worst_i;
+} kd_query;
+
+/* (d, i) < (hd[a], hi[a]) in the (distance, index) order */
+#define KD_LESS(d, i, da, ia) ((d) < (da) || ((d) == (da) && (i) < (ia)))
+
+static void heap_sift_down(double *hd, uint32_t *hi, size_t cnt, size_t k)
+{
+    double d = hd[k];
+    uint32_t id = hi[k];
+    for (;;) {
+        size_t c = 2 * k + 1;
+        if (c >= cnt) break;
+        if (c + 1 < cnt && KD_LESS(hd[c], hi[c], hd[c + 1], hi[c + 1])) c++;
+        if (!KD_LESS(d, id, hd[c], hi[c])) break;
+        hd[k] = hd[c];
+        hi[k] = hi[c];
+        k = c;
+    }
+    hd[k] = d;
+    hi[k] = id;
+}
+
+static void heap_push(kd_query *s, double d, uint32_t id)
+{
+    if (s->cnt < s->cap) {
+        size_t k = s->cnt++;
+        while (k > 0) {
+            size_t p = (k - 1) / 2;
+            if (!KD_LESS(s->hd[p], s->hi[p], d, id)) break;
+            s->hd[k] = s->hd[p];
+            s->hi[k] = s->hi[p];
+            k = p;
+        }
+        s->hd[k] = d;
+        s->hi[k] = id;
+        if (s->cnt < s->cap) return; /* not full: the bound stays open */
+    } else {
+        s->hd[0] = d;
+        s->hi[0] = id;
+        heap_sift_down(s->hd, s->hi, s->cnt, 0);
+    }
+    s->worst_d = s->hd[0];
+    s->worst_i = s->hi[0];
+}
+
+static void search(kd_query *s, uint32_t ni, double g[3])
+{
+    const kd_node *nd = &s->ix->nodes[ni];
+    if ((nd->dim & 3u) == KD_IS_LEAF) {
+        const double *p = s->ix->pts + 3 * (size_t)nd->first;
+        const uint32_t *id = s->ix->id + nd->first;
+        uint32_t cnt = nd->dim >> 2;
+        for (uint32_t j = 0; j < cnt; j++, p += 3) {
+            double dx = s->q[0] - p[0], dy = s->q[1] - p[1],
+                   dz = s->q[2] - p[2];
+            double d = dx * dx + dy * dy + dz * dz;
+            if (KD_LESS(d, id[j], s->worst_d, s->worst_i))
+                heap_push(s, d, id[j]);
+        }
+        return;
+    }
+    int dim = (int)nd->dim;
+    double v = s->q[dim];
+    uint32_t near, far;
+    double gap;
+    if ((v - nd->lo) + (v - nd->hi) < 0) {
+        near = nd->first;
+        far = nd->first + 1;
+        gap = nd->hi - v;   /* far (right) points have coordinate >= hi */
+    } else {
+        near = nd->first + 1;
+        far = nd->first;
+        gap = v - nd->lo;   /* far (left) points have coordinate <= lo */
+    }
+    search(s, near, g);
+    if (gap < 0) gap = 0;
+    double old = g[dim];
+    if (gap > old) g[dim] = gap; /* both are lower bounds of |q - p| on dim */
+    double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (bound <= s->worst_d) search(s, far, g);
+    g[dim] = old;
+}
+
+/* Runs the search and sorts the heap nearest first. */
+static void run_query(kd_query *s)
+{
+    const jf_index *ix = s->ix;
+    if (!ix->m || !s->cap) return;
+    double g[3];
+    for (int d = 0; d < 3; d++) {
+        double a = ix->bbox[d] - s->q[d], b = s->q[d] - ix->bbox[3 + d];
+        g[d] = a > 0 ? a : (b > 0 ? b : 0);
+    }
+    double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (bound <= s->worst_d) search(s, 0, g);
+    /* heap sort: repeatedly move the worst to the end */
+    for (size_t end = s->cnt; end > 1; end--) {
+        double td = s->hd[0];
+        uint32_t ti = s->hi[0];
+        s->hd[0] = s->hd[end - 1];
+        s->hi[0] = s->hi[end - 1];
+        s->hd[end - 1] = td;
+        s->hi[end - 1] = ti;
+        heap_sift_down(s->hd, s->hi, end - 1, 0);
+    }
+}
+
+static jf_status query_common(const jf_index *ix, const double q[3],
+                              size_t k, double bound, uint32_t *idx,
+                              double *d2, size_t *found)
+{
+    if (found) *found = 0;
+    if (!ix || !q || !found || (k && !idx)) return JF_ERR_INVALID;
+    if (!finite3(q)) return JF_ERR_INVALID;
+    if (k > ix->m) k = ix->m;
+    double stack_keys[KD_STACK_KEYS];
+    double *keys = d2;
+    if (!keys) {
+        if (k <= KD_STACK_KEYS) keys = stack_keys;
+        else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
+    }
+    kd_query s = {ix, {q[0], q[1], q[2]}, keys, idx, k, 0, bound, UINT32_MAX};
+    run_query(&s);
+    if (keys != d2 && keys != stack_keys) free(keys);
+    *found = s.cnt;
+    return JF_OK;
+}
+
+jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,
+                       uint32_t *idx, double *d2, size_t *found)
+{
+    return query_common(ix, q, k, INFINITY, idx, d2, found);
+}
+
+jf_status jf_index_radius(const jf_index *ix, const double q[3], double r,
+                          size_t max, uint32_t *idx, double *d2,
+                          size_t *found)
+{
+    if (found) *found = 0;
+    if (!(r >= 0) || !isfinite(r)) return JF_ERR_INVALID;
+    /* inclusive: (r*r, UINT32_MAX) is beaten by every d2 <= r*r */
+    return query_common(ix, q, max, r * r, idx, d2, found);
+}

@@ -1,0 +1,412 @@
+/* test_kdtree.c -- jf_index (k-NN, radius) against brute force, and
+ * jf_spatial_order. */
+#include <check.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "jetfit.h"
+
+/* ---------------------------------------------------------------- helpers */
+
+static uint64_t rng_state = 88172645463325252ULL;
+static double urand(void) /* xorshift64*: reproducible, in [0, 1) */
+{
+    rng_state ^= rng_state >> 12;
+    rng_state ^= rng_state << 25;
+    rng_state ^= rng_state >> 27;
+    return (double)((rng_state * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
+}
+
+typedef struct {
+    double d;
+    uint32_t i;
+} pair;
+
+static int cmp_pair(const void *a, const void *b)
+{
+    const pair *x = a, *y = b;
+    if (x->d != y->d) return x->d < y->d ? -1 : 1;
+    return (x->i > y->i) - (x->i < y->i);
+}
+
+/* All finite points sorted by (d2, index); d2 computed the documented way.
+ * Returns their number. */
+static size_t brute(const double *xyz, size_t n, const double q[3], pair *out)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+        out[m].d = dx * dx + dy * dy + dz * dz;
+        out[m].i = (uint32_t)i;
+        m++;
+    }
+    qsort(out, m, sizeof *out, cmp_pair);
+    return m;
+}
+
+/* Checks knn for every k in ks and radius for a few r at query q. */
+static void check_query(const jf_index *ix, const double *xyz, size_t n,
+                        const double q[3])
+{
+    pair *ref = malloc((n + 1) * sizeof *ref);
+    uint32_t *idx = malloc((n + 8) * sizeof *idx);
+    double *d2 = malloc((n + 8) * sizeof *d2);
+    size_t m = brute(xyz, n, q, ref);
+    const size_t ks[] = {1, 2, 5, 16, 33, 100, n, n + 7};
+    for (size_t t = 0; t < sizeof ks / sizeof ks[0]; t++) {
+        size_t k = ks[t], found = 99;
+        ck_assert_int_eq(jf_index_knn(ix, q, k, idx, d2, &found), JF_OK);
+        size_t want = k < m ? k : m;
+        ck_assert_uint_eq(found, want);
+        for (size_t j = 0; j < found; j++) {
+            ck_assert_uint_eq(idx[j], ref[j].i);
+            ck_assert(d2[j] == ref[j].d);
+        }
+    }
+    /* radius: inclusive, capped to the nearest `max` */
+    if (m) {
+        double rs[] = {0.0, sqrt(ref[m / 3].d), sqrt(ref[m - 1].d) * 2,
+                       sqrt(ref[m > 10 ? 10 : m - 1].d)};
+        for (size_t t = 0; t < 4; t++) {
+            double r = rs[t], r2 = r * r;
+            size_t within = 0;
+            while (within < m && ref[within].d <= r2) within++;
+            size_t maxes[] = {n + 1, within / 2 + 1, 3};
+            for (size_t u = 0; u < 3; u++) {
+                size_t found = 99;
+                ck_assert_int_eq(jf_index_radius(ix, q, r, maxes[u], idx, d2,
+                                                 &found), JF_OK);
+                size_t want = within < maxes[u] ? within : maxes[u];
+                ck_assert_uint_eq(found, want);
+                for (size_t j = 0; j < found; j++) {
+                    ck_assert_uint_eq(idx[j], ref[j].i);
+                    ck_assert(d2[j] <= r2);
+                }
+            }
+        }
+    }
+    free(ref);
+    free(idx);
+    free(d2);
+}
+
+static void check_cloud(const double *xyz, size_t n, size_t nq_random)
+{
+    jf_index *ix = NULL;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    size_t finite = 0;
+    for (size_t i = 0; i < n; i++)
+        finite += isfinite(xyz[3 * i]) && isfinite(xyz[3 * i + 1]) &&
+                  isfinite(xyz[3 * i + 2]);
+    ck_assert_uint_eq(jf_index_size(ix), finite);
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++)
+            if (isfinite(xyz[3 * i + d])) {
+                if (xyz[3 * i + d] < lo[d]) lo[d] = xyz[3 * i + d];
+                if (xyz[3 * i + d] > hi[d]) hi[d] = xyz[3 * i + d];
+            }
+    for (size_t t = 0; t < nq_random; t++) {
+        double q[3];
+        for (int d = 0; d < 3; d++) /* inside and a little outside */
+            q[d] = lo[d] + (hi[d] - lo[d]) * (1.4 * urand() - 0.2);
+        check_query(ix, xyz, n, q);
+    }
+    /* queries at data points: the point (or its smallest duplicate) first */
+    for (size_t i = 0; i < n; i += n / 13 + 1) {
+        const double *p = xyz + 3 * i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        check_query(ix, xyz, n, p);
+        uint32_t idx[1];
+        double d2[1];
+        size_t found;
+        ck_assert_int_eq(jf_index_knn(ix, p, 1, idx, d2, &found), JF_OK);
+        ck_assert_uint_eq(found, 1);
+        ck_assert(d2[0] == 0.0);
+        ck_assert_uint_le(idx[0], i);
+        ck_assert(memcmp(xyz + 3 * (size_t)idx[0], p, 3 * sizeof *p) == 0);
+    }
+    jf_index_free(ix);
+}
+
+/* ---------------------------------------------------------------- tests */
+
+START_TEST(knn_uniform)
+{
+    size_t n = 1500;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    check_cloud(xyz, n, 40);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(knn_clustered_offset)
+{
+    /* tight clusters far apart, the whole cloud offset by 1e6 */
+    size_t n = 1200;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < n; i++) {
+        size_t c = i % 5;
+        for (int d = 0; d < 3; d++)
+            xyz[3 * i + d] = 1e6 + 10.0 * (double)(c * (size_t)(d + 1) % 7) +
+                             1e-3 * urand();
+    }
+    check_cloud(xyz, n, 30);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(knn_duplicates_grid)
+{
+    /* a 7x6x5 integer grid, every point written 3 times, shuffled: many
+     * exact duplicates and equidistant ties */
+    size_t g = 7 * 6 * 5, n = 3 * g;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < n; i++) {
+        size_t c = (i * 37) % g;
+        xyz[3 * i] = (double)(c % 7);
+        xyz[3 * i + 1] = (double)(c / 7 % 6);
+        xyz[3 * i + 2] = (double)(c / 42);
+    }
+    check_cloud(xyz, n, 40);
+    /* half-integer queries: up to 8 grid points at one distance */
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    for (int t = 0; t < 20; t++) {
+        double q[3] = {0.5 + (t % 6), 0.5 + (t % 5), 0.5 + (t % 4)};
+        check_query(ix, xyz, n, q);
+    }
+    jf_index_free(ix);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(knn_all_equal_and_planar)
+{
+    size_t n = 200;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = 2.5;
+    check_cloud(xyz, n, 5);
+    for (size_t i = 0; i < n; i++) { /* a flat grid: z constant */
+        xyz[3 * i] = (double)(i % 20);
+        xyz[3 * i + 1] = (double)(i / 20);
+        xyz[3 * i + 2] = -1.0;
+    }
+    check_cloud(xyz, n, 20);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(knn_nonfinite_points)
+{
+    size_t n = 600;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    for (size_t i = 0; i < n; i += 7) xyz[3 * i + i % 3] = NAN;
+    for (size_t i = 3; i < n; i += 11) xyz[3 * i + 1] = (i % 2) ? INFINITY
+                                                                  : -INFINITY;
+    check_cloud(xyz, n, 30);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(knn_edge_cases)
+{
+    jf_index *ix = (jf_index *)1;
+    uint32_t idx[4];
+    double d2[4];
+    size_t found = 7;
+    double q[3] = {0, 0, 0};
+    /* empty and all-NaN clouds: valid, find nothing */
+    ck_assert_int_eq(jf_index_build(NULL, 0, &ix), JF_OK);
+    ck_assert_int_eq(jf_index_knn(ix, q, 4, idx, d2, &found), JF_OK);
+    ck_assert_uint_eq(found, 0);
+    jf_index_free(ix);
+    double bad[6] = {NAN, 0, 0, 1, INFINITY, 1};
+    ck_assert_int_eq(jf_index_build(bad, 2, &ix), JF_OK);
+    ck_assert_uint_eq(jf_index_size(ix), 0);
+    ck_assert_int_eq(jf_index_radius(ix, q, 10.0, 4, idx, d2, &found), JF_OK);
+    ck_assert_uint_eq(found, 0);
+    jf_index_free(ix);
+    /* bad arguments */
+    double one[3] = {1, 2, 3};
+    ck_assert_int_eq(jf_index_build(one, 1, NULL), JF_ERR_INVALID);
+    ck_assert_int_eq(jf_index_build(NULL, 3, &ix), JF_ERR_INVALID);
+    ck_assert_ptr_null(ix);
+    ck_assert_int_eq(jf_index_build(one, 1, &ix), JF_OK);
+    double qn[3] = {0, NAN, 0};
+    ck_assert_int_eq(jf_index_knn(ix, qn, 1, idx, d2, &found), JF_ERR_INVALID);
+    ck_assert_int_eq(jf_index_radius(ix, q, -1.0, 4, idx, d2, &found),
+                     JF_ERR_INVALID);
+    ck_assert_int_eq(jf_index_radius(ix, q, NAN, 4, idx, d2, &found),
+                     JF_ERR_INVALID);
+    ck_assert_int_eq(jf_index_knn(ix, q, 0, idx, d2, &found), JF_OK);
+    ck_assert_uint_eq(found, 0);
+    ck_assert_int_eq(jf_index_knn(ix, q, 3, idx, NULL, &found), JF_OK);
+    ck_assert_uint_eq(found, 1);
+    ck_assert_uint_eq(idx[0], 0);
+    /* radius is inclusive: |one| = sqrt(14) */
+    ck_assert_int_eq(jf_index_radius(ix, q, sqrt(14.0), 4, idx, d2, &found),
+                     JF_OK);
+    ck_assert_uint_eq(found, (sqrt(14.0) * sqrt(14.0) >= 14.0) ? 1 : 0);
+    ck_assert_int_eq(jf_index_radius(ix, one, 0.0, 4, idx, d2, &found), JF_OK);
+    ck_assert_uint_eq(found, 1);
+    ck_assert_uint_gt(jf_index_memory(ix), 0);
+    jf_index_free(ix);
+    jf_index_free(NULL);
+}
+END_TEST
+
+START_TEST(knn_large_k_without_d2)
+{
+    /* k > 1024 with d2 == NULL takes the allocating path */
+    size_t n = 3000, k = 2500;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    pair *ref = malloc(n * sizeof *ref);
+    uint32_t *idx = malloc(k * sizeof *idx);
+    double q[3] = {0.3, 0.6, 0.1};
+    brute(xyz, n, q, ref);
+    size_t found;
+    ck_assert_int_eq(jf_index_knn(ix, q, k, idx, NULL, &found), JF_OK);
+    ck_assert_uint_eq(found, k);
+    for (size_t j = 0; j < k; j++) ck_assert_uint_eq(idx[j], ref[j].i);
+    free(idx);
+    free(ref);
+    free(xyz);
+    jf_index_free(ix);
+}
+END_TEST
+
+START_TEST(knn_threads_agree)
+{
+    /* the same queries from several OpenMP threads give identical results */
+    size_t n = 2000, k = 8;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    uint32_t *a = malloc(n * k * sizeof *a), *b = malloc(n * k * sizeof *b);
+    for (size_t i = 0; i < n; i++) {
+        size_t f;
+        jf_index_knn(ix, xyz + 3 * i, k, a + i * k, NULL, &f);
+    }
+    int bad = 0;
+#pragma omp parallel for num_threads(2) reduction(+ : bad)
+    for (long i = 0; i < (long)n; i++) {
+        size_t f;
+        if (jf_index_knn(ix, xyz + 3 * i, k, b + (size_t)i * k, NULL, &f) ||
+            f != k)
+            bad++;
+    }
+    ck_assert_int_eq(bad, 0);
+    ck_assert(memcmp(a, b, n * k * sizeof *a) == 0);
+    free(a);
+    free(b);
+    free(xyz);
+    jf_index_free(ix);
+}
+END_TEST
+
+/* ---------------------------------------------------------------- order */
+
+START_TEST(order_is_permutation)
+{
+    size_t n = 5000;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand() * 100 - 50;
+    for (size_t i = 5; i < n; i += 97) xyz[3 * i + 2] = NAN;
+    size_t nbad = 0;
+    for (size_t i = 5; i < n; i += 97) nbad++;
+    uint32_t *ord = malloc(n * sizeof *ord);
+    char *hit = calloc(n, 1);
+    ck_assert_int_eq(jf_spatial_order(xyz, n, ord), JF_OK);
+    for (size_t i = 0; i < n; i++) {
+        ck_assert_uint_lt(ord[i], n);
+        ck_assert(!hit[ord[i]]);
+        hit[ord[i]] = 1;
+    }
+    /* non-finite points last, in index order */
+    for (size_t j = 0; j < nbad; j++)
+        ck_assert_uint_eq(ord[n - nbad + j], 5 + 97 * j);
+    /* deterministic */
+    uint32_t *ord2 = malloc(n * sizeof *ord2);
+    ck_assert_int_eq(jf_spatial_order(xyz, n, ord2), JF_OK);
+    ck_assert(memcmp(ord, ord2, n * sizeof *ord) == 0);
+    /* locality: consecutive points are close on average (uniform random
+     * order would give a mean step of about 66; a Z-curve through 5000
+     * points in a 100-cube steps about 100/5000^(1/3) ~ 6 on average) */
+    double sum = 0;
+    for (size_t i = 1; i < n - nbad; i++) {
+        const double *a = xyz + 3 * (size_t)ord[i - 1],
+                     *b = xyz + 3 * (size_t)ord[i];
+        sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) +
+                    (a[1] - b[1]) * (a[1] - b[1]) +
+                    (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    ck_assert_double_lt(sum / (double)(n - nbad - 1), 15.0);
+    free(ord);
+    free(ord2);
+    free(hit);
+    free(xyz);
+}
+END_TEST
+
+START_TEST(order_morton_cube)
+{
+    /* the 8 corners of a cube, given in reverse Morton order, plus a
+     * duplicate of the first corner: Z-order is x fastest, then y, then z
+     * (x in the lowest key bit), duplicates in index order */
+    double xyz[9 * 3];
+    for (int c = 0; c < 8; c++) {
+        int m = 7 - c;
+        xyz[3 * c] = m & 1;
+        xyz[3 * c + 1] = (m >> 1) & 1;
+        xyz[3 * c + 2] = (m >> 2) & 1;
+    }
+    xyz[24] = 1, xyz[25] = 1, xyz[26] = 1; /* duplicate of corner 7 (c=0) */
+    uint32_t ord[9];
+    ck_assert_int_eq(jf_spatial_order(xyz, 9, ord), JF_OK);
+    const uint32_t want[9] = {7, 6, 5, 4, 3, 2, 1, 0, 8};
+    for (int i = 0; i < 9; i++) ck_assert_uint_eq(ord[i], want[i]);
+    ck_assert_int_eq(jf_spatial_order(xyz, 0, NULL), JF_OK);
+    ck_assert_int_eq(jf_spatial_order(NULL, 3, ord), JF_ERR_INVALID);
+}
+END_TEST
+
+static Suite *kdtree_suite(void)
+{
+    Suite *s = suite_create("kdtree");
+    TCase *tc = tcase_create("knn");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, knn_uniform);
+    tcase_add_test(tc, knn_clustered_offset);
+    tcase_add_test(tc, knn_duplicates_grid);
+    tcase_add_test(tc, knn_all_equal_and_planar);
+    tcase_add_test(tc, knn_nonfinite_points);
+    tcase_add_test(tc, knn_edge_cases);
+    tcase_add_test(tc, knn_large_k_without_d2);
+    tcase_add_test(tc, knn_threads_agree);
+    suite_add_tcase(s, tc);
+    TCase *to = tcase_create("order");
+    tcase_add_test(to, order_is_permutation);
+    tcase_add_test(to, order_morton_cube);
+    suite_add_tcase(s, to);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(kdtree_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}
