@@ -1,12 +1,430 @@
-/* cmd_estimate.c -- `jetfit estimate` (placeholder until its issue lands). */
+/* cmd_estimate.c -- `jetfit estimate INPUT -o OUTPUT [options]`: read,
+ * estimate (jf_estimate), write one row per input point, summarise.
+ * Uses only the public header. */
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <omp.h>
 
 #include "cmd.h"
+#include "jetfit.h"
+
+#define DEFAULT_NEIGHBORS "knn:32"
+
+static void usage(FILE *f)
+{
+    jf_params p;
+    jf_params_init(&p);
+    fprintf(f,
+        "usage: jetfit estimate INPUT -o OUTPUT [options]\n"
+        "\n"
+        "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
+        "and writes one row per input point, in input order.\n"
+        "INPUT: .ply .xyz .pts .txt .csv .off    OUTPUT: .ply .csv .xyz .txt\n"
+        "\n"
+        "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
+        "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings:N (mesh input)\n"
+        "                        | natural[:N]     (default " DEFAULT_NEIGHBORS "; K counts the point)\n"
+        "  --degree N            jet degree 1..%d (default %d)\n"
+        "  --monge-degree N      2..4, <= degree: 3 adds b0..b3, 4 adds c0..c4\n"
+        "                        (default min(degree, 4))\n"
+        "  --fit MODE            approx | interp (default approx)\n"
+        "  --frame MODE          pca | axis (default pca)\n"
+        "  --max-cond X          lower the degree while cond > X (default %g)\n"
+        "  --orient MODE         none | input | viewpoint:X,Y,Z | mst[:K]\n"
+        "                        (default: input if INPUT has normals, else none;\n"
+        "                        mst uses K nearest neighbours, default 8)\n"
+        "  --normal MODE         natural only: tangent plane from poles | mincirc |\n"
+        "                        pca (PCA of knn:16) | input (default poles)\n"
+        "  --robust MODE         none | huber | tukey (default none)\n"
+        "  --scales K1,K2,...    per-point scale selection among these K (default off)\n"
+        "  --columns X,Y,Z[,NX,NY,NZ]\n"
+        "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
+        "                        (default: x y z first, normals in 3..5 if 6 columns)\n"
+        "  --threads N           OpenMP threads (default: all cores, here %d)\n"
+        "  --ascii               ascii PLY output (default binary little endian)\n"
+        "  --quiet               no progress line, no summary\n"
+        "  -h, --help            this text\n"
+        "\n"
+        "Columns: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z [b0..b3] [c0..c4]\n"
+        "         degree neighbors cond residual status\n"
+        "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
+        JF_MAX_DEGREE, p.degree, p.max_cond, omp_get_max_threads());
+}
+
+static int bad_option(const char *opt, const char *val, const char *why)
+{
+    fprintf(stderr, "jetfit estimate: %s '%s': %s (jetfit estimate --help)\n", opt,
+            val ? val : "", why);
+    return 2;
+}
+
+/* Strict number parsing: the whole string must be consumed. */
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi) return -1;
+    *out = (int)v;
+    return 0;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+/* "a,b,c" -> up to max doubles; returns the count or -1. */
+static int parse_list(const char *s, double *v, int max)
+{
+    int n = 0;
+    const char *p = s;
+    while (*p) {
+        char buf[64];
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        if (len == 0 || len >= sizeof buf || n == max) return -1;
+        memcpy(buf, p, len);
+        buf[len] = '\0';
+        if (parse_double(buf, &v[n++])) return -1;
+        p += len;
+        if (*p == ',') {
+            p++;
+            if (!*p) return -1;
+        }
+    }
+    return n;
+}
+
+/* ---- progress line and summary ---------------------------------------- */
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+typedef struct {
+    double t0, last;
+    int shown;
+} progress_state;
+
+/* Called by the library on the calling thread: redraw at most 4x/s. */
+static void progress(void *user, size_t done, size_t total)
+{
+    progress_state *ps = user;
+    double t = now_s();
+    if (done < total && t - ps->last < 0.25) return;
+    ps->last = t;
+    double el = t - ps->t0, rate = el > 0 ? (double)done / el : 0;
+    double eta = rate > 0 ? (double)(total - done) / rate : 0;
+    fprintf(stderr, "\rjetfit: %5.1f%%  %zu/%zu points  %.0f points/s  ETA %.0f s   ",
+            total ? 100.0 * (double)done / (double)total : 100.0, done, total, rate, eta);
+    if (done == total) fputc('\n', stderr);
+    fflush(stderr);
+    ps->shown = 1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void summary(const jf_result *r, size_t n, double secs, const char *out)
+{
+    size_t flags[32] = {0}, ok = 0, deg[JF_MAX_DEGREE + 1] = {0};
+    for (size_t i = 0; i < n; i++) {
+        if (!r[i].status) ok++;
+        for (int b = 0; b < 32; b++)
+            if (r[i].status & (1u << b)) flags[b]++;
+        if (r[i].degree >= 0 && r[i].degree <= JF_MAX_DEGREE) deg[r[i].degree]++;
+    }
+    fprintf(stderr, "jetfit: %zu points in %.2f s (%.0f points/s)\n", n, secs,
+            secs > 0 ? (double)n / secs : 0.0);
+    fprintf(stderr, "  status: ok %zu", ok);
+    for (int b = 0; b < 32; b++) {
+        char name[64];
+        if (flags[b])
+            fprintf(stderr, ", %s %zu", jf_point_status_str(1u << b, name, sizeof name),
+                    flags[b]);
+    }
+    fprintf(stderr, "\n  degree:");
+    for (int d = 0; d <= JF_MAX_DEGREE; d++)
+        if (deg[d]) fprintf(stderr, " %d: %zu", d, deg[d]);
+    fputc('\n', stderr);
+    double *c = malloc((n ? n : 1) * sizeof *c);
+    size_t m = 0;
+    if (c) {
+        for (size_t i = 0; i < n; i++)
+            if (isfinite(r[i].cond)) c[m++] = r[i].cond;
+        qsort(c, m, sizeof *c, cmp_double);
+    }
+    if (m)
+        fprintf(stderr, "  cond: p50 %.3g, p90 %.3g, p99 %.3g, max %.3g\n",
+                c[(m - 1) / 2], c[(size_t)(0.9 * (double)(m - 1))],
+                c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
+    free(c);
+    fprintf(stderr, "  output: %s\n", out);
+}
+
+/* ---- output ------------------------------------------------------------ */
+
+static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",  "k1",
+                                        "k2",  "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
+static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
+static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
+
+static size_t make_columns(int monge, jf_column *cols)
+{
+    size_t n = 0;
+    for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
+    if (monge >= 3)
+        for (size_t j = 0; j < 4; j++) cols[n++] = (jf_column){b_cols[j], JF_COL_F64};
+    if (monge >= 4)
+        for (size_t j = 0; j < 5; j++) cols[n++] = (jf_column){c_cols[j], JF_COL_F64};
+    cols[n++] = (jf_column){"degree", JF_COL_I32};
+    cols[n++] = (jf_column){"neighbors", JF_COL_I32};
+    cols[n++] = (jf_column){"cond", JF_COL_F64};
+    cols[n++] = (jf_column){"residual", JF_COL_F64};
+    cols[n++] = (jf_column){"status", JF_COL_I32};
+    return n;
+}
+
+static size_t make_row(const double *p, const jf_result *r, int monge, double *v)
+{
+    size_t n = 0;
+    for (int j = 0; j < 3; j++) v[n++] = p[j];
+    for (int j = 0; j < 3; j++) v[n++] = r->normal[j];
+    v[n++] = r->k1;
+    v[n++] = r->k2;
+    for (int j = 0; j < 3; j++) v[n++] = r->d1[j];
+    for (int j = 0; j < 3; j++) v[n++] = r->d2[j];
+    if (monge >= 3)
+        for (int j = 0; j < 4; j++) v[n++] = r->b[j];
+    if (monge >= 4)
+        for (int j = 0; j < 5; j++) v[n++] = r->c[j];
+    v[n++] = r->degree;
+    v[n++] = r->n_used;
+    v[n++] = r->cond;
+    v[n++] = r->residual;
+    v[n++] = (double)r->status;
+    return n;
+}
+
+/* ---- the command ---------------------------------------------------------- */
 
 int jf_cmd_estimate(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    fprintf(stderr, "jetfit estimate: not implemented yet\n");
-    return 2;
+    const char *in = NULL, *out = NULL, *nbspec = DEFAULT_NEIGHBORS;
+    int quiet = 0, ascii = 0, monge = -1, orient_set = 0;
+    jf_estimate_opts o;
+    jf_read_opts ro;
+    jf_estimate_opts_init(&o);
+    jf_read_opts_init(&ro);
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        }
+        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = 1;
+            continue;
+        }
+        if (!strcmp(a, "--ascii")) {
+            ascii = 1;
+            continue;
+        }
+        if (a[0] != '-' || !a[1]) {
+            if (in) return bad_option("argument", a, "only one INPUT file is accepted");
+            in = a;
+            continue;
+        }
+        /* every other option takes a value: "--opt VALUE" or "--opt=VALUE" */
+        char name[32];
+        const char *val = NULL, *eq = strchr(a, '=');
+        if (eq && (size_t)(eq - a) < sizeof name) {
+            memcpy(name, a, (size_t)(eq - a));
+            name[eq - a] = '\0';
+            val = eq + 1;
+        } else {
+            snprintf(name, sizeof name, "%s", a);
+            if (i + 1 >= argc) return bad_option(a, "", "needs a value");
+            val = argv[++i];
+        }
+        int iv;
+        double dv, list[8];
+        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
+            out = val;
+        } else if (!strcmp(name, "--neighbors") || !strcmp(name, "--neighbours")) {
+            nbspec = val;
+        } else if (!strcmp(name, "--degree")) {
+            if (parse_int(val, 1, JF_MAX_DEGREE, &iv))
+                return bad_option(name, val, "expected an integer 1..9");
+            o.params.degree = iv;
+        } else if (!strcmp(name, "--monge-degree")) {
+            if (parse_int(val, 2, JF_MAX_MONGE_DEGREE, &iv))
+                return bad_option(name, val, "expected 2, 3 or 4");
+            monge = iv;
+        } else if (!strcmp(name, "--fit")) {
+            if (!strcmp(val, "approx")) o.params.fit = JF_FIT_APPROX;
+            else if (!strcmp(val, "interp")) o.params.fit = JF_FIT_INTERP;
+            else return bad_option(name, val, "expected approx or interp");
+        } else if (!strcmp(name, "--frame")) {
+            if (!strcmp(val, "pca")) o.params.frame = JF_FRAME_PCA;
+            else if (!strcmp(val, "axis")) o.params.frame = JF_FRAME_AXIS;
+            else return bad_option(name, val, "expected pca or axis");
+        } else if (!strcmp(name, "--max-cond")) {
+            if (parse_double(val, &dv) || !(dv >= 1))
+                return bad_option(name, val, "expected a number >= 1");
+            o.params.max_cond = dv;
+        } else if (!strcmp(name, "--orient")) {
+            orient_set = 1;
+            if (!strcmp(val, "none")) o.orient = JF_ORIENT_NONE;
+            else if (!strcmp(val, "input")) o.orient = JF_ORIENT_INPUT;
+            else if (!strncmp(val, "viewpoint:", 10)) {
+                if (parse_list(val + 10, o.viewpoint, 3) != 3)
+                    return bad_option(name, val, "expected viewpoint:X,Y,Z");
+                o.orient = JF_ORIENT_VIEWPOINT;
+            } else if (!strcmp(val, "mst")) o.orient = JF_ORIENT_MST;
+            else if (!strncmp(val, "mst:", 4)) {
+                if (parse_int(val + 4, 1, 256, &iv))
+                    return bad_option(name, val, "expected mst:K with K in 1..256");
+                o.orient = JF_ORIENT_MST;
+                o.orient_k = (size_t)iv;
+            } else
+                return bad_option(name, val, "expected none, input, viewpoint:X,Y,Z or mst[:K]");
+        } else if (!strcmp(name, "--normal")) {
+            if (!strcmp(val, "poles")) o.normal = JF_NORMAL_POLES;
+            else if (!strcmp(val, "mincirc")) o.normal = JF_NORMAL_MINCIRC;
+            else if (!strcmp(val, "pca")) o.normal = JF_NORMAL_PCA;
+            else if (!strcmp(val, "input")) o.normal = JF_NORMAL_INPUT;
+            else return bad_option(name, val, "expected poles, mincirc, pca or input");
+        } else if (!strcmp(name, "--robust")) {
+            if (!strcmp(val, "none")) o.params.robust = JF_ROBUST_NONE;
+            else if (!strcmp(val, "huber")) o.params.robust = JF_ROBUST_HUBER;
+            else if (!strcmp(val, "tukey")) o.params.robust = JF_ROBUST_TUKEY;
+            else return bad_option(name, val, "expected none, huber or tukey");
+        } else if (!strcmp(name, "--scales")) {
+            int m = parse_list(val, list, 8);
+            if (m < 1) return bad_option(name, val, "expected 1 to 8 sizes K1,K2,...");
+            for (int j = 0; j < m; j++) {
+                if (list[j] < 3 || list[j] > 100000 || list[j] != floor(list[j]) ||
+                    (j && list[j] <= list[j - 1]))
+                    return bad_option(name, val, "expected ascending integers >= 3");
+                o.params.scales[j] = (size_t)list[j];
+            }
+            o.params.nscales = m;
+        } else if (!strcmp(name, "--columns")) {
+            int m = parse_list(val, list, 6);
+            if (m != 3 && m != 6) return bad_option(name, val, "expected 3 or 6 column numbers");
+            for (int j = 0; j < m; j++) {
+                if (list[j] < 0 || list[j] > 1000 || list[j] != floor(list[j]))
+                    return bad_option(name, val, "expected 0-based column numbers");
+                ro.columns[j] = (int)list[j];
+            }
+        } else if (!strcmp(name, "--threads")) {
+            if (parse_int(val, 1, 4096, &iv))
+                return bad_option(name, val, "expected a positive integer");
+            o.threads = iv;
+        } else {
+            return bad_option("unknown option", a, "not an option of estimate");
+        }
+    }
+    if (!in) return bad_option("INPUT", "", "missing input file");
+    if (!out) return bad_option("-o", "", "missing output file");
+    jf_error err = {{0}};
+    const char *why = NULL;
+    if (jf_nb_parse(nbspec, &o.nb, &why) != JF_OK)
+        return bad_option("--neighbors", nbspec, why ? why : "bad neighbourhood");
+    if (monge < 0) monge = o.params.degree < JF_MAX_MONGE_DEGREE ? o.params.degree
+                                                                 : JF_MAX_MONGE_DEGREE;
+    if (monge < 2) monge = 2; /* degree 1: no curvature; columns stay (NaN) */
+    else if (monge > o.params.degree)
+        return bad_option("--monge-degree", "", "must not exceed --degree");
+    o.params.monge_degree = monge < o.params.degree ? monge : o.params.degree;
+    /* the fitter must accept the largest neighbourhood we may hand it */
+    size_t need = o.nb.kind == JF_NB_KNN || o.nb.kind == JF_NB_KNN_RADIUS ? o.nb.k : o.nb.n;
+    for (int j = 0; j < o.params.nscales; j++)
+        if (o.params.scales[j] > need) need = o.params.scales[j];
+    if (need > o.params.max_neighbors) o.params.max_neighbors = need;
+    const char *bad = NULL;
+    if (jf_params_validate(&o.params, &bad) != JF_OK)
+        return bad_option("parameters", bad ? bad : "?", "invalid combination");
+
+    double t0 = now_s();
+    jf_cloud c = {0};
+    jf_status st = jf_cloud_read(in, &ro, &c, &err);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        return 1;
+    }
+    if (!orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
+    if (c.n == 0) {
+        fprintf(stderr, "jetfit: %s: no points\n", in);
+        jf_cloud_free(&c);
+        return 1;
+    }
+
+    /* open the output first: a missing folder fails before the work */
+    jf_column cols[32];
+    size_t ncols = make_columns(monge, cols);
+    jf_writer *w = NULL;
+    st = jf_writer_open(out, cols, ncols, c.n, ascii, &w, &err);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        jf_cloud_free(&c);
+        return 1;
+    }
+    jf_result *r = malloc(c.n * sizeof *r);
+    if (!r) {
+        fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);
+        jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    progress_state ps = {t0, 0, 0};
+    if (!quiet && isatty(2)) {
+        o.progress = progress;
+        o.progress_user = &ps;
+    }
+    st = jf_estimate(&c, &o, r, &err);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s: %s\n", in, err.msg[0] ? err.msg : jf_strerror(st));
+        jf_writer_abort(w);
+        free(r);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    double row[32];
+    for (size_t i = 0; i < c.n; i++) {
+        make_row(c.xyz + 3 * i, &r[i], monge, row);
+        if (jf_writer_row(w, row) != JF_OK) break;
+    }
+    /* commit reports a failed row too, and removes the temporary */
+    st = jf_writer_commit(w, &err);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        free(r);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    if (!quiet) summary(r, c.n, now_s() - t0, out);
+    free(r);
+    jf_cloud_free(&c);
+    return 0;
 }

@@ -709,6 +709,53 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
                            uint32_t *idx, size_t cap, size_t *found,
                            size_t *ring_end);
 
+/* ------------------------------------------------------------------ */
+/* Estimation pipeline (src/pipeline.c): a whole cloud, with OpenMP    */
+/* ------------------------------------------------------------------ */
+#define JF_ESTIMATE_DEFAULT_K 32   /* knn:32, the command's default    */
+
+/* Progress report: `done` of `total` points fitted.  Called on the
+ * thread that called jf_estimate only (never concurrently), a few
+ * hundred points apart, and once with done == total. */
+typedef void (*jf_progress_fn)(void *user, size_t done, size_t total);
+
+typedef struct {
+    jf_params params;        /* the fit (params.max_neighbors must hold
+                                the neighbourhood: knn K, rings N, ...)  */
+    jf_nb_spec nb;           /* neighbourhood (default knn:32; K and N
+                                count the point itself).  natural with
+                                n = 0: max(2 N_n, 12) points            */
+    jf_normal_source normal; /* natural only: tangent planes from poles
+                                (default), mincirc, pca (PCA of the 16
+                                nearest points) or input (c->nrm)       */
+    jf_orient_mode orient;   /* default none                            */
+    double viewpoint[3];     /* JF_ORIENT_VIEWPOINT                     */
+    size_t orient_k;         /* JF_ORIENT_MST: k of the k-NN graph (8)  */
+    int threads;             /* <= 0: all cores (OpenMP default)        */
+    jf_progress_fn progress; /* may be NULL                             */
+    void *progress_user;
+} jf_estimate_opts;
+
+/* Fills defaults.  Never fails. */
+void jf_estimate_opts_init(jf_estimate_opts *o);
+
+/* Fits every point of c (out has c->n entries, caller-owned; out[i]
+ * belongs to point i): builds what the neighbourhood needs (k-d tree,
+ * mesh adjacency, or Delaunay triangulation and tangent-plane normals),
+ * fits the points in Z-order with one fitter per thread
+ * (jf_fit_point_full), then orients.  Non-finite points get
+ * JF_PT_NONFINITE and NaN values and are nobody's neighbour; a point
+ * whose neighbourhood is smaller than asked gets JF_PT_FEW_NEIGHBORS.
+ * The results are bit-identical for any thread count.  Peak memory
+ * besides c and out: about 40 bytes per point (knn/radius; rings: the
+ * adjacency; natural: the bridge's ~100 + 28 bytes per point).
+ * Returns JF_OK, JF_ERR_INVALID (bad options, rings without faces,
+ * orient/normal input without normals; err says which), JF_ERR_NOMEM,
+ * JF_ERR_FORMAT (bad face indices), or the failing stage's status; err
+ * (may be NULL) gets one line.  Thread-safe on distinct outputs. */
+jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
+                      jf_result *out, jf_error *err);
+
 #ifdef __cplusplus
 }
 #endif

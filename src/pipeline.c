@@ -1,0 +1,416 @@
+/* pipeline.c -- jf_estimate: index -> per point {neighbourhood, fit} ->
+ * orientation, over a whole cloud, with OpenMP.
+ *
+ * design (DESIGN.md "The per-point computation", "Performance rules"):
+ *  1. Build what the neighbourhood needs once: the k-d tree (non-finite
+ *     points are left out of it: nobody's neighbour), the mesh adjacency
+ *     (rings), or the Delaunay triangulation and a tangent-plane normal
+ *     per point (natural, §5.1); and a Z-order of the points.
+ *  2. Threads take chunks of the Z-order (consecutive queries touch the
+ *     same tree nodes and coordinates: cache friendly); each thread owns a
+ *     fitter and buffers made once, so nothing is allocated per point.
+ *     Result i is stored at out[i] (input order), and each result depends
+ *     only on its own neighbourhood (sorted, ties by index): any thread
+ *     count gives the same bits.
+ *  3. Orientation (orient.c), which needs every normal.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <omp.h>
+
+#include "jetfit.h"
+
+#define CHUNK 256      /* points per scheduling unit (and progress tick) */
+#define PCA_K 16       /* --normal pca: PCA of the 16 nearest points     */
+
+void jf_estimate_opts_init(jf_estimate_opts *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    jf_params_init(&o->params);
+    o->nb.kind = JF_NB_KNN;
+    o->nb.k = JF_ESTIMATE_DEFAULT_K;
+    o->normal = JF_NORMAL_POLES;
+    o->orient = JF_ORIENT_NONE;
+    o->orient_k = 8;
+}
+
+static void set_err(jf_error *err, const char *msg)
+{
+    if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
+}
+
+/* A row for a point that cannot be fitted: NaN quantities and flags. */
+static void nan_result(jf_result *r, unsigned status)
+{
+    memset(r, 0, sizeof *r);
+    r->status = status;
+    r->cond = r->residual = r->k1 = r->k2 = NAN;
+    for (int j = 0; j < 3; j++) r->pca_eval[j] = r->normal[j] = r->d1[j] = r->d2[j] = NAN;
+    for (int j = 0; j < 4; j++) r->b[j] = NAN;
+    for (int j = 0; j < 5; j++) r->c[j] = NAN;
+}
+
+static int finite3(const double *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+/* ---- the neighbourhood of a point, whatever its kind ------------------- */
+
+typedef struct {
+    const jf_nb_spec *nb;
+    const double *xyz;
+    const jf_index *ix;
+    jf_mesh *mesh;        /* rings                                     */
+    jf_natural *nt;       /* natural                                   */
+    double *nrm_own;      /* natural: normals we computed (3n)         */
+    const double *nrm;    /* natural: the tangent-plane normals        */
+    unsigned *nflags;     /* natural: JF_PT_NORMAL_* per point         */
+    size_t min_count;     /* N_n of the asked degree                   */
+    size_t want;          /* fewer found than this: FEW_NEIGHBORS      */
+    size_t cap;           /* buffer size (largest neighbourhood)       */
+    jf_fit_mode fit;
+} nbctx;
+
+/* Smallest-eigenvalue eigenvector of the centred covariance of pts (m
+ * points): cyclic Jacobi on the 3x3 symmetric matrix.  Returns 0 if the
+ * points span less than a plane (no unique normal). */
+static int pca_normal(const double *pts, size_t m, double nrm[3])
+{
+    double c[3] = {0, 0, 0}, a[3][3] = {{0}}, v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    if (m < 3) return 0;
+    for (size_t i = 0; i < m; i++)
+        for (int j = 0; j < 3; j++) c[j] += pts[3 * i + j];
+    for (int j = 0; j < 3; j++) c[j] /= (double)m;
+    for (size_t i = 0; i < m; i++) /* second pass: centred (no cancellation) */
+        for (int r = 0; r < 3; r++)
+            for (int s = 0; s < 3; s++)
+                a[r][s] += (pts[3 * i + r] - c[r]) * (pts[3 * i + s] - c[s]);
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
+        if (off <= 1e-300 || off <= 1e-18 * (fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2])))
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0) continue;
+                double th = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+                double t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
+                double cs = 1 / sqrt(t * t + 1), sn = t * cs;
+                for (int k = 0; k < 3; k++) { /* A <- A J */
+                    double x = a[k][p], y = a[k][q];
+                    a[k][p] = cs * x - sn * y;
+                    a[k][q] = sn * x + cs * y;
+                }
+                for (int k = 0; k < 3; k++) { /* A <- J^T A */
+                    double x = a[p][k], y = a[q][k];
+                    a[p][k] = cs * x - sn * y;
+                    a[q][k] = sn * x + cs * y;
+                }
+                for (int k = 0; k < 3; k++) { /* V <- V J */
+                    double x = v[k][p], y = v[k][q];
+                    v[k][p] = cs * x - sn * y;
+                    v[k][q] = sn * x + cs * y;
+                }
+            }
+    }
+    int lo = 0, hi = 0;
+    for (int j = 1; j < 3; j++) {
+        if (a[j][j] < a[lo][lo]) lo = j;
+        if (a[j][j] > a[hi][hi]) hi = j;
+    }
+    int mid = 3 - lo - hi;
+    if (lo == hi || !(a[mid][mid] > 1e-24 * a[hi][hi])) return 0; /* collinear */
+    for (int j = 0; j < 3; j++) nrm[j] = v[j][lo];
+    return 1;
+}
+
+/* --normal pca: the PCA normal of the PCA_K nearest points, in parallel. */
+static jf_status pca_normals(const jf_index *ix, const double *xyz, size_t n, int nt,
+                             double *nrm, unsigned *flags)
+{
+    jf_status st = JF_OK;
+#pragma omp parallel num_threads(nt)
+    {
+        uint32_t idx[PCA_K];
+        double d2[PCA_K], pts[3 * PCA_K];
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            size_t found = 0;
+            int ok = finite3(xyz + 3 * i) &&
+                     jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) == JF_OK;
+            for (size_t j = 0; ok && j < found; j++)
+                memcpy(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3]));
+            if (!ok || !pca_normal(pts, found, nrm + 3 * i)) {
+                nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
+                flags[i] |= JF_PT_FAILED;
+            }
+        }
+    }
+    return st;
+}
+
+/* Step 1 for natural[:N]: triangulation and tangent-plane normals. */
+static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src, int nt,
+                               jf_error *err)
+{
+    size_t n = c->n;
+    x->nflags = calloc(n, sizeof *x->nflags);
+    if (!x->nflags) return JF_ERR_NOMEM;
+    jf_status st = jf_natural_create(c->xyz, n, &x->nt);
+    if (st != JF_OK) {
+        set_err(err, "natural neighbours: building the Delaunay triangulation failed");
+        return st;
+    }
+    if (src == JF_NORMAL_INPUT) {
+        if (!c->nrm) {
+            set_err(err, "--normal input: the input file has no normals");
+            return JF_ERR_INVALID;
+        }
+        x->nrm = c->nrm;
+        for (size_t i = 0; i < n; i++) x->nflags[i] = JF_PT_NORMAL_INPUT;
+        return JF_OK;
+    }
+    x->nrm_own = malloc(3 * n * sizeof *x->nrm_own);
+    if (!x->nrm_own) return JF_ERR_NOMEM;
+    x->nrm = x->nrm_own;
+    if (src == JF_NORMAL_PCA) return pca_normals(x->ix, c->xyz, n, nt, x->nrm_own, x->nflags);
+    st = jf_natural_normals(x->nt, src, nt, x->nrm_own, x->nflags, NULL);
+    if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
+    return st;
+}
+
+/* Neighbourhood of point i into idx[0..cap-1]; *flags gets per-point
+ * flags (few neighbours, the natural normal's source, failure). */
+static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, uint32_t *idx,
+                          double *d2, size_t *found, unsigned *flags)
+{
+    jf_status st;
+    *found = 0;
+    *flags = 0;
+    switch (x->nb->kind) {
+    case JF_NB_RINGS:
+        st = jf_nb_query_mesh(x->mesh, x->xyz, x->nb, x->min_count, x->fit, (uint32_t)i, idx,
+                              x->cap, found);
+        break;
+    case JF_NB_NATURAL:
+        *flags = x->nflags[i];
+        if (!finite3(x->nrm + 3 * i)) return JF_OK; /* no normal: FAILED */
+        st = jf_natural_neighbors(x->nt, ws, i, x->nrm + 3 * i, x->want, idx, x->cap, found);
+        break;
+    default:
+        st = jf_nb_query(x->ix, x->nb, x->min_count, x->xyz + 3 * i, idx, d2, x->cap, found);
+    }
+    if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
+    return st;
+}
+
+/* ---- per-thread workspace and the per-point step ----------------------- */
+
+typedef struct {
+    jf_fitter *fit;
+    jf_natural_ws *nws;
+    uint32_t *idx;
+    double *d2, *coords;
+} worker;
+
+static void worker_free(worker *w)
+{
+    jf_fitter_free(w->fit);
+    jf_natural_ws_free(w->nws);
+    free(w->idx);
+    free(w->d2);
+    free(w->coords);
+    memset(w, 0, sizeof *w);
+}
+
+static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x)
+{
+    memset(w, 0, sizeof *w);
+    jf_status st = jf_fitter_create(p, &w->fit);
+    if (st == JF_OK && x->nt) st = jf_natural_ws_create(x->nt, &w->nws);
+    if (st == JF_OK) {
+        w->idx = malloc(x->cap * sizeof *w->idx);
+        w->d2 = malloc(x->cap * sizeof *w->d2);
+        w->coords = malloc(3 * x->cap * sizeof *w->coords);
+        if (!w->idx || !w->d2 || !w->coords) st = JF_ERR_NOMEM;
+    }
+    if (st != JF_OK) worker_free(w);
+    return st;
+}
+
+static jf_status fit_one(worker *w, const nbctx *x, size_t i, jf_result *out)
+{
+    const double *p = x->xyz + 3 * i;
+    if (!finite3(p)) {
+        nan_result(out, JF_PT_NONFINITE);
+        return JF_OK;
+    }
+    size_t found = 0;
+    unsigned flags = 0;
+    jf_status st = nb_query(x, w->nws, i, w->idx, w->d2, &found, &flags);
+    if (st != JF_OK) return st;
+    if (flags & JF_PT_FAILED) {
+        nan_result(out, flags);
+        return JF_OK;
+    }
+    for (size_t j = 0; j < found; j++)
+        memcpy(w->coords + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
+    st = jf_fit_point_full(w->fit, p, w->coords, found, out);
+    out->status |= flags;
+    return st;
+}
+
+/* ---- the whole cloud ------------------------------------------------- */
+
+static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
+
+jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
+                      jf_error *err)
+{
+    const char *bad = NULL;
+    if (err) err->msg[0] = '\0';
+    if (!c || !o || (c->n && (!c->xyz || !out))) {
+        set_err(err, "jf_estimate: NULL argument");
+        return JF_ERR_INVALID;
+    }
+    if (jf_params_validate(&o->params, &bad) != JF_OK) {
+        char m[128];
+        snprintf(m, sizeof m, "invalid parameter '%s'", bad ? bad : "?");
+        set_err(err, m);
+        return JF_ERR_INVALID;
+    }
+    size_t n = c->n;
+    if (n >= UINT32_MAX - 2) {
+        set_err(err, "too many points (2^32 - 2 at most)");
+        return JF_ERR_TOO_LARGE;
+    }
+    if (o->orient == JF_ORIENT_INPUT && !c->nrm) {
+        set_err(err, "--orient input: the input file has no normals");
+        return JF_ERR_INVALID;
+    }
+    if (o->nb.kind == JF_NB_RINGS && !c->nfaces) {
+        set_err(err, "--neighbors rings needs a mesh (faces in the input file)");
+        return JF_ERR_INVALID;
+    }
+    if (n == 0) return JF_OK;
+
+    int nt = o->threads > 0 ? o->threads : omp_get_max_threads();
+    const jf_params *p = &o->params;
+    nbctx x = {0};
+    jf_nb_spec nb = o->nb;
+    /* scale selection picks among the first K of the list: fetch the most */
+    if (nb.kind == JF_NB_KNN)
+        for (int j = 0; j < p->nscales; j++) nb.k = max_sz(nb.k, p->scales[j]);
+    x.nb = &nb;
+    x.xyz = c->xyz;
+    x.fit = p->fit;
+    x.min_count = jf_jet_size(p->degree);
+    x.cap = p->max_neighbors;
+    switch (o->nb.kind) {
+    case JF_NB_KNN: x.want = x.cap = nb.k; break;
+    case JF_NB_KNN_RADIUS: x.cap = o->nb.k; x.want = x.min_count < x.cap ? x.min_count : x.cap; break;
+    case JF_NB_RADIUS: x.want = 0; break;
+    case JF_NB_RINGS:
+        x.want = o->nb.n ? o->nb.n : x.min_count;
+        if (o->nb.n) x.cap = o->nb.n;
+        break;
+    case JF_NB_NATURAL: x.want = x.cap = o->nb.n ? o->nb.n : max_sz(2 * x.min_count, 12); break;
+    }
+    x.cap = max_sz(x.cap, 1);
+    if (x.cap > p->max_neighbors) {
+        set_err(err, "neighbourhood larger than params.max_neighbors");
+        return JF_ERR_INVALID;
+    }
+
+    jf_status st = JF_OK;
+    jf_index *ix = NULL;
+    uint32_t *order = NULL;
+    int need_index = nb.kind <= JF_NB_KNN_RADIUS || o->orient == JF_ORIENT_MST ||
+                     (o->nb.kind == JF_NB_NATURAL && o->normal == JF_NORMAL_PCA);
+    if (need_index && (st = jf_index_build(c->xyz, n, &ix)) != JF_OK) {
+        set_err(err, "building the k-d tree failed");
+        goto out;
+    }
+    x.ix = ix;
+    if (o->nb.kind == JF_NB_RINGS &&
+        (st = jf_mesh_build(n, c->nfaces, c->face_off, c->face_idx, &x.mesh, err)) != JF_OK)
+        goto out;
+    if (o->nb.kind == JF_NB_NATURAL && (st = natural_setup(&x, c, o->normal, nt, err)) != JF_OK) {
+        if (err && !err->msg[0]) set_err(err, jf_strerror(st));
+        goto out;
+    }
+    order = malloc(n * sizeof *order);
+    if (!order) {
+        st = JF_ERR_NOMEM;
+        set_err(err, "out of memory (point order)");
+        goto out;
+    }
+    if ((st = jf_spatial_order(c->xyz, n, order)) != JF_OK) {
+        set_err(err, "spatial order failed");
+        goto out;
+    }
+
+    /* step 2 */
+    size_t nchunks = (n + CHUNK - 1) / CHUNK, done = 0;
+    jf_status failed = JF_OK;
+#pragma omp parallel num_threads(nt)
+    {
+        worker w;
+        jf_status wst = worker_init(&w, p, &x);
+        if (wst != JF_OK) {
+#pragma omp atomic write
+            failed = wst;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (size_t ch = 0; ch < nchunks; ch++) {
+            jf_status seen;
+#pragma omp atomic read
+            seen = failed;
+            if (seen != JF_OK || wst != JF_OK) continue;
+            size_t beg = ch * CHUNK, end = beg + CHUNK < n ? beg + CHUNK : n;
+            for (size_t k = beg; k < end && wst == JF_OK; k++)
+                wst = fit_one(&w, &x, order[k], &out[order[k]]);
+            if (wst != JF_OK) {
+#pragma omp atomic write
+                failed = wst;
+            }
+            size_t now;
+#pragma omp atomic capture
+            now = done += end - beg;
+            /* the progress callback runs on the calling thread only */
+            if (o->progress && omp_get_thread_num() == 0) o->progress(o->progress_user, now, n);
+        }
+        worker_free(&w);
+    }
+    if (failed != JF_OK) {
+        st = failed;
+        set_err(err, failed == JF_ERR_NOMEM ? "out of memory (per-thread workspace)"
+                                            : "a neighbourhood query or fit failed");
+        goto out;
+    }
+    free(order);
+    order = NULL;
+    if (o->progress) o->progress(o->progress_user, n, n);
+
+    /* step 3 */
+    switch (o->orient) {
+    case JF_ORIENT_NONE: break;
+    case JF_ORIENT_INPUT: st = jf_orient_input(out, n, c->nrm); break;
+    case JF_ORIENT_VIEWPOINT: st = jf_orient_viewpoint(out, c->xyz, n, o->viewpoint); break;
+    case JF_ORIENT_MST: st = jf_orient_mst(out, c->xyz, n, ix, o->orient_k); break;
+    default: st = JF_ERR_INVALID;
+    }
+    if (st != JF_OK) set_err(err, "orientation failed");
+out:
+    free(order);
+    jf_index_free(ix);
+    jf_mesh_free(x.mesh);
+    jf_natural_free(x.nt);
+    free(x.nrm_own);
+    free(x.nflags);
+    return st;
+}
