@@ -19,6 +19,9 @@
  * up to STACK_N neighbours; above that, one heap buffer per thread (C11
  * tss, freed at thread exit) grown only when a larger n is first seen. */
 #include <math.h>
+#ifdef JF_ROBUST_DEBUG
+#include <stdio.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 #include <threads.h>
@@ -28,6 +31,7 @@
 #define STACK_N 512
 #define NORMAL_TOL 1e-6 /* rad: IRLS stops when the normal moves less... */
 #define CURV_TOL 1e-6   /* ...and |dk| * h does: both scale invariant     */
+#define REL_TOL 0.01    /* or both move less than 1% of the noise scale   */
 
 /* Weight of the scale-selection variance term against the bias term
  * (score()); chosen by measurement (tests/bench_pcpnet.cpp, README). */
@@ -101,9 +105,12 @@ static double select_kth(double *a, size_t n, size_t k)
     return a[k];
 }
 
-static double mad_scale(const double *r, double *tmp, size_t n)
+static double mad_scale(const double *r, double *tmp, size_t nr)
 {
-    for (size_t i = 0; i < n; i++) tmp[i] = fabs(r[i]);
+    size_t n = 0; /* non-finite input points have NaN residuals: left out */
+    for (size_t i = 0; i < nr; i++)
+        if (isfinite(r[i])) tmp[n++] = fabs(r[i]);
+    if (n == 0) return 0.0;
     double m = select_kth(tmp, n, n / 2);
     if (n % 2 == 0) { /* the lower middle is the max of the lower half */
         double lo = tmp[0];
@@ -160,7 +167,8 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
         size_t live = 0;
         for (size_t i = 0; i < n; i++) {
             double a = fabs(res[i]) / c, wi;
-            if (tukey) wi = a < 1.0 ? (1.0 - a * a) * (1.0 - a * a) : 0.0;
+            if (!isfinite(a)) wi = 0.0; /* a non-finite input point */
+            else if (tukey) wi = a < 1.0 ? (1.0 - a * a) * (1.0 - a * a) : 0.0;
             else wi = a <= 1.0 ? 1.0 : 1.0 / a;
             live += wi > 0.0;
             /* jf_fit_point_weighted multiplies each equation by its weight:
@@ -179,7 +187,14 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
         double ang = acos(dot > 1.0 ? 1.0 : dot);
         double dk = fabs(prev.k1 - out->k1) + fabs(prev.k2 - out->k2);
         int pt = pr->robust == JF_ROBUST_TUKEY && it < 2; /* Huber warm-up */
-        if (!pt && ang < NORMAL_TOL && dk * h < CURV_TOL) {
+#ifdef JF_ROBUST_DEBUG
+        fprintf(stderr, "it %d s %g ang %g dk*h %g live %zu/%zu\n", it, s, ang, dk * h, live, n);
+#endif
+        /* converged: the jet moved by a small fraction of the noise scale
+         * over the neighbourhood (tilt ang * h, curvature dk h^2), or by a
+         * negligible amount outright */
+        if (!pt && ((ang * h <= REL_TOL * s && dk * h * h <= REL_TOL * s) ||
+                    (ang < NORMAL_TOL && dk * h < CURV_TOL))) {
             converged = 1;
             break;
         }

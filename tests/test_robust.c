@@ -1,0 +1,314 @@
+/* test_robust.c -- jf_fit_point_full: IRLS reweighting and scale selection
+ * against the analytic truth of the paper's §6.1 surface
+ * f(u, v) = 0.1 exp(2u + v - v^2), sampled on a perturbed grid with noise
+ * and outliers.  Neighbours by brute force (nearest first). */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "jetfit.h"
+
+/* ---- the surface and its exact quantities ---- */
+static double fz(double u, double v) { return 0.1 * exp(2 * u + v - v * v); }
+
+/* Unit normal (-fu, -fv, 1)/|.| and principal curvatures k1 >= k2 w.r.t.
+ * it, from the Weingarten map of a graph (Table 1's formulas). */
+static void truth(double u, double v, double n[3], double *k1, double *k2)
+{
+    double f = fz(u, v), gu = 2.0, gv = 1.0 - 2.0 * v;
+    double fu = f * gu, fv = f * gv, fuu = f * gu * gu, fuv = f * gu * gv,
+           fvv = f * (gv * gv - 2.0);
+    double w = sqrt(1 + fu * fu + fv * fv);
+    n[0] = -fu / w;
+    n[1] = -fv / w;
+    n[2] = 1 / w;
+    double E = 1 + fu * fu, F = fu * fv, G = 1 + fv * fv;
+    double e = fuu / w, ff = fuv / w, g = fvv / w;
+    /* jetfit's sign: z = (k1 x^2 + k2 y^2)/2 along n, so k = +II/I */
+    double K = (e * g - ff * ff) / (E * G - F * F);
+    double H = (e * G - 2 * ff * F + g * E) / (2 * (E * G - F * F));
+    double d = sqrt(fmax(H * H - K, 0.0));
+    *k1 = H + d;
+    *k2 = H - d;
+}
+
+/* ---- deterministic RNG (splitmix64) ---- */
+static uint64_t rng_state;
+static double urand(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+static double grand(void)
+{
+    double a = urand(), b = urand();
+    return sqrt(-2.0 * log(a + 1e-300)) * cos(6.283185307179586 * b);
+}
+
+static int quadric; /* make_cloud samples z = 0.4u^2 - 0.2v^2 + 0.1uv */
+
+typedef struct {
+    size_t n;
+    double *xyz;   /* noisy / corrupted samples */
+    double *uv;    /* parameters of the clean samples */
+} cloud;
+
+/* Grid of side m over [-0.5,0.5]^2 perturbed by [0,0.9]h (§6.1), Gaussian
+ * noise sigma (absolute, per axis), a fraction `outl` of the points moved
+ * off the surface by +-[5,10] sigma_o along z. */
+static cloud make_cloud(int m, double sigma, double outl, double sigma_o, uint64_t seed)
+{
+    cloud c;
+    rng_state = seed;
+    c.n = (size_t)m * (size_t)m;
+    c.xyz = malloc(3 * c.n * sizeof *c.xyz);
+    c.uv = malloc(2 * c.n * sizeof *c.uv);
+    double h = 1.0 / (m - 1);
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++) {
+            size_t k = (size_t)i * m + j;
+            double u = -0.5 + i * h + 0.9 * h * urand() - 0.45 * h;
+            double v = -0.5 + j * h + 0.9 * h * urand() - 0.45 * h;
+            c.uv[2 * k] = u;
+            c.uv[2 * k + 1] = v;
+            c.xyz[3 * k] = u + sigma * grand();
+            c.xyz[3 * k + 1] = v + sigma * grand();
+            c.xyz[3 * k + 2] = fz(u, v) + sigma * grand();
+            /* always draw, so that clouds with and without outliers share
+             * their samples */
+            double a = urand(), b = urand(), t = urand();
+            if (outl > 0 && a < outl) c.xyz[3 * k + 2] += (b < 0.5 ? -1 : 1) * sigma_o * (5 + 5 * t);
+            if (quadric) c.xyz[3 * k + 2] = 0.4 * u * u - 0.2 * v * v + 0.1 * u * v;
+        }
+    return c;
+}
+
+/* Brute-force k nearest of point q (nearest first, ties by index). */
+static void knn(const cloud *c, size_t q, size_t k, double *nbr, size_t *d_idx, double *d2)
+{
+    /* partial insertion sort: k is small */
+    size_t cnt = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double dx = c->xyz[3 * i] - c->xyz[3 * q], dy = c->xyz[3 * i + 1] - c->xyz[3 * q + 1],
+               dz = c->xyz[3 * i + 2] - c->xyz[3 * q + 2];
+        double d = dx * dx + dy * dy + dz * dz;
+        if (cnt == k && d >= d2[k - 1]) continue;
+        size_t pos = cnt < k ? cnt++ : k - 1;
+        while (pos > 0 && d2[pos - 1] > d) {
+            d2[pos] = d2[pos - 1];
+            d_idx[pos] = d_idx[pos - 1];
+            pos--;
+        }
+        d2[pos] = d;
+        d_idx[pos] = i;
+    }
+    for (size_t t = 0; t < k; t++)
+        memcpy(nbr + 3 * t, c->xyz + 3 * d_idx[t], 3 * sizeof *nbr);
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+static double median(double *v, size_t n)
+{
+    qsort(v, n, sizeof *v, cmpd);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+typedef struct {
+    double med_normal;  /* median normal angle, degrees */
+    double med_curv;    /* median of |dk1| and |dk2| relative errors */
+    size_t nflag;       /* rows with the given flag */
+} errs;
+
+/* Fits `nq` query points of the inner region |u|,|v| < 0.3 (jet fits are
+ * one-sided at the border) with params p from their kmax nearest. */
+static double region = 0.3;
+static errs run(const cloud *c, const jf_params *p, size_t kmax, unsigned flag)
+{
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(p, &f), JF_OK);
+    double *nbr = malloc(3 * kmax * sizeof *nbr), *d2 = malloc(kmax * sizeof *d2);
+    size_t *idx = malloc(kmax * sizeof *idx);
+    double *en = malloc(c->n * sizeof *en), *ek = malloc(2 * c->n * sizeof *ek);
+    size_t m = 0;
+    errs e = {0, 0, 0};
+    for (size_t q = 0; q < c->n; q += 7) {
+        double u = c->uv[2 * q], v = c->uv[2 * q + 1];
+        if (fabs(u) > region || fabs(v) > region) continue;
+        knn(c, q, kmax, nbr, idx, d2);
+        jf_result r;
+        ck_assert_int_eq(jf_fit_point_full(f, c->xyz + 3 * q, nbr, kmax, &r), JF_OK);
+        double nt[3], k1, k2, ea[2], er[2];
+        truth(u, v, nt, &k1, &k2);
+        en[m] = jf_normal_angle_deg(r.normal, nt);
+        jf_curv_compare(r.normal, r.k1, r.k2, nt, k1, k2, ea, er);
+        ek[2 * m] = ea[0] / fmax(fabs(k1), 1e-3); /* relative: k ~ 0.1..1 here */
+        ek[2 * m + 1] = ea[1] / fmax(fabs(k1), 1e-3);
+        if (r.status & flag) e.nflag++;
+        m++;
+    }
+    e.med_normal = median(en, m);
+    e.med_curv = median(ek, 2 * m);
+    free(nbr);
+    free(d2);
+    free(idx);
+    free(en);
+    free(ek);
+    jf_fitter_free(f);
+    return e;
+}
+
+static int verbose(void) { return getenv("JF_TEST_VERBOSE") != NULL; }
+
+/* With neither option set, jf_fit_point_full is jf_fit_point bit for bit. */
+START_TEST(plain_is_jf_fit_point)
+{
+    cloud c = make_cloud(30, 0.002, 0, 0, 1);
+    jf_params p;
+    jf_params_init(&p);
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    double nbr[3 * 40], d2[40];
+    size_t idx[40];
+    for (size_t q = 0; q < c.n; q += 37) {
+        knn(&c, q, 40, nbr, idx, d2);
+        jf_result a, b;
+        ck_assert_int_eq(jf_fit_point(f, c.xyz + 3 * q, nbr, 40, &a), JF_OK);
+        ck_assert_int_eq(jf_fit_point_full(f, c.xyz + 3 * q, nbr, 40, &b), JF_OK);
+        ck_assert_int_eq(memcmp(&a, &b, sizeof a), 0);
+    }
+    jf_fitter_free(f);
+    free(c.xyz);
+    free(c.uv);
+}
+END_TEST
+
+/* §6.1 surface, 0.5% Gaussian noise: per-point scale selection among
+ * K in {16, 32, 64, 128, 256} has a lower median normal error than every fixed
+ * K of the set. */
+START_TEST(scale_selection_beats_best_fixed_k)
+{
+    const double diag = sqrt(2.0 + 0.3 * 0.3); /* bbox diagonal ~ 1.45 */
+    int m = getenv("JF_M") ? atoi(getenv("JF_M")) : 70;
+    double lv = getenv("JF_NOISE") ? atof(getenv("JF_NOISE")) : 0.005;
+    cloud c = make_cloud(m, lv * diag, 0, 0, 2);
+    region = getenv("JF_REGION") ? atof(getenv("JF_REGION")) : 0.45;
+    const size_t ks[] = {32, 64, 128, 256, 512};
+    jf_params p;
+    jf_params_init(&p);
+    p.max_neighbors = 512;
+    double best = INFINITY;
+    for (int i = 0; i < 5; i++) {
+        errs e = run(&c, &p, ks[i], 0);
+        if (verbose()) printf("fixed K=%zu: median normal %.4f deg\n", ks[i], e.med_normal);
+        if (e.med_normal < best) best = e.med_normal;
+    }
+    p.nscales = 5;
+    for (int i = 0; i < 5; i++) p.scales[i] = ks[i];
+    errs s = run(&c, &p, 512, JF_PT_SCALE_SELECTED);
+    if (verbose())
+        printf("selected: median normal %.4f deg (best fixed %.4f), %zu points below K=128\n",
+               s.med_normal, best, s.nflag);
+    ck_assert(s.nflag > 0);
+    ck_assert_double_lt(s.med_normal, best);
+    free(c.xyz);
+    free(c.uv);
+}
+END_TEST
+
+/* 5% outliers: Tukey reweighting keeps the median curvature error within
+ * 1.5x of the plain fit of the outlier-free cloud; the plain fit with the
+ * outliers does not (so the test can fail). */
+START_TEST(reweighting_suppresses_outliers)
+{
+    const double sigma = 0.0002;
+    cloud clean = make_cloud(60, sigma, 0, 0, 3);
+    cloud dirty = make_cloud(60, sigma, 0.05, 0.003, 3); /* same samples + outliers */
+    jf_params p;
+    jf_params_init(&p);
+    p.max_neighbors = 64;
+    errs e0 = run(&clean, &p, 64, 0);
+    errs e1 = run(&dirty, &p, 64, 0);
+    p.robust = JF_ROBUST_TUKEY;
+    errs e2 = run(&dirty, &p, 64, JF_PT_ROBUST_NOCONV);
+    p.robust = JF_ROBUST_HUBER;
+    errs e3 = run(&dirty, &p, 64, JF_PT_ROBUST_NOCONV);
+    if (verbose())
+        printf("median curvature error: clean %.4f, outliers plain %.4f, tukey %.4f (%zu noconv), "
+               "huber %.4f\nmedian normal: clean %.4f, plain %.4f, tukey %.4f, huber %.4f\n",
+               e0.med_curv, e1.med_curv, e2.med_curv, e2.nflag, e3.med_curv, e0.med_normal,
+               e1.med_normal, e2.med_normal, e3.med_normal);
+    ck_assert_double_gt(e1.med_curv, 1.5 * e0.med_curv);
+    ck_assert_double_le(e2.med_curv, 1.5 * e0.med_curv);
+    ck_assert_double_lt(e3.med_curv, e1.med_curv);
+    free(clean.xyz);
+    free(clean.uv);
+    free(dirty.xyz);
+    free(dirty.uv);
+}
+END_TEST
+
+/* A noiseless quadric: residuals vanish, IRLS stops at once (converged),
+ * the result equals the plain fit's quantities. */
+START_TEST(exact_surface_converges)
+{
+    quadric = 1;
+    cloud c = make_cloud(30, 0, 0, 0, 4);
+    quadric = 0;
+    jf_params p;
+    jf_params_init(&p);
+    p.robust = JF_ROBUST_TUKEY;
+    p.frame = JF_FRAME_AXIS; /* z: the quadric is exactly a height function */
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    double nbr[3 * 30], d2[30];
+    size_t idx[30];
+    size_t q = 15 * 30 + 15;
+    knn(&c, q, 30, nbr, idx, d2);
+    jf_result a, b;
+    ck_assert_int_eq(jf_fit_point(f, c.xyz + 3 * q, nbr, 30, &a), JF_OK);
+    ck_assert_int_eq(jf_fit_point_full(f, c.xyz + 3 * q, nbr, 30, &b), JF_OK);
+    if (verbose()) printf("exact: a.k1 %g b.k1 %g status %u\n", a.k1, b.k1, b.status);
+    ck_assert_uint_eq(b.status & JF_PT_ROBUST_NOCONV, 0);
+    ck_assert_double_eq_tol(a.k1, b.k1, 1e-6 * fabs(a.k1));
+    ck_assert_double_eq_tol(a.k2, b.k2, 1e-6 * fabs(a.k1));
+    /* a corrupted neighbour among few points and NaN neighbours: no crash,
+     * finite result */
+    nbr[3 * 5 + 2] += 0.05;
+    nbr[3 * 7] = NAN;
+    ck_assert_int_eq(jf_fit_point_full(f, c.xyz + 3 * q, nbr, 30, &b), JF_OK);
+    ck_assert(isfinite(b.k1) && isfinite(b.normal[2]));
+    /* the exact normal of the quadric at (u, v) */
+    double u = c.uv[2 * q], v = c.uv[2 * q + 1];
+    double nt[3] = {-(0.8 * u + 0.1 * v), -(-0.4 * v + 0.1 * u), 1.0};
+    ck_assert_double_lt(jf_normal_angle_deg(b.normal, nt), 1e-6);
+    jf_fitter_free(f);
+    free(c.xyz);
+    free(c.uv);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("robust");
+    TCase *tc = tcase_create("core");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, plain_is_jf_fit_point);
+    tcase_add_test(tc, exact_surface_converges);
+    tcase_add_test(tc, scale_selection_beats_best_fixed_k);
+    tcase_add_test(tc, reweighting_suppresses_outliers);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}
