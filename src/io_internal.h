@@ -57,6 +57,10 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
  * Clinger's one-rounding case; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
 
+/* Writes v exactly as printf("%.17g", v) does, except NaN -> "nan"
+ * (never "-nan"); at most 24 bytes, no NUL.  Returns the end. */
+char *jf_fmt_g17(char *out, double v);
+
 /* Parses [s, e) as an unsigned decimal integer <= max: 1 ok, 0 not. */
 int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out);
 

@@ -1,0 +1,618 @@
+/*
+ * io_write.c -- the table writer (jf_writer_*) and jf_cloud_write.
+ *
+ * design: output goes to a buffer (1 MiB, one write(2) per flush) feeding a
+ * temporary ".NAME.tmp.PID" beside the final file; commit closes it and
+ * renames it onto NAME, any failure or abort unlinks it, so a reader never
+ * sees a partial file under the final name.  Doubles are written exactly
+ * as "%.17g" would write them, by a fast integer path for the usual
+ * magnitudes (1e-11 <= |v| < 1e17, exact 128-bit arithmetic) and by
+ * snprintf for the rest.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "io_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* ---- exact "%.17g" ---------------------------------------------------- */
+
+static char *put_uint(char *o, uint64_t v)
+{
+    char tmp[24];
+    int n = 0;
+    do {
+        tmp[n++] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v);
+    while (n)
+        *o++ = tmp[--n];
+    return o;
+}
+
+/* M = round_half_even(|v| * 10^k) for 0 <= k <= 27; 0 if out of reach. */
+static int scaled(uint64_t m, int q, int k, uint64_t *out)
+{
+    unsigned __int128 p = m;
+    for (int i = 0; i < k; i++)
+        p *= 5;
+    int s = q + k; /* |v| * 10^k = p * 2^s */
+    if (s >= 0) {
+        if (s > 10)
+            return 0;
+        *out = (uint64_t)(p << s);
+        return 1;
+    }
+    int r = -s;
+    if (r >= 127)
+        return 0;
+    unsigned __int128 one = 1, t = p >> r, rem = p & ((one << r) - 1),
+                      half = one << (r - 1);
+    if (rem > half || (rem == half && (t & 1)))
+        t++;
+    if (t >> 64)
+        return 0;
+    *out = (uint64_t)t;
+    return 1;
+}
+
+/* Writes v as printf("%.17g") does (NaN as "nan"); returns the end. */
+char *jf_fmt_g17(char *o, double v)
+{
+    if (isnan(v))
+        return memcpy(o, "nan", 3), o + 3;
+    if (isinf(v))
+        return v < 0 ? (memcpy(o, "-inf", 4), o + 4)
+                     : (memcpy(o, "inf", 3), o + 3);
+    uint64_t bits;
+    memcpy(&bits, &v, 8);
+    int bexp = (int)((bits >> 52) & 0x7ff);
+    double a = fabs(v);
+    if (v == 0 || bexp == 0 || !(a >= 1e-11 && a < 1e17))
+        return o + snprintf(o, 32, "%.17g", v);
+    uint64_t m = (bits & ((UINT64_C(1) << 52) - 1)) | (UINT64_C(1) << 52);
+    int q = bexp - 1075;
+    int E = (int)floor(log10(a));
+    uint64_t M = 0;
+    const uint64_t lo = UINT64_C(10000000000000000), hi = lo * 10;
+    for (int tries = 0;; tries++) {
+        int k = 16 - E;
+        if (tries > 3 || k < 0 || k > 27 || !scaled(m, q, k, &M))
+            return o + snprintf(o, 32, "%.17g", v);
+        if (M > hi) { /* E estimated one too low */
+            E++;
+            continue;
+        }
+        if (M < lo) {
+            E--;
+            continue;
+        }
+        break;
+    }
+    if (M == hi) { /* 10^(E+1) exactly, or rounding carried */
+        M /= 10;
+        E++;
+    }
+    char d[17];
+    for (int i = 16; i >= 0; i--) {
+        d[i] = (char)('0' + M % 10);
+        M /= 10;
+    }
+    int nd = 17;
+    while (nd > 1 && d[nd - 1] == '0')
+        nd--;
+    if (v < 0)
+        *o++ = '-';
+    if (E < -4 || E >= 17) { /* %g's scientific form */
+        *o++ = d[0];
+        if (nd > 1) {
+            *o++ = '.';
+            memcpy(o, d + 1, (size_t)nd - 1);
+            o += nd - 1;
+        }
+        *o++ = 'e';
+        *o++ = E < 0 ? '-' : '+';
+        int ae = E < 0 ? -E : E;
+        if (ae < 10)
+            *o++ = '0';
+        return put_uint(o, (uint64_t)ae);
+    }
+    if (E >= 0) {
+        int ni = E + 1; /* integer digits, <= 17 */
+        memcpy(o, d, (size_t)ni);
+        o += ni;
+        if (nd > ni) {
+            *o++ = '.';
+            memcpy(o, d + ni, (size_t)(nd - ni));
+            o += nd - ni;
+        }
+        return o;
+    }
+    *o++ = '0';
+    *o++ = '.';
+    for (int i = 0; i < -E - 1; i++)
+        *o++ = '0';
+    memcpy(o, d, (size_t)nd);
+    return o + nd;
+}
+
+/* ---- buffered temporary file ------------------------------------------ */
+
+#define BUF_CAP (1u << 20)
+
+typedef struct {
+    int fd;
+    char *tmp, *final;
+    char *buf;
+    size_t len, cap;
+    jf_status st;
+    jf_error err;
+} wfile;
+
+static jf_status wf_fail(wfile *f, jf_status st, const char *fmt, ...)
+{
+    if (f->st != JF_OK)
+        return f->st;
+    f->st = st;
+    char why[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, sizeof why, fmt, ap);
+    va_end(ap);
+    jf_io_fail(&f->err, st, f->final ? f->final : "(output)", 0, "%s", why);
+    return st;
+}
+
+static jf_status wf_open(wfile *f, const char *path, size_t min_cap)
+{
+    memset(f, 0, sizeof *f);
+    f->fd = -1;
+    const char *slash = strrchr(path, '/');
+    size_t dirlen = slash ? (size_t)(slash - path + 1) : 0;
+    const char *base = path + dirlen;
+    size_t n = strlen(path) + 48;
+    f->final = strdup(path);
+    f->tmp = malloc(n);
+    f->cap = min_cap > BUF_CAP ? min_cap : BUF_CAP;
+    f->buf = malloc(f->cap);
+    if (!f->final || !f->tmp || !f->buf) {
+        return wf_fail(f, JF_ERR_NOMEM, "out of memory");
+    }
+    if (!*base)
+        return wf_fail(f, JF_ERR_INVALID, "no file name");
+    snprintf(f->tmp, n, "%.*s.%s.tmp.%ld", (int)dirlen, path, base,
+             (long)getpid());
+    f->fd = open(f->tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (f->fd < 0)
+        return wf_fail(f, JF_ERR_IO, "cannot create %s: %s", f->tmp,
+                       strerror(errno));
+    return JF_OK;
+}
+
+static jf_status wf_flush(wfile *f)
+{
+    size_t done = 0;
+    while (f->st == JF_OK && done < f->len) {
+        ssize_t w = write(f->fd, f->buf + done, f->len - done);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return wf_fail(f, JF_ERR_IO, "write failed: %s",
+                           w < 0 ? strerror(errno) : "no progress");
+        done += (size_t)w;
+    }
+    f->len = 0;
+    return f->st;
+}
+
+/* Room for `need` more bytes in the buffer (need <= cap). */
+static inline char *wf_room(wfile *f, size_t need)
+{
+    if (f->cap - f->len < need && wf_flush(f) != JF_OK)
+        return NULL;
+    return f->buf + f->len;
+}
+
+static jf_status wf_puts(wfile *f, const char *s)
+{
+    size_t n = strlen(s);
+    while (n) {
+        char *o = wf_room(f, 1);
+        if (!o)
+            return f->st;
+        size_t k = f->cap - f->len < n ? f->cap - f->len : n;
+        memcpy(o, s, k);
+        f->len += k;
+        s += k;
+        n -= k;
+    }
+    return f->st;
+}
+
+/* Frees f; on success (st OK) renames the temporary onto the final name,
+ * else removes it.  Returns the final status and fills err. */
+static jf_status wf_close(wfile *f, jf_error *err)
+{
+    jf_status st = f->st;
+    if (st == JF_OK)
+        st = wf_flush(f);
+    if (f->fd >= 0 && close(f->fd) != 0 && st == JF_OK)
+        st = wf_fail(f, JF_ERR_IO, "close failed: %s", strerror(errno));
+    f->fd = -1;
+    if (st == JF_OK && (!f->tmp || rename(f->tmp, f->final) != 0))
+        st = wf_fail(f, JF_ERR_IO, "cannot rename %s onto it: %s", f->tmp,
+                     strerror(errno));
+    if (st != JF_OK && f->tmp)
+        unlink(f->tmp);
+    if (err)
+        *err = f->err;
+    if (err && st == JF_ERR_NOMEM && !f->err.msg[0])
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+    free(f->tmp);
+    free(f->final);
+    free(f->buf);
+    return st;
+}
+
+/* ---- the table writer ------------------------------------------------- */
+
+enum { FMT_PLY, FMT_CSV, FMT_XYZ };
+
+struct jf_writer {
+    wfile f;
+    int fmt, ascii;
+    size_t ncols, nrows, rows;
+    jf_col_type *types;
+    char **names;
+    int header_done;
+    size_t nfaces;
+    const size_t *foff;
+    const uint32_t *fidx;
+};
+
+static int host_little(void)
+{
+    const uint16_t one = 1;
+    return *(const unsigned char *)&one == 1;
+}
+
+static int32_t to_i32(double v)
+{
+    if (!(v >= -2147483648.0 && v <= 2147483647.0))
+        return INT32_MIN;
+    return (int32_t)lround(v);
+}
+
+static jf_status write_header(jf_writer *w)
+{
+    wfile *f = &w->f;
+    static const char *const ply_t[] = {"double", "float", "int"};
+    char line[128];
+    w->header_done = 1;
+    if (w->fmt == FMT_PLY) {
+        snprintf(line, sizeof line, "ply\nformat %s 1.0\n",
+                 w->ascii ? "ascii" : "binary_little_endian");
+        wf_puts(f, line);
+        wf_puts(f, "comment written by jetfit " JF_VERSION_STRING "\n");
+        snprintf(line, sizeof line, "element vertex %zu\n", w->nrows);
+        wf_puts(f, line);
+        for (size_t j = 0; j < w->ncols; j++) {
+            wf_puts(f, "property ");
+            wf_puts(f, ply_t[w->types[j]]);
+            wf_puts(f, " ");
+            wf_puts(f, w->names[j]);
+            wf_puts(f, "\n");
+        }
+        if (w->foff) {
+            snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
+            wf_puts(f, line);
+            wf_puts(f, "property list uchar int vertex_indices\n");
+        }
+        return wf_puts(f, "end_header\n");
+    }
+    wf_puts(f, w->fmt == FMT_CSV ? "" : "# ");
+    for (size_t j = 0; j < w->ncols; j++) {
+        if (j)
+            wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
+        wf_puts(f, w->names[j]);
+    }
+    return wf_puts(f, "\n");
+}
+
+jf_status jf_writer_open(const char *path, const jf_column *cols,
+                         size_t ncols, size_t nrows, int ascii,
+                         jf_writer **out, jf_error *err)
+{
+    if (out)
+        *out = NULL;
+    if (err)
+        err->msg[0] = '\0';
+    const char *nm = path ? path : "(null)";
+    if (!path || !cols || !out || ncols == 0 || ncols > 4096)
+        return jf_io_fail(err, JF_ERR_INVALID, nm, 0,
+                          "invalid writer arguments");
+    jf_format fmt = jf_format_from_path(path);
+    if (fmt != JF_FMT_PLY && fmt != JF_FMT_CSV && fmt != JF_FMT_XYZ)
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, nm, 0,
+                          "cannot write a table in this format (use .ply, "
+                          ".csv, .xyz or .txt)");
+    for (size_t j = 0; j < ncols; j++) {
+        const char *c = cols[j].name;
+        int bad = !c || !*c || (unsigned)cols[j].type > JF_COL_I32;
+        for (; c && *c && !bad; c++)
+            bad = (unsigned char)*c <= ' ' || *c == ',' || *c == '#';
+        if (bad)
+            return jf_io_fail(err, JF_ERR_INVALID, nm, 0,
+                              "column %zu: bad name or type", j);
+    }
+    jf_writer *w = calloc(1, sizeof *w);
+    if (!w)
+        return jf_io_fail(err, JF_ERR_NOMEM, nm, 0, "out of memory");
+    w->fmt = fmt == JF_FMT_PLY ? FMT_PLY : fmt == JF_FMT_CSV ? FMT_CSV
+                                                             : FMT_XYZ;
+    w->ascii = ascii != 0;
+    w->ncols = ncols;
+    w->nrows = nrows;
+    w->types = malloc(ncols * sizeof *w->types);
+    w->names = calloc(ncols, sizeof *w->names);
+    jf_status st = JF_OK;
+    /* a row takes at most 32 bytes per value */
+    if (wf_open(&w->f, path, ncols * 32 + 64) != JF_OK)
+        st = w->f.st != JF_OK ? w->f.st : JF_ERR_NOMEM;
+    for (size_t j = 0; st == JF_OK && j < ncols; j++) {
+        if (!w->types || !w->names || !(w->names[j] = strdup(cols[j].name)))
+            st = wf_fail(&w->f, JF_ERR_NOMEM, "out of memory");
+        else
+            w->types[j] = cols[j].type;
+    }
+    if (st != JF_OK) {
+        if (err) {
+            *err = w->f.err;
+            if (!err->msg[0])
+                jf_io_fail(err, st, nm, 0, "out of memory");
+        }
+        jf_writer_abort(w);
+        return st;
+    }
+    *out = w;
+    return JF_OK;
+}
+
+jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
+                          const uint32_t *idx)
+{
+    if (!w || w->header_done || (nfaces && (!off || !idx)))
+        return JF_ERR_INVALID;
+    for (size_t f = 0; f < nfaces; f++) {
+        if (off[f + 1] < off[f] || off[f + 1] - off[f] > 255)
+            return JF_ERR_INVALID;
+        for (size_t k = off[f]; k < off[f + 1]; k++)
+            if (idx[k] >= w->nrows)
+                return JF_ERR_INVALID;
+    }
+    w->nfaces = nfaces;
+    w->foff = off;
+    w->fidx = idx;
+    return JF_OK;
+}
+
+jf_status jf_writer_row(jf_writer *w, const double *vals)
+{
+    if (!w || !vals)
+        return JF_ERR_INVALID;
+    wfile *f = &w->f;
+    if (f->st != JF_OK)
+        return f->st;
+    if (!w->header_done && write_header(w) != JF_OK)
+        return f->st;
+    if (w->rows == w->nrows)
+        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
+                       w->nrows);
+    char *o = wf_room(f, w->ncols * 32 + 2);
+    if (!o)
+        return f->st;
+    char *o0 = o;
+    if (w->fmt == FMT_PLY && !w->ascii) {
+        int little = host_little();
+        for (size_t j = 0; j < w->ncols; j++) {
+            unsigned char b[8];
+            size_t n;
+            if (w->types[j] == JF_COL_F64) {
+                memcpy(b, &vals[j], 8), n = 8;
+            } else if (w->types[j] == JF_COL_F32) {
+                float x = (float)vals[j];
+                memcpy(b, &x, 4), n = 4;
+            } else {
+                int32_t x = to_i32(vals[j]);
+                memcpy(b, &x, 4), n = 4;
+            }
+            if (little) {
+                memcpy(o, b, n);
+            } else {
+                for (size_t i = 0; i < n; i++)
+                    o[i] = (char)b[n - 1 - i];
+            }
+            o += n;
+        }
+    } else {
+        char sep = w->fmt == FMT_CSV ? ',' : ' ';
+        for (size_t j = 0; j < w->ncols; j++) {
+            if (j)
+                *o++ = sep;
+            double v = vals[j];
+            if (w->types[j] == JF_COL_F64) {
+                o = jf_fmt_g17(o, v);
+            } else if (w->types[j] == JF_COL_F32) {
+                float x = (float)v;
+                if (isnan(x))
+                    memcpy(o, "nan", 3), o += 3;
+                else
+                    o += snprintf(o, 32, "%.9g", (double)x);
+            } else {
+                int32_t x = to_i32(v);
+                if (x < 0)
+                    *o++ = '-';
+                o = put_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
+            }
+        }
+        *o++ = '\n';
+    }
+    f->len += (size_t)(o - o0);
+    w->rows++;
+    return JF_OK;
+}
+
+static jf_status write_faces(jf_writer *w)
+{
+    wfile *f = &w->f;
+    int little = host_little();
+    for (size_t i = 0; i < w->nfaces && f->st == JF_OK; i++) {
+        size_t k = w->foff[i + 1] - w->foff[i];
+        char *o = wf_room(f, 16 * k + 8);
+        if (!o)
+            break;
+        char *o0 = o;
+        const uint32_t *ix = w->fidx + w->foff[i];
+        if (w->ascii) {
+            o = put_uint(o, k);
+            for (size_t j = 0; j < k; j++) {
+                *o++ = ' ';
+                o = put_uint(o, ix[j]);
+            }
+            *o++ = '\n';
+        } else {
+            *o++ = (char)(unsigned char)k;
+            for (size_t j = 0; j < k; j++) {
+                int32_t x = (int32_t)ix[j];
+                unsigned char b[4];
+                memcpy(b, &x, 4);
+                for (int t = 0; t < 4; t++)
+                    *o++ = (char)(little ? b[t] : b[3 - t]);
+            }
+        }
+        f->len += (size_t)(o - o0);
+    }
+    return f->st;
+}
+
+jf_status jf_writer_commit(jf_writer *w, jf_error *err)
+{
+    if (!w)
+        return JF_ERR_INVALID;
+    wfile *f = &w->f;
+    if (f->st == JF_OK && !w->header_done)
+        write_header(w);
+    if (f->st == JF_OK && w->rows != w->nrows)
+        wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced",
+                w->rows, w->nrows);
+    if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
+        write_faces(w);
+    jf_status st = wf_close(f, err);
+    for (size_t j = 0; w->names && j < w->ncols; j++)
+        free(w->names[j]);
+    free(w->names);
+    free(w->types);
+    free(w);
+    return st;
+}
+
+void jf_writer_abort(jf_writer *w)
+{
+    if (!w)
+        return;
+    if (w->f.st == JF_OK)
+        w->f.st = JF_ERR_INVALID; /* makes wf_close remove the temporary */
+    wf_close(&w->f, NULL);
+    for (size_t j = 0; w->names && j < w->ncols; j++)
+        free(w->names[j]);
+    free(w->names);
+    free(w->types);
+    free(w);
+}
+
+/* ---- clouds and meshes -------------------------------------------------- */
+
+static jf_status write_off(const char *path, const jf_cloud *c, jf_error *err)
+{
+    wfile f;
+    if (wf_open(&f, path, 4096) != JF_OK)
+        return wf_close(&f, err);
+    char line[96];
+    wf_puts(&f, c->nrm ? "NOFF\n" : "OFF\n");
+    snprintf(line, sizeof line, "%zu %zu 0\n", c->n, c->nfaces);
+    wf_puts(&f, line);
+    int nc = c->nrm ? 6 : 3;
+    for (size_t i = 0; i < c->n && f.st == JF_OK; i++) {
+        char *o = wf_room(&f, 6 * 32 + 2);
+        if (!o)
+            break;
+        char *o0 = o;
+        for (int j = 0; j < nc; j++) {
+            if (j)
+                *o++ = ' ';
+            o = jf_fmt_g17(o, j < 3 ? c->xyz[3 * i + j] : c->nrm[3 * i + j - 3]);
+        }
+        *o++ = '\n';
+        f.len += (size_t)(o - o0);
+    }
+    for (size_t i = 0; i < c->nfaces && f.st == JF_OK; i++) {
+        size_t k = c->face_off[i + 1] - c->face_off[i];
+        if (k > 1000000) {
+            wf_fail(&f, JF_ERR_INVALID, "face %zu: bad offsets", i);
+            break;
+        }
+        char *o = wf_room(&f, 12 * k + 24);
+        if (!o)
+            break;
+        char *o0 = o;
+        o = put_uint(o, k);
+        for (size_t j = 0; j < k; j++) {
+            *o++ = ' ';
+            o = put_uint(o, c->face_idx[c->face_off[i] + j]);
+        }
+        *o++ = '\n';
+        f.len += (size_t)(o - o0);
+    }
+    return wf_close(&f, err);
+}
+
+jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
+                         jf_error *err)
+{
+    const char *nm = path ? path : "(null)";
+    if (err)
+        err->msg[0] = '\0';
+    if (!path || !c || (c->n && !c->xyz) ||
+        (c->nfaces && (!c->face_off || !c->face_idx)))
+        return jf_io_fail(err, JF_ERR_INVALID, nm, 0, "invalid arguments");
+    if (jf_format_from_path(path) == JF_FMT_OFF)
+        return write_off(path, c, err);
+    static const char *const names[6] = {"x", "y", "z", "nx", "ny", "nz"};
+    jf_column cols[6];
+    size_t nc = c->nrm ? 6 : 3;
+    for (size_t j = 0; j < nc; j++)
+        cols[j] = (jf_column){names[j], JF_COL_F64};
+    jf_writer *w;
+    jf_status st = jf_writer_open(path, cols, nc, c->n, ascii, &w, err);
+    if (st != JF_OK)
+        return st;
+    if (c->nfaces && (st = jf_writer_faces(w, c->nfaces, c->face_off,
+                                           c->face_idx)) != JF_OK) {
+        jf_writer_abort(w);
+        return jf_io_fail(err, st, nm, 0, "a face has more than 255 "
+                                          "vertices or bad offsets");
+    }
+    for (size_t i = 0; i < c->n && st == JF_OK; i++) {
+        double v[6];
+        memcpy(v, c->xyz + 3 * i, 3 * sizeof(double));
+        if (c->nrm)
+            memcpy(v + 3, c->nrm + 3 * i, 3 * sizeof(double));
+        st = jf_writer_row(w, v);
+    }
+    return jf_writer_commit(w, err);
+}
