@@ -351,12 +351,11 @@ int jf_cmd_estimate(int argc, char **argv)
     const char *why = NULL;
     if (jf_nb_parse(nbspec, &o.nb, &why) != JF_OK)
         return bad_option("--neighbors", nbspec, why ? why : "bad neighbourhood");
-    if (monge < 0) monge = o.params.degree < JF_MAX_MONGE_DEGREE ? o.params.degree
-                                                                 : JF_MAX_MONGE_DEGREE;
-    if (monge < 2) monge = 2; /* degree 1: no curvature; columns stay (NaN) */
-    else if (monge > o.params.degree)
-        return bad_option("--monge-degree", "", "must not exceed --degree");
-    o.params.monge_degree = monge < o.params.degree ? monge : o.params.degree;
+    /* degree 1 has no curvature: monge 2, its columns are NaN */
+    int top = o.params.degree < 2 ? 2 : o.params.degree;
+    if (monge < 0) monge = top < JF_MAX_MONGE_DEGREE ? top : JF_MAX_MONGE_DEGREE;
+    else if (monge > top) return bad_option("--monge-degree", "", "must not exceed --degree");
+    o.params.monge_degree = monge;
     /* the fitter must accept the largest neighbourhood we may hand it */
     size_t need = o.nb.kind == JF_NB_KNN || o.nb.kind == JF_NB_KNN_RADIUS ? o.nb.k : o.nb.n;
     for (int j = 0; j < o.params.nscales; j++)
