@@ -38,6 +38,8 @@ static int parse_radius(const char *s, const char **rest, double *out)
     errno = 0;
     double r = strtod(s, &end);
     if (end == s || errno == ERANGE || !isfinite(r) || !(r > 0)) return 0;
+    for (const char *c = s; c < end; c++) /* no hex floats */
+        if (!strchr("0123456789.eE+-", *c)) return 0;
     *rest = end;
     *out = r;
     return 1;
