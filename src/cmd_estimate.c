@@ -228,7 +228,7 @@ static size_t make_row(const double *p, const jf_result *r, int monge, double *v
 
 int jf_cmd_estimate(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *nbspec = DEFAULT_NEIGHBORS;
+    const char *in = NULL, *out = NULL, *nbspec = DEFAULT_NEIGHBORS, *monge_s = "";
     int quiet = 0, ascii = 0, monge = -1, orient_set = 0;
     jf_estimate_opts o;
     jf_read_opts ro;
@@ -280,6 +280,7 @@ int jf_cmd_estimate(int argc, char **argv)
             if (parse_int(val, 2, JF_MAX_MONGE_DEGREE, &iv))
                 return bad_option(name, val, "expected 2, 3 or 4");
             monge = iv;
+            monge_s = val;
         } else if (!strcmp(name, "--fit")) {
             if (!strcmp(val, "approx")) o.params.fit = JF_FIT_APPROX;
             else if (!strcmp(val, "interp")) o.params.fit = JF_FIT_INTERP;
@@ -354,7 +355,7 @@ int jf_cmd_estimate(int argc, char **argv)
     /* degree 1 has no curvature: monge 2, its columns are NaN */
     int top = o.params.degree < 2 ? 2 : o.params.degree;
     if (monge < 0) monge = top < JF_MAX_MONGE_DEGREE ? top : JF_MAX_MONGE_DEGREE;
-    else if (monge > top) return bad_option("--monge-degree", "", "must not exceed --degree");
+    else if (monge > top) return bad_option("--monge-degree", monge_s, "must not exceed --degree");
     o.params.monge_degree = monge;
     /* the fitter must accept the largest neighbourhood we may hand it */
     size_t need = o.nb.kind == JF_NB_KNN || o.nb.kind == JF_NB_KNN_RADIUS ? o.nb.k : o.nb.n;

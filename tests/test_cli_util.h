@@ -23,7 +23,7 @@
 static char cli_dir[256];     /* the test's temporary folder       */
 static char cli_err[8192];    /* stderr of the last run            */
 
-static void cli_setup(void)
+static inline void cli_setup(void)
 {
     snprintf(cli_dir, sizeof cli_dir, "/tmp/jf_cli_XXXXXX");
     if (!mkdtemp(cli_dir)) {
@@ -33,7 +33,7 @@ static void cli_setup(void)
 }
 
 /* Removes the folder and everything in it (flat). */
-static void cli_teardown(void)
+static inline void cli_teardown(void)
 {
     DIR *d = opendir(cli_dir);
     if (d) {
@@ -50,7 +50,7 @@ static void cli_teardown(void)
 }
 
 /* cli_dir "/" name, in a rotating static buffer (8 live paths). */
-static const char *cli_path(const char *name)
+static inline const char *cli_path(const char *name)
 {
     static char buf[8][512];
     static int k;
@@ -59,14 +59,14 @@ static const char *cli_path(const char *name)
     return buf[k];
 }
 
-static int cli_exists(const char *path)
+static inline int cli_exists(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0;
 }
 
 /* Number of entries in cli_dir (to see that no temporary was left). */
-static int cli_count_files(void)
+static inline int cli_count_files(void)
 {
     int n = 0;
     DIR *d = opendir(cli_dir);
@@ -79,7 +79,7 @@ static int cli_count_files(void)
 
 /* Runs `jetfit ARGS...` (NULL-terminated), stdout to /dev/null, stderr
  * captured in cli_err.  Returns the exit status (or 128 + signal). */
-static int cli_run(const char *first, ...)
+static inline int cli_run(const char *first, ...)
 {
     const char *argv[64];
     int argc = 0;
@@ -116,7 +116,7 @@ static int cli_run(const char *first, ...)
     return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
-static void cli_write_text(const char *path, const char *text)
+static inline void cli_write_text(const char *path, const char *text)
 {
     FILE *f = fopen(path, "wb");
     if (!f) exit(2);
@@ -125,7 +125,7 @@ static void cli_write_text(const char *path, const char *text)
 }
 
 /* Fibonacci sphere: n points, radius R, centre c. */
-static void cli_sphere(size_t n, double R, const double c[3], double *xyz)
+static inline void cli_sphere(size_t n, double R, const double c[3], double *xyz)
 {
     const double ga = M_PI * (3.0 - sqrt(5.0));
     for (size_t i = 0; i < n; i++) {
@@ -138,7 +138,7 @@ static void cli_sphere(size_t n, double R, const double c[3], double *xyz)
 
 /* The §6.1 surface z = 0.1 exp(2x + y - y^2) on a jittered grid, in a
  * shuffled order (so input order is not the spatial order). */
-static void cli_surface61(size_t side, double *xyz, unsigned long long seed)
+static inline void cli_surface61(size_t side, double *xyz, unsigned long long seed)
 {
     size_t n = side * side;
     double h = 1.0 / (double)side;
@@ -165,7 +165,7 @@ static void cli_surface61(size_t side, double *xyz, unsigned long long seed)
 }
 
 /* Writes x y z [nx ny nz] as .xyz text with %.17g (exact). */
-static void cli_write_xyz(const char *path, const double *xyz, const double *nrm, size_t n)
+static inline void cli_write_xyz(const char *path, const double *xyz, const double *nrm, size_t n)
 {
     FILE *f = fopen(path, "w");
     if (!f) exit(2);
@@ -177,7 +177,7 @@ static void cli_write_xyz(const char *path, const double *xyz, const double *nrm
     fclose(f);
 }
 
-static void put_be64(FILE *f, double v)
+static inline void put_be64(FILE *f, double v)
 {
     uint64_t u;
     memcpy(&u, &v, 8);
@@ -186,7 +186,7 @@ static void put_be64(FILE *f, double v)
 
 /* Writes a PLY of x y z doubles: fmt 0 ascii, 1 binary LE, 2 binary BE,
  * with an extra float property and a comment to be skipped. */
-static void cli_write_ply(const char *path, const double *xyz, size_t n, int fmt)
+static inline void cli_write_ply(const char *path, const double *xyz, size_t n, int fmt)
 {
     static const char *const names[] = {"ascii", "binary_little_endian", "binary_big_endian"};
     FILE *f = fopen(path, "wb");
@@ -213,7 +213,7 @@ static void cli_write_ply(const char *path, const double *xyz, size_t n, int fmt
 }
 
 /* Reads an output table; aborts the test process on failure. */
-static void cli_read(const char *path, jf_eval_table *t)
+static inline void cli_read(const char *path, jf_eval_table *t)
 {
     jf_error e = {{0}};
     if (jf_eval_table_read(path, t, &e) != JF_OK) {
@@ -223,7 +223,7 @@ static void cli_read(const char *path, jf_eval_table *t)
 }
 
 /* Value of column `name` in row i. */
-static double cli_val(const jf_eval_table *t, size_t i, const char *name)
+static inline double cli_val(const jf_eval_table *t, size_t i, const char *name)
 {
     int c = jf_eval_table_col(t, name);
     if (c < 0) {
