@@ -1,12 +1,216 @@
-/* cmd_convergence.c -- `jetfit convergence` (placeholder until its issue lands). */
+/* cmd_convergence.c -- `jetfit convergence --out DIR [--quick]`: the §6.1
+ * experiment end to end (src/convergence.c), its tables and the plots of
+ * Figures 5-12 made with gnuplot (optional: without it the CSVs are still
+ * written and a note goes to stderr). */
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
 
 #include "cmd.h"
+#include "convergence.h"
+#include "jetfit.h"
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+        "usage: jetfit convergence --out DIR [--quick] [--seed S] [--no-plots]\n"
+        "\n"
+        "The paper's 6.1 experiment: f(u,v) = 0.1 exp(2u + v - v^2) on a\n"
+        "triangulated square grid of side h = 2^-2 .. 2^-6, each vertex moved by\n"
+        "(d h, d' h), d, d' uniform in [0, 0.9]; jets of degree 1..9 by\n"
+        "interpolation (N_n points) and approximation (the fewest whole mesh\n"
+        "rings with >= 2 N_n points) at the grid vertices nearest to a 5 x 5\n"
+        "lattice over [-0.25, 0.25]^2; errors against the exact values: sine of\n"
+        "the normal angle, relative errors of kmin and kmax (average, maximum).\n"
+        "\n"
+        "  --out DIR   writes DIR/convergence.csv\n"
+        "              (mode,degree,h,normal_avg,normal_max,kmin_avg,kmin_max,\n"
+        "              kmax_avg,kmax_max), DIR/slopes.csv (mode,degree,\n"
+        "              normal_slope,kmin_slope,kmax_slope: least-squares slopes of\n"
+        "              log(1/delta_avg) against log(1/h), Theorem 3 predicts\n"
+        "              n - k + 1), DIR/slopes_points.csv (how many h, from the\n"
+        "              coarsest, each slope used: the points above the double-\n"
+        "              precision floor), DIR/convergence.gp and its PNGs\n"
+        "  --quick     degrees 1..4 and a 3 x 3 lattice (seconds; for CI)\n"
+        "  --seed S    grid perturbation seed (default 1); same seed, same bits\n"
+        "  --no-plots  do not run gnuplot\n");
+}
+
+static const char *mode_name(jf_fit_mode m) { return m == JF_FIT_INTERP ? "interp" : "approx"; }
+
+static FILE *open_in(const char *dir, const char *name, char *path, size_t len)
+{
+    snprintf(path, len, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        fprintf(stderr, "jetfit convergence: %s: %s\n", path, strerror(errno));
+    return f;
+}
+
+static int close_checked(FILE *f, const char *path)
+{
+    int bad = ferror(f);
+    if (fclose(f) || bad) {
+        fprintf(stderr, "jetfit convergence: %s: write failed\n", path);
+        return -1;
+    }
+    return 0;
+}
+
+/* The gnuplot script: Figs. 5-10 (log(1/delta) vs log(1/h) per degree)
+ * and Figs. 11-12 (log(1/delta)/log(1/h) vs degree at h = hfix). */
+static int write_script(const char *dir, const jf_conv_config *c, double hfix)
+{
+    char path[4096];
+    FILE *f = open_in(dir, "convergence.gp", path, sizeof path);
+    if (!f)
+        return -1;
+    static const char *qn[3] = {"normal", "kmin", "kmax"};
+    fprintf(f, "# made by jetfit convergence; run in this folder: gnuplot convergence.gp\n"
+               "set terminal pngcairo size 640,480 font ',10'\n"
+               "set datafile separator ','\nset key outside right\nset grid\n"
+               "set xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
+    for (int m = 0; m < 2; m++) {
+        const char *mn = m ? "approx" : "interp";
+        if ((m == 0 && !c->interp) || (m == 1 && !c->approx))
+            continue;
+        for (int q = 0; q < 3; q++) {
+            fprintf(f, "set output '%s_%s.png'\n"
+                       "set title 'exp graph: %s error (average) vs h, %s'\n"
+                       "plot for [d=%d:%d] 'convergence.csv' skip 1 using "
+                       "(strcol(1) eq '%s' && $2 == d ? log(1/$3) : 1/0):"
+                       "(log(1/$%d)) with linespoints title sprintf('deg %%d', d)\n",
+                    qn[q], mn, qn[q], mn, c->deg_lo, c->deg_hi, mn, 4 + 2 * q);
+        }
+        fprintf(f, "set output 'degree_%s.png'\nset xlabel 'degree'\n"
+                   "set ylabel 'log(1/delta)/log(1/h)'\n"
+                   "set title sprintf('exp graph: errors vs degree at h = %%g, %s', %.17g)\n"
+                   "plot ",
+                mn, mn, hfix);
+        for (int q = 0; q < 3; q++)
+            for (int a = 0; a < 2; a++)
+                fprintf(f, "%s'convergence.csv' skip 1 using "
+                           "(strcol(1) eq '%s' && $3 == %.17g ? $2 : 1/0):"
+                           "(log(1/$%d)/log(1/$3)) with linespoints title '%s_%s'",
+                        q + a ? ", " : "", mn, hfix, 4 + 2 * q + a, qn[q],
+                        a ? "max" : "av");
+        fprintf(f, "\nset xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
+    }
+    return close_checked(f, path);
+}
 
 int jf_cmd_convergence(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    fprintf(stderr, "jetfit convergence: not implemented yet\n");
-    return 2;
+    const char *dir = NULL;
+    int quick = 0, plots = 1;
+    unsigned long long seed = 1;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            usage(stdout);
+            return 0;
+        } else if (!strcmp(argv[i], "--quick")) {
+            quick = 1;
+        } else if (!strcmp(argv[i], "--no-plots")) {
+            plots = 0;
+        } else if (!strcmp(argv[i], "--out") && i + 1 < argc) {
+            dir = argv[++i];
+        } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+            char *end;
+            const char *v = argv[++i];
+            errno = 0;
+            seed = strtoull(v, &end, 10);
+            if (end == v || *end || errno || *v == '-') {
+                fprintf(stderr, "jetfit convergence: --seed wants a non-negative integer, not '%s'\n", v);
+                return 2;
+            }
+        } else {
+            fprintf(stderr, "jetfit convergence: unknown or incomplete option '%s' (jetfit convergence --help)\n", argv[i]);
+            return 2;
+        }
+    }
+    if (!dir) {
+        fprintf(stderr, "jetfit convergence: --out DIR is required (jetfit convergence --help)\n");
+        return 2;
+    }
+    if (mkdir(dir, 0777) && errno != EEXIST) {
+        fprintf(stderr, "jetfit convergence: cannot create %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    jf_conv_config c;
+    jf_conv_config_init(&c, quick);
+    c.seed = seed;
+    size_t nr = jf_conv_row_count(&c);
+    jf_conv_row *rows = calloc(nr, sizeof *rows);
+    jf_status st = rows ? jf_conv_run(&c, rows) : JF_ERR_NOMEM;
+    if (st) {
+        fprintf(stderr, "jetfit convergence: %s\n", jf_strerror(st));
+        free(rows);
+        return 1;
+    }
+    char p1[4096], p2[4096], p3[4096];
+    FILE *fc = open_in(dir, "convergence.csv", p1, sizeof p1);
+    FILE *fs = fc ? open_in(dir, "slopes.csv", p2, sizeof p2) : NULL;
+    FILE *fu = fs ? open_in(dir, "slopes_points.csv", p3, sizeof p3) : NULL;
+    if (!fu) {
+        if (fc) fclose(fc);
+        if (fs) fclose(fs);
+        free(rows);
+        return 1;
+    }
+    fprintf(fc, "mode,degree,h,normal_avg,normal_max,kmin_avg,kmin_max,kmax_avg,kmax_max\n");
+    fprintf(fs, "mode,degree,normal_slope,kmin_slope,kmax_slope\n");
+    fprintf(fu, "mode,degree,normal_used,kmin_used,kmax_used\n");
+    printf("%-6s %3s  %14s %14s %14s   (Theorem 3: n, n-1, n-1)\n", "mode", "deg",
+           "normal_slope", "kmin_slope", "kmax_slope");
+    size_t lowered = 0, failed = 0;
+    for (size_t g = 0; g < nr; g += (size_t)c.nh) {
+        const jf_conv_row *r = rows + g;
+        for (int k = 0; k < c.nh; k++) {
+            fprintf(fc, "%s,%d,%.17g", mode_name(r[k].mode), r[k].degree, r[k].h);
+            for (int q = 0; q < 3; q++)
+                fprintf(fc, ",%.17g,%.17g", r[k].avg[q], r[k].max[q]);
+            fprintf(fc, "\n");
+            lowered += r[k].lowered;
+            failed += r[k].failed;
+        }
+        size_t used[3];
+        double sl[3];
+        for (int q = 0; q < 3; q++)
+            sl[q] = jf_conv_slope(r, (size_t)c.nh, q, &used[q]);
+        fprintf(fs, "%s,%d,%.17g,%.17g,%.17g\n", mode_name(r->mode), r->degree,
+                sl[0], sl[1], sl[2]);
+        fprintf(fu, "%s,%d,%zu,%zu,%zu\n", mode_name(r->mode), r->degree, used[0],
+                used[1], used[2]);
+        printf("%-6s %3d  %8.2f (%zu h) %8.2f (%zu h) %8.2f (%zu h)\n", mode_name(r->mode),
+               r->degree, sl[0], used[0], sl[1], used[1], sl[2], used[2]);
+    }
+    free(rows);
+    int bad = close_checked(fc, p1) | close_checked(fs, p2) | close_checked(fu, p3);
+    if (bad)
+        return 1;
+    if (lowered || failed)
+        fprintf(stderr, "jetfit convergence: note: %zu fits were rank deficient "
+                        "(lower degree), %zu failed\n", lowered, failed);
+    double hfix = c.h[c.nh > 2 ? 2 : c.nh - 1];
+    if (write_script(dir, &c, hfix))
+        return 1;
+    if (!plots)
+        return 0;
+    if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
+        fprintf(stderr, "jetfit convergence: gnuplot not found: CSVs written, no plots "
+                        "(install gnuplot-nox, then run gnuplot convergence.gp in %s)\n", dir);
+        return 0;
+    }
+    if (strchr(dir, '\'')) {
+        fprintf(stderr, "jetfit convergence: folder name has a quote; run gnuplot convergence.gp in it yourself\n");
+        return 0;
+    }
+    char cmd[4200];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot convergence.gp", dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "jetfit convergence: gnuplot failed; CSVs are written\n");
+    return 0;
 }
