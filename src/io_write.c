@@ -35,8 +35,9 @@ static char *put_uint(char *o, uint64_t v)
     return o;
 }
 
-/* M = round_half_even(|v| * 10^k) for 0 <= k <= 27; 0 if out of reach. */
-static int scaled(uint64_t m, int q, int k, uint64_t *out)
+/* For |v| = m 2^q: *out = round_half_even(|v| 10^k) and *fl its floor,
+ * 0 <= k <= 27 (5^27 m < 2^116: exact in 128 bits); 0 if out of reach. */
+static int scaled(uint64_t m, int q, int k, uint64_t *out, uint64_t *fl)
 {
     unsigned __int128 p = m;
     for (int i = 0; i < k; i++)
@@ -45,7 +46,7 @@ static int scaled(uint64_t m, int q, int k, uint64_t *out)
     if (s >= 0) {
         if (s > 10)
             return 0;
-        *out = (uint64_t)(p << s);
+        *out = *fl = (uint64_t)(p << s);
         return 1;
     }
     int r = -s;
@@ -53,6 +54,9 @@ static int scaled(uint64_t m, int q, int k, uint64_t *out)
         return 0;
     unsigned __int128 one = 1, t = p >> r, rem = p & ((one << r) - 1),
                       half = one << (r - 1);
+    if (t >> 64)
+        return 0;
+    *fl = (uint64_t)t;
     if (rem > half || (rem == half && (t & 1)))
         t++;
     if (t >> 64)
@@ -78,23 +82,25 @@ char *jf_fmt_g17(char *o, double v)
     uint64_t m = (bits & ((UINT64_C(1) << 52) - 1)) | (UINT64_C(1) << 52);
     int q = bexp - 1075;
     int E = (int)floor(log10(a));
-    uint64_t M = 0;
+    uint64_t M = 0, F = 0;
     const uint64_t lo = UINT64_C(10000000000000000), hi = lo * 10;
+    /* E = floor(log10|v|) may be off by one near powers of ten: the
+     * floor of |v| 10^(16-E) must have exactly 17 digits */
     for (int tries = 0;; tries++) {
         int k = 16 - E;
-        if (tries > 3 || k < 0 || k > 27 || !scaled(m, q, k, &M))
+        if (tries > 3 || k < 0 || k > 27 || !scaled(m, q, k, &M, &F))
             return o + snprintf(o, 32, "%.17g", v);
-        if (M > hi) { /* E estimated one too low */
+        if (F >= hi) {
             E++;
             continue;
         }
-        if (M < lo) {
+        if (F < lo) {
             E--;
             continue;
         }
         break;
     }
-    if (M == hi) { /* 10^(E+1) exactly, or rounding carried */
+    if (M == hi) { /* rounding carried into an 18th digit */
         M /= 10;
         E++;
     }
