@@ -1,0 +1,199 @@
+/* test_cli_formats.c -- `jetfit estimate` end to end on files: the same
+ * points in PLY ascii / binary LE / binary BE / CSV / XYZ give the same
+ * values in every output format; rows keep the input order exactly;
+ * --threads 1 and 2 write identical bytes; --columns; Monge columns. */
+#include <check.h>
+
+#include "test_cli_util.h"
+
+#define N 700
+
+static double pts[3 * N];
+
+/* The §6.1 surface, shuffled, offset far from the origin (as
+ * georeferenced scans are): coordinates are exact doubles in every
+ * input format (text is written with %.17g). */
+static void make_points(void)
+{
+    cli_surface61(26, pts, 99); /* 676 points */
+    for (size_t i = 676; i < N; i++) /* pad with a second copy, shifted */
+        for (int k = 0; k < 3; k++) pts[3 * i + k] = pts[3 * (i - 676) + k] + (k == 2 ? 3.0 : 0);
+    for (size_t i = 0; i < N; i++) pts[3 * i] += 4.5e5, pts[3 * i + 1] -= 5.2e6;
+}
+
+/* Same bits, NaN equal to NaN. */
+static int same(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static void assert_tables_equal(const jf_eval_table *a, const jf_eval_table *b, const char *what)
+{
+    ck_assert_msg(a->nrows == b->nrows && a->ncols == b->ncols, "%s: shape", what);
+    for (size_t j = 0; j < a->ncols; j++) ck_assert_str_eq(a->names[j], b->names[j]);
+    for (size_t i = 0; i < a->nrows * a->ncols; i++)
+        ck_assert_msg(same(a->v[i], b->v[i]), "%s: row %zu column %s: %.17g vs %.17g", what,
+                      i / a->ncols, a->names[i % a->ncols], a->v[i], b->v[i]);
+}
+
+START_TEST(input_formats_agree)
+{
+    make_points();
+    cli_write_xyz(cli_path("in.xyz"), pts, NULL, N);
+    cli_write_ply(cli_path("in_a.ply"), pts, N, 0);
+    cli_write_ply(cli_path("in_le.ply"), pts, N, 1);
+    cli_write_ply(cli_path("in_be.ply"), pts, N, 2);
+    FILE *f = fopen(cli_path("in.csv"), "w");
+    fprintf(f, "x,y,z\n");
+    for (size_t i = 0; i < N; i++)
+        fprintf(f, "%.17g,%.17g,%.17g\n", pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+    fclose(f);
+    static const char *const ins[] = {"in.xyz", "in_a.ply", "in_le.ply", "in_be.ply", "in.csv"};
+    jf_eval_table ref;
+    for (size_t k = 0; k < 5; k++) {
+        ck_assert_msg(cli_run("estimate", cli_path(ins[k]), "-o", cli_path("o.csv"), "--quiet",
+                              "--neighbors", "knn:20", NULL) == 0,
+                      "%s: %s", ins[k], cli_err);
+        jf_eval_table t;
+        cli_read(cli_path("o.csv"), &t);
+        if (k == 0) {
+            ref = t;
+            /* input order, exactly */
+            ck_assert_uint_eq(ref.nrows, N);
+            for (size_t i = 0; i < N; i++) {
+                ck_assert(same(cli_val(&ref, i, "x"), pts[3 * i]));
+                ck_assert(same(cli_val(&ref, i, "y"), pts[3 * i + 1]));
+                ck_assert(same(cli_val(&ref, i, "z"), pts[3 * i + 2]));
+                ck_assert_double_eq(cli_val(&ref, i, "status"), 0);
+                ck_assert_double_eq(cli_val(&ref, i, "neighbors"), 20);
+            }
+        } else {
+            assert_tables_equal(&ref, &t, ins[k]);
+            jf_eval_table_free(&t);
+        }
+    }
+    jf_eval_table_free(&ref);
+}
+END_TEST
+
+START_TEST(output_formats_agree)
+{
+    make_points();
+    cli_write_xyz(cli_path("in.xyz"), pts, NULL, N);
+    static const char *const outs[] = {"o.csv", "o.ply", "o_ascii.ply", "o.xyz", "o.txt"};
+    jf_eval_table ref;
+    for (size_t k = 0; k < 5; k++) {
+        int ascii = k == 2;
+        int rc = ascii ? cli_run("estimate", cli_path("in.xyz"), "-o", cli_path(outs[k]),
+                                 "--ascii", "--degree", "4", NULL)
+                       : cli_run("estimate", cli_path("in.xyz"), "-o", cli_path(outs[k]),
+                                 "--degree", "4", NULL);
+        ck_assert_msg(rc == 0, "%s: %s", outs[k], cli_err);
+        /* the summary names the output */
+        ck_assert(strstr(cli_err, outs[k]) != NULL);
+        jf_eval_table t;
+        cli_read(cli_path(outs[k]), &t);
+        if (k == 0) {
+            ref = t;
+            static const char *const names[] = {
+                "x",  "y",  "z",  "nx", "ny", "nz", "k1", "k2", "d1x", "d1y", "d1z",
+                "d2x", "d2y", "d2z", "b0", "b1", "b2", "b3", "c0", "c1", "c2", "c3",
+                "c4", "degree", "neighbors", "cond", "residual", "status"};
+            ck_assert_uint_eq(ref.ncols, sizeof names / sizeof names[0]);
+            for (size_t j = 0; j < ref.ncols; j++) ck_assert_str_eq(ref.names[j], names[j]);
+        } else {
+            assert_tables_equal(&ref, &t, outs[k]);
+            jf_eval_table_free(&t);
+        }
+    }
+    jf_eval_table_free(&ref);
+    /* the PLY header says binary little endian unless --ascii */
+    FILE *f = fopen(cli_path("o.ply"), "rb");
+    char head[64] = {0};
+    ck_assert(fread(head, 1, 40, f) == 40);
+    fclose(f);
+    ck_assert(strstr(head, "format binary_little_endian 1.0") != NULL);
+    /* default monge degree follows the degree: 2 -> no b, c columns */
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("d2.csv"), NULL), 0);
+    jf_eval_table t;
+    cli_read(cli_path("d2.csv"), &t);
+    ck_assert_int_eq(jf_eval_table_col(&t, "b0"), -1);
+    ck_assert_int_eq(jf_eval_table_col(&t, "status"), 18);
+    jf_eval_table_free(&t);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("d3.csv"),
+                             "--degree", "3", NULL), 0);
+    cli_read(cli_path("d3.csv"), &t);
+    ck_assert_int_eq(jf_eval_table_col(&t, "b3"), 17);
+    ck_assert_int_eq(jf_eval_table_col(&t, "c0"), -1);
+    jf_eval_table_free(&t);
+}
+END_TEST
+
+static int files_equal(const char *a, const char *b)
+{
+    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
+    int eq = fa && fb, ca, cb;
+    while (eq) {
+        ca = fgetc(fa);
+        cb = fgetc(fb);
+        if (ca != cb) eq = 0;
+        if (ca == EOF) break;
+    }
+    if (fa) fclose(fa);
+    if (fb) fclose(fb);
+    return eq;
+}
+
+START_TEST(threads_identical)
+{
+    make_points();
+    cli_write_ply(cli_path("in.ply"), pts, N, 1);
+    static const char *const nbs[] = {"knn:16", "radius:0.08", "knn:40,radius:0.06"};
+    for (size_t k = 0; k < 3; k++) {
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("t1.ply"),
+                                 "--threads", "1", "--neighbors", nbs[k], "--degree", "3",
+                                 "--orient", "mst", NULL), 0);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("t2.ply"),
+                                 "--threads", "2", "--neighbors", nbs[k], "--degree", "3",
+                                 "--orient", "mst", NULL), 0);
+        ck_assert_msg(files_equal(cli_path("t1.ply"), cli_path("t2.ply")), "%s", nbs[k]);
+    }
+}
+END_TEST
+
+/* --columns picks x y z out of wider rows (0-based). */
+START_TEST(columns_option)
+{
+    make_points();
+    cli_write_xyz(cli_path("in.xyz"), pts, NULL, N);
+    FILE *f = fopen(cli_path("wide.txt"), "w");
+    for (size_t i = 0; i < N; i++)
+        fprintf(f, "%zu 7 %.17g 9 %.17g %.17g\n", i, pts[3 * i + 2], pts[3 * i],
+                pts[3 * i + 1]);
+    fclose(f);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("a.csv"), NULL), 0);
+    ck_assert_msg(cli_run("estimate", cli_path("wide.txt"), "-o", cli_path("b.csv"),
+                          "--columns", "4,5,2", NULL) == 0, "%s", cli_err);
+    jf_eval_table a, b;
+    cli_read(cli_path("a.csv"), &a);
+    cli_read(cli_path("b.csv"), &b);
+    assert_tables_equal(&a, &b, "--columns");
+    jf_eval_table_free(&a);
+    jf_eval_table_free(&b);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("cli_formats");
+    TCase *tc = tcase_create("cli_formats");
+    tcase_add_checked_fixture(tc, cli_setup, cli_teardown);
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, input_formats_agree);
+    tcase_add_test(tc, output_formats_agree);
+    tcase_add_test(tc, threads_identical);
+    tcase_add_test(tc, columns_option);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failures = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failures ? 1 : 0;
+}
