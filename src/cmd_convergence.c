@@ -60,44 +60,53 @@ static int close_checked(FILE *f, const char *path)
     return 0;
 }
 
-/* The gnuplot script: Figs. 5-10 (log(1/delta) vs log(1/h) per degree)
- * and Figs. 11-12 (log(1/delta)/log(1/h) vs degree at h = hfix). */
-static int write_script(const char *dir, const jf_conv_config *c, double hfix)
+/* The gnuplot script: Figs. 5-10 (log(1/delta) vs log(1/h) per degree,
+ * read from convergence.csv) and Figs. 11-12 (log(1/delta)/log(1/h) vs
+ * degree at h = c->h[kfix], inline data blocks so the lines join). */
+static int write_script(const char *dir, const jf_conv_config *c,
+                        const jf_conv_row *rows, int kfix)
 {
     char path[4096];
     FILE *f = open_in(dir, "convergence.gp", path, sizeof path);
     if (!f)
         return -1;
     static const char *qn[3] = {"normal", "kmin", "kmax"};
+    int nd = c->deg_hi - c->deg_lo + 1;
     fprintf(f, "# made by jetfit convergence; run in this folder: gnuplot convergence.gp\n"
-               "set terminal pngcairo size 640,480 font ',10'\n"
-               "set datafile separator ','\nset key outside right\nset grid\n"
-               "set xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
-    for (int m = 0; m < 2; m++) {
+               "set terminal pngcairo size 640,480 font ',10' noenhanced\n"
+               "set datafile separator ','\nset key outside right\nset grid\n");
+    for (int m = 0, g = 0; m < 2; m++) {
         const char *mn = m ? "approx" : "interp";
         if ((m == 0 && !c->interp) || (m == 1 && !c->approx))
             continue;
-        for (int q = 0; q < 3; q++) {
+        fprintf(f, "$deg_%s << EOD\n", mn);
+        for (int d = 0; d < nd; d++) {
+            const jf_conv_row *r = rows + ((size_t)g * nd + d) * c->nh + kfix;
+            fprintf(f, "%d", r->degree);
+            for (int q = 0; q < 3; q++)
+                fprintf(f, ",%.6g,%.6g", log(1 / r->avg[q]) / log(1 / r->h),
+                        log(1 / r->max[q]) / log(1 / r->h));
+            fprintf(f, "\n");
+        }
+        fprintf(f, "EOD\n");
+        g++;
+        fprintf(f, "set xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
+        for (int q = 0; q < 3; q++)
             fprintf(f, "set output '%s_%s.png'\n"
                        "set title 'exp graph: %s error (average) vs h, %s'\n"
                        "plot for [d=%d:%d] 'convergence.csv' skip 1 using "
                        "(strcol(1) eq '%s' && $2 == d ? log(1/$3) : 1/0):"
                        "(log(1/$%d)) with linespoints title sprintf('deg %%d', d)\n",
                     qn[q], mn, qn[q], mn, c->deg_lo, c->deg_hi, mn, 4 + 2 * q);
-        }
         fprintf(f, "set output 'degree_%s.png'\nset xlabel 'degree'\n"
                    "set ylabel 'log(1/delta)/log(1/h)'\n"
-                   "set title sprintf('exp graph: errors vs degree at h = %%g, %s', %.17g)\n"
-                   "plot ",
-                mn, mn, hfix);
+                   "set title 'exp graph: errors vs degree at h = %g, %s'\nplot ",
+                mn, c->h[kfix], mn);
         for (int q = 0; q < 3; q++)
             for (int a = 0; a < 2; a++)
-                fprintf(f, "%s'convergence.csv' skip 1 using "
-                           "(strcol(1) eq '%s' && $3 == %.17g ? $2 : 1/0):"
-                           "(log(1/$%d)/log(1/$3)) with linespoints title '%s_%s'",
-                        q + a ? ", " : "", mn, hfix, 4 + 2 * q + a, qn[q],
-                        a ? "max" : "av");
-        fprintf(f, "\nset xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
+                fprintf(f, "%s$deg_%s using 1:%d with linespoints title '%s_%s'",
+                        q + a ? ", " : "", mn, 2 + 2 * q + a, qn[q], a ? "max" : "av");
+        fprintf(f, "\n");
     }
     return close_checked(f, path);
 }
@@ -187,16 +196,15 @@ int jf_cmd_convergence(int argc, char **argv)
         printf("%-6s %3d  %8.2f (%zu h) %8.2f (%zu h) %8.2f (%zu h)\n", mode_name(r->mode),
                r->degree, sl[0], used[0], sl[1], used[1], sl[2], used[2]);
     }
-    free(rows);
     int bad = close_checked(fc, p1) | close_checked(fs, p2) | close_checked(fu, p3);
-    if (bad)
+    if (bad || write_script(dir, &c, rows, c.nh > 2 ? 2 : c.nh - 1)) {
+        free(rows);
         return 1;
+    }
+    free(rows);
     if (lowered || failed)
         fprintf(stderr, "jetfit convergence: note: %zu fits were rank deficient "
                         "(lower degree), %zu failed\n", lowered, failed);
-    double hfix = c.h[c.nh > 2 ? 2 : c.nh - 1];
-    if (write_script(dir, &c, hfix))
-        return 1;
     if (!plots)
         return 0;
     if (system("command -v gnuplot >/dev/null 2>&1") != 0) {

@@ -160,6 +160,14 @@ int jf_cmd_generate(int argc, char **argv)
             surf_name = a;
             continue;
         }
+        static const char *const valued[] = {
+            "-o", "--truth", "--n", "--seed", "--density", "--grid-h",
+            "--perturb", "--noise", "--noise-uniform", "--outliers"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
+            known |= !strcmp(a, valued[k]);
+        if (!known)
+            return fail("unknown option '%s'", a);
         if (i + 1 >= argc)
             return fail("%s needs a value", a);
         const char *v = argv[++i];
@@ -206,8 +214,6 @@ int jf_cmd_generate(int argc, char **argv)
             if (!(d >= 0 && d <= 1))
                 return fail("--outliers wants F in [0, 1], not '%s'", v);
             outliers = d;
-        } else {
-            return fail("unknown option '%s'", a);
         }
     }
     jf_surface surf;
