@@ -94,10 +94,11 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
     if (nc < 2)
         return jf_io_fail(err, JF_ERR_FORMAT, name, cline,
                           "expected the counts \"nv nf [ne]\"");
-    /* room: a vertex line takes >= 6 bytes, a face line >= 8 */
+    /* room before allocating: any line takes >= 2 bytes (a short line
+     * then gets its own message below) */
     size_t left = (size_t)(t.end - t.p) + 1;
-    if (cnt[0] > left / 6 || cnt[1] > left / 8 ||
-        cnt[0] * 6 + cnt[1] * 8 > left)
+    if (cnt[0] > left / 2 || cnt[1] > left / 2 ||
+        cnt[0] * 2 + cnt[1] * 2 > left)
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, cline,
                           "%llu vertices and %llu faces cannot fit in the "
                           "%zu bytes left in the file",

@@ -7,7 +7,7 @@
  * element, property and list is skipped (the Stanford range scans carry a
  * range_grid element of lists).  Before allocating from a count the bytes
  * left are checked: a binary row needs at least its fixed size, an ascii
- * row two bytes per value.  Ascii rows are one line each.
+ * row a byte per value.  Ascii rows are one line each.
  */
 #include "io_internal.h"
 
@@ -371,7 +371,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
             need += h->format ? type_size[pr->count_type != T_NONE
                                               ? pr->count_type
                                               : pr->type]
-                              : 2;
+                              : 1;
         }
         size_t left = h->format ? (size_t)(h->end - h->p)
                                 : (size_t)(h->tx.end - h->tx.p) + 1;
@@ -381,7 +381,8 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
             st = jf_io_fail(err, JF_ERR_TOO_LARGE, name,
                             h->format ? 0 : h->tx.line,
                             "element %s: %llu rows cannot fit in the %zu "
-                            "bytes left in the file", el->name,
+                            "bytes left in the file (count too large or "
+                            "file truncated)", el->name,
                             (unsigned long long)el->count, left);
             break;
         }

@@ -226,9 +226,6 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
             if (header)
                 continue;
         }
-        if (n == cap)
-            return jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
-                              "more rows than supported");
         const char *p = ls, *fs, *fe;
         double v[6];
         int j = 0;
@@ -251,6 +248,9 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
             return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line,
                               "row %zu: expected %d numbers, found %d", n,
                               t.maxcol + 1, count_fields(&t, ls, le));
+        if (n == cap) /* cannot happen for rows that parse: the bound */
+            return jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
+                              "more rows than supported");
         memcpy(c->xyz + 3 * n, v, 3 * sizeof(double));
         if (have_nrm)
             memcpy(c->nrm + 3 * n, v + 3, 3 * sizeof(double));
