@@ -26,9 +26,9 @@ struct jf_fitter {
     double *w;        /* maxn equation weights (0 = not usable)        */
     double *dist;     /* maxn squared distances to p                   */
     uint32_t *order;  /* maxn indices of usable points, nearest first  */
-    double *m;        /* maxn*maxc scaled Vandermonde matrix M' / U    */
+    double *m;        /* maxn*maxc scaled Vandermonde M', column-major  */
     double *v;        /* maxc*maxc right singular vectors              */
-    double *x;        /* maxc*maxc scratch for the QR-first SVD        */
+    double *x;        /* maxc*maxc R of M' = QR, then U of its SVD      */
     double *s;        /* maxc singular values                          */
     double *work;     /* maxc GSL scratch                              */
     double *rhs;      /* maxn right-hand side                          */

@@ -85,22 +85,47 @@ jf_status jf_fitter_create(const jf_params *p, jf_fitter **out)
 
 const jf_params *jf_fitter_params(const jf_fitter *f) { return f ? &f->p : NULL; }
 
+/* Householder QR of the rows x cols matrix a, stored column-major (column
+ * j at a + j*rows, contiguous for the inner loops), applied to b in the
+ * same sweep (Golub & Van Loan §5.2): on return the upper cols x cols
+ * triangle of a is R and b[0..cols-1] is (Q^T b)[0..cols-1].  R has the
+ * singular values of a, so the SVD that follows is only cols x cols. */
+static void householder_qr(double *a, double *b, size_t rows, size_t cols)
+{
+    for (size_t k = 0; k < cols; k++) {
+        double *ak = a + k * rows;
+        double nrm2 = 0;
+        for (size_t i = k; i < rows; i++) nrm2 += ak[i] * ak[i];
+        if (nrm2 == 0.0) continue; /* zero column: R_kk = 0 */
+        const double akk = ak[k];
+        const double alpha = akk > 0 ? -sqrt(nrm2) : sqrt(nrm2);
+        ak[k] = akk - alpha; /* v = ak[k..rows-1] */
+        const double tau = 2.0 / (nrm2 - akk * akk + ak[k] * ak[k]);
+        for (size_t j = k + 1; j <= cols; j++) { /* j == cols: the rhs */
+            double *aj = j < cols ? a + j * rows : b;
+            double sdot = 0;
+            for (size_t i = k; i < rows; i++) sdot += ak[i] * aj[i];
+            sdot *= tau;
+            for (size_t i = k; i < rows; i++) aj[i] -= sdot * ak[i];
+        }
+        ak[k] = alpha;
+    }
+}
+
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
 {
-    gsl_matrix_view a = gsl_matrix_view_array(f->m, rows, cols);
+    /* QR first (ours, plain loops on the workspace), then GSL's SVD of the
+     * small triangle R: the same singular values as M', a fraction of the
+     * cost of GSL's SVD of the tall matrix for N >> N_n. */
+    householder_qr(f->m, f->rhs, rows, cols);
+    double *r = f->x;
+    for (size_t i = 0; i < cols; i++)
+        for (size_t j = 0; j < cols; j++) r[i * cols + j] = j < i ? 0.0 : f->m[j * rows + i];
+    gsl_matrix_view u = gsl_matrix_view_array(r, cols, cols);
     gsl_matrix_view v = gsl_matrix_view_array(f->v, cols, cols);
     gsl_vector_view s = gsl_vector_view_array(f->s, cols);
     gsl_vector_view w = gsl_vector_view_array(f->work, cols);
-    gsl_vector_view b = gsl_vector_view_array(f->rhs, rows);
-    gsl_vector_view y = gsl_vector_view_array(f->sol, cols);
-    int rc;
-    if (rows >= 2 * cols) { /* tall: QR first (GSL's modified Golub-Reinsch) */
-        gsl_matrix_view x = gsl_matrix_view_array(f->x, cols, cols);
-        rc = gsl_linalg_SV_decomp_mod(&a.matrix, &x.matrix, &v.matrix, &s.vector, &w.vector);
-    } else {
-        rc = gsl_linalg_SV_decomp(&a.matrix, &v.matrix, &s.vector, &w.vector);
-    }
-    if (rc != GSL_SUCCESS) {
+    if (gsl_linalg_SV_decomp(&u.matrix, &v.matrix, &s.vector, &w.vector) != GSL_SUCCESS) {
         *cond = NAN;
         return -1;
     }
@@ -108,9 +133,18 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
     *cond = smax / smin; /* +Inf when singular */
     /* numerical rank test of LAPACK/numpy: sigma_min <= sigma_max max(m,n) eps */
     if (!(smax > 0) || smin <= smax * (double)rows * DBL_EPSILON) return 1;
-    if (gsl_linalg_SV_solve(&a.matrix, &v.matrix, &s.vector, &b.vector, &y.vector) !=
-        GSL_SUCCESS)
-        return -1;
+    /* Y = V S^-1 U^T (Q^T b); gsl_linalg_SV_solve would allocate */
+    double *t = f->work;
+    for (size_t j = 0; j < cols; j++) {
+        double acc = 0;
+        for (size_t i = 0; i < cols; i++) acc += r[i * cols + j] * f->rhs[i];
+        t[j] = acc / f->s[j];
+    }
+    for (size_t i = 0; i < cols; i++) {
+        double acc = 0;
+        for (size_t j = 0; j < cols; j++) acc += f->v[i * cols + j] * t[j];
+        f->sol[i] = acc;
+    }
     return 0;
 }
 
@@ -228,7 +262,7 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
         h = 0;
         for (size_t t = 0; t < rows; t++) {
             const double *q = f->loc + 3 * f->order[t];
-            h += hypot(q[0], q[1]);
+            h += sqrt(q[0] * q[0] + q[1] * q[1]);
         }
         h /= (double)rows;
         if (!(h > 0) || !isfinite(h)) { /* every point on the z axis */
@@ -240,11 +274,9 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
         for (size_t t = 0; t < rows; t++) {
             size_t i = f->order[t];
             const double *q = f->loc + 3 * i;
-            double *row = f->m + t * cols;
-            monomials(q[0] * ih, q[1] * ih, d, row);
+            monomials(q[0] * ih, q[1] * ih, d, mon);
             const double wi = f->w[i];
-            if (wi != 1.0)
-                for (size_t c = 0; c < cols; c++) row[c] *= wi;
+            for (size_t c = 0; c < cols; c++) f->m[c * rows + t] = wi * mon[c];
             f->rhs[t] = wi * q[2];
         }
         int rc = jf__svd_solve(f, rows, cols, &out->cond);

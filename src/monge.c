@@ -111,7 +111,8 @@ void jf__quantities(const double *a, int deg, int monge_degree,
     /* Shape operator in {t1,t2}: [[2g20, g11], [g11, 2g02]]; closed-form
      * eigen-decomposition, theta = angle of d1 (largest eigenvalue). */
     const double g20 = g[TPI(2, 0)], g11 = g[TPI(1, 1)], g02 = g[TPI(0, 2)];
-    const double mean = g20 + g02, rad = hypot(g20 - g02, g11);
+    const double mean = g20 + g02;
+    const double rad = sqrt((g20 - g02) * (g20 - g02) + g11 * g11);
     double k1 = mean + rad, k2 = mean - rad, th = 0.5 * atan2(2.0 * g11, 2.0 * (g20 - g02));
     double big = fmax(1.0, fmax(fabs(k1), fabs(k2)));
     if (deg >= 2 && k1 - k2 <= 1e-10 * big) {
