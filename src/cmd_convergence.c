@@ -16,7 +16,8 @@
 static void usage(FILE *out)
 {
     fprintf(out,
-        "usage: jetfit convergence --out DIR [--quick] [--seed S] [--no-plots]\n"
+        "usage: jetfit convergence --out DIR [--quick] [--seed S] [--finest K]\n"
+        "         [--no-plots]\n"
         "\n"
         "The paper's 6.1 experiment: f(u,v) = 0.1 exp(2u + v - v^2) on a\n"
         "triangulated square grid of side h = 2^-2 .. 2^-6, each vertex moved by\n"
@@ -36,6 +37,8 @@ static void usage(FILE *out)
         "              precision floor), DIR/convergence.gp and its PNGs\n"
         "  --quick     degrees 1..4 and a 3 x 3 lattice (seconds; for CI)\n"
         "  --seed S    grid perturbation seed (default 1); same seed, same bits\n"
+        "  --finest K  h down to 2^-K, K in 3..9 (default 6, the paper's; 8 or 9\n"
+        "              shows the double-precision floor of high degrees)\n"
         "  --no-plots  do not run gnuplot\n");
 }
 
@@ -97,7 +100,8 @@ static int write_script(const char *dir, const jf_conv_config *c,
                        "plot for [d=%d:%d] 'convergence.csv' skip 1 using "
                        "(strcol(1) eq '%s' && $2 == d ? log(1/$3) : 1/0):"
                        "(log(1/$%d)) with linespoints title sprintf('deg %%d', d)\n",
-                    qn[q], mn, qn[q], mn, c->deg_lo, c->deg_hi, mn, 4 + 2 * q);
+                    qn[q], mn, qn[q], mn, q && c->deg_lo < 2 ? 2 : c->deg_lo,
+                    c->deg_hi, mn, 4 + 2 * q);
         fprintf(f, "set output 'degree_%s.png'\nset xlabel 'degree'\n"
                    "set ylabel 'log(1/delta)/log(1/h)'\n"
                    "set title 'exp graph: errors vs degree at h = %g, %s'\nplot ",
@@ -116,6 +120,7 @@ int jf_cmd_convergence(int argc, char **argv)
     const char *dir = NULL;
     int quick = 0, plots = 1;
     unsigned long long seed = 1;
+    int finest = 6;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             usage(stdout);
@@ -126,6 +131,13 @@ int jf_cmd_convergence(int argc, char **argv)
             plots = 0;
         } else if (!strcmp(argv[i], "--out") && i + 1 < argc) {
             dir = argv[++i];
+        } else if (!strcmp(argv[i], "--finest") && i + 1 < argc) {
+            const char *v = argv[++i];
+            if (strlen(v) != 1 || v[0] < '3' || v[0] > '9') {
+                fprintf(stderr, "jetfit convergence: --finest wants K in 3..9, not '%s'\n", v);
+                return 2;
+            }
+            finest = v[0] - '0';
         } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
             char *end;
             const char *v = argv[++i];
@@ -151,6 +163,9 @@ int jf_cmd_convergence(int argc, char **argv)
     jf_conv_config c;
     jf_conv_config_init(&c, quick);
     c.seed = seed;
+    c.nh = finest - 1; /* 2^-2 .. 2^-finest */
+    for (int k = 0; k < c.nh; k++)
+        c.h[k] = ldexp(1.0, -(k + 2));
     size_t nr = jf_conv_row_count(&c);
     jf_conv_row *rows = calloc(nr, sizeof *rows);
     jf_status st = rows ? jf_conv_run(&c, rows) : JF_ERR_NOMEM;

@@ -53,9 +53,12 @@ void jf_surface_domain(jf_surface s, double lo[2], double hi[2])
         hi[0] = hi[1] = 0.5;
         break;
     case JF_SURF_PARABOLOID:
-    case JF_SURF_REVOLUTION:
         lo[0] = lo[1] = -1.0;
         hi[0] = hi[1] = 1.0;
+        break;
+    case JF_SURF_REVOLUTION: /* parabolic circles r = pi/20, pi/10 inside */
+        lo[0] = lo[1] = -0.4;
+        hi[0] = hi[1] = 0.4;
         break;
     case JF_SURF_SPHERE:
     case JF_SURF_ELLIPSOID:

@@ -27,7 +27,7 @@
 typedef enum {
     JF_SURF_EXP = 0,     /* §6.1: z = 0.1 exp(2x + y - y^2), [-.5,.5]^2  */
     JF_SURF_PARABOLOID,  /* Fig. 1: z = 2x^2 + y^2, [-1,1]^2             */
-    JF_SURF_REVOLUTION,  /* Fig. 2: z = 0.1 sin(10 r), [-1,1]^2; r = 0
+    JF_SURF_REVOLUTION,  /* Fig. 2: z = 0.1 sin(10 r), [-.4,.4]^2; r = 0
                             is a cone point (truth NaN there)           */
     JF_SURF_SPHERE,      /* radius 1, centre 0                            */
     JF_SURF_ELLIPSOID,   /* x^2/1 + y^2/0.75^2 + z^2/0.5^2 = 1 (4 umbilics
