@@ -226,6 +226,36 @@ START_TEST(bad_options)
 }
 END_TEST
 
+/* render: a PNG from a truth file (it has k1 k2 d1 d2), both views; a
+ * missing column or a bad option is a clear error. */
+START_TEST(render_pictures)
+{
+    ck_assert_int_eq(run("generate paraboloid --n 400 -o p.xyz --truth t.csv"), 0);
+    ck_assert_int_eq(run("render t.csv -o top.png --color aniso --directions --view top --small"), 0);
+    ck_assert_int_eq(run("render t.csv -o 3d.png --color gauss --directions --glyphs 50"), 0);
+    static const unsigned char magic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    const char *files[2] = {"top.png", "3d.png"};
+    for (int i = 0; i < 2; i++) {
+        size_t n;
+        char *b = slurp(files[i], &n);
+        ck_assert_msg(b && n > 1000 && !memcmp(b, magic, 8), "%s is not a PNG", files[i]);
+        free(b);
+    }
+    /* p.xyz has x y z only: colouring needs k1 k2 */
+    ck_assert_int_eq(run("render p.xyz -o x.png"), 1);
+    ck_assert(err_has("needs k1 k2"));
+    ck_assert_int_eq(run("render p.xyz -o x.png --color none"), 0);
+    ck_assert_int_eq(run("render t.csv -o x.jpg"), 2);
+    ck_assert(err_has("-o wants a .png file"));
+    ck_assert_int_eq(run("render t.csv -o x.png --color curl"), 2);
+    ck_assert(err_has("--color wants"));
+    ck_assert_int_eq(run("render t.csv -o x.png --view sideways"), 2);
+    ck_assert(err_has("--view wants"));
+    ck_assert_int_eq(run("render missing.csv -o x.png"), 1);
+    ck_assert(err_has("missing.csv"));
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("generate_cli");
@@ -237,6 +267,7 @@ int main(void)
     tcase_add_test(tc, outliers_and_meshes);
     tcase_add_test(tc, convergence_quick_reproducible);
     tcase_add_test(tc, bad_options);
+    tcase_add_test(tc, render_pictures);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
