@@ -226,6 +226,73 @@ START_TEST(bad_options)
 }
 END_TEST
 
+/* Largest and median of v[0..n-1] (sorts v). */
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Errors of an estimate against a truth file, row by row: sine of the
+ * normal angle and relative k1, k2 errors after orienting the estimate
+ * along the true normal (flip: k1, k2 -> -k2, -k1). */
+static void mesh_errors(const char *est, const char *truth, double med[3], double mx[3])
+{
+    char p[256];
+    jf_eval_table e, t;
+    jf_error err;
+    snprintf(p, sizeof p, "%s/%s", dir, est);
+    ck_assert_int_eq(jf_eval_table_read(p, &e, &err), JF_OK);
+    snprintf(p, sizeof p, "%s/%s", dir, truth);
+    ck_assert_int_eq(jf_eval_table_read(p, &t, &err), JF_OK);
+    ck_assert_uint_eq(e.nrows, t.nrows);
+    int en = jf_eval_table_col(&e, "nx"), ek = jf_eval_table_col(&e, "k1");
+    ck_assert(en >= 0 && ek == en + 3);
+    size_t n = t.nrows;
+    double *v[3];
+    for (int q = 0; q < 3; q++)
+        v[q] = malloc(n * sizeof(double));
+    for (size_t i = 0; i < n; i++) {
+        const double *a = e.v + i * e.ncols + en, *b = t.v + i * t.ncols + 3;
+        double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+        double k1 = d >= 0 ? a[3] : -a[4], k2 = d >= 0 ? a[4] : -a[3];
+        v[0][i] = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        v[1][i] = fabs(k1 - b[3]) / fabs(b[3]);
+        v[2][i] = fabs(k2 - b[4]) / fabs(b[4]);
+    }
+    for (int q = 0; q < 3; q++) {
+        qsort(v[q], n, sizeof(double), cmp_d);
+        med[q] = v[q][n / 2];
+        mx[q] = v[q][n - 1];
+        free(v[q]);
+    }
+    jf_eval_table_free(&e);
+    jf_eval_table_free(&t);
+}
+
+/* `jetfit estimate --neighbors rings` on generated meshes against their
+ * exact truth: a closed UV sphere (OFF; poles and seam) and the §6.1
+ * graph (PLY, perturbed grid, boundary included). */
+START_TEST(estimate_on_generated_meshes)
+{
+    double med[3], mx[3];
+    ck_assert_int_eq(run("generate sphere --mesh --grid-h 0.1 -o s.off --truth s_t.csv"), 0);
+    ck_assert_int_eq(run("estimate s.off -o s_e.csv --neighbors rings --degree 2 --quiet"), 0);
+    mesh_errors("s_e.csv", "s_t.csv", med, mx);
+    ck_assert_msg(mx[0] < 1e-2 && med[0] < 2e-3, "sphere normal %g %g", med[0], mx[0]);
+    ck_assert_msg(mx[1] < 0.1 && mx[2] < 0.1 && med[1] < 0.03 && med[2] < 0.03,
+                  "sphere k %g %g %g %g", med[1], med[2], mx[1], mx[2]);
+    ck_assert_int_eq(run("generate exp --mesh --grid-h 0.03125 -o g.ply --truth g_t.csv"), 0);
+    ck_assert_int_eq(run("estimate g.ply -o g_e.csv --neighbors rings --degree 3 --quiet"), 0);
+    mesh_errors("g_e.csv", "g_t.csv", med, mx);
+    ck_assert_msg(mx[0] < 1e-3 && med[0] < 1e-4, "exp normal %g %g", med[0], mx[0]);
+    ck_assert_msg(mx[1] < 0.1 && mx[2] < 0.1 && med[1] < 5e-3 && med[2] < 5e-3,
+                  "exp k %g %g %g %g", med[1], med[2], mx[1], mx[2]);
+}
+END_TEST
+
 /* render: a PNG from a truth file (it has k1 k2 d1 d2), both views; a
  * missing column or a bad option is a clear error. */
 START_TEST(render_pictures)
@@ -268,6 +335,7 @@ int main(void)
     tcase_add_test(tc, convergence_quick_reproducible);
     tcase_add_test(tc, bad_options);
     tcase_add_test(tc, render_pictures);
+    tcase_add_test(tc, estimate_on_generated_meshes);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
