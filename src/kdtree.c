@@ -26,6 +26,7 @@
 
 #define KD_LEAF 12          /* largest leaf: 6..12 points per leaf        */
 #define KD_STACK_KEYS 1024  /* d2 scratch on the stack when d2 == NULL    */
+#define KD_SORTED_MAX 48    /* k up to this: sorted array, else heap      */
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
 
 typedef struct {
@@ -222,6 +223,7 @@ typedef struct {
     double *hd;       /* heap keys: squared distances                     */
     uint32_t *hi;     /* heap values: original indices                    */
     size_t cap, cnt;
+    int sorted;       /* small k: a sorted array instead of the heap     */
     double worst_d;   /* (worst_d, worst_i): the pair a candidate must beat */
     uint32_t worst_i;
 } kd_query;
@@ -269,42 +271,98 @@ static void heap_push(kd_query *s, double d, uint32_t id)
     s->worst_i = s->hi[0];
 }
 
-static void search(kd_query *s, uint32_t ni, double g[3])
+/* Small k: insertion into the sorted prefix (short, predictable moves
+ * beat the heap's data-dependent sifts). */
+static void sorted_push(kd_query *s, double d, uint32_t id)
 {
-    const kd_node *nd = &s->ix->nodes[ni];
-    if ((nd->dim & 3u) == KD_IS_LEAF) {
-        const double *p = s->ix->pts + 3 * (size_t)nd->first;
-        const uint32_t *id = s->ix->id + nd->first;
-        uint32_t cnt = nd->dim >> 2;
-        for (uint32_t j = 0; j < cnt; j++, p += 3) {
-            double dx = s->q[0] - p[0], dy = s->q[1] - p[1],
-                   dz = s->q[2] - p[2];
-            double d = dx * dx + dy * dy + dz * dz;
-            if (KD_LESS(d, id[j], s->worst_d, s->worst_i))
-                heap_push(s, d, id[j]);
+    size_t j = s->cnt < s->cap ? s->cnt++ : s->cap - 1;
+    while (j > 0 && KD_LESS(d, id, s->hd[j - 1], s->hi[j - 1])) {
+        s->hd[j] = s->hd[j - 1];
+        s->hi[j] = s->hi[j - 1];
+        j--;
+    }
+    s->hd[j] = d;
+    s->hi[j] = id;
+    if (s->cnt == s->cap) {
+        s->worst_d = s->hd[s->cap - 1];
+        s->worst_i = s->hi[s->cap - 1];
+    }
+}
+
+static void scan_leaf(kd_query *s, const kd_node *nd)
+{
+    const double *p = s->ix->pts + 3 * (size_t)nd->first;
+    const uint32_t *id = s->ix->id + nd->first;
+    uint32_t cnt = nd->dim >> 2;
+    double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2];
+    for (uint32_t j = 0; j < cnt; j++, p += 3) {
+        double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+        double d = dx * dx + dy * dy + dz * dz;
+        if (d > s->worst_d) continue; /* the common case, decided fast */
+        if (KD_LESS(d, id[j], s->worst_d, s->worst_i)) {
+            if (s->sorted) sorted_push(s, d, id[j]);
+            else heap_push(s, d, id[j]);
         }
-        return;
     }
-    int dim = (int)nd->dim;
-    double v = s->q[dim];
-    uint32_t near, far;
-    double gap;
-    if ((v - nd->lo) + (v - nd->hi) < 0) {
-        near = nd->first;
-        far = nd->first + 1;
-        gap = nd->hi - v;   /* far (right) points have coordinate >= hi */
-    } else {
-        near = nd->first + 1;
-        far = nd->first;
-        gap = v - nd->lo;   /* far (left) points have coordinate <= lo */
+}
+
+/* Depth first, nearer child first, with an explicit stack of deferred
+ * far children, each with its per-axis gaps (the tree is balanced, so
+ * depth <= log2(UINT32_MAX) + 1 and KD_DEPTH entries suffice). */
+#define KD_DEPTH 64
+typedef struct {
+    double g[3];
+    uint32_t node;
+} kd_frame;
+
+static void search(kd_query *s, const double g0[3])
+{
+    const kd_node *nodes = s->ix->nodes;
+    kd_frame stack[KD_DEPTH];
+    size_t top = 0;
+    double g[3] = {g0[0], g0[1], g0[2]};
+    uint32_t ni = 0;
+    for (;;) {
+        const kd_node *nd = &nodes[ni];
+        if ((nd->dim & 3u) != KD_IS_LEAF) {
+            int dim = (int)nd->dim;
+            double v = s->q[dim], gap;
+            uint32_t far;
+            if ((v - nd->lo) + (v - nd->hi) < 0) {
+                ni = nd->first;
+                far = nd->first + 1;
+                gap = nd->hi - v; /* far (right) points: coordinate >= hi */
+            } else {
+                ni = nd->first + 1;
+                far = nd->first;
+                gap = v - nd->lo; /* far (left) points: coordinate <= lo */
+            }
+            kd_frame *f = &stack[top];
+            f->g[0] = g[0];
+            f->g[1] = g[1];
+            f->g[2] = g[2];
+            /* both are lower bounds of |q - p| on dim */
+            if (gap > f->g[dim]) f->g[dim] = gap;
+            f->node = far;
+            top++;
+            continue;
+        }
+        scan_leaf(s, nd);
+        /* next deferred cell whose bound can still beat the worst */
+        for (;;) {
+            if (!top) return;
+            kd_frame *f = &stack[--top];
+            double bound = f->g[0] * f->g[0] + f->g[1] * f->g[1] +
+                           f->g[2] * f->g[2];
+            if (bound <= s->worst_d) {
+                g[0] = f->g[0];
+                g[1] = f->g[1];
+                g[2] = f->g[2];
+                ni = f->node;
+                break;
+            }
+        }
     }
-    search(s, near, g);
-    if (gap < 0) gap = 0;
-    double old = g[dim];
-    if (gap > old) g[dim] = gap; /* both are lower bounds of |q - p| on dim */
-    double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (bound <= s->worst_d) search(s, far, g);
-    g[dim] = old;
 }
 
 /* Runs the search and sorts the heap nearest first. */
@@ -318,7 +376,8 @@ static void run_query(kd_query *s)
         g[d] = a > 0 ? a : (b > 0 ? b : 0);
     }
     double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (bound <= s->worst_d) search(s, 0, g);
+    if (bound <= s->worst_d) search(s, g);
+    if (s->sorted) return;
     /* heap sort: repeatedly move the worst to the end */
     for (size_t end = s->cnt; end > 1; end--) {
         double td = s->hd[0];
@@ -345,7 +404,8 @@ static jf_status query_common(const jf_index *ix, const double q[3],
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
-    kd_query s = {ix, {q[0], q[1], q[2]}, keys, idx, k, 0, bound, UINT32_MAX};
+    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  idx,
+                  k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX};
     run_query(&s);
     if (keys != d2 && keys != stack_keys) free(keys);
     *found = s.cnt;
