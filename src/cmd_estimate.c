@@ -397,7 +397,7 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    progress_state ps = {t0, 0, 0};
+    progress_state ps = {now_s(), 0, 0}; /* rate of the estimation itself */
     if (!quiet && isatty(2)) {
         o.progress = progress;
         o.progress_user = &ps;

@@ -1,0 +1,230 @@
+// bench_estimate.cpp -- end-to-end speed and peak memory of
+// `jetfit estimate` (read, index, fit, write) beside CGAL's peers, in the
+// same run, on N points (default 1,000,000) of the paper's §6.1 surface
+// z = 0.1 exp(2x + y - y^2) in random order, stored as binary PLY.
+//
+//   bench_estimate [N]            (needs the built jetfit next to it:
+//                                  JF_BUILD_DIR/jetfit)
+//
+// Every contender runs in its own child process (fork), so its peak
+// memory (wait4's ru_maxrss) is its own:
+//  - jetfit estimate --threads 1 / 2 (exec of the built binary);
+//  - CGAL end to end: read_PLY, k-d tree (Orthogonal_k_neighbor_search),
+//    Monge_via_jet_fitting per point (query point first), binary PLY out
+//    of the same quantities (x y z n k1 k2 d1 d2);
+//  - CGAL jet_estimate_normals<Sequential_tag> (normals only), read and
+//    write included.
+// Configurations: knn:16 degree 2 and knn:32 degree 3 (monge 3).
+#include <CGAL/Monge_via_jet_fitting.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/IO/read_ply_points.h>
+#include <CGAL/IO/write_ply_points.h>
+#include <CGAL/jet_estimate_normals.h>
+#include <CGAL/property_map.h>
+
+#include "cgalref_svd.hpp" // CGAL's default SVD (Eigen) or a GSL stand-in
+
+#include <sys/resource.h>
+#include <sys/time.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+extern "C" {
+#include "jetfit.h"
+}
+
+typedef CGAL::Simple_cartesian<double> Kernel;
+typedef Kernel::Point_3 Point;
+typedef Kernel::Vector_3 Vector;
+
+static std::string g_dir;
+
+// ---- the input ----------------------------------------------------------
+
+static void make_input(size_t n, const std::string &path)
+{
+    std::vector<double> xyz(3 * n);
+    unsigned long long s = 2003;
+    auto rnd = [&s]() {
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        return (double)(s >> 11) / 9007199254740992.0;
+    };
+    for (size_t i = 0; i < n; i++) { // uniform random samples: random order
+        double x = rnd() - 0.5, y = rnd() - 0.5;
+        xyz[3 * i] = x;
+        xyz[3 * i + 1] = y;
+        xyz[3 * i + 2] = 0.1 * std::exp(2 * x + y - y * y);
+    }
+    jf_cloud c = {};
+    c.n = n;
+    c.xyz = xyz.data();
+    jf_error e;
+    if (jf_cloud_write(path.c_str(), &c, 0, &e) != JF_OK) {
+        std::fprintf(stderr, "cannot write %s: %s\n", path.c_str(), e.msg);
+        std::exit(1);
+    }
+}
+
+// ---- running a contender in a child -----------------------------------------
+
+struct Run {
+    double secs, cpu;
+    long maxrss_kb;
+    int ok;
+};
+
+template <class F> static Run in_child(F f)
+{
+    std::fflush(nullptr);
+    auto t0 = std::chrono::steady_clock::now();
+    pid_t pid = fork();
+    if (pid == 0) _exit(f());
+    int status = 0;
+    struct rusage ru;
+    wait4(pid, &status, 0, &ru);
+    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                 (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+    return {secs, cpu, ru.ru_maxrss, WIFEXITED(status) && WEXITSTATUS(status) == 0};
+}
+
+static int run_jetfit(const std::string &in, int k, int degree, int threads)
+{
+    std::string out = g_dir + "/jetfit_out.ply", nb = "knn:" + std::to_string(k);
+    std::string deg = std::to_string(degree), th = std::to_string(threads);
+    const char *argv[] = {JF_BUILD_DIR "/jetfit", "estimate", in.c_str(), "-o", out.c_str(),
+                          "--neighbors", nb.c_str(), "--degree", deg.c_str(), "--threads",
+                          th.c_str(), "--quiet", nullptr};
+    execv(argv[0], (char *const *)argv);
+    return 127;
+}
+
+static int run_cgal_monge(const std::string &in, int k, int degree)
+{
+    typedef CGAL::Search_traits_3<Kernel> Traits;
+    typedef CGAL::Orthogonal_k_neighbor_search<Traits> Search;
+    typedef jf_cgalref::Monge_fitting Monge;
+    std::vector<Point> pts;
+    std::ifstream is(in, std::ios::binary);
+    if (!CGAL::IO::read_PLY(is, std::back_inserter(pts))) return 1;
+    Search::Tree tree(pts.begin(), pts.end());
+    std::string out = g_dir + "/cgal_out.ply";
+    FILE *f = std::fopen(out.c_str(), "wb");
+    if (!f) return 1;
+    std::fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %zu\n", pts.size());
+    const char *names[] = {"x", "y", "z", "nx", "ny", "nz", "k1", "k2",
+                           "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
+    for (const char *nm : names) std::fprintf(f, "property double %s\n", nm);
+    std::fprintf(f, "end_header\n");
+    std::vector<Point> nb;
+    nb.reserve(k);
+    Monge fit;
+    int monge = degree < 3 ? degree : 3;
+    for (const Point &p : pts) {
+        Search search(tree, p, k); // sorted: p itself first (distance 0)
+        nb.clear();
+        for (auto it = search.begin(); it != search.end(); ++it) nb.push_back(it->first);
+        Monge::Monge_form m = fit(nb.begin(), nb.end(), degree, monge);
+        Vector n = m.normal_direction(), d1 = m.maximal_principal_direction(),
+               d2 = m.minimal_principal_direction();
+        double row[14] = {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(),
+                          m.principal_curvatures(0), m.principal_curvatures(1),
+                          d1.x(), d1.y(), d1.z(), d2.x(), d2.y(), d2.z()};
+        std::fwrite(row, sizeof row, 1, f);
+    }
+    return std::fclose(f) == 0 ? 0 : 1;
+}
+
+static int run_cgal_jet_normals(const std::string &in, int k, int degree)
+{
+    typedef std::pair<Point, Vector> PN;
+    std::vector<PN> pts;
+    auto pm = CGAL::First_of_pair_property_map<PN>();
+    auto nm = CGAL::Second_of_pair_property_map<PN>();
+    std::ifstream is(in, std::ios::binary);
+    if (!CGAL::IO::read_PLY(is, std::back_inserter(pts), CGAL::parameters::point_map(pm)))
+        return 1;
+#ifdef CGAL_EIGEN3_ENABLED
+    CGAL::jet_estimate_normals<CGAL::Sequential_tag>(
+        pts, k, CGAL::parameters::point_map(pm).normal_map(nm).degree_fitting(degree));
+#else
+    CGAL::jet_estimate_normals<CGAL::Sequential_tag>(
+        pts, k,
+        CGAL::parameters::point_map(pm).normal_map(nm).degree_fitting(degree).svd_traits(
+            jf_cgalref::Gsl_svd()));
+#endif
+    std::ofstream os(g_dir + "/cgal_normals.ply", std::ios::binary);
+    CGAL::IO::set_binary_mode(os);
+    return CGAL::IO::write_PLY(os, pts, CGAL::parameters::point_map(pm).normal_map(nm)) ? 0 : 1;
+}
+
+// Wall time gives points/s; CPU time (user + sys of the child) is shown
+// too, since the machine may be shared: on one thread CPU ~ wall when idle.
+static void report(const char *what, size_t n, const Run &r, const Run *ref)
+{
+    double pps = r.ok ? (double)n / r.secs : 0;
+    double bpp = 1024.0 * (double)r.maxrss_kb / (double)n;
+    std::printf("%-40s %7.2f s wall %7.2f s cpu %9.0f points/s %7.1f MB %5.0f B/point", what,
+                r.secs, r.cpu, pps, (double)r.maxrss_kb / 1024.0, bpp);
+    if (ref && ref->ok && r.ok)
+        std::printf("  x%.2f wall, x%.2f cpu vs CGAL", ref->secs / r.secs, ref->cpu / r.cpu);
+    std::printf("%s\n", r.ok ? "" : "   FAILED");
+    std::fflush(stdout);
+}
+
+static void loadavg(const char *when)
+{
+    double l[3] = {0, 0, 0};
+    FILE *f = std::fopen("/proc/loadavg", "r");
+    if (f && std::fscanf(f, "%lf %lf %lf", &l[0], &l[1], &l[2]) == 3)
+        std::printf("load average %s: %.2f %.2f %.2f (%ld cores)\n", when, l[0], l[1], l[2],
+                    sysconf(_SC_NPROCESSORS_ONLN));
+    if (f) std::fclose(f);
+}
+
+int main(int argc, char **argv)
+{
+    size_t n = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 1000000;
+    char tmpl[] = "/tmp/jf_bench_XXXXXX";
+    if (!mkdtemp(tmpl)) return 1;
+    g_dir = tmpl;
+    std::string in = g_dir + "/surface61.ply";
+    make_input(n, in);
+    std::printf("bench_estimate: %zu points of the §6.1 surface, random order, binary PLY;\n"
+                "end to end (read, index, fit, write), each in a child process;\n"
+                "CGAL's SVD: %s\n\n",
+                n, jf_cgalref::cgal_svd_name);
+    loadavg("before");
+    const int cfg[2][2] = {{16, 2}, {32, 3}};
+    for (auto &c : cfg) {
+        int k = c[0], d = c[1];
+        std::printf("knn:%d degree %d\n", k, d);
+        Run cg = in_child([&] { return run_cgal_monge(in, k, d); });
+        report("  CGAL kd-tree + Monge_via_jet_fitting", n, cg, nullptr);
+        Run jn = in_child([&] { return run_cgal_jet_normals(in, k, d); });
+        report("  CGAL jet_estimate_normals (seq)", n, jn, &cg);
+        Run j1 = in_child([&] { return run_jetfit(in, k, d, 1); });
+        report("  jetfit estimate --threads 1", n, j1, &cg);
+        Run j2 = in_child([&] { return run_jetfit(in, k, d, 2); });
+        report("  jetfit estimate --threads 2", n, j2, &cg);
+        if (j1.ok && j2.ok) std::printf("  jetfit speed-up 1 -> 2 threads: x%.2f\n", j1.secs / j2.secs);
+        std::printf("\n");
+    }
+    loadavg("after");
+    for (const char *f : {"surface61.ply", "jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
+        std::remove((g_dir + "/" + f).c_str());
+    rmdir(g_dir.c_str());
+    return 0;
+}
