@@ -220,7 +220,7 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
     }
     out->n_used = (int)usable;
     if (usable < 3) {
-        fail_result(out, JF_PT_LOWERED_FEW);
+        fail_result(out, JF_PT_LOWERED_FEW | JF_PT_FAILED);
         return JF_OK;
     }
 
@@ -246,6 +246,24 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
             f->dist[f->order[t]] = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
         }
         sort_by_distance(f->dist, f->order, usable);
+        /* interpolation needs distinct points: an exact duplicate (same
+         * distance, same coordinates as a point kept before) is skipped,
+         * else it would make every degree rank deficient */
+        size_t kept = 0;
+        for (size_t t = 0; t < usable; t++) {
+            const uint32_t i = f->order[t];
+            const double *q = f->loc + 3 * i;
+            int dup = 0;
+            for (size_t u = kept; u-- > 0 && f->dist[f->order[u]] == f->dist[i];) {
+                const double *o = f->loc + 3 * f->order[u];
+                if (o[0] == q[0] && o[1] == q[1] && o[2] == q[2]) {
+                    dup = 1;
+                    break;
+                }
+            }
+            if (!dup) f->order[kept++] = i;
+        }
+        usable = kept;
     }
 
     /* 3. adaptive degree */
