@@ -113,13 +113,15 @@ typedef enum {
 
 typedef struct {
     int degree;              /* jet degree n, 1..JF_MAX_DEGREE (default 2) */
-    int monge_degree;        /* 2..4 and <= degree; 3 gives b0..b3,
+    int monge_degree;        /* 2..4 and <= max(degree, 2); 3 gives b0..b3,
                                 4 also c0..c4 (default 2)                  */
     jf_fit_mode fit;         /* approximation (N > N_n) or interpolation
                                 (the N_n nearest points)  (default approx) */
     jf_frame_mode frame;     /* fitting frame, §5.2 (default pca)          */
     double max_cond;         /* adaptive degree: lower the degree while
-                                kappa(M') > max_cond (default: see README) */
+                                kappa(M') > max_cond; >= 1, +INFINITY
+                                disables the test (default 1e6, measured:
+                                README "Choosing --max-cond")             */
     size_t max_neighbors;    /* largest N a fitter accepts (default 256)   */
     jf_robust_mode robust;   /* IRLS weights on residuals (default none)   */
     int robust_iters;        /* IRLS iteration cap (default 10)            */
@@ -131,23 +133,43 @@ typedef struct {
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);
 
-/* Checks every field.  Returns JF_ERR_INVALID and, if `bad_field` is not
- * NULL, sets it to the name of the first bad field (static string). */
+/* Checks every field.  Returns JF_OK (and sets *bad_field to NULL), or
+ * JF_ERR_INVALID and, if `bad_field` is not NULL, sets it to the name of
+ * the first bad field (static string).  Thread-safe. */
 jf_status jf_params_validate(const jf_params *p, const char **bad_field);
 
-/* Number of coefficients of an n-jet of a surface: (n+1)(n+2)/2. */
+/* Number of coefficients N_n of an n-jet of a surface: (n+1)(n+2)/2
+ * (0 for n < 0). */
 size_t jf_jet_size(int degree);
 
 /* ------------------------------------------------------------------ */
 /* Result of one fit                                                   */
 /* ------------------------------------------------------------------ */
+/* Conventions of a fit (jet.c, monge.c):
+ *  - The normal points to the +z side of the fitting frame (PCA: the
+ *    pinned smallest-variance axis, whose largest-|component| is positive;
+ *    axis: the positive world axis) until jf_result_orient/flip.
+ *  - The Monge frame is (d1, d2, normal) at the jet's point above p
+ *    (0, 0, A00 in the fitting frame); k1 >= k2 and b, c are signed
+ *    w.r.t. `normal`: z = (k1 x^2 + k2 y^2)/2 + (b0 x^3 + 3 b1 x^2 y
+ *    + 3 b2 x y^2 + b3 y^3)/6 + (c0 x^4 + 4 c1 x^3 y + 6 c2 x^2 y^2
+ *    + 4 c3 x y^3 + c4 y^4)/24 + ...
+ *  - A quantity of higher order than the degree used is NaN, never a
+ *    silent 0: k1, k2 at degree 1 (d1, d2 are then a tangent pair), b at
+ *    degree < 3 (if monge_degree >= 3), c at degree < 4 (if 4).
+ *  - FAILED and NONFINITE rows: degree 0, every quantity NaN. */
 typedef struct {
     unsigned status;      /* JF_PT_* flags                              */
     int degree;           /* degree actually used (0 when FAILED)       */
-    int n_used;           /* number of points in the fit                */
+    int n_used;           /* number of points in the fit (FAILED: the
+                             number of usable neighbours offered)       */
     double cond;          /* kappa(M') = sigma_max/sigma_min of the
-                             preconditioned Vandermonde matrix (§2.3)   */
-    double residual;      /* RMS of the fit residuals, in length units  */
+                             preconditioned Vandermonde matrix (§2.3) at
+                             the degree used (FAILED: the last one tried,
+                             +Inf if singular, NaN if none was built)   */
+    double residual;      /* RMS of the fit residuals z_i - J(x_i,y_i)
+                             over the points used, in length units
+                             (weighted fits: sqrt(sum w^2 r^2 / sum w^2)) */
     double pca_eval[3];   /* covariance eigenvalues, ascending          */
     double normal[3];     /* unit normal                                */
     double k1, k2;        /* principal curvatures, k1 >= k2, signed
@@ -163,7 +185,8 @@ typedef struct {
  * Monge_via_jet_fitting).  d1 x d2 = n is kept. */
 void jf_result_flip(jf_result *r);
 
-/* Flips `r` if its normal points away from `dir` (n . dir < 0). */
+/* Flips `r` if its normal points away from `dir` (n . dir < 0).
+ * Both are no-ops on NULL.  Thread-safe (on distinct results). */
 void jf_result_orient(jf_result *r, const double dir[3]);
 
 /* ------------------------------------------------------------------ */
@@ -172,7 +195,11 @@ void jf_result_orient(jf_result *r, const double dir[3]);
 typedef struct jf_fitter jf_fitter;
 
 /* Creates a workspace for the parameters `p` (validated; copied).  All
- * memory a fit needs is allocated here: jf_fit_point never allocates. */
+ * memory a fit needs is allocated here: jf_fit_point never allocates.
+ * Returns JF_OK, the validation status, or JF_ERR_NOMEM; *out is NULL on
+ * failure.  The first call turns GSL's abort-on-error handler off for the
+ * whole process (gsl_set_error_handler_off, once, under pthread_once): the
+ * library checks its inputs so GSL never has to report.  Thread-safe. */
 jf_status jf_fitter_create(const jf_params *p, jf_fitter **out);
 void jf_fitter_free(jf_fitter *f);
 
@@ -180,20 +207,31 @@ void jf_fitter_free(jf_fitter *f);
  * (p itself may be one of them; it is the origin of the fit).  Always
  * fills *out (status flags say what happened) and returns JF_OK, or
  * JF_ERR_INVALID / JF_ERR_TOO_LARGE (n > max_neighbors) for bad
- * arguments.  With interpolation the N_n nearest points are used.
+ * arguments.  Steps: translate to p; drop non-finite neighbours; fitting
+ * frame from the covariance of all remaining neighbours; approximation
+ * uses them all, interpolation the N_n nearest distinct ones (exact
+ * duplicates skipped; ties by index).  Adaptive degree (§5.2): while
+ * N < N_d (LOWERED_FEW), M' is rank deficient (sigma_min <= sigma_max *
+ * rows * DBL_EPSILON: LOWERED_RANK) or kappa > max_cond (LOWERED_COND),
+ * try d - 1; below 1: FAILED.  Deterministic: a reused fitter gives
+ * bit-identical results to a fresh one.
  * Not thread-safe on one fitter; use one fitter per thread. */
 jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr,
                        size_t n, jf_result *out);
 
-/* Same, with one weight per neighbour (>= 0) multiplying its equation. */
+/* Same, with one finite weight per neighbour (>= 0, else JF_ERR_INVALID)
+ * multiplying its equation; weight-0 neighbours are left out of the fit
+ * and of the frame (whose covariance is weighted by w). */
 jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3],
                                 const double *nbr, const double *w,
                                 size_t n, jf_result *out);
 
 /* Signed residuals z_i - J(x_i, y_i) of each of the n neighbours given to
  * the last fit on this fitter (in the fitting frame, in the order given;
- * interpolation: points not used also get their residual).  res has n
- * entries.  JF_ERR_INVALID if n differs from the last fit's n. */
+ * interpolation: points not used also get their residual; NaN for
+ * non-finite neighbours and when the fit FAILED).  res has n entries.
+ * JF_ERR_INVALID if n differs from the last fit's n, or the last call on
+ * this fitter was jf_fit_curve or none. */
 jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n);
 
 /* The parameters the fitter was created with. */
@@ -208,9 +246,13 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
                             const double *nbr, size_t n, jf_result *out);
 
 /* Fits every point i of a cloud from the neighbour lists
- * idx[off[i] .. off[i+1]-1] (CSR; off has n+1 entries).  Non-finite
- * points get JF_PT_NONFINITE.  threads <= 0 means all cores.  Results
- * are identical for any thread count. */
+ * idx[off[i] .. off[i+1]-1] (CSR; off has n+1 entries, off[0] = 0; each
+ * index < n, else JF_ERR_INVALID) with jf_fit_point.  Non-finite points
+ * get JF_PT_NONFINITE (and are skipped as neighbours).  The workspaces
+ * hold the longest list even beyond p->max_neighbors.  OpenMP, one
+ * fitter per thread; threads <= 0 means all cores.  Results are
+ * bit-identical for any thread count.  Returns JF_OK, JF_ERR_INVALID or
+ * JF_ERR_NOMEM. */
 jf_status jf_fit_cloud(const jf_params *p, const double *xyz, size_t n,
                        const size_t *off, const uint32_t *idx, int threads,
                        jf_result *out);
@@ -220,19 +262,26 @@ jf_status jf_fit_cloud(const jf_params *p, const double *xyz, size_t n,
 /* ------------------------------------------------------------------ */
 typedef struct {
     unsigned status;     /* JF_PT_* flags                              */
-    int degree;          /* degree used                                */
+    int degree;          /* degree used (0 when FAILED: all NaN)       */
     double cond;         /* kappa of the preconditioned system         */
     double coef[JF_MAX_DEGREE + 1]; /* B0..Bn in the fitting frame     */
     double normal[2];    /* unit normal                                */
     double tangent[2];   /* unit tangent                               */
     double k;            /* curvature 2B2/(1+B1^2)^(3/2), signed w.r.t.
-                            normal                                      */
-    double dk;           /* dk/ds (n >= 3), else 0                     */
+                            normal (NaN at degree 1)                    */
+    double dk;           /* dk/ds = [f'''(1+f'^2) - 3 f' f''^2]/(1+f'^2)^3
+                            at x = 0, s along `tangent`; 0 if degree < 3
+                            was asked, NaN if lowered below 3           */
 } jf_curve_result;
 
-/* Fits a curve jet at p from n 2D samples xy[2*i..].  The frame: PCA of
- * the samples (x along the tangent estimate).  Uses the fitter's
- * workspace (the fitter's degree bounds `degree`). */
+/* Fits a curve jet at p from n 2D samples xy[2*i..] (n <= the fitter's
+ * max_neighbors, else JF_ERR_TOO_LARGE).  The frame: translate to p, PCA
+ * of the samples, x along the largest-variance axis (sign pinned: its
+ * largest-|component| positive), y = x turned +90 degrees; `normal` is on
+ * the +y side, (tangent, normal) direct.  degree 1..JF_MAX_DEGREE
+ * whatever the fitter's degree; the same preconditioning (h = mean |x_i|),
+ * SVD, adaptive degree and flags as surfaces; uses the fitter's
+ * workspace and max_cond.  Not thread-safe on one fitter. */
 jf_status jf_fit_curve(jf_fitter *f, const double p[2], const double *xy,
                        size_t n, int degree, jf_fit_mode mode,
                        jf_curve_result *out);
