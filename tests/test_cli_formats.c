@@ -180,6 +180,61 @@ START_TEST(columns_option)
 }
 END_TEST
 
+/* rings on an OFF mesh (a UV sphere), natural on its vertices as a
+ * cloud; rings without faces is an error naming the option. */
+START_TEST(neighbourhood_kinds)
+{
+    enum { NU = 60, NV = 30 };
+    size_t n = (size_t)NU * (NV - 1), nf = 2 * (size_t)NU * (NV - 2);
+    double R = 2, *xyz = malloc(3 * n * sizeof *xyz);
+    FILE *f = fopen(cli_path("s.off"), "w");
+    fprintf(f, "OFF\n%zu %zu 0\n", n, nf);
+    for (int j = 1; j < NV; j++)
+        for (int i = 0; i < NU; i++) {
+            double th = M_PI * j / NV, ph = 2 * M_PI * i / NU;
+            double *p = xyz + 3 * ((size_t)(j - 1) * NU + i);
+            p[0] = R * sin(th) * cos(ph), p[1] = R * sin(th) * sin(ph), p[2] = R * cos(th);
+            fprintf(f, "%.17g %.17g %.17g\n", p[0], p[1], p[2]);
+        }
+    for (int j = 0; j < NV - 2; j++)
+        for (int i = 0; i < NU; i++) {
+            int a = j * NU + i, b = j * NU + (i + 1) % NU;
+            fprintf(f, "3 %d %d %d\n3 %d %d %d\n", a, a + NU, b, b, a + NU, b + NU);
+        }
+    fclose(f);
+    cli_write_xyz(cli_path("s.xyz"), xyz, NULL, n);
+    ck_assert_msg(cli_run("estimate", cli_path("s.off"), "-o", cli_path("r.csv"), "--neighbors",
+                          "rings:19", "--orient", "viewpoint:0,0,0", NULL) == 0, "%s", cli_err);
+    ck_assert_msg(cli_run("estimate", cli_path("s.xyz"), "-o", cli_path("n.csv"), "--neighbors",
+                          "natural", "--orient", "mst", NULL) == 0, "%s", cli_err);
+    jf_eval_table r, t;
+    cli_read(cli_path("r.csv"), &r);
+    cli_read(cli_path("n.csv"), &t);
+    ck_assert_uint_eq(r.nrows, n);
+    ck_assert_uint_eq(t.nrows, n);
+    for (size_t i = 0; i < n; i++) {
+        size_t lat = i / NU + 1;
+        ck_assert(same(cli_val(&r, i, "x"), xyz[3 * i]));
+        if (lat < 5 || lat > NV - 5) continue; /* thin triangles near the poles */
+        ck_assert_double_eq(cli_val(&r, i, "neighbors"), 19);
+        ck_assert_double_eq_tol(cli_val(&r, i, "k1"), 1 / R, 0.03 / R);  /* inward */
+        ck_assert_double_eq_tol(cli_val(&t, i, "k2"), -1 / R, 0.05 / R); /* outward */
+        unsigned st = (unsigned)cli_val(&t, i, "status");
+        ck_assert_uint_ne(st & (JF_PT_NORMAL_POLES | JF_PT_NORMAL_MINCIRC), 0);
+    }
+    jf_eval_table_free(&r);
+    jf_eval_table_free(&t);
+    ck_assert_int_ne(cli_run("estimate", cli_path("s.xyz"), "-o", cli_path("x.csv"),
+                             "--neighbors", "rings:19", NULL), 0);
+    ck_assert(strstr(cli_err, "rings") != NULL);
+    ck_assert_int_ne(cli_run("estimate", cli_path("s.xyz"), "-o", cli_path("x.csv"),
+                             "--neighbors", "natural", "--normal", "input", NULL), 0);
+    ck_assert(strstr(cli_err, "--normal input") != NULL);
+    ck_assert(!cli_exists(cli_path("x.csv")));
+    free(xyz);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_formats");
@@ -190,6 +245,7 @@ int main(void)
     tcase_add_test(tc, output_formats_agree);
     tcase_add_test(tc, threads_identical);
     tcase_add_test(tc, columns_option);
+    tcase_add_test(tc, neighbourhood_kinds);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
