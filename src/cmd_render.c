@@ -15,6 +15,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -82,13 +83,28 @@ static double quantile(double *tmp, size_t n, double q)
 }
 
 /* Screen coordinates of p for the view (gnuplot: rotate about z by rotz,
- * then about x by rotx; top view is rotx = rotz = 0). */
-static void project(const double p[3], double rotx, double rotz, double s[2])
+ * then about x by rotx; top view is rotx = rotz = 0) and its depth
+ * (larger = nearer the viewer; checked against gnuplot's `set view`). */
+static double project(const double p[3], double rotx, double rotz, double s[2])
 {
-    double cz = cos(rotz), sz = sin(rotz), cx = cos(rotx);
+    double cz = cos(rotz), sz = sin(rotz), cx = cos(rotx), sx = sin(rotx);
     double x = cz * p[0] + sz * p[1], y = -sz * p[0] + cz * p[1];
     s[0] = x;
-    s[1] = cx * y + sin(rotx) * p[2];
+    s[1] = cx * y + sx * p[2];
+    return cx * p[2] - sx * y;
+}
+
+typedef struct {
+    double depth;
+    size_t i;
+} by_depth;
+
+static int cmp_depth(const void *a, const void *b)
+{
+    const by_depth *x = a, *y = b;
+    if (x->depth != y->depth)
+        return x->depth < y->depth ? -1 : 1;
+    return (x->i > y->i) - (x->i < y->i);
 }
 
 typedef struct {
@@ -236,13 +252,33 @@ int jf_cmd_render(int argc, char **argv)
         vhi = fmax(-vlo, vhi), vlo = -vhi;
     if (!(vhi > vlo))
         vhi = vlo + 1e-12 + fabs(vlo) * 1e-6;
-    /* glyphs: first point of each cell of a g x g screen grid */
+    /* painter's order: far points first, so near ones cover them
+     * (gnuplot does not depth-sort points) */
+    by_depth *ord = malloc(n * sizeof *ord);
+    for (size_t i = 0; ord && i < n; i++) {
+        double s[2];
+        ord[i].depth = project(t.v + i * nc + c.x, rotx, rotz, s);
+        ord[i].i = i;
+        if (!isfinite(ord[i].depth))
+            ord[i].depth = -INFINITY;
+    }
+    if (!ord) {
+        fprintf(stderr, "jetfit render: out of memory\n");
+        free(val), free(tmp), free(take);
+        jf_eval_table_free(&t);
+        return 1;
+    }
+    qsort(ord, n, sizeof *ord, cmp_depth);
+    /* glyphs: the nearest point of each cell of a g x g screen grid */
     double span = fmax(smax[0] - smin[0], smax[1] - smin[1]);
     int g = (int)ceil(sqrt((double)glyphs));
     double cell = g ? span / g : 0, len = 0.8 * cell;
     if (dirs && g > 0 && span > 0) {
-        unsigned char *used = calloc((size_t)g * g, 1);
-        for (size_t i = 0; used && i < n; i++) {
+        size_t *best = malloc((size_t)g * g * sizeof *best);
+        for (size_t k = 0; best && k < (size_t)g * g; k++)
+            best[k] = SIZE_MAX;
+        for (size_t k = 0; best && k < n; k++) { /* far to near */
+            size_t i = ord[k].i;
             const double *r = t.v + i * nc;
             double s[2];
             project(r + c.x, rotx, rotz, s);
@@ -250,12 +286,12 @@ int jf_cmd_render(int argc, char **argv)
                 continue;
             int a = (int)fmin(g - 1, (s[0] - smin[0]) / cell);
             int b = (int)fmin(g - 1, (s[1] - smin[1]) / cell);
-            if (!used[(size_t)b * g + a]) {
-                used[(size_t)b * g + a] = 1;
-                take[i] = 1;
-            }
+            best[(size_t)b * g + a] = i;
         }
-        free(used);
+        for (size_t k = 0; best && k < (size_t)g * g; k++)
+            if (best[k] != SIZE_MAX)
+                take[best[k]] = 1;
+        free(best);
     }
     if (ps <= 0)
         ps = n > 100000 ? 0.15 : n > 20000 ? 0.3 : n > 4000 ? 0.5 : 0.8;
@@ -295,7 +331,8 @@ int jf_cmd_render(int argc, char **argv)
         fprintf(gp, "unset colorbox\n");
     /* data: x y z value; glyph segments: x y z dx dy dz, per direction */
     fprintf(gp, "$pts << EOD\n");
-    for (size_t i = 0; i < n; i++) {
+    for (size_t k = 0; k < n; k++) {
+        size_t i = ord[k].i;
         const double *r = t.v + i * nc;
         if (isfinite(r[c.x]) && isfinite(r[c.y]) && isfinite(r[c.z]))
             fprintf(gp, "%.9g %.9g %.9g %.9g\n", r[c.x], r[c.y], r[c.z],
@@ -322,7 +359,7 @@ int jf_cmd_render(int argc, char **argv)
             fprintf(gp, ", $dir1 using 1:2:4:5 with vectors nohead lw 2 lc rgb '#e41a1c'"
                         ", $dir2 using 1:2:4:5 with vectors nohead lw 2 lc rgb '#1f4fd8'");
     } else {
-        fprintf(gp, "set view %g,%g\nset view equal xyz\nset xyplane 0\n",
+        fprintf(gp, "set view %g,%g,1.5\nset view equal xyz\nset xyplane 0\n",
                 rotx * 180.0 / M_PI, rotz * 180.0 / M_PI);
         fprintf(gp, "splot $pts using 1:2:3%s with points pt 7 ps %g %s",
                 need_k ? ":4" : "", ps, pts);
@@ -332,7 +369,7 @@ int jf_cmd_render(int argc, char **argv)
     }
     fprintf(gp, "\n");
     int rc = pclose(gp);
-    free(val), free(tmp), free(take);
+    free(val), free(tmp), free(take), free(ord);
     jf_eval_table_free(&t);
     if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
         fprintf(stderr, "jetfit render: gnuplot failed writing %s\n", out);
