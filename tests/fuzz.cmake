@@ -1,0 +1,21 @@
+# libFuzzer harnesses for the file readers (tests/fuzz/README.md).  Built
+# only with -DJF_FUZZ=ON and clang; the reader sources are compiled into
+# each harness so they carry the fuzzer's coverage instrumentation.
+if(JF_FUZZ)
+  if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "JF_FUZZ=ON needs clang: configure with "
+            "-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  set(JF_FUZZ_READER_SOURCES
+      ${PROJECT_SOURCE_DIR}/src/io_read.c ${PROJECT_SOURCE_DIR}/src/io_ply.c
+      ${PROJECT_SOURCE_DIR}/src/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io_off.c)
+  set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
+      -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
+  foreach(reader ply xyz off)
+    add_executable(fuzz_${reader} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_${reader}.c
+                   ${JF_FUZZ_READER_SOURCES})
+    target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src)
+    target_compile_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
+    target_link_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
+  endforeach()
+endif()
