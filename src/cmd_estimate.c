@@ -28,8 +28,9 @@ static void usage(FILE *f)
         "INPUT: .ply .xyz .pts .txt .csv .off    OUTPUT: .ply .csv .xyz .txt\n"
         "\n"
         "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
-        "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings:N (mesh input)\n"
-        "                        | natural[:N]     (default " DEFAULT_NEIGHBORS "; K counts the point)\n"
+        "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
+        "                        | natural[:N]     (default " DEFAULT_NEIGHBORS "; K and N count\n"
+        "                        the point; radius:R keeps at most the 256 nearest)\n"
         "  --degree N            jet degree 1..%d (default %d)\n"
         "  --monge-degree N      2..4, <= degree: 3 adds b0..b3, 4 adds c0..c4\n"
         "                        (default min(degree, 4))\n"
@@ -390,6 +391,9 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
+    /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
+     * the surface); polygons over 255 vertices: vertices only */
+    if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
     jf_result *r = malloc(c.n * sizeof *r);
     if (!r) {
         fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);
