@@ -207,6 +207,30 @@ START_TEST(closed_meshes_are_closed_and_outward)
 }
 END_TEST
 
+/* The open cylinder: faces outward (normal . (x, y, 0) > 0), a seam
+ * joined: every vertex in some face, (2 pi R / h) x (2 / h + 1) vertices. */
+START_TEST(cylinder_mesh_outward)
+{
+    jf_rng r;
+    jf_sample s;
+    jf_rng_seed(&r, 5);
+    ck_assert_int_eq(jf_sample_grid(JF_SURF_CYLINDER, 0.1, 0.0, 1, &r, &s), JF_OK);
+    ck_assert_uint_eq(s.n, 31 * 21);
+    ck_assert_uint_eq(s.nfaces, 2 * 31 * 20);
+    for (size_t f = 0; f < s.nfaces; f++) {
+        const uint32_t *t = s.face_idx + 3 * f;
+        double e1[3], e2[3], nf[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = s.xyz[3 * t[1] + k] - s.xyz[3 * t[0] + k];
+            e2[k] = s.xyz[3 * t[2] + k] - s.xyz[3 * t[0] + k];
+        }
+        cross3(e1, e2, nf);
+        ck_assert(nf[0] * s.xyz[3 * t[0]] + nf[1] * s.xyz[3 * t[0] + 1] > 0);
+    }
+    jf_sample_free(&s);
+}
+END_TEST
+
 START_TEST(graph_grid_layout_and_determinism)
 {
     jf_rng r1, r2;
@@ -226,8 +250,8 @@ START_TEST(graph_grid_layout_and_determinism)
     jf_sample_free(&b);
     jf_rng_seed(&r2, 9); /* unperturbed (perturbing may flip a few) */
     ck_assert_int_eq(jf_sample_graph_grid(JF_SURF_EXP, 0.125, 5, 0.0, &r2, &b), JF_OK);
+    ck_assert(memcmp(a.face_idx, b.face_idx, 3 * a.nfaces * sizeof(uint32_t)) == 0);
     for (size_t f = 0; f < b.nfaces; f++) { /* upward faces */
-        ck_assert(memcmp(a.face_idx, b.face_idx, 3 * a.nfaces * sizeof(uint32_t)) == 0);
         const uint32_t *t = b.face_idx + 3 * f;
         double e1x = b.uv[2 * t[1]] - b.uv[2 * t[0]], e1y = b.uv[2 * t[1] + 1] - b.uv[2 * t[0] + 1];
         double e2x = b.uv[2 * t[2]] - b.uv[2 * t[0]], e2y = b.uv[2 * t[2] + 1] - b.uv[2 * t[0] + 1];
@@ -279,6 +303,7 @@ int main(void)
     tcase_add_test(tc, closed_form_values);
     tcase_add_test(tc, random_samples_lie_on_surface);
     tcase_add_test(tc, closed_meshes_are_closed_and_outward);
+    tcase_add_test(tc, cylinder_mesh_outward);
     tcase_add_test(tc, graph_grid_layout_and_determinism);
     tcase_add_test(tc, noise_models);
     suite_add_tcase(s, tc);
