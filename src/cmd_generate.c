@@ -61,7 +61,8 @@ static void usage(FILE *out)
         "  --truth FILE     exact truth, one row per point in output order:\n"
         "                   x y z nx ny nz k1 k2 [d1x d1y d1z d2x d2y d2z]\n"
         "                   (.csv, or .xyz/.txt with a '# names' header, or .ply;\n"
-        "                   x y z is the noise-free point; d1, d2 are written for\n"
+        "                   x y z is the noise-free point (an outlier: itself);\n"
+        "                   d1, d2 are written for\n"
         "                   every surface but the sphere and are NaN at umbilics)\n"
         "  --ascii          ascii PLY\n",
         DEFAULT_N);
