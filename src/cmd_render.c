@@ -12,6 +12,7 @@
  * most --glyphs points, one per cell of a screen-space grid, each a
  * segment centred on its point; everything is piped to gnuplot as inline
  * data blocks (no temporary files). */
+#define _POSIX_C_SOURCE 200809L /* popen, pclose */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
