@@ -53,8 +53,9 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
 
 /* Parses the whole token [s, e) as a double (decimal, exponent, "nan",
  * "inf", hex floats): 1 on success, 0 if the token is not one number.
- * Exact: the fast path (<= 19 digits, mantissa <= 2^53, |exp| <= 22) is
- * Clinger's one-rounding case; everything else goes to strtod. */
+ * Exact: <= 19 digits with mantissa <= 2^53 and |exp| <= 22 is Clinger's
+ * one-rounding case; <= 19 digits with |exp| <= 27 use exact 128-bit
+ * integers; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
 
 /* Writes v exactly as printf("%.17g", v) does, except NaN -> "nan"
@@ -87,10 +88,12 @@ static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
     return 1;
 }
 
-/* Separator classes for jf_next_token. */
+/* Separator classes for jf_next_token: 1 = blank, 2 = ',' or ';'. */
+extern const unsigned char jf_sep_class[256];
+
 static inline int jf_is_space(char ch)
 {
-    return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f';
+    return jf_sep_class[(unsigned char)ch] & 1;
 }
 
 /* Next token of [*p, e) separated by whitespace (and ',' ';' when
@@ -98,15 +101,16 @@ static inline int jf_is_space(char ch)
 static inline int jf_next_token(const char **p, const char *e, int commas,
                                 const char **ts, const char **te)
 {
+    const unsigned mask = commas ? 3u : 1u;
     const char *q = *p;
-    while (q < e && (jf_is_space(*q) || (commas && (*q == ',' || *q == ';'))))
+    while (q < e && (jf_sep_class[(unsigned char)*q] & mask))
         q++;
     if (q >= e) {
         *p = q;
         return 0;
     }
     *ts = q;
-    while (q < e && !jf_is_space(*q) && !(commas && (*q == ',' || *q == ';')))
+    while (q < e && !(jf_sep_class[(unsigned char)*q] & mask))
         q++;
     *te = q;
     *p = q;

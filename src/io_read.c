@@ -13,12 +13,17 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+const unsigned char jf_sep_class[256] = {
+    ['\t'] = 1, ['\v'] = 1, ['\f'] = 1, ['\r'] = 1, [' '] = 1,
+    [','] = 2, [';'] = 2};
 
 void jf_read_opts_init(jf_read_opts *o)
 {
@@ -112,6 +117,43 @@ static int slow_double(const char *s, const char *e, double *out)
     return 1;
 }
 
+/* 5^0 .. 5^27 (5^27 < 2^63). */
+static uint64_t pow5(int k)
+{
+    uint64_t p = 1;
+    while (k--)
+        p *= 5;
+    return p;
+}
+
+/* m 10^e10 correctly rounded, for m < 2^64, |e10| <= 27, by exact 128-bit
+ * integer arithmetic (the digits a %.17g writer produces); 0 if the result
+ * would be subnormal (left to strtod). */
+static int wide_double(uint64_t m, int e10, double *out)
+{
+    if (m == 0)
+        return 0;
+    if (e10 >= 0) {
+        /* m 5^e < 2^127: exact; one rounding in the conversion */
+        unsigned __int128 p = (unsigned __int128)m * pow5(e10);
+        *out = ldexp((double)p, e10);
+        return 1;
+    }
+    int k = -e10, lz = __builtin_clzll(m);
+    uint64_t d = pow5(k);
+    /* q = floor(m 2^(lz+63) / 5^k) has >= 64 bits; a sticky last bit for a
+     * non-zero remainder makes the one rounding to 53 bits exact */
+    unsigned __int128 num = (unsigned __int128)(m << lz) << 63;
+    unsigned __int128 q = num / d;
+    q |= (num % d) != 0;
+    double v = (double)q;
+    int sh = lz + 63 + k;
+    if (ilogb(v) - sh < -1021)
+        return 0;
+    *out = ldexp(v, -sh);
+    return 1;
+}
+
 int jf_parse_double(const char *s, const char *e, double *out)
 {
     const char *p = s;
@@ -163,8 +205,13 @@ int jf_parse_double(const char *s, const char *e, double *out)
     }
     if (p != e)
         return slow_double(s, e, out); /* hex float, or not a number */
-    if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22)
-        return slow_double(s, e, out);
+    if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22) {
+        double v;
+        if (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v))
+            return slow_double(s, e, out);
+        *out = neg ? -v : v;
+        return 1;
+    }
     double v = (double)m;
     v = exp10 >= 0 ? v * jf_pow10[exp10] : v / jf_pow10[-exp10];
     *out = neg ? -v : v;

@@ -386,6 +386,62 @@ START_TEST(exact_decimal_parse)
 }
 END_TEST
 
+START_TEST(parse_vs_strtod)
+{
+    /* 19-, 18-, 17- and short-digit mantissas, exponents -40..40, and
+     * halfway-looking tails: the parser must agree with strtod bit for bit
+     * (read through a file as the reader sees them) */
+    size_t n = 60000;
+    char *buf = malloc(n * 3 * 40);
+    size_t len = 0;
+    uint64_t s = 777;
+    for (size_t i = 0; i < 3 * n; i++) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        int digits = 1 + (int)(s % 19);
+        uint64_t m = s >> 3;
+        char d[24];
+        int k = snprintf(d, sizeof d, "%llu", (unsigned long long)m);
+        if (k > digits)
+            k = digits;
+        if (i % 7 == 0 && k > 2)
+            d[k - 1] = '5'; /* ...5: near a rounding boundary */
+        d[k] = '\0';
+        int e = (int)((s >> 40) % 81) - 40;
+        int point = (int)((s >> 50) % (unsigned)(k + 1));
+        len += (size_t)sprintf(buf + len, "%s%.*s.%se%d%c",
+                               (s >> 63) ? "-" : "", point, d, d + point, e,
+                               i % 3 == 2 ? '\n' : ' ');
+    }
+    jf_cloud c;
+    read_ok(fixture("dec.xyz", buf, len), NULL, &c);
+    ck_assert_uint_eq(c.n, n);
+    const char *p = buf;
+    for (size_t i = 0; i < 3 * n; i++) {
+        char *end;
+        double want = strtod(p, &end);
+        p = end + 1;
+        ck_assert_msg(memcmp(&want, &c.xyz[i], 8) == 0,
+                      "value %zu: %.17g vs strtod %.17g", i, c.xyz[i], want);
+    }
+    jf_cloud_free(&c);
+    free(buf);
+    /* exact halfway points between doubles (ties to even) and just off */
+    static const char *const half[] = {
+        "9007199254740993", "9007199254740995", "4503599627370496.5",
+        "4503599627370497.5", "4503599627370496.501", "4503599627370496.499",
+        "1.00000000000000011102230246251565404", "0.1e-27", "123456789e27"};
+    for (size_t i = 0; i < sizeof half / sizeof *half; i++) {
+        char line[128];
+        snprintf(line, sizeof line, "%s 0 0\n", half[i]);
+        read_ok(text("half.xyz", line), NULL, &c);
+        double want = strtod(half[i], NULL);
+        ck_assert_msg(memcmp(&want, &c.xyz[0], 8) == 0, "%s: %.17g vs %.17g",
+                      half[i], c.xyz[0], want);
+        jf_cloud_free(&c);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("io_read");
@@ -404,6 +460,7 @@ int main(void)
     tcase_add_test(tc, csv_header);
     tcase_add_test(tc, off_variants);
     tcase_add_test(tc, exact_decimal_parse);
+    tcase_add_test(tc, parse_vs_strtod);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

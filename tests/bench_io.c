@@ -1,0 +1,264 @@
+/*
+ * bench_io.c -- speed and peak memory of the writers and readers on N
+ * generated points (default 10^7), beside naive stdio peers measured in
+ * the same run: fprintf("%.17g") for writing text, fscanf("%lf") for
+ * reading it.
+ *
+ *   bench_io [N] [DIR]      (files DIR/jf_bench.*; removed at the end)
+ *
+ * Each step runs in its own forked child so its peak memory (ru_maxrss,
+ * from wait4) is its own; the points array (24 bytes/point) is part of
+ * every step's peak.  Also the table writer on 10^6 rows x 28 columns
+ * (the estimate command's widest output) as binary PLY and CSV.
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/time.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "jetfit.h"
+
+static size_t N = 10000000;
+static char dir[512] = "/tmp";
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* N points on a wavy surface, full-precision doubles (17 digits in text) */
+static double *gen(size_t n)
+{
+    double *p = malloc(3 * n * sizeof *p);
+    if (!p)
+        exit(2);
+    uint64_t s = 42;
+    for (size_t i = 0; i < n; i++) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        double u = (double)(s >> 11) * 0x1p-53;
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        double v = (double)(s >> 11) * 0x1p-53;
+        p[3 * i] = 100 * u;
+        p[3 * i + 1] = 100 * v;
+        p[3 * i + 2] = sin(u * 20) * cos(v * 20);
+    }
+    return p;
+}
+
+static void path(char *out, const char *ext)
+{
+    snprintf(out, 600, "%s/jf_bench.%s", dir, ext);
+}
+
+/* ---- the steps (run in a child; return seconds, or < 0 on failure) ---- */
+
+static double write_cloud(const char *ext, int ascii)
+{
+    jf_cloud c = {0};
+    c.n = N;
+    c.xyz = gen(N);
+    char p[600];
+    path(p, ext);
+    jf_error e;
+    double t = now();
+    jf_status st = jf_cloud_write(p, &c, ascii, &e);
+    t = now() - t;
+    if (st != JF_OK)
+        fprintf(stderr, "%s\n", e.msg);
+    free(c.xyz);
+    return st == JF_OK ? t : -1;
+}
+
+static double write_fprintf(void)
+{
+    double *x = gen(N);
+    char p[600];
+    path(p, "peer.xyz");
+    double t = now();
+    FILE *f = fopen(p, "w");
+    if (!f)
+        return -1;
+    for (size_t i = 0; i < N; i++)
+        fprintf(f, "%.17g %.17g %.17g\n", x[3 * i], x[3 * i + 1],
+                x[3 * i + 2]);
+    int bad = fclose(f) != 0;
+    t = now() - t;
+    free(x);
+    return bad ? -1 : t;
+}
+
+static double read_cloud(const char *ext)
+{
+    char p[600];
+    path(p, ext);
+    jf_cloud c;
+    jf_error e;
+    double t = now();
+    jf_status st = jf_cloud_read(p, NULL, &c, &e);
+    t = now() - t;
+    if (st != JF_OK) {
+        fprintf(stderr, "%s\n", e.msg);
+        return -1;
+    }
+    /* must equal the generated points bit for bit */
+    double *x = gen(N);
+    int same = c.n == N && !memcmp(x, c.xyz, 3 * N * sizeof *x);
+    free(x);
+    jf_cloud_free(&c);
+    if (!same)
+        fprintf(stderr, "%s: read back differs\n", p);
+    return same ? t : -1;
+}
+
+static double read_fscanf(void)
+{
+    char p[600];
+    path(p, "xyz");
+    double t = now();
+    FILE *f = fopen(p, "r");
+    if (!f)
+        return -1;
+    size_t n = 0, cap = 1024;
+    double *x = malloc(3 * cap * sizeof *x);
+    while (x && fscanf(f, "%lf %lf %lf", &x[3 * n], &x[3 * n + 1],
+                       &x[3 * n + 2]) == 3) {
+        if (++n == cap) {
+            cap *= 2;
+            x = realloc(x, 3 * cap * sizeof *x);
+        }
+    }
+    fclose(f);
+    t = now() - t;
+    int ok = n == N;
+    free(x);
+    return ok ? t : -1;
+}
+
+static double write_table(const char *ext)
+{
+    size_t rows = N / 10, ncols = 28;
+    jf_column cols[28];
+    char names[28][8];
+    for (size_t j = 0; j < ncols; j++) {
+        snprintf(names[j], sizeof names[j], "c%zu", j);
+        cols[j].name = names[j];
+        cols[j].type = j >= 23 && j != 25 && j != 26 ? JF_COL_I32
+                                                      : JF_COL_F64;
+    }
+    double *x = gen(rows * 10); /* 30 values per row to pick from */
+    char p[600];
+    path(p, ext);
+    jf_writer *w;
+    jf_error e;
+    double t = now();
+    if (jf_writer_open(p, cols, ncols, rows, 0, &w, &e) != JF_OK)
+        return -1;
+    for (size_t i = 0; i < rows; i++)
+        jf_writer_row(w, x + 30 * i);
+    jf_status st = jf_writer_commit(w, &e);
+    t = now() - t;
+    free(x);
+    return st == JF_OK ? t : -1;
+}
+
+/* ---- driver ------------------------------------------------------------ */
+
+typedef struct {
+    const char *what;
+    int kind;
+    const char *ext;
+    int ascii;
+    size_t count; /* points or rows per run (0: N) */
+} step;
+
+static double run(const step *s)
+{
+    switch (s->kind) {
+    case 0: return write_cloud(s->ext, s->ascii);
+    case 1: return write_fprintf();
+    case 2: return read_cloud(s->ext);
+    case 3: return read_fscanf();
+    default: return write_table(s->ext);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1)
+        N = strtoull(argv[1], NULL, 10);
+    if (argc > 2)
+        snprintf(dir, sizeof dir, "%s", argv[2]);
+    if (N < 10)
+        N = 10;
+    const step steps[] = {
+        {"write binary PLY (jetfit)", 0, "ply", 0, 0},
+        {"write ascii PLY (jetfit)", 0, "a.ply", 1, 0},
+        {"write xyz (jetfit)", 0, "xyz", 0, 0},
+        {"write xyz (peer: fprintf %.17g)", 1, "peer.xyz", 0, 0},
+        {"read binary PLY (jetfit)", 2, "ply", 0, 0},
+        {"read ascii PLY (jetfit)", 2, "a.ply", 0, 0},
+        {"read xyz (jetfit)", 2, "xyz", 0, 0},
+        {"read xyz (peer: fscanf %lf)", 3, "xyz", 0, 0},
+        {"table N/10 x 28 cols, binary PLY", 4, "t.ply", 0, 1},
+        {"table N/10 x 28 cols, CSV", 4, "t.csv", 0, 1},
+    };
+    size_t nsteps = sizeof steps / sizeof *steps;
+    double secs[16];
+    printf("bench_io: N = %zu points, files in %s\n", N, dir);
+    printf("%-36s %9s %14s %10s\n", "step", "seconds", "points/s",
+           "peak MiB");
+    for (size_t i = 0; i < nsteps; i++) {
+        int fd[2];
+        if (pipe(fd) != 0)
+            return 2;
+        pid_t pid = fork();
+        if (pid == 0) {
+            close(fd[0]);
+            double t = run(&steps[i]);
+            if (write(fd[1], &t, sizeof t) != sizeof t)
+                _exit(3);
+            _exit(0);
+        }
+        close(fd[1]);
+        double t = -1;
+        if (read(fd[0], &t, sizeof t) != sizeof t)
+            t = -1;
+        close(fd[0]);
+        int status;
+        struct rusage ru;
+        wait4(pid, &status, 0, &ru);
+        size_t count = steps[i].count ? N / 10 : N;
+        secs[i] = t;
+        if (t < 0)
+            printf("%-36s %9s\n", steps[i].what, "FAILED");
+        else
+            printf("%-36s %9.2f %14.0f %10.0f\n", steps[i].what, t,
+                   (double)count / t, (double)ru.ru_maxrss / 1024.0);
+        fflush(stdout);
+    }
+    if (secs[2] > 0 && secs[3] > 0)
+        printf("write xyz: jetfit is %.2fx the speed of fprintf\n",
+               secs[3] / secs[2]);
+    if (secs[6] > 0 && secs[7] > 0)
+        printf("read xyz: jetfit is %.2fx the speed of fscanf\n",
+               secs[7] / secs[6]);
+    if (secs[4] > 0 && secs[7] > 0)
+        printf("read binary PLY: %.2fx the speed of fscanf on xyz\n",
+               secs[7] / secs[4]);
+    static const char *const exts[] = {"ply", "a.ply", "xyz", "peer.xyz",
+                                       "t.ply", "t.csv"};
+    for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
+        char p[600];
+        path(p, exts[i]);
+        unlink(p);
+    }
+    return 0;
+}
