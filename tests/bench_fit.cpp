@@ -16,7 +16,9 @@
 // (getrusage ru_maxrss) is its own; the timing is the child's CPU time
 // (the machine is shared), best of R rounds, sides alternating.
 //
-// Usage: bench_fit [Q=20000] [R=3]
+// Usage: bench_fit [Q=20000] [R=3] [only=jetfit|cgal] [setting 0..3]
+//   with `only`, runs that side alone in-process (for perf record /
+//   valgrind --tool=callgrind) and prints its fits/s.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,6 +28,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <vector>
 
@@ -187,8 +190,11 @@ int main(int argc, char **argv)
 {
     size_t Q = argc > 1 ? (size_t)std::strtoul(argv[1], NULL, 10) : 20000;
     int R = argc > 2 ? std::atoi(argv[2]) : 3;
-    if (Q < 1 || R < 1) {
-        std::fprintf(stderr, "usage: bench_fit [Q=20000] [R=3]\n");
+    const char *only = argc > 3 ? argv[3] : NULL;
+    if (Q < 1 || R < 1 ||
+        (only && std::strcmp(only, "jetfit") && std::strcmp(only, "cgal"))) {
+        std::fprintf(stderr, "usage: bench_fit [Q=20000] [R=3] "
+                             "[only=jetfit|cgal]\n");
         return 2;
     }
     const int g = 300;  // 90k samples, h = 1/299
@@ -208,7 +214,13 @@ int main(int argc, char **argv)
                 "CGAL MB+", "lowered");
     const int set[4][2] = {{2, 16}, {2, 32}, {3, 32}, {4, 64}};
     double worst = 1e300;
-    for (int si = 0; si < 4; si++) {
+    int s0 = 0, s1 = 4;
+    if (argc > 4) {
+        s0 = std::atoi(argv[4]);
+        if (s0 < 0 || s0 > 3) return 2;
+        s1 = s0 + 1;
+    }
+    for (int si = s0; si < s1; si++) {
         int d = set[si][0], K = set[si][1];
         std::vector<double> nb;
         nb.reserve(3 * (size_t)K * Q);
@@ -217,6 +229,15 @@ int main(int argc, char **argv)
         pts.reserve((size_t)K * Q);
         for (size_t i = 0; i < nb.size(); i += 3)
             pts.push_back(Point(nb[i], nb[i+1], nb[i+2]));
+        if (only) {  // profiling mode: one side, in this process
+            for (int r = 0; r < R; r++) {
+                Side x = only[0] == 'j' ? run_jetfit(nb, Q, K, d)
+                                        : run_cgal(pts, Q, K, d);
+                std::printf("%-7d %-4d %s %.0f fits/s\n", d, K, only,
+                            Q / x.seconds);
+            }
+            continue;
+        }
         Side bj = {1e300, 0, 0, 0, 0}, bc = {1e300, 0, 0, 0, 0};
         for (int r = 0; r < R; r++) {
             Side j = in_child([&] { return run_jetfit(nb, Q, K, d); });
@@ -238,6 +259,7 @@ int main(int argc, char **argv)
     }
     std::printf("peak RSS of this process %.1f MB (inputs); MB+ = child's "
                 "peak RSS above its RSS at fork\n", maxrss_mb());
-    std::printf("worst ratio jetfit/CGAL: %.2fx (goal >= 3x)\n", worst);
+    if (!only)
+        std::printf("worst ratio jetfit/CGAL: %.2fx (goal >= 3x)\n", worst);
     return 0;
 }
