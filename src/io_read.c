@@ -308,6 +308,9 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
                         "unknown file extension (expected .ply, .xyz, .pts, "
                         ".txt, .csv or .off)");
     }
+    /* a header announcing 0 vertices is as useless as an empty file */
+    if (st == JF_OK && c->n == 0)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
     if (st != JF_OK)
         jf_cloud_free(c);
     return st;

@@ -120,7 +120,7 @@ typedef struct {
     jf_frame_mode frame;     /* fitting frame, §5.2 (default pca)          */
     double max_cond;         /* adaptive degree: lower the degree while
                                 kappa(M') > max_cond; >= 1, +INFINITY
-                                disables the test (default 1e6, measured:
+                                disables the test (default 1e3, measured:
                                 README "Choosing --max-cond")             */
     size_t max_neighbors;    /* largest N a fitter accepts (default 256)   */
     jf_robust_mode robust;   /* IRLS weights on residuals (default none)   */
@@ -503,6 +503,7 @@ void jf_read_opts_init(jf_read_opts *o);
  *  - OFF (also COFF/NOFF/STOFF variants; NOFF normals are read): polygons
  *    of any size >= 3; indices are checked against the vertex count.
  * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
+ * A file without points (empty, comments only, 0 vertices) is an error.
  * o may be NULL (defaults).  c is overwritten (not freed first).
  * On failure returns the status (JF_ERR_IO, JF_ERR_FORMAT,
  * JF_ERR_TOO_LARGE, JF_ERR_NOMEM, JF_ERR_INVALID, JF_ERR_UNSUPPORTED),

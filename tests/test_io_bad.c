@@ -82,6 +82,10 @@ START_TEST(files)
     bad("empty.ply", "", 0, JF_ERR_FORMAT, ": empty file", 0, 0);
     bad("empty.xyz", "", 0, JF_ERR_FORMAT, "empty", 0, 0);
     bad("comments.xyz", "# nothing\n\n", 0, JF_ERR_FORMAT, "no points", 0, 0);
+    bad("zero.off", "OFF\n0 0 0\n", 0, JF_ERR_FORMAT, "no points", 0, 0);
+    bad("zero.ply", "ply\nformat ascii 1.0\nelement vertex 0\n"
+                    "property float x\nproperty float y\nproperty float z\n"
+                    "end_header\n", 0, JF_ERR_FORMAT, "no points", 0, 0);
 }
 END_TEST
 
