@@ -7,7 +7,8 @@
  * parses rows in place.  Comments ('#', '//') and blank lines are
  * skipped; a line holding a single integer is a point count (PTS files
  * start with one, concatenated scans repeat it) and is skipped when it is
- * the first data line or follows exactly that many rows.
+ * the first data line or follows exactly that many rows.  A first line
+ * of names only ("X Y Z nx ny nz") is a header, as in CSV.
  */
 #include "io_internal.h"
 
@@ -102,11 +103,12 @@ static jf_status csv_header(tab *t, const char *ls, const char *le,
                 found[k] = j;
     }
     if (want_names & 1) {
-        if (found[0] < 0 || found[1] < 0 || found[2] < 0)
+        int named = found[0] >= 0 && found[1] >= 0 && found[2] >= 0;
+        if (!named && t->csv)
             return jf_io_fail(t->err, JF_ERR_FORMAT, t->name, line,
                               "CSV header has no columns named x, y and z");
         for (int k = 0; k < 3; k++)
-            t->col[k] = found[k];
+            t->col[k] = named ? found[k] : k; /* xyz: default columns */
     }
     if ((want_names & 2) && found[3] >= 0 && found[4] >= 0 && found[5] >= 0)
         for (int k = 3; k < 6; k++)
@@ -126,6 +128,17 @@ static int all_numeric(const tab *t, const char *ls, const char *le)
         n++;
     }
     return n > 0;
+}
+
+/* 1 if no field of the row is a number (a header line of names). */
+static int none_numeric(const tab *t, const char *ls, const char *le)
+{
+    const char *p = ls, *fs, *fe;
+    double v;
+    while (next_field(t, &p, le, &fs, &fe))
+        if (jf_parse_double(fs, fe, &v))
+            return 0;
+    return 1;
 }
 
 /* Default normals: exactly 6 fields whose 3..5 look like a unit vector. */
@@ -201,7 +214,10 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
         if (!started) {
             /* the first data line decides the columns */
             started = 1;
-            int header = t.csv && !all_numeric(&t, ls, le);
+            /* csv: a header unless all numbers; xyz: a line of names
+             * only ("X Y Z", "x y z nx ny nz") */
+            int header = t.csv ? !all_numeric(&t, ls, le)
+                               : none_numeric(&t, ls, le);
             if (header) {
                 jf_status st = csv_header(&t, ls, le, tx.line,
                                           (setx ? 0 : 1) | (setn ? 0 : 2));

@@ -497,7 +497,8 @@ void jf_read_opts_init(jf_read_opts *o);
  *    vertex_indices or vertex_index) fills the face arrays.
  *  - XYZ/PTS/TXT: whitespace (or ',' ';') separated, 3 or more columns,
  *    '#' and '//' comments, blank lines skipped; a line holding one
- *    integer (a point count, as PTS files start) is skipped.
+ *    integer (a point count, as PTS files start) is skipped; a first line
+ *    of names only is a header (x,y,z[,nx,ny,nz] found by name as CSV).
  *  - CSV: comma separated; a header line naming the columns, or no header
  *    (all-numeric first line: x y z first).
  *  - OFF (also COFF/NOFF/STOFF variants; NOFF normals are read): polygons
@@ -703,6 +704,11 @@ typedef struct jf_natural jf_natural;
  * JF_OK, JF_ERR_INVALID (NULL args), JF_ERR_TOO_LARGE (n >= 2^32 - 1),
  * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Not parallel. */
 jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
+/* Same, with the per-vertex extraction (adjacency, poles) on `threads`
+ * threads (<= 0: all cores; jf_natural_create uses all); the insertion
+ * itself is sequential.  The result does not depend on threads. */
+jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
+                                    jf_natural **out);
 void jf_natural_free(jf_natural *nt);
 
 typedef struct {

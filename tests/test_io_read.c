@@ -244,6 +244,12 @@ START_TEST(xyz_columns)
     ck_assert_ptr_nonnull(c.nrm);
     ck_assert(c.nrm[0] == 0 && c.nrm[1] == 7 && c.nrm[4] == 8);
     jf_cloud_free(&c);
+    /* a header line of names (not a comment) picks the columns */
+    read_ok(text("named.txt", "id Z y X\n1 3 2 1\n2 6 5 4\n"), NULL, &c);
+    ck_assert_uint_eq(c.n, 2);
+    ck_assert(c.xyz[0] == 1 && c.xyz[1] == 2 && c.xyz[2] == 3);
+    ck_assert(c.xyz[3] == 4 && c.xyz[5] == 6);
+    jf_cloud_free(&c);
     /* default: first three columns */
     read_ok(text("plain.xyz", "1 2 3\n4,5,6\n7;8;9 10\n"), NULL, &c);
     ck_assert_uint_eq(c.n, 3);
