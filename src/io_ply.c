@@ -375,8 +375,8 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
         }
         size_t left = h->format ? (size_t)(h->end - h->p)
                                 : (size_t)(h->tx.end - h->tx.p) + 1;
-        if (need == 0 && !is_vertex && !is_face)
-            continue; /* rows of no bytes: nothing to skip */
+        if (need == 0 && !is_vertex)
+            continue; /* rows of no bytes (or faces without a list) */
         if (need && el->count > left / need) {
             st = jf_io_fail(err, JF_ERR_TOO_LARGE, name,
                             h->format ? 0 : h->tx.line,

@@ -113,6 +113,11 @@ START_TEST(ply_header)
         JF_ERR_FORMAT, "no x, y, z", 0, 0);
     bad("h9.ply", "ply\nformat ascii 1.0\nbogus line\nend_header\n", 0,
         JF_ERR_FORMAT, ":3: unknown header line 'bogus'", 0, 0);
+    /* a face element of no properties and a huge count: skipped at once */
+    bad("h11.ply", "ply\nformat binary_little_endian 1.0\nelement face "
+                   "18446744073709551615\nelement vertex 1\nproperty float x"
+                   "\nproperty float y\nproperty float z\nend_header\n", 0,
+        JF_ERR_TOO_LARGE, "element vertex: 1 rows cannot fit", 0, 0);
     bad("h10.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n", 0,
         JF_ERR_FORMAT, "no vertex element", 0, 0);
 }
