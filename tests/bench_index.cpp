@@ -14,7 +14,7 @@
  * pick different points, never different distances).
  *
  * usage: bench_index [--n N] [--no-cgal] [--no-nanoflann]
- *                    [--data uniform|surface|both]
+ *                    [--data uniform|surface|mesh|both]
  */
 #include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Search_traits_3.h>
@@ -254,6 +254,53 @@ void make_surface(Data &d, size_t n)
     }
 }
 
+/* Mesh side (§5.1 mesh case): the §6.1 surface on a g x g perturbed grid,
+ * two triangles per cell; adjacency build, then the default approximation
+ * neighbourhood of degree 2 (whole rings, >= 2 N_2 = 12 points) of every
+ * vertex, in vertex order.  No peer: CGAL has no ring query. */
+void run_mesh(size_t n, Result &out)
+{
+    size_t g = (size_t)std::ceil(std::sqrt((double)n));
+    size_t nv = g * g, nf = 2 * (g - 1) * (g - 1);
+    std::vector<double> xyz(3 * nv);
+    double h = 1.0 / (double)g;
+    for (size_t i = 0; i < nv; i++) {
+        double u = -0.5 + h * ((double)(i % g) + 0.9 * urand());
+        double v = -0.5 + h * ((double)(i / g) + 0.9 * urand());
+        xyz[3 * i] = u;
+        xyz[3 * i + 1] = v;
+        xyz[3 * i + 2] = 0.1 * std::exp(2 * u + v - v * v);
+    }
+    std::vector<size_t> off(nf + 1);
+    std::vector<uint32_t> fi(3 * nf);
+    size_t f = 0;
+    for (size_t j = 0; j + 1 < g; j++)
+        for (size_t i = 0; i + 1 < g; i++) {
+            uint32_t a = (uint32_t)(i + g * j), b = a + 1,
+                     c = (uint32_t)(a + g + 1), d = (uint32_t)(a + g);
+            uint32_t t[6] = {a, b, c, a, c, d};
+            for (int k = 0; k < 6; k++) fi[3 * f + k] = t[k];
+            off[f + 1] = 3 * (f + 1);
+            off[f + 2] = 3 * (f + 2);
+            f += 2;
+        }
+    double t0 = now();
+    jf_mesh *m = nullptr;
+    if (jf_mesh_build(nv, nf, off.data(), fi.data(), &m, nullptr) != JF_OK) return;
+    out.build_s = now() - t0;
+    uint32_t idx[64];
+    double sum = 0;
+    t0 = now();
+    for (size_t v = 0; v < nv; v++) {
+        size_t found;
+        jf_mesh_rings_full(m, xyz.data(), (uint32_t)v, 12, idx, 64, &found);
+        sum += (double)found;
+    }
+    out.query_s[0][0] = now() - t0;
+    out.sum[0] = sum / (double)nv;
+    jf_mesh_free(m);
+}
+
 void report(const char *who, const Result &r, const Result &ours, size_t n)
 {
     if (!r.ok) {
@@ -296,7 +343,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--data") && i + 1 < argc) which = argv[++i];
         else {
             fprintf(stderr, "usage: %s [--n N] [--no-cgal] [--no-nanoflann] "
-                            "[--data uniform|surface|both]\n", argv[0]);
+                            "[--data uniform|surface|mesh|both]\n", argv[0]);
             return 2;
         }
     }
@@ -332,6 +379,15 @@ int main(int argc, char **argv)
             Result cg = in_child([&](Result &r) { run_cgal(d, r); });
             report("CGAL", cg, ours, n);
         }
+    }
+    if (which == "both" || which == "mesh") {
+        Result m = in_child([&](Result &r) { run_mesh(n, r); });
+        if (m.ok)
+            printf("mesh (%zu vertices, 6.1 surface grid): adjacency %.3f s, "
+                   "rings (whole, >= 12 points, mean %.1f) %.3f s = %.2fM "
+                   "vertices/s | peak %.1f MB, extra %.1f MB\n", n,
+                   m.build_s, m.sum[0], m.query_s[0][0],
+                   (double)n / m.query_s[0][0] * 1e-6, m.peak_mb, m.extra_mb);
     }
     return 0;
 }
