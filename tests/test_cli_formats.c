@@ -51,6 +51,7 @@ START_TEST(input_formats_agree)
         ck_assert_msg(cli_run("estimate", cli_path(ins[k]), "-o", cli_path("o.csv"), "--quiet",
                               "--neighbors", "knn:20", NULL) == 0,
                       "%s: %s", ins[k], cli_err);
+        ck_assert_str_eq(cli_err, ""); /* --quiet */
         jf_eval_table t;
         cli_read(cli_path("o.csv"), &t);
         if (k == 0) {
@@ -86,8 +87,12 @@ START_TEST(output_formats_agree)
                        : cli_run("estimate", cli_path("in.xyz"), "-o", cli_path(outs[k]),
                                  "--degree", "4", NULL);
         ck_assert_msg(rc == 0, "%s: %s", outs[k], cli_err);
-        /* the summary names the output */
+        /* the summary (stderr, not a terminal: no progress line) */
         ck_assert(strstr(cli_err, outs[k]) != NULL);
+        ck_assert_msg(strstr(cli_err, "jetfit: 700 points in ") == cli_err, "%s", cli_err);
+        ck_assert(strstr(cli_err, "points/s") && strstr(cli_err, "  status: ok "));
+        ck_assert(strstr(cli_err, "  degree: ") && strstr(cli_err, "  cond: p50 "));
+        ck_assert(!strchr(cli_err, '\r'));
         jf_eval_table t;
         cli_read(cli_path(outs[k]), &t);
         if (k == 0) {
