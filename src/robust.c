@@ -31,12 +31,16 @@
 #define STACK_N 512
 #define NORMAL_TOL 1e-6 /* rad: IRLS stops when the normal moves less... */
 #define CURV_TOL 1e-6   /* ...and |dk| * h does: both scale invariant     */
-#define REL_TOL 0.01    /* or both move less than 1% of the noise scale   */
+#define REL_TOL 0.1     /* or both move less than 10% of the noise scale  */
 
-/* Weight of the scale-selection variance term against the bias term
- * (score()); chosen by measurement (tests/bench_pcpnet.cpp, README). */
-#ifndef JF_SCALE_VAR_WEIGHT
-#define JF_SCALE_VAR_WEIGHT 1.0
+/* Width of the scale-selection confidence intervals, in standard
+ * deviations (see jf_fit_point_full); chosen by measurement
+ * (tests/bench_pcpnet.cpp, README). */
+#ifndef JF_SCALE_TAU
+#define JF_SCALE_TAU 2.0
+#endif
+#ifndef JF_SCALE_TARGET
+#define JF_SCALE_TARGET 0.2
 #endif
 
 /* ---- per-thread fallback buffer for n > STACK_N ---- */
@@ -203,22 +207,95 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
     return JF_OK;
 }
 
-/* Estimated squared normal error of a fit of n points at radius h, from
- * the noise variance sigma0^2 (the least unbiased residual variance over
- * the candidates) and this fit's residual variance s2:
- *   variance: the slope of a least-squares jet has variance about
- *     sigma^2 / (sigma_min(M')^2 h^2) and sigma_max(M') ~ sqrt(n), so
- *     sigma0^2 kappa^2 / (n h^2)  (§2.3: kappa = sigma_max / sigma_min);
- *   bias: the residual variance above the noise is the truncation error
- *     of the jet, O(h^(n+1)), whose slope error is that over h. */
-static double score(double sigma0_2, double s2, double cond, size_t n, double h)
+/* Standard deviation (radians) of the normal of a least-squares jet fit of
+ * degree d to n points with noise sigma along the normal: the slope
+ * (A_10, A_01) has covariance sigma^2 [(M^T M)^-1] restricted to the two
+ * linear columns (M: the Vandermonde matrix of §2, eq. 7).  M^T M is built
+ * in the result's tangent frame (the fit's frame up to a rotation about
+ * the normal, which leaves the trace used here unchanged), preconditioned
+ * by h (§2.3), and inverted by Cholesky.  sigma^2 is the unbiased residual
+ * variance (n residuals, N_d coefficients).  INFINITY when undefined. */
+#define SD_MAXN 15 /* degree <= 4: N_4 = 15; higher degrees use degree 4 */
+static double normal_sd(const jf_result *r, double sigma, const double p[3],
+                        const double *nbr, size_t n)
 {
-    if (!(h > 0.0)) return INFINITY;
-    double var = sigma0_2 * cond * cond / ((double)n * h * h);
-    double bias = s2 > sigma0_2 ? (s2 - sigma0_2) / (h * h) : 0.0;
-    return JF_SCALE_VAR_WEIGHT * var + bias;
+    int d = r->degree < 4 ? r->degree : 4;
+    size_t nn = jf_jet_size(d), nfit = jf_jet_size(r->degree);
+    if (n <= nfit) return INFINITY;
+    double h = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *q = nbr + 3 * i;
+        double v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        h += hypot(v[0] * r->d1[0] + v[1] * r->d1[1] + v[2] * r->d1[2],
+                   v[0] * r->d2[0] + v[1] * r->d2[1] + v[2] * r->d2[2]);
+    }
+    h /= (double)n;
+    if (!(h > 0.0) || !isfinite(h)) return INFINITY;
+    double g[SD_MAXN * SD_MAXN] = {0}, mon[SD_MAXN];
+    for (size_t i = 0; i < n; i++) {
+        const double *q = nbr + 3 * i;
+        double v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double x = (v[0] * r->d1[0] + v[1] * r->d1[1] + v[2] * r->d1[2]) / h;
+        double y = (v[0] * r->d2[0] + v[1] * r->d2[1] + v[2] * r->d2[2]) / h;
+        if (!isfinite(x) || !isfinite(y)) continue;
+        size_t c = 0; /* monomials x^(k-j) y^j, k = 0..d, as the core orders them */
+        for (int k = 0; k <= d; k++)
+            for (int j = 0; j <= k; j++) mon[c++] = pow(x, k - j) * pow(y, j);
+        for (size_t a = 0; a < nn; a++)
+            for (size_t b = 0; b <= a; b++) g[a * nn + b] += mon[a] * mon[b];
+    }
+    /* Cholesky G = L L^T in the lower triangle */
+    for (size_t j = 0; j < nn; j++) {
+        double sum = g[j * nn + j];
+        for (size_t k = 0; k < j; k++) sum -= g[j * nn + k] * g[j * nn + k];
+        if (!(sum > 1e-14 * (double)n)) return INFINITY; /* (near) singular */
+        g[j * nn + j] = sqrt(sum);
+        for (size_t i = j + 1; i < nn; i++) {
+            double t = g[i * nn + j];
+            for (size_t k = 0; k < j; k++) t -= g[i * nn + k] * g[j * nn + k];
+            g[i * nn + j] = t / g[j * nn + j];
+        }
+    }
+    /* [G^-1]_cc = |L^-1 e_c|^2 for the linear columns c = 1 (x), 2 (y) */
+    double var = 0.0;
+    for (size_t c = 1; c <= 2; c++) {
+        double z[SD_MAXN] = {0};
+        for (size_t i = c; i < nn; i++) { /* forward substitution, L z = e_c */
+            double t = i == c ? 1.0 : 0.0;
+            for (size_t k = c; k < i; k++) t -= g[i * nn + k] * z[k];
+            z[i] = t / g[i * nn + i];
+        }
+        for (size_t i = c; i < nn; i++) var += z[i] * z[i];
+    }
+    double s2 = sigma * sigma * (double)n / (double)(n - nfit);
+    /* Floor: a misfit of size sigma over the radius h tilts the plane by
+     * about sigma / h whatever n is (systematic error, or a neighbourhood
+     * so small that its PCA frame follows the noise). */
+    double sd = sqrt(s2 * var) / h, fl = sqrt(s2) / h;
+    return sd > fl ? sd : fl;
 }
 
+static double angle(const double a[3], const double b[3])
+{
+    double d = fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+    return acos(d > 1.0 ? 1.0 : d);
+}
+
+double jf__scale_tau = JF_SCALE_TAU; /* tuning hooks for bench_pcpnet */
+double jf__scale_target = JF_SCALE_TARGET;
+/* A normal whose standard deviation exceeds this (radians) is noise: it
+ * cannot reveal a bias, so it takes no part in the interval test. */
+#define SD_MEANINGFUL 0.3
+
+/* Scale selection by the intersection of confidence intervals (Lepski's
+ * method, as in Katkovnik's ICI rule): walk the candidates from the
+ * smallest K up; K_i is accepted while its normal lies within
+ * tau (sd_i + sd_j) of the normal of every smaller accepted K_j.  Noise
+ * alone keeps the normals within their intervals, so the walk goes on to
+ * large K (less variance); once the truncation error (bias, growing with
+ * the radius) moves the normal out, the walk stops at the last K whose
+ * normal agreed with all smaller ones.  The first failure ends the walk, so
+ * clean, curved regions never pay for the large fits. */
 jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
                             size_t n, jf_result *out)
 {
@@ -243,42 +320,30 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
         if (k > 0 && (nk == 0 || k > ks[nk - 1])) ks[nk++] = k;
     }
     if (nk == 0) return jf_fit_point(f, p, nbr, n, out);
-    if (nk == 1) return fit_robust(f, pr, p, nbr, ks[0], buf, out, &sigma);
 
-    jf_result res[8];
-    double s2[8], h[8];
-    double sigma0_2 = INFINITY;
+    double nrm[8][3], sd[8];
+    int acc = 0, best = -1;
     for (int i = 0; i < nk; i++) {
-        jf_status st = fit_robust(f, pr, p, nbr, ks[i], buf, &res[i], &sigma);
+        jf_result r;
+        jf_status st = fit_robust(f, pr, p, nbr, ks[i], buf, &r, &sigma);
         if (st != JF_OK) return st;
-        h[i] = NAN;
-        s2[i] = INFINITY;
-        if (!usable(&res[i])) continue;
-        size_t nn = jf_jet_size(res[i].degree);
-        size_t used = res[i].n_used > 0 ? (size_t)res[i].n_used : ks[i];
-        if (used <= nn) continue; /* interpolation: no residual to learn from */
-        /* unbiased variance: n residuals, N_n coefficients */
-        s2[i] = sigma * sigma * (double)used / (double)(used - nn);
-        h[i] = tangential_radius(p, nbr, ks[i], res[i].normal);
-        if (s2[i] < sigma0_2) sigma0_2 = s2[i];
-    }
-    int best = nk - 1;
-    if (isfinite(sigma0_2)) {
-        double bs = INFINITY;
-        for (int i = 0; i < nk; i++) {
-            if (!isfinite(s2[i])) continue;
-            size_t used = res[i].n_used > 0 ? (size_t)res[i].n_used : ks[i];
-            double sc = score(sigma0_2, s2[i], res[i].cond, used, h[i]);
-            if (sc < bs) {
-                bs = sc;
-                best = i;
-            }
+        if (!usable(&r)) {
+            if (best < 0) *out = r; /* nothing better yet: report this one */
+            continue;
         }
-    } else {
-        /* nothing scored: the largest candidate that fitted at all */
-        while (best > 0 && !usable(&res[best])) best--;
+        size_t used = r.n_used > 0 ? (size_t)r.n_used : ks[i];
+        (void)used;
+        double s = normal_sd(&r, sigma, p, nbr, ks[i]);
+        int ok = 1;
+        for (int j = 0; j < acc && ok; j++)
+            ok = !(sd[j] < SD_MEANINGFUL) || angle(r.normal, nrm[j]) <= jf__scale_tau * (s + sd[j]);
+        if (!ok) break;
+        memcpy(nrm[acc], r.normal, sizeof nrm[acc]);
+        sd[acc++] = s;
+        *out = r;
+        best = i;
+        if (s <= jf__scale_target) break; /* precise enough: stop growing */
     }
-    *out = res[best];
-    if (best != nk - 1) out->status |= JF_PT_SCALE_SELECTED;
+    if (best >= 0 && best != nk - 1) out->status |= JF_PT_SCALE_SELECTED;
     return JF_OK;
 }

@@ -1,0 +1,304 @@
+// bench_pcpnet.cpp -- the PCPNet normal study on armadillo100k (issue 6).
+//
+// For the clean shape and Gaussian-noise copies (sigma = level x bbox
+// diagonal per axis, levels 0.00125 / 0.006 / 0.012, fixed seed; the GT
+// normals are those of the clean point of the same index), the RMS of the
+// unoriented normal angle on the 5000 .pidx points, for:
+//   jetfit  jf_index k-NN + jf_fit_point_full, K = 18 / 112 / 450,
+//           degree 2 and 3, and robust / scale-selection configurations;
+//   CGAL    jet_estimate_normals (degree 2 and 3) and pca_estimate_normals,
+//           Sequential_tag, on the same points in the same run.
+// CGAL computes every one of the 100k points (its API has no query subset);
+// jetfit fits only the 5000 evaluated points, so times are reported per
+// fit.  Usage: bench_pcpnet [DATA_DIR] [--quick] (--quick: clean shape and
+// the largest noise only, K = 18 and 112).
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/jet_estimate_normals.h>
+#include <CGAL/pca_estimate_normals.h>
+#include <CGAL/property_map.h>
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "jetfit.h"
+
+extern "C" double jf__scale_tau;    // src/robust.c: scale-selection interval width
+extern "C" double jf__scale_target; // ... and the normal sd that is enough
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
+typedef Kernel::Point_3 Point;
+typedef Kernel::Vector_3 Vector;
+typedef std::pair<Point, Vector> PN;
+
+static double now()
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+static long peak_kb()
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss;
+}
+
+static bool load(const std::string &path, jf_eval_table &t)
+{
+    jf_error e;
+    if (jf_eval_table_read(path.c_str(), &t, &e) != JF_OK) {
+        std::fprintf(stderr, "bench_pcpnet: %s\n", e.msg);
+        return false;
+    }
+    return true;
+}
+
+struct Study {
+    std::vector<double> xyz;          // current (noisy) cloud
+    std::vector<double> gt;           // GT normals, 3 per point
+    std::vector<uint32_t> pidx;       // evaluated points
+};
+
+static double g_median, g_p95; // of the last rms_angle call
+static double rms_angle(const Study &s, const std::vector<double> &nrm, size_t *nonfinite)
+{
+    std::vector<double> all;
+    double sum = 0;
+    size_t m = 0;
+    *nonfinite = 0;
+    for (size_t j = 0; j < s.pidx.size(); j++) {
+        uint32_t i = s.pidx[j];
+        double a = jf_normal_angle_deg(&nrm[3 * j], &s.gt[3 * i]);
+        if (!std::isfinite(a)) {
+            (*nonfinite)++;
+            a = 90.0; // an unfitted point counts as the worst angle
+        }
+        sum += a * a;
+        all.push_back(a);
+        m++;
+    }
+    jf_err_stats st;
+    jf_err_stats_compute(all.data(), all.size(), &st);
+    g_median = st.median;
+    g_p95 = st.p95;
+    return std::sqrt(sum / (double)m);
+}
+
+struct Config {
+    const char *name;
+    int degree;
+    size_t k;                  // neighbours fetched (largest scale)
+    jf_robust_mode robust;
+    int nscales;
+    size_t scales[8];
+};
+
+// jetfit on the .pidx points; returns the RMS angle, fills secs.
+static double run_jetfit(const Study &s, const jf_index *ix, const Config &c, double *secs,
+                         size_t *flagged)
+{
+    jf_params p;
+    jf_params_init(&p);
+    p.degree = c.degree;
+    p.max_neighbors = c.k;
+    p.robust = c.robust;
+    p.nscales = c.nscales;
+    for (int i = 0; i < c.nscales; i++) p.scales[i] = c.scales[i];
+    jf_fitter *f = nullptr;
+    const char *bad = nullptr;
+    if (jf_params_validate(&p, &bad) != JF_OK || jf_fitter_create(&p, &f) != JF_OK) {
+        std::fprintf(stderr, "bench_pcpnet: bad params (%s)\n", bad ? bad : "?");
+        return NAN;
+    }
+    std::vector<uint32_t> idx(c.k);
+    std::vector<double> nbr(3 * c.k), nrm(3 * s.pidx.size());
+    *flagged = 0;
+    double t0 = now();
+    for (size_t j = 0; j < s.pidx.size(); j++) {
+        const double *q = &s.xyz[3 * s.pidx[j]];
+        size_t found = 0;
+        jf_index_knn(ix, q, c.k, idx.data(), nullptr, &found);
+        for (size_t t = 0; t < found; t++)
+            std::memcpy(&nbr[3 * t], &s.xyz[3 * idx[t]], 3 * sizeof(double));
+        jf_result r;
+        jf_fit_point_full(f, q, nbr.data(), found, &r);
+        std::memcpy(&nrm[3 * j], r.normal, 3 * sizeof(double));
+        if (r.status & (JF_PT_ROBUST_NOCONV | JF_PT_FAILED)) (*flagged)++;
+    }
+    *secs = now() - t0;
+    jf_fitter_free(f);
+    size_t nf;
+    return rms_angle(s, nrm, &nf);
+}
+
+// CGAL on the whole cloud; the RMS on the .pidx points.
+static double run_cgal(const Study &s, bool jet, int degree, size_t k, double *secs)
+{
+    size_t n = s.xyz.size() / 3;
+    std::vector<PN> pts(n);
+    for (size_t i = 0; i < n; i++)
+        pts[i] = PN(Point(s.xyz[3 * i], s.xyz[3 * i + 1], s.xyz[3 * i + 2]), Vector(0, 0, 0));
+    auto np = CGAL::parameters::point_map(CGAL::First_of_pair_property_map<PN>())
+                  .normal_map(CGAL::Second_of_pair_property_map<PN>());
+    double t0 = now();
+    if (jet)
+        CGAL::jet_estimate_normals<CGAL::Sequential_tag>(pts, (unsigned)k, np.degree_fitting(degree));
+    else
+        CGAL::pca_estimate_normals<CGAL::Sequential_tag>(pts, (unsigned)k, np);
+    *secs = now() - t0;
+    std::vector<double> nrm(3 * s.pidx.size());
+    for (size_t j = 0; j < s.pidx.size(); j++) {
+        const Vector &v = pts[s.pidx[j]].second;
+        nrm[3 * j] = v.x();
+        nrm[3 * j + 1] = v.y();
+        nrm[3 * j + 2] = v.z();
+    }
+    size_t nf;
+    return rms_angle(s, nrm, &nf);
+}
+
+int main(int argc, char **argv)
+{
+    std::string dir = JF_SHARED_DATA "/pcpnet";
+    bool quick = false, no_cgal = false, no_fixed = false;
+    const char *sweep = nullptr; // "K,deg,robust K,deg,robust ...": extra fixed configs
+    for (int i = 1; i < argc; i++) {
+        if (!std::strcmp(argv[i], "--quick")) quick = true;
+        else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
+        else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
+        else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__scale_tau = std::atof(argv[++i]);
+        else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__scale_target = std::atof(argv[++i]);
+        else if (!std::strcmp(argv[i], "--sweep") && i + 1 < argc) sweep = argv[++i];
+        else dir = argv[i];
+    }
+    jf_eval_table tx, tn, ti;
+    if (!load(dir + "/armadillo100k.xyz", tx) || !load(dir + "/armadillo100k.normals", tn) ||
+        !load(dir + "/armadillo100k.pidx", ti))
+        return 1;
+    Study s;
+    std::vector<double> clean(tx.v, tx.v + 3 * tx.nrows);
+    s.gt.assign(tn.v, tn.v + 3 * tn.nrows);
+    for (size_t j = 0; j < ti.nrows; j++) s.pidx.push_back((uint32_t)ti.v[j]);
+    size_t n = tx.nrows;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) {
+            lo[d] = std::fmin(lo[d], clean[3 * i + d]);
+            hi[d] = std::fmax(hi[d], clean[3 * i + d]);
+        }
+    double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    std::printf("# armadillo100k: %zu points, %zu evaluated (.pidx), bbox diagonal %.3f\n", n,
+                s.pidx.size(), diag);
+    std::printf("# RMS unoriented normal angle (degrees) on the .pidx points; time: seconds for\n"
+                "# the 5000 jetfit fits (k-NN included) / for CGAL's 100k points\n");
+
+    std::vector<double> levels = {0.0, 0.00125, 0.006, 0.012};
+    std::vector<size_t> ks = {18, 112, 450};
+    if (quick) {
+        levels = {0.0, 0.012};
+        ks = {18, 112};
+    }
+    std::printf("%-8s %-34s %5s %4s %9s %9s %s\n", "noise", "method", "K", "deg", "rms_deg",
+                "time_s", "flagged");
+    for (double lv : levels) {
+        s.xyz = clean;
+        std::mt19937_64 rng(20031);
+        std::normal_distribution<double> g(0.0, lv * diag);
+        if (lv > 0)
+            for (double &x : s.xyz) x += g(rng);
+        jf_index *ix = nullptr;
+        if (jf_index_build(s.xyz.data(), n, &ix) != JF_OK) return 1;
+        std::vector<Config> cfg;
+        for (size_t k : ks)
+            for (int d = 2; d <= 3 && !no_fixed; d++)
+                cfg.push_back({"jetfit", d, k, JF_ROBUST_NONE, 0, {0}});
+        size_t kmax = ks.back();
+        // --sweep "K,deg,robust ..." (robust 0/1/2 = none/huber/tukey);
+        // K may be a scale set "12/18/36" (scale selection, the last the largest)
+        for (const char *q = sweep; q && *q;) {
+            Config c = {"jetfit sweep", 2, 0, JF_ROBUST_NONE, 0, {0}};
+            int d, rb, used = 0;
+            unsigned long k;
+            while (std::sscanf(q, "%lu%n", &k, &used) == 1) {
+                c.scales[c.nscales++] = k;
+                c.k = k;
+                q += used;
+                if (*q != '/' || c.nscales == 8) break;
+                q++;
+            }
+            if (std::sscanf(q, ",%d,%d%n", &d, &rb, &used) != 2) break;
+            c.degree = d;
+            c.robust = (jf_robust_mode)rb;
+            if (c.nscales == 1) c.nscales = 0;
+            cfg.push_back(c);
+            q += used;
+            while (*q == ' ') q++;
+        }
+        for (size_t k : ks)
+            for (int d = 2; d <= 3 && !no_fixed; d++)
+                cfg.push_back({"jetfit huber", d, k, JF_ROBUST_HUBER, 0, {0}});
+        for (int d = 2; d <= 3; d++) {
+            cfg.push_back({"jetfit scales 18/36/112/225/450", d, kmax, JF_ROBUST_NONE, 5,
+                           {18, 36, 112, 225, 450}});
+            cfg.push_back({"jetfit scales 18/36/112/225/450 huber", d, kmax, JF_ROBUST_HUBER, 5,
+                           {18, 36, 112, 225, 450}});
+            cfg.push_back({"jetfit scales 18/36/112/225/450 tukey", d, kmax, JF_ROBUST_TUKEY, 5,
+                           {18, 36, 112, 225, 450}});
+        }
+        for (const Config &c : cfg) {
+            Config cc = c;
+            if (cc.nscales) { // clamp scales to kmax in --quick
+                int m = 0;
+                for (int i = 0; i < cc.nscales; i++)
+                    if (cc.scales[i] <= kmax) cc.scales[m++] = cc.scales[i];
+                cc.nscales = m;
+            }
+            double secs;
+            size_t fl;
+            double r = run_jetfit(s, ix, cc, &secs, &fl);
+            char name[128];
+            std::snprintf(name, sizeof name, "%s%s", cc.name,
+                          cc.robust == JF_ROBUST_TUKEY ? " tukey" : cc.robust == JF_ROBUST_HUBER ? " huber" : "");
+            if (cc.nscales && !std::strcmp(cc.name, "jetfit sweep")) {
+                std::snprintf(name, sizeof name, "jetfit scales");
+                for (int i = 0; i < cc.nscales; i++)
+                    std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), "%s%zu",
+                                  i ? "/" : " ", cc.scales[i]);
+                if (cc.robust)
+                    std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), " %s",
+                                  cc.robust == JF_ROBUST_TUKEY ? "tukey" : "huber");
+            }
+            std::printf("%-8g %-34s %5zu %4d %9.3f %9.3f %zu  (median %.2f p95 %.2f)\n", lv, name,
+                        cc.k, cc.degree, r, secs, fl, g_median, g_p95);
+            std::fflush(stdout);
+        }
+        for (size_t k : ks) {
+            if (no_cgal) break;
+            for (int d = 2; d <= 3; d++) {
+                double secs, r = run_cgal(s, true, d, k, &secs);
+                std::printf("%-8g %-34s %5zu %4d %9.3f %9.3f -\n", lv, "CGAL jet_estimate_normals", k,
+                            d, r, secs);
+                std::fflush(stdout);
+            }
+            double secs, r = run_cgal(s, false, 0, k, &secs);
+            std::printf("%-8g %-34s %5zu %4s %9.3f %9.3f -\n", lv, "CGAL pca_estimate_normals", k, "-",
+                        r, secs);
+            std::fflush(stdout);
+        }
+        jf_index_free(ix);
+    }
+    std::printf("# peak RSS %ld kB\n", peak_kb());
+    jf_eval_table_free(&tx);
+    jf_eval_table_free(&tn);
+    jf_eval_table_free(&ti);
+    return 0;
+}
