@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_linalg.h>
+
 #include "fitter_internal.h"
 #include "jetfit.h"
 
@@ -259,7 +261,7 @@ START_TEST(test_residuals_weights)
             double dot = 0;
             for (int i = 0; i < 30; i++)
                 dot += res[i] * pow(xyz[3 * i], k - j) * pow(xyz[3 * i + 1], j);
-            ck_assert_double_eq_tol(dot, 0, 1e-15);
+            ck_assert_double_eq_tol(dot, 0, 1e-13); /* ~ kappa eps |r| |m| */
         }
     for (int i = 0; i < 30; i++) {
         double z = poly_eval(f->coef, 3, xyz[3 * i], xyz[3 * i + 1]);
@@ -315,6 +317,74 @@ START_TEST(test_no_hidden_state)
             jf_fitter_free(fresh);
             jf_fitter_free(used);
         }
+}
+END_TEST
+
+/* The solver (pivoted Householder QR + one-sided Jacobi SVD of R) against
+ * GSL's Golub-Reinsch SVD of the whole matrix: kappa and the least-squares
+ * solution on random tall matrices with graded columns (kappa up to
+ * ~1e10), and the rank-deficiency verdict on a matrix with two equal
+ * columns. */
+START_TEST(test_solver_vs_gsl)
+{
+    jf_params p;
+    jf_params_init(&p);
+    p.degree = 4;
+    p.max_neighbors = 64;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    rng_state = 1234;
+    const size_t shapes[4][2] = {{6, 6}, {16, 6}, {32, 10}, {64, 15}};
+    for (int t = 0; t < 40; t++) {
+        size_t rows = shapes[t % 4][0], cols = shapes[t % 4][1];
+        gsl_matrix *a = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
+        gsl_vector *sv = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
+        gsl_vector *b = gsl_vector_alloc(rows), *x = gsl_vector_alloc(cols);
+        double grade = pow(10.0, -(double)(t % 11)); /* column scales 1 .. grade */
+        for (size_t j = 0; j < cols; j++) {
+            double sc = pow(grade, (double)j / (double)(cols - 1));
+            for (size_t i = 0; i < rows; i++) {
+                double e = sc * (2 * urand() - 1);
+                gsl_matrix_set(a, i, j, e);
+                f->m[j * rows + i] = e;
+            }
+        }
+        for (size_t i = 0; i < rows; i++) {
+            double e = 2 * urand() - 1;
+            gsl_vector_set(b, i, e);
+            f->rhs[i] = e;
+        }
+        double cond;
+        int rc = jf__svd_solve(f, rows, cols, &cond);
+        ck_assert_int_eq(gsl_linalg_SV_decomp(a, v, sv, w), 0);
+        ck_assert_int_eq(gsl_linalg_SV_solve(a, v, sv, b, x), 0);
+        double gcond = gsl_vector_get(sv, 0) / gsl_vector_get(sv, cols - 1);
+        ck_assert_int_eq(rc, 0);
+        ck_assert_msg(fabs(cond - gcond) <= 1e-8 * gcond, "cond %g gsl %g", cond, gcond);
+        /* solutions agree to ~ kappa eps */
+        double xn = 0;
+        for (size_t j = 0; j < cols; j++) xn = fmax(xn, fabs(gsl_vector_get(x, j)));
+        for (size_t j = 0; j < cols; j++)
+            ck_assert_msg(fabs(f->sol[j] - gsl_vector_get(x, j)) <= 1e-14 * gcond * xn,
+                          "t %d sol %zu: %.17g gsl %.17g (cond %g)", t, j, f->sol[j],
+                          gsl_vector_get(x, j), gcond);
+        gsl_matrix_free(a);
+        gsl_matrix_free(v);
+        gsl_vector_free(sv);
+        gsl_vector_free(w);
+        gsl_vector_free(b);
+        gsl_vector_free(x);
+    }
+    /* rank deficient: column 3 = column 1 */
+    for (size_t i = 0; i < 16; i++) {
+        for (size_t j = 0; j < 6; j++) f->m[j * 16 + i] = 2 * urand() - 1;
+        f->m[3 * 16 + i] = f->m[1 * 16 + i];
+        f->rhs[i] = 1;
+    }
+    double cond;
+    ck_assert_int_eq(jf__svd_solve(f, 16, 6, &cond), 1);
+    ck_assert(cond > 1e14);
+    jf_fitter_free(f);
 }
 END_TEST
 
@@ -386,6 +456,7 @@ int main(void)
     tcase_add_test(tc, test_residuals_weights);
     tcase_add_test(tc, test_no_hidden_state);
     tcase_add_test(tc, test_params);
+    tcase_add_test(tc, test_solver_vs_gsl);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
