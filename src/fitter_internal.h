@@ -33,12 +33,12 @@ struct jf_fitter {
     double *work;     /* maxc GSL scratch                              */
     double *rhs;      /* maxn right-hand side                          */
     double *sol;      /* maxc scaled solution Y                        */
-    double *res;      /* maxn signed residuals of the last fit         */
     double coef[JF_CURVE_COLS > 55 ? JF_CURVE_COLS : 55]; /* jet A_ij  */
     int perm[55];     /* column pivoting of the QR                     */
     double tmp[55];   /* solution in pivoted order                     */
     double frame[9];  /* last fitting frame: rows ex, ey, ez (world)   */
     int last_deg;     /* degree of coef (0 when the last fit failed)   */
+    double last_h;    /* its preconditioning scale h                   */
     size_t last_n;    /* n of the last surface fit (residuals)         */
     int have_last;
 };

@@ -54,7 +54,6 @@ void jf_fitter_free(jf_fitter *f)
     free(f->work);
     free(f->rhs);
     free(f->sol);
-    free(f->res);
     free(f);
 }
 
@@ -83,9 +82,8 @@ jf_status jf_fitter_create(const jf_params *p, jf_fitter **out)
     f->work = malloc(f->maxc * sizeof(double));
     f->rhs = malloc(rows * sizeof(double));
     f->sol = malloc(f->maxc * sizeof(double));
-    f->res = malloc(rows * sizeof(double));
     if (!f->loc || !f->w || !f->dist || !f->order || !f->m || !f->v || !f->x || !f->s ||
-        !f->work || !f->rhs || !f->sol || !f->res) {
+        !f->work || !f->rhs || !f->sol) {
         jf_fitter_free(f);
         return JF_ERR_NOMEM;
     }
@@ -342,7 +340,6 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
     f->last_n = n;
     f->have_last = 1;
     f->last_deg = 0;
-    for (size_t i = 0; i < n; i++) f->res[i] = NAN;
     for (int k = 0; k < 3; k++) out->pca_eval[k] = NAN;
     if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
         fail_result(out, JF_PT_NONFINITE);
@@ -466,22 +463,12 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
             for (int j = 0; j <= k; j++, c++) f->coef[c] = f->sol[c] / hk;
     }
     const size_t cols = jf_jet_size(deg);
-    const double ih = 1.0 / h;
+    /* weighted residual norm for free: after the QR, the components
+     * rows cols.. of Q^T b are the residual in an orthonormal basis */
     double sw2 = 0, sr2 = 0;
-    for (size_t i = 0; i < n; i++) {
-        const double *q = f->loc + 3 * i;
-        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
-        monomials(q[0] * ih, q[1] * ih, deg, mon);
-        double z = 0;
-        for (size_t c = 0; c < cols; c++) z += f->sol[c] * mon[c];
-        f->res[i] = q[2] - z;
-    }
-    for (size_t t = 0; t < rows; t++) {
-        size_t i = f->order[t];
-        double w2 = f->w[i] * f->w[i];
-        sw2 += w2;
-        sr2 += w2 * f->res[i] * f->res[i];
-    }
+    for (size_t t = 0; t < rows; t++) sw2 += f->w[f->order[t]] * f->w[f->order[t]];
+    for (size_t t = cols; t < rows; t++) sr2 += f->rhs[t] * f->rhs[t];
+    f->last_h = h;
     memcpy(f->frame, r, sizeof r);
     f->last_deg = deg;
     out->degree = deg;
@@ -505,6 +492,22 @@ jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr, size_
 jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n)
 {
     if (!f || (n > 0 && !res) || !f->have_last || n != f->last_n) return JF_ERR_INVALID;
-    if (n > 0) memcpy(res, f->res, n * sizeof *res);
+    /* computed on demand from the last fit's local points and scaled
+     * solution Y (J(x,y) = sum Y_ij (x/h)^i (y/h)^j), kept in the fitter */
+    const int deg = f->last_deg;
+    const size_t cols = jf_jet_size(deg);
+    const double ih = deg > 0 ? 1.0 / f->last_h : 0.0;
+    double mon[55];
+    for (size_t i = 0; i < n; i++) {
+        const double *q = f->loc + 3 * i;
+        if (deg == 0 || !isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+            res[i] = NAN;
+            continue;
+        }
+        monomials(q[0] * ih, q[1] * ih, deg, mon);
+        double z = 0;
+        for (size_t c = 0; c < cols; c++) z += f->sol[c] * mon[c];
+        res[i] = q[2] - z;
+    }
     return JF_OK;
 }

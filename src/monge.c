@@ -18,24 +18,27 @@
 
 #define TPI(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j)) /* x^i y^j */
 
-/* out = a * b truncated at order m (out must not alias a or b). */
-static void tp_mul(const double *a, const double *b, int m, double *out)
+/* out = a * b truncated at order m (out must not alias a or b); a has no
+ * terms below order amin, b none below bmin (the loops skip them). */
+static void tp_mul(const double *a, int amin, const double *b, int bmin, int m, double *out)
 {
     int sz = (m + 1) * (m + 2) / 2;
     for (int k = 0; k < sz; k++) out[k] = 0.0;
-    for (int ka = 0; ka <= m; ka++)
+    for (int ka = amin; ka + bmin <= m; ka++)
         for (int ja = 0; ja <= ka; ja++) {
-            double ca = a[ka * (ka + 1) / 2 + ja];
-            if (ca == 0.0) continue;
-            for (int kb = 0; kb + ka <= m; kb++)
-                for (int jb = 0; jb <= kb; jb++)
-                    out[TPI(ka - ja + kb - jb, ja + jb)] += ca * b[kb * (kb + 1) / 2 + jb];
+            const double ca = a[ka * (ka + 1) / 2 + ja];
+            for (int kb = bmin; kb + ka <= m; kb++) {
+                const double *bk = b + kb * (kb + 1) / 2;
+                double *o = out + TPI(ka - ja + kb, ja); /* x^(ka-ja+kb-jb) y^(ja+jb) */
+                for (int jb = 0; jb <= kb; jb++) o[jb] += ca * bk[jb];
+            }
         }
 }
 
 /* out = sum over orders kmin..min(deg,m) of the coefficients a (jet
  * order) evaluated at (U, V), truncated at order m.  U, V have no
- * constant term, so jet terms above order m do not contribute. */
+ * constant term, so jet terms above order m do not contribute and
+ * U^i V^j starts at order i + j. */
 static void tp_compose(const double *a, int deg, int kmin, const double *u,
                        const double *v, int m, double *out)
 {
@@ -43,15 +46,15 @@ static void tp_compose(const double *a, int deg, int kmin, const double *u,
     int sz = (m + 1) * (m + 2) / 2, top = deg < m ? deg : m;
     memset(pw[0][0], 0, sizeof pw[0][0]);
     pw[0][0][0] = 1.0;
-    for (int i = 1; i <= top; i++) tp_mul(pw[i - 1][0], u, m, pw[i][0]);
+    for (int i = 1; i <= top; i++) tp_mul(pw[i - 1][0], i - 1, u, 1, m, pw[i][0]);
     for (int i = 0; i <= top; i++)
-        for (int j = 1; i + j <= top; j++) tp_mul(pw[i][j - 1], v, m, pw[i][j]);
+        for (int j = 1; i + j <= top; j++) tp_mul(pw[i][j - 1], i + j - 1, v, 1, m, pw[i][j]);
     for (int k = 0; k < sz; k++) out[k] = 0.0;
     for (int k = kmin; k <= top; k++)
         for (int j = 0; j <= k; j++) {
-            double c = a[TPI(k - j, j)];
+            const double c = a[TPI(k - j, j)];
             if (c == 0.0) continue;
-            for (int t = 0; t < sz; t++) out[t] += c * pw[k - j][j][t];
+            for (int t = k * (k + 1) / 2; t < sz; t++) out[t] += c * pw[k - j][j][t];
         }
 }
 
