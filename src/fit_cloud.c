@@ -4,7 +4,9 @@
  * design: each point is independent and a fitter keeps no state between
  * fits, so results do not depend on the thread count or the schedule.
  * The neighbour coordinates are gathered into a per-thread buffer sized
- * once for the longest list. */
+ * once for the longest list.  Each point goes through jf_fit_point_full
+ * (robust.c), so params.robust and params.scales are honoured; with
+ * neither set it is jf_fit_point. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -62,7 +64,7 @@ jf_status jf_fit_cloud(const jf_params *p, const double *xyz, size_t n,
                 buf[3 * k + 2] = q[2];
                 k++;
             }
-            jf_status s = jf_fit_point(f, pi, buf, k, out + i);
+            jf_status s = jf_fit_point_full(f, pi, buf, k, out + i);
             if (s != JF_OK) {
 #pragma omp critical(jf_fit_cloud_err)
                 if (err == JF_OK) err = s;
