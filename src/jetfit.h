@@ -247,7 +247,8 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
 
 /* Fits every point i of a cloud from the neighbour lists
  * idx[off[i] .. off[i+1]-1] (CSR; off has n+1 entries, off[0] = 0; each
- * index < n, else JF_ERR_INVALID) with jf_fit_point.  Non-finite points
+ * index < n, else JF_ERR_INVALID) with jf_fit_point_full (so robust and
+ * scales are honoured; with scales, lists nearest first).  Non-finite points
  * get JF_PT_NONFINITE (and are skipped as neighbours).  The workspaces
  * hold the longest list even beyond p->max_neighbors.  OpenMP, one
  * fitter per thread; threads <= 0 means all cores.  Results are
