@@ -62,6 +62,9 @@ int jf_parse_double(const char *s, const char *e, double *out);
  * (never "-nan"); at most 24 bytes, no NUL.  Returns the end. */
 char *jf_fmt_g17(char *out, double v);
 
+/* Writes v in decimal (no NUL); returns the end. */
+char *jf_fmt_uint(char *out, uint64_t v);
+
 /* Parses [s, e) as an unsigned decimal integer <= max: 1 ok, 0 not. */
 int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out);
 

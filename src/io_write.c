@@ -5,9 +5,7 @@
  * temporary ".NAME.tmp.PID" beside the final file; commit closes it and
  * renames it onto NAME, any failure or abort unlinks it, so a reader never
  * sees a partial file under the final name.  Doubles are written exactly
- * as "%.17g" would write them, by a fast integer path for the usual
- * magnitudes (1e-11 <= |v| < 1e17, exact 128-bit arithmetic) and by
- * snprintf for the rest.
+ * as "%.17g" would write them (jf_fmt_g17, io_fmt.c).
  */
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
@@ -19,133 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-/* ---- exact "%.17g" ---------------------------------------------------- */
-
-static char *put_uint(char *o, uint64_t v)
-{
-    char tmp[24];
-    int n = 0;
-    do {
-        tmp[n++] = (char)('0' + v % 10);
-        v /= 10;
-    } while (v);
-    while (n)
-        *o++ = tmp[--n];
-    return o;
-}
-
-/* For |v| = m 2^q: *out = round_half_even(|v| 10^k) and *fl its floor,
- * 0 <= k <= 27 (5^27 m < 2^116: exact in 128 bits); 0 if out of reach. */
-static int scaled(uint64_t m, int q, int k, uint64_t *out, uint64_t *fl)
-{
-    unsigned __int128 p = m;
-    for (int i = 0; i < k; i++)
-        p *= 5;
-    int s = q + k; /* |v| * 10^k = p * 2^s */
-    if (s >= 0) {
-        if (s > 10)
-            return 0;
-        *out = *fl = (uint64_t)(p << s);
-        return 1;
-    }
-    int r = -s;
-    if (r >= 127)
-        return 0;
-    unsigned __int128 one = 1, t = p >> r, rem = p & ((one << r) - 1),
-                      half = one << (r - 1);
-    if (t >> 64)
-        return 0;
-    *fl = (uint64_t)t;
-    if (rem > half || (rem == half && (t & 1)))
-        t++;
-    if (t >> 64)
-        return 0;
-    *out = (uint64_t)t;
-    return 1;
-}
-
-/* Writes v as printf("%.17g") does (NaN as "nan"); returns the end. */
-char *jf_fmt_g17(char *o, double v)
-{
-    if (isnan(v))
-        return memcpy(o, "nan", 3), o + 3;
-    if (isinf(v))
-        return v < 0 ? (memcpy(o, "-inf", 4), o + 4)
-                     : (memcpy(o, "inf", 3), o + 3);
-    uint64_t bits;
-    memcpy(&bits, &v, 8);
-    int bexp = (int)((bits >> 52) & 0x7ff);
-    double a = fabs(v);
-    if (v == 0 || bexp == 0 || !(a >= 1e-11 && a < 1e17))
-        return o + snprintf(o, 32, "%.17g", v);
-    uint64_t m = (bits & ((UINT64_C(1) << 52) - 1)) | (UINT64_C(1) << 52);
-    int q = bexp - 1075;
-    int E = (int)floor(log10(a));
-    uint64_t M = 0, F = 0;
-    const uint64_t lo = UINT64_C(10000000000000000), hi = lo * 10;
-    /* E = floor(log10|v|) may be off by one near powers of ten: the
-     * floor of |v| 10^(16-E) must have exactly 17 digits */
-    for (int tries = 0;; tries++) {
-        int k = 16 - E;
-        if (tries > 3 || k < 0 || k > 27 || !scaled(m, q, k, &M, &F))
-            return o + snprintf(o, 32, "%.17g", v);
-        if (F >= hi) {
-            E++;
-            continue;
-        }
-        if (F < lo) {
-            E--;
-            continue;
-        }
-        break;
-    }
-    if (M == hi) { /* rounding carried into an 18th digit */
-        M /= 10;
-        E++;
-    }
-    char d[17];
-    for (int i = 16; i >= 0; i--) {
-        d[i] = (char)('0' + M % 10);
-        M /= 10;
-    }
-    int nd = 17;
-    while (nd > 1 && d[nd - 1] == '0')
-        nd--;
-    if (v < 0)
-        *o++ = '-';
-    if (E < -4 || E >= 17) { /* %g's scientific form */
-        *o++ = d[0];
-        if (nd > 1) {
-            *o++ = '.';
-            memcpy(o, d + 1, (size_t)nd - 1);
-            o += nd - 1;
-        }
-        *o++ = 'e';
-        *o++ = E < 0 ? '-' : '+';
-        int ae = E < 0 ? -E : E;
-        if (ae < 10)
-            *o++ = '0';
-        return put_uint(o, (uint64_t)ae);
-    }
-    if (E >= 0) {
-        int ni = E + 1; /* integer digits, <= 17 */
-        memcpy(o, d, (size_t)ni);
-        o += ni;
-        if (nd > ni) {
-            *o++ = '.';
-            memcpy(o, d + ni, (size_t)(nd - ni));
-            o += nd - ni;
-        }
-        return o;
-    }
-    *o++ = '0';
-    *o++ = '.';
-    for (int i = 0; i < -E - 1; i++)
-        *o++ = '0';
-    memcpy(o, d, (size_t)nd);
-    return o + nd;
-}
 
 /* ---- buffered temporary file ------------------------------------------ */
 
@@ -463,7 +334,7 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
                 int32_t x = to_i32(v);
                 if (x < 0)
                     *o++ = '-';
-                o = put_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
+                o = jf_fmt_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
             }
         }
         *o++ = '\n';
@@ -485,10 +356,10 @@ static jf_status write_faces(jf_writer *w)
         char *o0 = o;
         const uint32_t *ix = w->fidx + w->foff[i];
         if (w->ascii) {
-            o = put_uint(o, k);
+            o = jf_fmt_uint(o, k);
             for (size_t j = 0; j < k; j++) {
                 *o++ = ' ';
-                o = put_uint(o, ix[j]);
+                o = jf_fmt_uint(o, ix[j]);
             }
             *o++ = '\n';
         } else {
@@ -576,10 +447,10 @@ static jf_status write_off(const char *path, const jf_cloud *c, jf_error *err)
         if (!o)
             break;
         char *o0 = o;
-        o = put_uint(o, k);
+        o = jf_fmt_uint(o, k);
         for (size_t j = 0; j < k; j++) {
             *o++ = ' ';
-            o = put_uint(o, c->face_idx[c->face_off[i] + j]);
+            o = jf_fmt_uint(o, c->face_idx[c->face_off[i] + j]);
         }
         *o++ = '\n';
         f.len += (size_t)(o - o0);
