@@ -198,7 +198,11 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, uint32_t 
         break;
     case JF_NB_NATURAL:
         *flags = x->nflags[i];
-        if (!finite3(x->nrm + 3 * i)) return JF_OK; /* no normal: FAILED */
+        const double *m = x->nrm + 3 * i;
+        if (!finite3(m) || (m[0] == 0 && m[1] == 0 && m[2] == 0)) {
+            *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
+            return JF_OK;
+        }
         st = jf_natural_neighbors(x->nt, ws, i, x->nrm + 3 * i, x->want, idx, x->cap, found);
         break;
     default:

@@ -285,6 +285,23 @@ START_TEST(natural_on_sphere)
         ck_assert(radial_cos(&r[i], xyz + 3 * i, c) > cos(2 * M_PI / 180));
         ck_assert_double_eq_tol(r[i].k1, -1 / R, 0.05 / R);
     }
+    /* normals from the input: a zero one fails that row only */
+    double *nrm = malloc(3 * n * sizeof *nrm);
+    for (size_t i = 0; i < 3 * n; i++) nrm[i] = xyz[i] - c[i % 3];
+    nrm[3 * 7] = nrm[3 * 7 + 1] = nrm[3 * 7 + 2] = 0;
+    cl.nrm = nrm;
+    o.normal = JF_NORMAL_INPUT;
+    ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
+    for (size_t i = 0; i < n; i++) {
+        if (i == 7) {
+            ck_assert_uint_ne(r[i].status & JF_PT_FAILED, 0);
+            continue;
+        }
+        ck_assert_uint_eq(r[i].status & ~(unsigned)JF_PT_UMBILIC, JF_PT_NORMAL_INPUT);
+        ck_assert(radial_cos(&r[i], xyz + 3 * i, c) > cos(2 * M_PI / 180));
+    }
+    cl.nrm = NULL;
+    free(nrm);
     /* pca normals: same neighbourhood kind, no pole flags */
     o.normal = JF_NORMAL_PCA;
     ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
