@@ -169,6 +169,7 @@ static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *
     }
 }
 
+#ifndef JF_GSL_SVD
 /* One-sided (Hestenes) Jacobi SVD of the cols x cols matrix a, stored
  * column-major (Demmel & Veselic 1992; Golub & Van Loan §8.6.3): plane
  * rotations of column pairs until all are orthogonal to working accuracy,
@@ -218,6 +219,7 @@ static int jacobi_svd(double *a, double *v, double *s, size_t c)
     }
     return -1;
 }
+#endif
 
 /* GSL's Golub-Reinsch SVD of the same R (row-major copy in f->v's
  * scratch): the reference, and the fallback should Jacobi not converge.
@@ -250,6 +252,10 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
         for (size_t i = 0; i < cols; i++) f->x[j * cols + i] = i >= j ? f->m[i * rows + j] : 0.0;
     if (jacobi_svd(f->x, f->v, f->s, cols) == 0) {
         for (size_t j = 0; j < cols; j++) {
+            if (!isfinite(f->s[j])) { /* overflow in M' (huge weights): no fit */
+                *cond = NAN;
+                return -1;
+            }
             smax = fmax(smax, f->s[j]);
             smin = fmin(smin, f->s[j]);
         }
