@@ -294,7 +294,7 @@ typedef struct jf_index jf_index;
 
 /* Builds an index over the finite points of xyz (non-finite points are
  * left out: nobody's neighbour).  The finite points are copied (the index
- * takes about 34 bytes per point), so xyz may change or go after the
+ * takes about 28-32 bytes per point), so xyz may change or go after the
  * call.  n must be < UINT32_MAX (else JF_ERR_TOO_LARGE).  O(n log n).
  * Returns JF_OK, JF_ERR_INVALID (NULL out, or NULL xyz with n > 0) or
  * JF_ERR_NOMEM.  Free with jf_index_free (NULL is a no-op). */
@@ -705,11 +705,6 @@ typedef struct jf_natural jf_natural;
  * JF_OK, JF_ERR_INVALID (NULL args), JF_ERR_TOO_LARGE (n >= 2^32 - 1),
  * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Not parallel. */
 jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
-/* Same, with the per-vertex extraction (adjacency, poles) on `threads`
- * threads (<= 0: all cores; jf_natural_create uses all); the insertion
- * itself is sequential.  The result does not depend on threads. */
-jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
-                                    jf_natural **out);
 void jf_natural_free(jf_natural *nt);
 
 typedef struct {
