@@ -40,7 +40,8 @@ typedef struct {
 } jfb_delaunay;
 
 /* Builds the triangulation of the finite points of xyz[3n] and fills *out
- * (zeroed first).  Identical points are merged into one vertex.  Returns 0
+ * (zeroed first).  Identical points are merged into one vertex.
+ * Sequential.  Returns 0
  * or a jf_status value (2 = no memory, 8 = CGAL threw); on failure *out
  * holds nothing to release.  Thread-safe (no shared state). */
 int jfb_delaunay_build(const double *xyz, size_t n, jfb_delaunay *out);

@@ -2,43 +2,29 @@
 // cloud, flattened into plain arrays (vertex map, CSR adjacency, poles).
 //
 // design:
-//  1. finite points -> (point, input index) pairs; the range insertion
-//     spatially sorts them (Hilbert order), so each location starts next to
-//     the previous point instead of at a random cell.
-//  2. vertices get dense ids; identical inputs were merged by CGAL, so the
-//     inputs that own no vertex are matched to theirs by exact coordinates.
-//  3. CSR adjacency from finite_adjacent_vertices, poles (poles.cpp), then
-//     the triangulation is destroyed: the C core keeps only the arrays.
+//  1. the finite points are spatially sorted (CGAL's Hilbert sort, as the
+//     range insert does) and inserted one by one with the previous vertex
+//     as hint, so each location walks a few cells; insert() returns the
+//     vertex of every input, identical points included (CGAL merges them),
+//     which gives the input -> vertex map without any lookup.
+//  2. vertices get dense ids in the triangulation's order (close to the
+//     insertion order, so spatially coherent); rep = smallest input index.
+//  3. adjacency, poles, hull directions (star.cpp), then the triangulation
+//     is destroyed: the C core keeps only the arrays.
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <new>
-#include <stdexcept>
-#include <unordered_map>
-#include <utility>
 #include <vector>
 
 #include "dt3.hpp"
 
 namespace {
 constexpr std::uint32_t kNone = UINT32_MAX;
-
-struct Key {
-    double x, y, z;
-    bool operator==(const Key &o) const { return x == o.x && y == o.y && z == o.z; }
-};
-struct KeyHash {
-    size_t operator()(const Key &k) const {
-        std::uint64_t h = 1469598103934665603ull, b[3];
-        std::memcpy(&b[0], &k.x, 8);
-        std::memcpy(&b[1], &k.y, 8);
-        std::memcpy(&b[2], &k.z, 8);
-        for (std::uint64_t v : b) h = (h ^ v) * 1099511628211ull ^ (v >> 29);
-        return (size_t)h;
-    }
-};
-// +0.0 turns -0.0 into 0.0: CGAL calls them equal, the hash must too
-Key key_of(const double *p) { return Key{p[0] + 0.0, p[1] + 0.0, p[2] + 0.0}; }
 
 template <class T> T *alloc(size_t n) {
     T *p = static_cast<T *>(std::malloc((n ? n : 1) * sizeof(T)));
@@ -50,67 +36,50 @@ void build(const double *xyz, size_t n, jfb_delaunay *d) {
     using namespace jfb;
     d->n = n;
     d->vertex_of = alloc<std::uint32_t>(n);
-    std::vector<std::pair<Point, std::uint32_t>> pts;
-    pts.reserve(n);
+    std::vector<Point> pts(n);
+    std::vector<std::size_t> order;  // size_t: the key type of the adapter
+    order.reserve(n);
     for (size_t i = 0; i < n; i++) {
         const double *p = xyz + 3 * i;
         d->vertex_of[i] = kNone;
-        if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
-            pts.emplace_back(Point(p[0], p[1], p[2]), (std::uint32_t)i);
-        else
+        if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) {
+            pts[i] = Point(p[0], p[1], p[2]);
+            order.push_back(i);
+        } else {
             d->nnonfinite++;
+        }
     }
-    size_t nfinite = pts.size();
+    size_t nfinite = order.size();
+    using Pmap = CGAL::Pointer_property_map<Point>::type;
+    using Traits = CGAL::Spatial_sort_traits_adapter_3<K, Pmap>;
+    CGAL::spatial_sort(order.begin(), order.end(), Traits(CGAL::make_property_map(pts)));
+
     DT3 t;
-    t.insert(pts.begin(), pts.end());
-    std::vector<std::pair<Point, std::uint32_t>>().swap(pts);
+    std::vector<DT3::Vertex_handle> of(n);
+    DT3::Vertex_handle hint;
+    for (std::size_t i : order) hint = of[i] = t.insert(pts[i], hint);
+    std::vector<Point>().swap(pts);
+    std::vector<std::size_t>().swap(order);
 
     d->dimension = t.dimension();
     d->nv = t.number_of_vertices();
     d->nduplicates = nfinite - d->nv;
-    d->rep = alloc<std::uint32_t>(d->nv);
-    d->adj_off = alloc<size_t>(d->nv + 1);
-    d->pole = alloc<double>(3 * d->nv);
-    d->hull = alloc<double>(3 * d->nv);
     std::vector<DT3::Vertex_handle> vh(d->nv);
     std::uint32_t id = 0;
     for (auto v = t.finite_vertices_begin(); v != t.finite_vertices_end(); ++v) {
-        d->rep[id] = v->info();
-        d->vertex_of[v->info()] = id;
         v->info() = id;
         vh[id++] = v;
     }
-    if (d->nduplicates > 0) {
-        // only here does a hash of every vertex cost anything
-        std::unordered_map<Key, std::uint32_t, KeyHash> at;
-        at.reserve(d->nv);
-        for (size_t v = 0; v < d->nv; v++) at.emplace(key_of(xyz + 3 * (size_t)d->rep[v]), (std::uint32_t)v);
-        for (size_t i = 0; i < n; i++) {
-            const double *p = xyz + 3 * i;
-            if (d->vertex_of[i] != kNone || !std::isfinite(p[0]) || !std::isfinite(p[1]) ||
-                !std::isfinite(p[2]))
-                continue;
-            auto it = at.find(key_of(p));
-            if (it == at.end()) throw std::runtime_error("duplicate without a vertex");
-            d->vertex_of[i] = it->second;
-            if (i < d->rep[it->second]) d->rep[it->second] = (std::uint32_t)i;
+    d->rep = alloc<std::uint32_t>(d->nv);
+    for (size_t v = 0; v < d->nv; v++) d->rep[v] = kNone;
+    for (size_t i = 0; i < n; i++)
+        if (of[i] != DT3::Vertex_handle()) {
+            std::uint32_t v = of[i]->info();
+            d->vertex_of[i] = v;
+            if (d->rep[v] == kNone) d->rep[v] = (std::uint32_t)i;  // i ascending: the smallest
         }
-    }
-
-    std::vector<std::uint32_t> adj;
-    adj.reserve(d->nv * 16);
-    std::vector<DT3::Vertex_handle> nb;
-    d->adj_off[0] = 0;
-    for (size_t v = 0; v < d->nv; v++) {
-        nb.clear();
-        if (d->dimension >= 1) t.finite_adjacent_vertices(vh[v], std::back_inserter(nb));
-        for (auto w : nb) adj.push_back(w->info());
-        d->adj_off[v + 1] = adj.size();
-    }
-    d->adj = alloc<std::uint32_t>(adj.size());
-    if (!adj.empty()) std::memcpy(d->adj, adj.data(), adj.size() * sizeof(std::uint32_t));
-    std::vector<std::uint32_t>().swap(adj);
-    compute_poles(t, d);
+    std::vector<DT3::Vertex_handle>().swap(of);
+    extract_stars(t, vh, d);
 }
 }  // namespace
 

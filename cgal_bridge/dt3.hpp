@@ -6,19 +6,20 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <cstdint>
+#include <vector>
 
 #include "cgal_bridge.h"
 
 namespace jfb {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-// info(): the input index while inserting, then the dense vertex id
+// info(): the dense vertex id (0 .. nv-1, in the triangulation's order)
 using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::uint32_t, K>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb>;
 using DT3 = CGAL::Delaunay_triangulation_3<K, Tds>;
 using Point = K::Point_3;
 
-// Fills d->pole and d->hull (arrays already allocated, vertex infos are
-// dense ids).  poles.cpp.
-void compute_poles(const DT3 &t, jfb_delaunay *d);
+// Allocates and fills d->adj_off, d->adj, d->pole, d->hull from the star
+// of every vertex (vh[id] is the vertex of id; star.cpp).
+void extract_stars(const DT3 &t, const std::vector<DT3::Vertex_handle> &vh, jfb_delaunay *d);
 }  // namespace jfb
 #endif
