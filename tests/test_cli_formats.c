@@ -240,6 +240,22 @@ START_TEST(neighbourhood_kinds)
 }
 END_TEST
 
+/* On a terminal: a progress line ("\r", percent, points/s, ETA) ending at
+ * 100%, then the summary; --quiet draws nothing. */
+START_TEST(progress_on_terminal)
+{
+    make_points();
+    cli_write_xyz(cli_path("in.xyz"), pts, NULL, N);
+    ck_assert_int_eq(cli_run_tty("estimate", cli_path("in.xyz"), "-o", cli_path("p.csv"), NULL),
+                     0);
+    ck_assert_msg(strstr(cli_err, "\rjetfit: 100.0%  700/700 points") != NULL, "%s", cli_err);
+    ck_assert(strstr(cli_err, "ETA") && strstr(cli_err, "cond: p50"));
+    ck_assert_int_eq(cli_run_tty("estimate", cli_path("in.xyz"), "-o", cli_path("p.csv"),
+                                 "--quiet", NULL), 0);
+    ck_assert_str_eq(cli_err, "");
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_formats");
@@ -251,6 +267,7 @@ int main(void)
     tcase_add_test(tc, threads_identical);
     tcase_add_test(tc, columns_option);
     tcase_add_test(tc, neighbourhood_kinds);
+    tcase_add_test(tc, progress_on_terminal);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

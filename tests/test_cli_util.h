@@ -5,6 +5,7 @@
 #define JF_TEST_CLI_UTIL_H
 
 #include <fcntl.h>
+#include <poll.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -114,6 +115,60 @@ static inline int cli_run(const char *first, ...)
     unlink(errpath);
     if (WIFEXITED(status)) return WEXITSTATUS(status);
     return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+/* glibc declares these only under _XOPEN_SOURCE, which check.h's
+ * includes may already have settled: declare them here. */
+int posix_openpt(int flags);
+int grantpt(int fd);
+int unlockpt(int fd);
+char *ptsname(int fd);
+
+/* Runs `jetfit ARGS...` with stderr on a pseudo-terminal (isatty(2) is
+ * true: the progress line is drawn); what it wrote is in cli_err. */
+static inline int cli_run_tty(const char *first, ...)
+{
+    const char *argv[64];
+    int argc = 0;
+    va_list ap;
+    argv[argc++] = JETFIT_BIN;
+    va_start(ap, first);
+    for (const char *a = first; a && argc < 63; a = va_arg(ap, const char *)) argv[argc++] = a;
+    va_end(ap);
+    argv[argc] = NULL;
+    int m = posix_openpt(O_RDWR | O_NOCTTY);
+    if (m < 0 || grantpt(m) || unlockpt(m)) return -1;
+    const char *slave = ptsname(m);
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int s = open(slave, O_RDWR | O_NOCTTY), fo = open("/dev/null", O_WRONLY);
+        if (s < 0 || fo < 0) _exit(126);
+        dup2(s, 2);
+        dup2(fo, 1);
+        execv(JETFIT_BIN, (char *const *)argv);
+        _exit(127);
+    }
+    size_t used = 0;
+    int status = 0, exited = 0;
+    for (;;) { /* read until the child is gone and nothing is left */
+        struct pollfd pf = {m, POLLIN, 0};
+        int ready = poll(&pf, 1, 200);
+        if (ready > 0 && (pf.revents & POLLIN)) {
+            ssize_t r = read(m, cli_err + used, sizeof cli_err - 1 - used);
+            if (r <= 0) break;
+            used += (size_t)r;
+            if (used == sizeof cli_err - 1) used = 0; /* keep the tail */
+            continue;
+        }
+        if (ready > 0 && !(pf.revents & POLLIN)) break; /* hang-up */
+        if (exited) break;
+        exited = waitpid(pid, &status, WNOHANG) == pid;
+    }
+    cli_err[used] = '\0';
+    if (!exited) waitpid(pid, &status, 0);
+    close(m);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
 static inline void cli_write_text(const char *path, const char *text)
