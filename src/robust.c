@@ -37,10 +37,10 @@
  * deviations (see jf_fit_point_full); chosen by measurement
  * (tests/bench_pcpnet.cpp, README). */
 #ifndef JF_SCALE_TAU
-#define JF_SCALE_TAU 2.0
+#define JF_SCALE_TAU 1.0
 #endif
 #ifndef JF_SCALE_TARGET
-#define JF_SCALE_TARGET 0.2
+#define JF_SCALE_TARGET 0.0
 #endif
 
 /* ---- per-thread fallback buffer for n > STACK_N ---- */
@@ -215,6 +215,7 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
  * the normal, which leaves the trace used here unchanged), preconditioned
  * by h (§2.3), and inverted by Cholesky.  sigma^2 is the unbiased residual
  * variance (n residuals, N_d coefficients).  INFINITY when undefined. */
+extern double jf__scale_floor;
 #define SD_MAXN 15 /* degree <= 4: N_4 = 15; higher degrees use degree 4 */
 static double normal_sd(const jf_result *r, double sigma, const double p[3],
                         const double *nbr, size_t n)
@@ -268,11 +269,12 @@ static double normal_sd(const jf_result *r, double sigma, const double p[3],
         for (size_t i = c; i < nn; i++) var += z[i] * z[i];
     }
     double s2 = sigma * sigma * (double)n / (double)(n - nfit);
-    /* Floor: a misfit of size sigma over the radius h tilts the plane by
-     * about sigma / h whatever n is (systematic error, or a neighbourhood
-     * so small that its PCA frame follows the noise). */
+    /* Floor: when the residual is a sizeable fraction of the radius the
+     * neighbourhood is a blob of noise whose PCA frame follows the noise
+     * and whose residual underestimates it; its normal is then uncertain
+     * by about sigma / h whatever n is. */
     double sd = sqrt(s2 * var) / h, fl = sqrt(s2) / h;
-    return sd > fl ? sd : fl;
+    return fl > jf__scale_floor && fl > sd ? fl : sd;
 }
 
 static double angle(const double a[3], const double b[3])
@@ -283,6 +285,7 @@ static double angle(const double a[3], const double b[3])
 
 double jf__scale_tau = JF_SCALE_TAU; /* tuning hooks for bench_pcpnet */
 double jf__scale_target = JF_SCALE_TARGET;
+double jf__scale_floor = 0.3;
 /* A normal whose standard deviation exceeds this (radians) is noise: it
  * cannot reveal a bias, so it takes no part in the interval test. */
 #define SD_MEANINGFUL 0.3
