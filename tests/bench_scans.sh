@@ -1,0 +1,52 @@
+#!/bin/sh
+# bench_scans.sh -- `jetfit estimate` on real scans: the ten raw Stanford
+# bunny range scans (ASCII PLY with range_grid elements, CRLF) and the
+# LAS-derived LiDAR .xyz clouds (georeferenced, coordinates ~1e5-1e6).
+# Checks: exit status 0, one row per input point, no NaN/Inf in a row whose
+# status is 0; prints per file: points, seconds, status counts.
+# Usage: sh tests/bench_scans.sh [BUILD_DIR] [-- extra estimate options]
+# (default build dir: build; data from ../shared/data/scans).
+set -u
+top=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$top/build}
+[ $# -gt 0 ] && shift
+[ "${1:-}" = "--" ] && shift
+jetfit=$build/jetfit
+data=$(cd "$top/../shared/data/scans" 2>/dev/null && pwd) || { echo "bench_scans: no ../shared/data/scans"; exit 2; }
+[ -x "$jetfit" ] || { echo "bench_scans: $jetfit not built"; exit 2; }
+tmp=$(mktemp -d /tmp/jf_scans.XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+printf '%-44s %8s %8s  %s\n' file points seconds "status counts (value: rows)"
+for f in "$data"/stanford_bunny/data/*.ply "$data"/lidar_laspy/*.xyz; do
+  [ -f "$f" ] || continue
+  out=$tmp/out.csv
+  t0=$(date +%s.%N)
+  if ! "$jetfit" estimate "$f" -o "$out" --quiet "$@" 2>"$tmp/err"; then
+    printf '%-44s FAILED: %s\n' "${f#$data/}" "$(head -1 "$tmp/err")"
+    fail=1
+    continue
+  fi
+  t1=$(date +%s.%N)
+  # status is the last column; a row with status 0 must be all finite
+  awk -F, -v name="${f#$data/}" -v secs="$(echo "$t1 - $t0" | bc)" '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i == "status") sc = i; next }
+    { n++; s = $sc + 0; cnt[s]++
+      if (s == 0) for (i = 1; i <= NF; i++) {
+        v = tolower($i); if (v ~ /nan|inf/) { bad++; break } } }
+    END {
+      line = ""
+      for (s in cnt) line = line sprintf("%s%d: %d", line == "" ? "" : ", ", s, cnt[s])
+      printf "%-44s %8d %8.2f  %s\n", name, n, secs, line
+      if (bad) { printf "  ERROR: %d rows with status 0 hold NaN/Inf\n", bad; exit 1 }
+    }' "$out" || fail=1
+  # one row per input point (PLY header count, or the lines of the .xyz)
+  case $f in
+    *.ply) want=$(grep -a -m1 '^element vertex' "$f" | tr -d '\r' | awk '{print $3}') ;;
+    *) want=$(grep -c -v '^[[:space:]]*\(#\|$\)' "$f") ;;
+  esac
+  got=$(($(wc -l < "$out") - 1))
+  [ "$got" = "$want" ] || { echo "  ERROR: $got rows for $want points"; fail=1; }
+done
+[ $fail -eq 0 ] && echo "bench_scans: all files ok" || echo "bench_scans: FAILURES"
+exit $fail
