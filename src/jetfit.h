@@ -673,6 +673,12 @@ jf_status jf_orient_viewpoint(jf_result *res, const double *xyz, size_t n,
 jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
                         const jf_index *ix, size_t k);
 
+/* Same on a stored graph: nbr[i*k .. i*k+k-1] are point i's neighbours
+ * (nearest first; UINT32_MAX = none; i itself is ignored), e.g. the first
+ * k of each fitting neighbourhood, as jf_estimate does (no queries). */
+jf_status jf_orient_mst_graph(jf_result *res, const double *xyz, size_t n,
+                              const uint32_t *nbr, size_t k);
+
 /* ------------------------------------------------------------------ */
 /* Natural neighbourhoods (§5.1, point clouds; src/natural.c over the  */
 /* CGAL bridge)                                                        */

@@ -152,6 +152,26 @@ static void seed_sort(const double *xyz, uint32_t *o, size_t len)
     }
 }
 
+/* Where the graph's edges come from: k-NN queries, or stored lists. */
+typedef struct {
+    const jf_index *ix;   /* query k+1 nearest (the point itself drops out) */
+    const uint32_t *g;    /* or: g[i*k .. i*k+k-1], UINT32_MAX = none      */
+    const double *xyz;
+    size_t k;
+} nbsrc;
+
+static jf_status get_neighbours(const nbsrc *src, uint32_t u, uint32_t *nb, size_t *found)
+{
+    if (src->ix)
+        return jf_index_knn(src->ix, src->xyz + 3 * (size_t)u, src->k + 1, nb, NULL, found);
+    const uint32_t *row = src->g + (size_t)u * src->k;
+    size_t m = 0;
+    for (size_t j = 0; j < src->k; j++)
+        if (row[j] != UINT32_MAX) nb[m++] = row[j];
+    *found = m;
+    return JF_OK;
+}
+
 /* design: Prim over the k-NN graph, neighbours queried again when a point
  * is popped (memory O(n): no adjacency is stored).
  *  1. Seeds in order of decreasing z.  A seed is oriented by its lightest
@@ -161,12 +181,9 @@ static void seed_sort(const double *xyz, uint32_t *o, size_t len)
  *  2. Pop the lightest reached point, flip it to agree with its parent,
  *     relax its k nearest neighbours with w = 1 - |ni.nj|.
  *  A seed with no orientable neighbour gets JF_PT_ORIENT_UNKNOWN. */
-jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
-                        const jf_index *ix, size_t k)
+static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *src)
 {
-    if (n && (!res || !xyz || !ix)) return JF_ERR_INVALID;
-    if (k < 1 || k > 1024) return JF_ERR_INVALID;
-    if (n >= DONE) return JF_ERR_TOO_LARGE;
+    size_t k = src->k;
     mheap h = {0};
     uint32_t *parent = malloc((n ? n : 1) * sizeof *parent);
     uint32_t *seeds = malloc((n ? n : 1) * sizeof *seeds);
@@ -192,14 +209,14 @@ jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
         if (h.pos[s] != NOT_SEEN) continue;
         /* step 1: orient the seed */
         size_t found = 0;
-        st = jf_index_knn(ix, xyz + 3 * (size_t)s, k + 1, nb, NULL, &found);
+        st = get_neighbours(src, s, nb, &found);
         if (st != JF_OK) goto out;
         uint32_t best = NOT_SEEN;
         double bestw = INFINITY;
         int neighbours = 0;
         for (size_t j = 0; j < found; j++) {
             uint32_t v = nb[j];
-            if (v == s || !orientable(&res[v])) continue;
+            if (v >= n || v == s || !orientable(&res[v])) continue;
             neighbours = 1;
             double w = 1.0 - fabs(dot3(res[s].normal, res[v].normal));
             if (h.pos[v] == DONE && w < bestw) {
@@ -222,11 +239,11 @@ jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
         while (h.len) {
             uint32_t u = heap_pop(&h);
             if (parent[u] != u) orient_along(&res[u], res[parent[u]].normal);
-            st = jf_index_knn(ix, xyz + 3 * (size_t)u, k + 1, nb, NULL, &found);
+            st = get_neighbours(src, u, nb, &found);
             if (st != JF_OK) goto out;
             for (size_t j = 0; j < found; j++) {
                 uint32_t v = nb[j];
-                if (h.pos[v] == DONE) continue;
+                if (v >= n || h.pos[v] == DONE) continue;
                 double w = 1.0 - fabs(dot3(res[u].normal, res[v].normal));
                 if (h.pos[v] == NOT_SEEN) {
                     h.key[v] = w;
@@ -251,4 +268,24 @@ out:
     free(h.pos);
     free(h.key);
     return st;
+}
+
+jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
+                        const jf_index *ix, size_t k)
+{
+    if (n && (!res || !xyz || !ix)) return JF_ERR_INVALID;
+    if (k < 1 || k > 1024) return JF_ERR_INVALID;
+    if (n >= DONE) return JF_ERR_TOO_LARGE;
+    nbsrc src = {ix, NULL, xyz, k};
+    return prim(res, xyz, n, &src);
+}
+
+jf_status jf_orient_mst_graph(jf_result *res, const double *xyz, size_t n,
+                              const uint32_t *nbr, size_t k)
+{
+    if (n && (!res || !xyz || !nbr)) return JF_ERR_INVALID;
+    if (k < 1 || k > 1024) return JF_ERR_INVALID;
+    if (n >= DONE) return JF_ERR_TOO_LARGE;
+    nbsrc src = {NULL, nbr, xyz, k};
+    return prim(res, xyz, n, &src);
 }

@@ -73,6 +73,8 @@ typedef struct {
     size_t min_count;     /* N_n of the asked degree                   */
     size_t want;          /* fewer found than this: FEW_NEIGHBORS      */
     size_t cap;           /* buffer size (largest neighbourhood)       */
+    uint32_t *graph;      /* mst: the first gk neighbours of each point */
+    size_t gk;
     jf_fit_mode fit;
 } nbctx;
 
@@ -246,9 +248,20 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x)
     return st;
 }
 
+/* mst: keep the gk nearest of the neighbourhood as i's graph edges. */
+static void keep_edges(const nbctx *x, size_t i, const uint32_t *idx, size_t found)
+{
+    uint32_t *row = x->graph + i * x->gk;
+    size_t m = 0;
+    for (size_t j = 0; j < found && m < x->gk; j++)
+        if (idx[j] != i) row[m++] = idx[j];
+    while (m < x->gk) row[m++] = UINT32_MAX;
+}
+
 static jf_status fit_one(worker *w, const nbctx *x, size_t i, jf_result *out)
 {
     const double *p = x->xyz + 3 * i;
+    if (x->graph) keep_edges(x, i, NULL, 0);
     if (!finite3(p)) {
         nan_result(out, JF_PT_NONFINITE);
         return JF_OK;
@@ -257,6 +270,7 @@ static jf_status fit_one(worker *w, const nbctx *x, size_t i, jf_result *out)
     unsigned flags = 0;
     jf_status st = nb_query(x, w->nws, i, w->idx, w->d2, &found, &flags);
     if (st != JF_OK) return st;
+    if (x->graph) keep_edges(x, i, w->idx, found);
     if (flags & JF_PT_FAILED) {
         nan_result(out, flags);
         return JF_OK;
@@ -333,7 +347,7 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     jf_status st = JF_OK;
     jf_index *ix = NULL;
     uint32_t *order = NULL;
-    int need_index = nb.kind <= JF_NB_KNN_RADIUS || o->orient == JF_ORIENT_MST ||
+    int need_index = nb.kind <= JF_NB_KNN_RADIUS ||
                      (o->nb.kind == JF_NB_NATURAL && o->normal == JF_NORMAL_PCA);
     if (need_index && (st = jf_index_build(c->xyz, n, &ix)) != JF_OK) {
         set_err(err, "building the k-d tree failed");
@@ -346,6 +360,21 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     if (o->nb.kind == JF_NB_NATURAL && (st = natural_setup(&x, c, o->normal, nt, err)) != JF_OK) {
         if (err && !err->msg[0]) set_err(err, jf_strerror(st));
         goto out;
+    }
+    if (o->orient == JF_ORIENT_MST) {
+        /* mst on the fit's own neighbourhoods: no queries again later */
+        if (o->orient_k < 1 || o->orient_k > 1024) {
+            st = JF_ERR_INVALID;
+            set_err(err, "orient_k must be 1..1024");
+            goto out;
+        }
+        x.gk = o->orient_k;
+        x.graph = malloc(n * x.gk * sizeof *x.graph);
+        if (!x.graph) {
+            st = JF_ERR_NOMEM;
+            set_err(err, "out of memory (orientation graph)");
+            goto out;
+        }
     }
     order = malloc(n * sizeof *order);
     if (!order) {
@@ -398,6 +427,8 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     }
     free(order);
     order = NULL;
+    jf_index_free(ix); /* the orientation does not need it: lower peak */
+    ix = NULL;
     if (o->progress) o->progress(o->progress_user, n, n);
 
     /* step 3 */
@@ -405,7 +436,7 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     case JF_ORIENT_NONE: break;
     case JF_ORIENT_INPUT: st = jf_orient_input(out, n, c->nrm); break;
     case JF_ORIENT_VIEWPOINT: st = jf_orient_viewpoint(out, c->xyz, n, o->viewpoint); break;
-    case JF_ORIENT_MST: st = jf_orient_mst(out, c->xyz, n, ix, o->orient_k); break;
+    case JF_ORIENT_MST: st = jf_orient_mst_graph(out, c->xyz, n, x.graph, x.gk); break;
     default: st = JF_ERR_INVALID;
     }
     if (st != JF_OK) set_err(err, "orientation failed");
@@ -416,5 +447,6 @@ out:
     jf_natural_free(x.nt);
     free(x.nrm_own);
     free(x.nflags);
+    free(x.graph);
     return st;
 }

@@ -174,6 +174,38 @@ START_TEST(bad_args)
 }
 END_TEST
 
+/* The stored-graph variant on the k-NN lists gives the same bits as the
+ * querying one (same graph, same Prim). */
+START_TEST(mst_graph_equals_queries)
+{
+    size_t n = 3000, k = 8;
+    double c[3] = {0, 0, 0}, *xyz = malloc(3 * n * sizeof *xyz);
+    jf_result *r = malloc(n * sizeof *r), *r2 = malloc(n * sizeof *r2);
+    uint32_t *g = malloc(n * k * sizeof *g), nb[9];
+    sphere(n, 1.0, c, xyz, r, 21);
+    memcpy(r2, r, n * sizeof *r);
+    jf_index *ix = NULL;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    for (size_t i = 0; i < n; i++) {
+        size_t found = 0, m = 0;
+        ck_assert_int_eq(jf_index_knn(ix, xyz + 3 * i, k + 1, nb, NULL, &found), JF_OK);
+        for (size_t j = 0; j < found && m < k; j++)
+            if (nb[j] != i) g[i * k + m++] = nb[j];
+        while (m < k) g[i * k + m++] = UINT32_MAX;
+    }
+    ck_assert_int_eq(jf_orient_mst(r, xyz, n, ix, k), JF_OK);
+    ck_assert_int_eq(jf_orient_mst_graph(r2, xyz, n, g, k), JF_OK);
+    ck_assert(memcmp(r, r2, n * sizeof *r) == 0);
+    for (size_t i = 0; i < n; i++) ck_assert(side(&r2[i], xyz + 3 * i, c) > 0);
+    ck_assert_int_eq(jf_orient_mst_graph(r2, xyz, n, NULL, k), JF_ERR_INVALID);
+    jf_index_free(ix);
+    free(xyz);
+    free(r);
+    free(r2);
+    free(g);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("orient");
@@ -183,6 +215,7 @@ int main(void)
     tcase_add_test(tc, mst_sphere_outward);
     tcase_add_test(tc, mst_components);
     tcase_add_test(tc, bad_args);
+    tcase_add_test(tc, mst_graph_equals_queries);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
