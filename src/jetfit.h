@@ -813,7 +813,7 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * order; rings: the adjacency; natural: the bridge's ~100 + 28), plus
  * 4 * orient_k for mst, which runs on the fit's own neighbourhoods (the
  * orient_k nearest of each).  Measured at 1M points, knn:16, the whole
- * command: 274 MB (284 with 2 threads), 305 MB with mst.
+ * command peaks at 271-278 MB (1-2 threads), 305 MB with mst.
  * Returns JF_OK, JF_ERR_INVALID (bad options, rings without faces,
  * orient/normal input without normals; err says which), JF_ERR_NOMEM,
  * JF_ERR_FORMAT (bad face indices), or the failing stage's status; err
