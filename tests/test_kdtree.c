@@ -304,6 +304,22 @@ START_TEST(knn_large_k_without_d2)
 }
 END_TEST
 
+START_TEST(index_memory_small)
+{
+    /* the index is a permuted copy (24 + 4 bytes per point) plus ~1 node
+     * per 8 points: it must stay under 40 bytes per point */
+    size_t n = 50000;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    ck_assert_uint_ge(jf_index_memory(ix), n * 28);
+    ck_assert_uint_le(jf_index_memory(ix), n * 40);
+    jf_index_free(ix);
+    free(xyz);
+}
+END_TEST
+
 START_TEST(knn_threads_agree)
 {
     /* the same queries from several OpenMP threads give identical results */
@@ -413,6 +429,7 @@ static Suite *kdtree_suite(void)
     tcase_add_test(tc, knn_edge_cases);
     tcase_add_test(tc, knn_large_k_without_d2);
     tcase_add_test(tc, knn_threads_agree);
+    tcase_add_test(tc, index_memory_small);
     suite_add_tcase(s, tc);
     TCase *to = tcase_create("order");
     tcase_add_test(to, order_is_permutation);
