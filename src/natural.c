@@ -301,7 +301,10 @@ static void project(const plane *h, const double *q, double *x, double *y, doubl
  * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
  * the clip line gets label s. */
 static void clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
-    size_t n = *m, o = 0;
+    size_t n = *m, o = 0, k0;
+    for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
+        if (ax * ws->px[k0] + ay * ws->py[k0] > b) break;
+    if (k0 == n) return;
     for (size_t k = 0; k < n; k++) {
         size_t k1 = k + 1 == n ? 0 : k + 1;
         double fu = ax * ws->px[k] + ay * ws->py[k] - b;
