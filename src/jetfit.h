@@ -237,11 +237,23 @@ jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n);
 /* The parameters the fitter was created with. */
 const jf_params *jf_fitter_params(const jf_fitter *f);
 
-/* The full per-point fit used by the command (src/robust.c): honours
- * params.robust (iteratively reweighted least squares on the residuals,
- * scale from the median absolute residual) and params.scales (per-point
- * choice of K among scales[], the first K of nbr, which must be sorted
- * nearest first).  With neither set it is exactly jf_fit_point. */
+/* The full per-point fit used by the command (src/robust.c).
+ *  - params.robust: iteratively reweighted least squares on the height
+ *    residuals; scale s = 1.4826 median|r|; Huber (c = 1.345 s) or Tukey
+ *    (c = 4.685 s, after two Huber steps) weights; at most robust_iters
+ *    refits, stopping when the normal and curvatures move by less than 10%
+ *    of the noise scale over the neighbourhood; otherwise (or when fewer
+ *    than N_n + 1 points keep a weight) JF_PT_ROBUST_NOCONV.
+ *  - params.scales: per-point choice of K among scales[] (the first K of
+ *    nbr, which must be sorted nearest first; K > n is clamped to n) by
+ *    the intersection of confidence intervals: K grows while its normal
+ *    stays within 1 standard deviation (sum of both) of every smaller K's
+ *    normal; JF_PT_SCALE_SELECTED when the chosen K is not the largest.
+ *    out->n_used tells the K used.
+ * With neither set it is exactly jf_fit_point.  Returns what jf_fit_point
+ * returns, or JF_ERR_NOMEM (n > 512 with robust: a per-thread buffer is
+ * allocated once, grown when a larger n is first seen, freed at thread
+ * exit).  Not thread-safe on one fitter, as jf_fit_point. */
 jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
                             const double *nbr, size_t n, jf_result *out);
 

@@ -11,9 +11,14 @@
  *    pass away from a corrupted p, so p's own equation is downweighted like
  *    any other; the quantities are those of the jet at (0, 0, A_00).
  *
- *  - scale selection (params.scales): for each candidate K (the first K
- *    neighbours, sorted nearest first) fit and estimate the normal error as
- *    variance + bias (see score()); keep the K of least estimated error.
+ *  - scale selection (params.scales): intersection of confidence intervals
+ *    (Lepski / Katkovnik's ICI rule) over the candidate K, smallest first:
+ *    each fit's normal has a standard deviation computed from the noise
+ *    estimate and the jet's normal matrix (normal_sd()); K grows while its
+ *    normal agrees with every smaller K's within tau (sd_i + sd_j).  Noise
+ *    alone keeps the normals within their intervals (large K wins); the
+ *    truncation error of a too-large neighbourhood moves the normal out.
+ *    tau = 1 chosen on PCPNet's armadillo (tests/bench_pcpnet.cpp).
  *
  * No allocation per point: the residual/weight buffers live on the stack
  * up to STACK_N neighbours; above that, one heap buffer per thread (C11
