@@ -304,6 +304,39 @@ START_TEST(exact_surface_converges)
 }
 END_TEST
 
+/* More neighbours than the stack buffer holds (the per-thread buffer):
+ * same answer as the plain fit on exact data, no NOCONV. */
+START_TEST(large_neighbourhood)
+{
+    quadric = 1;
+    cloud c = make_cloud(30, 0, 0, 0, 5);
+    quadric = 0;
+    jf_params p;
+    jf_params_init(&p);
+    p.robust = JF_ROBUST_HUBER;
+    p.frame = JF_FRAME_AXIS;
+    p.max_neighbors = 700;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    double *nbr = malloc(3 * 700 * sizeof *nbr), *d2 = malloc(700 * sizeof *d2);
+    size_t *idx = malloc(700 * sizeof *idx);
+    size_t q = 15 * 30 + 15;
+    knn(&c, q, 700, nbr, idx, d2);
+    jf_result a, b;
+    ck_assert_int_eq(jf_fit_point(f, c.xyz + 3 * q, nbr, 700, &a), JF_OK);
+    ck_assert_int_eq(jf_fit_point_full(f, c.xyz + 3 * q, nbr, 700, &b), JF_OK);
+    ck_assert_uint_eq(b.status & JF_PT_ROBUST_NOCONV, 0);
+    ck_assert_double_eq_tol(a.k1, b.k1, 1e-9);
+    ck_assert_double_eq_tol(b.k1, 0.8 + 0.0, 0.05); /* z = 0.4u^2 ...: k ~ 0.8 near 0 */
+    free(nbr);
+    free(d2);
+    free(idx);
+    jf_fitter_free(f);
+    free(c.xyz);
+    free(c.uv);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("robust");
@@ -311,6 +344,7 @@ int main(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, plain_is_jf_fit_point);
     tcase_add_test(tc, exact_surface_converges);
+    tcase_add_test(tc, large_neighbourhood);
     tcase_add_test(tc, scale_selection_beats_best_fixed_k);
     tcase_add_test(tc, reweighting_suppresses_outliers);
     suite_add_tcase(s, tc);
