@@ -559,7 +559,7 @@ typedef struct jf_writer jf_writer;
 /* Opens a table of ncols columns and exactly nrows rows (the PLY header
  * needs the count; commit fails if a different number was written).
  * ascii != 0 asks for ascii PLY (ignored for text formats).  Names must
- * be non-empty without whitespace or ','.  On failure *w is NULL, err
+ * be non-empty without whitespace, ',' or '#'.  On failure *w is NULL, err
  * (may be NULL) says why, nothing is left on disk. */
 jf_status jf_writer_open(const char *path, const jf_column *cols,
                          size_t ncols, size_t nrows, int ascii,
@@ -569,8 +569,8 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
  * (list uchar int vertex_indices) from nfaces polygons
  * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the
  * first row; the arrays are read at commit and must stay valid until
- * then.  JF_ERR_INVALID if rows were already written or a face has more
- * than 255 vertices. */
+ * then.  JF_ERR_INVALID if rows were already written, a face has more
+ * than 255 vertices or an index >= nrows. */
 jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
                           const uint32_t *idx);
 
