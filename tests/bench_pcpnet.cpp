@@ -10,8 +10,15 @@
 //           Sequential_tag, on the same points in the same run.
 // CGAL computes every one of the 100k points (its API has no query subset);
 // jetfit fits only the 5000 evaluated points, so times are reported per
-// fit.  Usage: bench_pcpnet [DATA_DIR] [--quick] (--quick: clean shape and
-// the largest noise only, K = 18 and 112).
+// fit.  CGAL's k counts the neighbours besides the query point (k + 1
+// points, Point_set_processing_3/internal/Neighbor_query.h); jetfit's K
+// counts the point itself (K points).
+// Usage: bench_pcpnet [DATA_DIR] [--quick] [--no-cgal] [--no-fixed]
+//   [--sweep "K,deg,robust ..."] [--tau X] [--floor X] [--target X]
+// --quick: clean shape and the largest noise only, K = 18 and 112;
+// --sweep adds configurations (K may be a scale set "12/18/36"; robust
+// 0/1/2 = none/huber/tukey; with --no-fixed only those run); --tau,
+// --floor, --target override the scale-selection constants of robust.c.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
 #include <CGAL/pca_estimate_normals.h>
@@ -33,6 +40,7 @@
 
 extern "C" double jf__scale_tau;    // src/robust.c: scale-selection interval width
 extern "C" double jf__scale_target; // ... and the normal sd that is enough
+extern "C" double jf__scale_floor;  // ... sigma/h above which sd >= sigma/h
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 typedef Kernel::Point_3 Point;
@@ -176,6 +184,7 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
         else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__scale_tau = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__scale_target = std::atof(argv[++i]);
+        else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__scale_floor = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--sweep") && i + 1 < argc) sweep = argv[++i];
         else dir = argv[i];
     }
@@ -246,7 +255,7 @@ int main(int argc, char **argv)
         for (size_t k : ks)
             for (int d = 2; d <= 3 && !no_fixed; d++)
                 cfg.push_back({"jetfit huber", d, k, JF_ROBUST_HUBER, 0, {0}});
-        for (int d = 2; d <= 3; d++) {
+        for (int d = 2; d <= 3 && !(no_fixed && sweep); d++) {
             cfg.push_back({"jetfit scales 18/36/112/225/450", d, kmax, JF_ROBUST_NONE, 5,
                            {18, 36, 112, 225, 450}});
             cfg.push_back({"jetfit scales 18/36/112/225/450 huber", d, kmax, JF_ROBUST_HUBER, 5,
