@@ -9,14 +9,15 @@
 // built before any timing; CGAL gets them as Point_3 arrays (its natural
 // input), jetfit as packed doubles.
 //
-// Settings: (degree, K) = (2,16) (2,32) (3,32) (4,64); Monge degree = jet
-// degree on both sides (2, 2, 3, 4), i.e. each computes everything it can;
+// Settings: (degree, K, Monge degree) = (2,16,2) (2,32,2) (3,32,3)
+// (4,64,4) -- each side computes everything it can -- then (3,32,2) and
+// (4,64,2) (curvatures only); the Monge degree is the same on both sides.
 // jetfit with default params otherwise (PCA frame, approximation).
 // Each side runs in its own forked child so that its peak RSS
 // (getrusage ru_maxrss) is its own; the timing is the child's CPU time
 // (the machine is shared), best of R rounds, sides alternating.
 //
-// Usage: bench_fit [Q=20000] [R=3] [only=jetfit|cgal] [setting 0..3]
+// Usage: bench_fit [Q=20000] [R=3] [only=jetfit|cgal] [setting 0..5]
 //   with `only`, runs that side alone in-process (for perf record /
 //   valgrind --tool=callgrind) and prints its fits/s.
 #include <sys/resource.h>
@@ -116,13 +117,14 @@ static double maxrss_mb()
     return ru.ru_maxrss / 1024.0;
 }
 
-static Side run_jetfit(const std::vector<double> &nb, size_t Q, int K, int d)
+static Side run_jetfit(const std::vector<double> &nb, size_t Q, int K, int d,
+                       int monge)
 {
     Side s = {0, 0, 0, 0, 0};
     jf_params p;
     jf_params_init(&p);
     p.degree = d;
-    p.monge_degree = d > 4 ? 4 : d;
+    p.monge_degree = monge;
     if (p.max_neighbors < (size_t)K) p.max_neighbors = (size_t)K;
     jf_fitter *f = NULL;
     if (jf_fitter_create(&p, &f) != JF_OK) {
@@ -142,11 +144,12 @@ static Side run_jetfit(const std::vector<double> &nb, size_t Q, int K, int d)
     return s;
 }
 
-static Side run_cgal(const std::vector<Point> &nb, size_t Q, int K, int d)
+static Side run_cgal(const std::vector<Point> &nb, size_t Q, int K, int d,
+                     int monge)
 {
     Side s = {0, 0, 0, 0, 0};
     Monge_fitting fit;
-    size_t dp = d > 4 ? 4 : (size_t)d;
+    size_t dp = (size_t)monge;
     double t0 = cpu_seconds();
     for (size_t q = 0; q < Q; q++) {
         auto b = nb.begin() + (ptrdiff_t)(q * (size_t)K);
@@ -212,16 +215,17 @@ int main(int argc, char **argv)
     std::printf("%-7s %-4s %-6s %12s %12s %7s %10s %10s %8s\n", "degree",
                 "K", "monge", "jetfit/s", "CGAL/s", "ratio", "jf MB+",
                 "CGAL MB+", "lowered");
-    const int set[4][2] = {{2, 16}, {2, 32}, {3, 32}, {4, 64}};
+    const int set[6][3] = {{2, 16, 2}, {2, 32, 2}, {3, 32, 3},
+                           {4, 64, 4}, {3, 32, 2}, {4, 64, 2}};
     double worst = 1e300;
-    int s0 = 0, s1 = 4;
+    int s0 = 0, s1 = 6;
     if (argc > 4) {
         s0 = std::atoi(argv[4]);
-        if (s0 < 0 || s0 > 3) return 2;
+        if (s0 < 0 || s0 > 5) return 2;
         s1 = s0 + 1;
     }
     for (int si = s0; si < s1; si++) {
-        int d = set[si][0], K = set[si][1];
+        int d = set[si][0], K = set[si][1], mo = set[si][2];
         std::vector<double> nb;
         nb.reserve(3 * (size_t)K * Q);
         for (size_t q : queries) knn_grid(xyz, g, q, K, nb);
@@ -231,8 +235,8 @@ int main(int argc, char **argv)
             pts.push_back(Point(nb[i], nb[i+1], nb[i+2]));
         if (only) {  // profiling mode: one side, in this process
             for (int r = 0; r < R; r++) {
-                Side x = only[0] == 'j' ? run_jetfit(nb, Q, K, d)
-                                        : run_cgal(pts, Q, K, d);
+                Side x = only[0] == 'j' ? run_jetfit(nb, Q, K, d, mo)
+                                        : run_cgal(pts, Q, K, d, mo);
                 std::printf("%-7d %-4d %s %.0f fits/s\n", d, K, only,
                             Q / x.seconds);
             }
@@ -240,15 +244,15 @@ int main(int argc, char **argv)
         }
         Side bj = {1e300, 0, 0, 0, 0}, bc = {1e300, 0, 0, 0, 0};
         for (int r = 0; r < R; r++) {
-            Side j = in_child([&] { return run_jetfit(nb, Q, K, d); });
-            Side c = in_child([&] { return run_cgal(pts, Q, K, d); });
+            Side j = in_child([&] { return run_jetfit(nb, Q, K, d, mo); });
+            Side c = in_child([&] { return run_cgal(pts, Q, K, d, mo); });
             if (j.seconds < bj.seconds) bj = j;
             if (c.seconds < bc.seconds) bc = c;
         }
         double fj = Q / bj.seconds, fc = Q / bc.seconds;
         worst = std::min(worst, fj / fc);
         std::printf("%-7d %-4d %-6d %12.0f %12.0f %6.2fx %10.1f %10.1f %8ld\n",
-                    d, K, d > 4 ? 4 : d, fj, fc, fj / fc,
+                    d, K, mo, fj, fc, fj / fc,
                     bj.maxrss_mb - bj.base_mb, bc.maxrss_mb - bc.base_mb,
                     bj.lowered);
         // Same neighbourhoods, same fit: the mean k1 - k2 must agree.
