@@ -24,9 +24,6 @@
  * up to STACK_N neighbours; above that, one heap buffer per thread (C11
  * tss, freed at thread exit) grown only when a larger n is first seen. */
 #include <math.h>
-#ifdef JF_ROBUST_DEBUG
-#include <stdio.h>
-#endif
 #include <stdlib.h>
 #include <string.h>
 #include <threads.h>
@@ -196,9 +193,6 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
         double ang = acos(dot > 1.0 ? 1.0 : dot);
         double dk = fabs(prev.k1 - out->k1) + fabs(prev.k2 - out->k2);
         int pt = pr->robust == JF_ROBUST_TUKEY && it < 2; /* Huber warm-up */
-#ifdef JF_ROBUST_DEBUG
-        fprintf(stderr, "it %d s %g ang %g dk*h %g live %zu/%zu\n", it, s, ang, dk * h, live, n);
-#endif
         /* converged: the jet moved by a small fraction of the noise scale
          * over the neighbourhood (tilt ang * h, curvature dk h^2), or by a
          * negligible amount outright */
