@@ -703,12 +703,12 @@ typedef enum {
 } jf_normal_source;
 
 /* A pole whose reliability (pole distance / nearest-neighbour distance)
- * is below this is replaced by the mincirc normal.  Measured on 20k
- * samples of a sphere and of the §6.1 surface with normal noise of 0.1,
- * 0.3, 1 x the spacing: in every reliability bin >= 1 the pole's mean
- * error is below mincirc's (e.g. [1,2): 21 vs 38 deg), below 1 (mostly
- * rim points of open surfaces, no usable pole) mincirc wins (clean rim:
- * 0.1 vs 27 deg). */
+ * is below this is replaced by the mincirc normal.  Measured by
+ * `bench_natural reliability` (20k samples of a sphere and of the §6.1
+ * surface, normal noise 0 / 0.1 / 0.3 / 1 x the spacing): in every
+ * reliability bin >= 1 the pole's mean error is below mincirc's (e.g.
+ * [1,2): 21 vs 35 deg); below 1 mincirc wins on the clean rim of the
+ * open patch (0.1 vs 26 deg) and on the noisy sphere (61 vs 68 deg). */
 #define JF_NATURAL_MIN_RELIABILITY 1.0
 
 /* The 3D Delaunay triangulation of a cloud, kept as plain arrays (vertex

@@ -13,6 +13,14 @@
 //   natural:16  jf_estimate end to end, --neighbors natural:16 (build,
 //               pole normals, natural neighbours, degree-2 fits)
 //   knn:16      jf_estimate end to end, --neighbors knn:16 (the peer)
+//
+//   bench_natural reliability
+//
+// The measurement behind JF_NATURAL_MIN_RELIABILITY: 20k samples of a unit
+// sphere and of the §6.1 surface with normal noise of 0, 0.1, 0.3, 1 x
+// the sample spacing; per bin of the pole reliability (pole distance /
+// nearest-neighbour distance), the mean angle error of the pole normal
+// (taken from the bridge, whatever its reliability) and of mincirc.
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <sys/resource.h>
@@ -24,8 +32,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "cgal_bridge.h"
 #include "jetfit.h"
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
@@ -103,7 +113,66 @@ static Meas measure(int (*fn)(void), int (*fnb)(bool), bool arg) {
     return m;
 }
 
+static double angle_deg(const double *a, const double *b) {
+    double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    return std::atan2(std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]),
+                      std::fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])) *
+           57.29577951308232;
+}
+
+static int reliability_table() {
+    const size_t n = 20000;
+    std::mt19937_64 g(5);
+    std::normal_distribution<double> nd(0.0, 1.0);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    const double edges[] = {0, 1, 2, 3, 4, 6, 8, 12, 20, 50, 1e300};
+    for (int surf = 0; surf < 2; surf++)
+        for (double noise : {0.0, 0.1, 0.3, 1.0}) {
+            std::vector<double> p(3 * n), t(3 * n);
+            double sp = surf ? 1.0 / std::sqrt((double)n) : std::sqrt(4 * 3.141592653589793 / n);
+            for (size_t i = 0; i < n; i++) {
+                double *q = &p[3 * i], *tn = &t[3 * i];
+                if (surf) {
+                    double x = u(g), y = u(g), z = 0.1 * std::exp(2 * x + y - y * y);
+                    double fx = 2 * z, fy = (1 - 2 * y) * z, l = std::sqrt(fx * fx + fy * fy + 1);
+                    tn[0] = -fx / l, tn[1] = -fy / l, tn[2] = 1 / l;
+                    q[0] = x, q[1] = y, q[2] = z;
+                } else {
+                    double v[3] = {nd(g), nd(g), nd(g)}, l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                    for (int k = 0; k < 3; k++) tn[k] = q[k] = v[k] / l;
+                }
+                double e = noise * sp * nd(g);
+                for (int k = 0; k < 3; k++) q[k] += e * tn[k];
+            }
+            jfb_delaunay d;
+            jf_natural *nt;
+            if (jfb_delaunay_build(p.data(), n, &d) != 0 || jf_natural_create(p.data(), n, &nt) != JF_OK) return 1;
+            std::vector<double> mc(3 * n), rel(n);
+            std::vector<unsigned> fl(n, 0);
+            jf_natural_normals(nt, JF_NORMAL_MINCIRC, 1, mc.data(), fl.data(), rel.data());
+            std::printf("%s, noise %.1f x spacing\n", surf ? "surface 6.1" : "sphere", noise);
+            for (int b = 0; b < 10; b++) {
+                double ep = 0, em = 0;
+                size_t c = 0, cp = 0;
+                for (size_t i = 0; i < n; i++) {
+                    if (rel[i] < edges[b] || rel[i] >= edges[b + 1]) continue;
+                    c++;
+                    em += angle_deg(&mc[3 * i], &t[3 * i]);
+                    const double *pl = d.pole + 3 * (size_t)d.vertex_of[i];
+                    if (std::isfinite(pl[0])) cp++, ep += angle_deg(pl, &t[3 * i]);
+                }
+                if (c)
+                    std::printf("  reliability [%g, %g): %5zu pts  mincirc %6.2f deg  pole %6.2f deg (%zu with a pole)\n",
+                                edges[b], edges[b + 1], c, em / c, cp ? ep / cp : NAN, cp);
+            }
+            jf_natural_free(nt);
+            jfb_delaunay_release(&d);
+        }
+    return 0;
+}
+
 int main(int argc, char **argv) {
+    if (argc > 1 && std::string(argv[1]) == "reliability") return reliability_table();
     size_t n = argc > 1 ? (size_t)std::atof(argv[1]) : 1000000;
     g_threads = argc > 2 ? std::atoi(argv[2]) : 2;
     unsigned seed = argc > 3 ? (unsigned)std::atoi(argv[3]) : 1;
