@@ -528,10 +528,9 @@ START_TEST(test_offset_1e6)
     }
     std::printf("offset 1e6: CGAL's own worst relative error %.2g\n",
                 worst_cgal);
-    // CGAL's offset error is at least 1e3 times our tolerance (measured:
-    // 2e-4 with Eigen 3.4, gcc 12).
-    ck_assert_msg(worst_cgal > 1e3 * REL, "CGAL at 1e6 offset: %.3g",
-                  worst_cgal);
+    // CGAL's offset error is far above our 1e-8 (measured: 2e-4 with
+    // Eigen 3.4, gcc 12).
+    ck_assert_msg(worst_cgal > 1e-5, "CGAL at 1e6 offset: %.3g", worst_cgal);
 }
 END_TEST
 
