@@ -161,11 +161,11 @@ static double ellipsoid_mean_error(size_t n, double *worst) {
 
 START_TEST(ellipsoid_poles_converge) {
     double w1, w2;
-    double m1 = ellipsoid_mean_error(10000, &w1), m2 = ellipsoid_mean_error(40000, &w2);
-    std::printf("ellipsoid pole error: 10k mean %.3f worst %.3f deg; 40k mean %.3f worst %.3f deg\n", m1, w1,
+    double m1 = ellipsoid_mean_error(5000, &w1), m2 = ellipsoid_mean_error(20000, &w2);
+    std::printf("ellipsoid pole error: 5k mean %.3f worst %.3f deg; 20k mean %.3f worst %.3f deg\n", m1, w1,
                 m2, w2);
-    ck_assert_double_lt(m1, 1.0);
-    ck_assert_double_lt(w1, 5.0);
+    ck_assert_double_lt(m1, 1.5);
+    ck_assert_double_lt(w1, 8.0);
     ck_assert_double_gt(m2 / m1, 0.35);
     ck_assert_double_lt(m2 / m1, 0.65);
 }
@@ -228,7 +228,7 @@ END_TEST
 // the uncertified version is broken in 5.5.1, fewer than 32 candidates can
 // miss neighbours, and p among the candidates returns only p).
 START_TEST(sphere_vs_surface_neighbors) {
-    std::vector<double> p = sphere(20000, 0.0, 11);
+    std::vector<double> p = sphere(10000, 0.0, 11);
     size_t np = p.size() / 3;
     jf_natural *nt;
     ck_assert_int_eq(jf_natural_create(p.data(), np, &nt), JF_OK);
@@ -236,7 +236,7 @@ START_TEST(sphere_vs_surface_neighbors) {
     ck_assert_int_eq(jf_natural_ws_create(nt, &ws), JF_OK);
     size_t mismatch = 0, queries = 0;
     std::vector<std::pair<double, unsigned>> d(np);
-    for (size_t i = 0; i < np; i += 97, queries++) {
+    for (size_t i = 0; i < np; i += 53, queries++) {
         const double *q = &p[3 * i];
         for (size_t j = 0; j < np; j++) {
             double dx = p[3 * j] - q[0], dy = p[3 * j + 1] - q[1], dz = p[3 * j + 2] - q[2];

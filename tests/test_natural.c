@@ -163,7 +163,7 @@ END_TEST
  * it engages exactly where the pole is unreliable, never NaN, and the
  * combined normals beat mincirc alone. */
 START_TEST(fallback_where_it_should) {
-    const size_t n = 8000;
+    const size_t n = 5000;
     double *p = malloc(3 * n * sizeof *p), *t = malloc(3 * n * sizeof *t);
     double *a = malloc(3 * n * sizeof *a), *b = malloc(3 * n * sizeof *b), *rel = malloc(n * sizeof *rel);
     unsigned *fa = calloc(n, sizeof *fa), *fb = calloc(n, sizeof *fb);
