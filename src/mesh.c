@@ -162,9 +162,9 @@ jf_status jf_mesh_build(size_t n, size_t nfaces, const size_t *face_off,
             m->stats.nonmanifold_vertices++;
     }
     m->off[n] = wr;
-    m->adj = realloc(raw, (wr ? wr : 1) * sizeof *raw);
-    if (!m->adj) m->adj = raw; /* shrinking failed: keep the larger block */
-    raw = NULL;
+    /* shrink to the deduplicated size; if that fails keep the larger block */
+    uint32_t *shrunk = wr ? realloc(raw, wr * sizeof *raw) : NULL;
+    m->adj = shrunk ? shrunk : raw;
     free(stamp);
     free(good);
     *out = m;
