@@ -70,7 +70,7 @@ void jf__result_nan(jf_result *out);
 
 /* jet.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
- * by GSL's SVD; fills f->s, f->sol, *cond; returns 0, 1 if the matrix is
+ * by pivoted QR, then an SVD of the cols x cols R (jet.c); fills f->s, f->sol, *cond; returns 0, 1 if the matrix is
  * rank deficient (sigma_min <= sigma_max * max(rows,cols) * DBL_EPSILON),
  * -1 on a GSL failure. */
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);

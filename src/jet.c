@@ -22,8 +22,8 @@
  * Jacobi path is 1.0-1.3x faster overall and agrees with GSL to ~kappa
  * eps (test_jet: test_solver_vs_gsl).  -DJF_SVD_GSLJ runs GSL's own
  * one-sided Jacobi (gsl_linalg_SV_decomp_jacobi, allocation-free) on R
- * instead: same results, but 2.3-3.0x slower fits (bench_fit), below the
- * >= 3x-CGAL goal, so not the default. */
+ * instead: same results, but 2-3x slower fits (bench_fit 20000 3:
+ * 1.1-2.0x CGAL against 3.2-3.8x), below the >= 3x goal: not the default. */
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
