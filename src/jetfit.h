@@ -89,8 +89,10 @@ enum {
                                       (e.g. mst: isolated point)        */
     JF_PT_NORMAL_INPUT = 1u << 12, /* natural: tangent plane from the
                                       normal read from the file         */
-    JF_PT_SCALE_SELECTED = 1u << 13 /* scale selection chose a K other
+    JF_PT_SCALE_SELECTED = 1u << 13,/* scale selection chose a K other
                                       than the largest candidate        */
+    JF_PT_MESH_NONMANIFOLD = 1u << 14 /* rings: the vertex is on a mesh
+                                      edge shared by more than 2 faces  */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf
@@ -128,6 +130,9 @@ typedef struct {
     int nscales;             /* scale selection: number of candidate K in
                                 scales[] (0 = off, default)               */
     size_t scales[8];        /* candidate neighbourhood sizes, ascending  */
+    int degree_select;       /* per-point degree selection (robust.c):
+                                0 = off (default), else the lowest degree
+                                tried, 1..degree                          */
 } jf_params;
 
 /* Fills defaults.  Never fails. */

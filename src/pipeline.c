@@ -197,6 +197,9 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, uint32_t 
     case JF_NB_RINGS:
         st = jf_nb_query_mesh(x->mesh, x->xyz, x->nb, x->min_count, x->fit, (uint32_t)i, idx,
                               x->cap, found);
+        /* rings through a non-manifold edge mix sheets: say so */
+        if (jf_mesh_vertex_flags(x->mesh)[i] & JF_MESH_NONMANIFOLD)
+            *flags |= JF_PT_MESH_NONMANIFOLD;
         break;
     case JF_NB_NATURAL:
         *flags = x->nflags[i];
