@@ -133,6 +133,9 @@ typedef struct {
     int degree_select;       /* per-point degree selection (robust.c):
                                 0 = off (default), else the lowest degree
                                 tried, 1..degree                          */
+    double dist_weight;      /* Gaussian distance weights (robust.c):
+                                sigma = dist_weight x the farthest
+                                neighbour's distance; 0 = off (default)   */
 } jf_params;
 
 /* Fills defaults.  Never fails. */
@@ -255,10 +258,25 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *    stays within 1 standard deviation (sum of both) of every smaller K's
  *    normal; JF_PT_SCALE_SELECTED when the chosen K is not the largest.
  *    out->n_used tells the K used.
- * With neither set it is exactly jf_fit_point.  Returns what jf_fit_point
- * returns, or JF_ERR_NOMEM (n > 512 with robust: a per-thread buffer is
- * allocated once, grown when a larger n is first seen, freed at thread
- * exit).  Not thread-safe on one fitter, as jf_fit_point. */
+ *  - params.degree_select = dmin >= 1: per-point choice of the degree among
+ *    degree..dmin by the same interval logic (noise variance from the
+ *    top-degree fit): a lower degree is kept while its normal stays within
+ *    1 sd (sum of both) of every higher degree's; out->degree tells the
+ *    degree used (at 1, k1/k2 are NaN as for any 1-jet).  With noise on a
+ *    small K the plane or quadric wins, on clean data the full degree.
+ *  - params.dist_weight = c > 0: Gaussian weights exp(-d^2 / (2 (c dmax)^2))
+ *    on each neighbour's distance d to p (dmax: the farthest); with
+ *    degree_select the weighted top-degree fit heads the chain (kept
+ *    unless the unweighted normal agrees within the intervals).  Lowers
+ *    truncation error on clean data, costs variance under noise.
+ * The degree-selection fitters of lower degrees are created once per thread
+ * (on first use; recreated only when the parameters change) and freed at
+ * thread exit.  Defaults (off) and constants: README, bench_pcpnet.
+ * With none set it is exactly jf_fit_point.  Returns what jf_fit_point
+ * returns, or JF_ERR_NOMEM (n > 512 with robust or dist_weight: a
+ * per-thread buffer is allocated once, grown when a larger n is first
+ * seen, freed at thread exit; or a lower-degree fitter could not be
+ * created).  Not thread-safe on one fitter, as jf_fit_point. */
 jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
                             const double *nbr, size_t n, jf_result *out);
 

@@ -67,5 +67,8 @@ jf_status jf_params_validate(const jf_params *p, const char **bad_field)
         if (p->scales[i] < 1 || p->scales[i] > p->max_neighbors) return bad(bad_field, "scales");
         if (i > 0 && p->scales[i] <= p->scales[i - 1]) return bad(bad_field, "scales");
     }
+    if (p->degree_select < 0 || p->degree_select > p->degree)
+        return bad(bad_field, "degree_select");
+    if (!(p->dist_weight >= 0.0) || !isfinite(p->dist_weight)) return bad(bad_field, "dist_weight");
     return JF_OK;
 }

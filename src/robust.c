@@ -44,12 +44,24 @@
 #ifndef JF_SCALE_TARGET
 #define JF_SCALE_TARGET 0.0
 #endif
+/* Width of the degree-selection intervals, in standard deviations. */
+#ifndef JF_DEGREE_TAU
+#define JF_DEGREE_TAU 1.0
+#endif
 
-/* ---- per-thread fallback buffer for n > STACK_N ---- */
+static double degree_tau = JF_DEGREE_TAU;
+static double degree_sdmin = 0.0;
+
+/* ---- per-thread state: fallback buffer for n > STACK_N, and the fitters
+ * of the lower degrees tried by degree selection (created on first use,
+ * kept for the thread's life; recreated only if the caller's parameters
+ * other than the degree change) ---- */
 typedef struct {
     double *buf;
     size_t cap;
-} tl_buffer;
+    jf_fitter *fit[JF_MAX_DEGREE + 1]; /* fit[d]: a fitter of degree d */
+    jf_params key;                     /* the parameters they were made from */
+} tl_state;
 
 static tss_t tl_key;
 static once_flag tl_once = ONCE_FLAG_INIT;
@@ -57,18 +69,21 @@ static int tl_ok;
 
 static void tl_free(void *p)
 {
-    tl_buffer *b = p;
-    if (b) free(b->buf);
+    tl_state *b = p;
+    if (b) {
+        free(b->buf);
+        for (int d = 0; d <= JF_MAX_DEGREE; d++) jf_fitter_free(b->fit[d]);
+    }
     free(b);
 }
 
 static void tl_init(void) { tl_ok = tss_create(&tl_key, tl_free) == thrd_success; }
 
-static double *tl_get(size_t need)
+static tl_state *tl_state_get(void)
 {
     call_once(&tl_once, tl_init);
     if (!tl_ok) return NULL;
-    tl_buffer *b = tss_get(tl_key);
+    tl_state *b = tss_get(tl_key);
     if (!b) {
         if (!(b = calloc(1, sizeof *b))) return NULL;
         if (tss_set(tl_key, b) != thrd_success) {
@@ -76,6 +91,13 @@ static double *tl_get(size_t need)
             return NULL;
         }
     }
+    return b;
+}
+
+static double *tl_get(size_t need)
+{
+    tl_state *b = tl_state_get();
+    if (!b) return NULL;
     if (b->cap < need) {
         double *nb = realloc(b->buf, need * sizeof *nb);
         if (!nb) return NULL;
@@ -83,6 +105,33 @@ static double *tl_get(size_t need)
         b->cap = need;
     }
     return b->buf;
+}
+
+/* A fitter of degree d with pr's other fitting parameters (frame, mode,
+ * max_cond, max_neighbors; monge_degree clamped to what d allows). */
+static jf_fitter *tl_fitter(const jf_params *pr, int d)
+{
+    tl_state *b = tl_state_get();
+    if (!b) return NULL;
+    const jf_params *k = &b->key;
+    if (k->fit != pr->fit || k->frame != pr->frame || k->max_cond != pr->max_cond ||
+        k->max_neighbors != pr->max_neighbors || k->monge_degree != pr->monge_degree) {
+        for (int i = 0; i <= JF_MAX_DEGREE; i++) {
+            jf_fitter_free(b->fit[i]);
+            b->fit[i] = NULL;
+        }
+        b->key = *pr;
+    }
+    if (!b->fit[d]) {
+        jf_params q = *pr;
+        q.degree = d;
+        if (q.monge_degree > (d < 2 ? 2 : d)) q.monge_degree = d < 2 ? 2 : d;
+        q.robust = JF_ROBUST_NONE;
+        q.nscales = 0;
+        q.degree_select = 0;
+        if (jf_fitter_create(&q, &b->fit[d]) != JF_OK) b->fit[d] = NULL;
+    }
+    return b->fit[d];
 }
 
 /* ---- median of |r| by quickselect on a scratch copy ---- */
@@ -145,17 +194,40 @@ static double tangential_radius(const double p[3], const double *nbr, size_t n,
 static int usable(const jf_result *r) { return !(r->status & (JF_PT_FAILED | JF_PT_NONFINITE)); }
 
 /* One fit of the first n neighbours, reweighted when params ask for it.
- * buf holds 3n doubles.  *sigma: the noise scale of the final fit (robust:
+ * buf holds 4n doubles.  *sigma: the noise scale of the final fit (robust:
  * the MAD of the residuals; else the RMS residual). */
 static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3],
-                            const double *nbr, size_t n, double *buf,
-                            jf_result *out, double *sigma)
+                            const double *nbr, size_t n, double *buf, double dist_c,
+                            jf_result *out, double *sigma, double *neff)
 {
-    jf_status st = jf_fit_point(f, p, nbr, n, out);
+    double *res = buf, *tmp = buf + n, *w = buf + 2 * n, *wd = NULL;
+    jf_status st;
+    *neff = (double)n;
+    if (dist_c > 0.0 && n > 0) { /* Gaussian weights on the distance to p */
+        wd = buf + 3 * n;
+        double r2max = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            const double *q = nbr + 3 * i;
+            double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                        (q[2] - p[2]) * (q[2] - p[2]);
+            wd[i] = isfinite(d2) ? d2 : 0.0;
+            if (wd[i] > r2max) r2max = wd[i];
+        }
+        double s2 = dist_c * dist_c * r2max;
+        double sw = 0.0, sww = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            wd[i] = s2 > 0.0 ? exp(-0.5 * wd[i] / s2) : 1.0;
+            w[i] = sqrt(wd[i]);
+            sw += wd[i];
+            sww += wd[i] * wd[i];
+        }
+        *neff = sww > 0.0 ? sw * sw / sww : (double)n; /* Kish's effective size */
+        st = jf_fit_point_weighted(f, p, nbr, w, n, out);
+    } else
+        st = jf_fit_point(f, p, nbr, n, out);
     *sigma = out->residual;
     if (st != JF_OK || pr->robust == JF_ROBUST_NONE || !usable(out)) return st;
 
-    double *res = buf, *tmp = buf + n, *w = buf + 2 * n;
     size_t need = jf_jet_size(out->degree) + 1;
     double h = tangential_radius(p, nbr, n, out->normal);
     int converged = 0;
@@ -179,7 +251,7 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
             live += wi > 0.0;
             /* jf_fit_point_weighted multiplies each equation by its weight:
              * IRLS minimises sum w r^2, so the row factor is sqrt(w). */
-            w[i] = sqrt(wi);
+            w[i] = sqrt(wd ? wi * wd[i] : wi);
         }
         if (live < need) break; /* too few inliers left: keep the last fit */
         jf_result prev = *out;
@@ -212,16 +284,16 @@ static jf_status fit_robust(jf_fitter *f, const jf_params *pr, const double p[3]
  * linear columns (M: the Vandermonde matrix of §2, eq. 7).  M^T M is built
  * in the result's tangent frame (the fit's frame up to a rotation about
  * the normal, which leaves the trace used here unchanged), preconditioned
- * by h (§2.3), and inverted by Cholesky.  sigma^2 is the unbiased residual
- * variance (n residuals, N_d coefficients).  INFINITY when undefined. */
-extern double jf__scale_floor;
+ * by h (§2.3), and inverted by Cholesky.  s2: the noise variance, e.g. the
+ * unbiased residual variance (unbiased_var()).  INFINITY when undefined. */
+static double scale_floor = 0.3; /* sqrt(s2)/h above which sd >= sqrt(s2)/h */
 #define SD_MAXN 15 /* degree <= 4: N_4 = 15; higher degrees use degree 4 */
-static double normal_sd(const jf_result *r, double sigma, const double p[3],
+static double normal_sd(const jf_result *r, double s2, const double p[3],
                         const double *nbr, size_t n)
 {
     int d = r->degree < 4 ? r->degree : 4;
     size_t nn = jf_jet_size(d), nfit = jf_jet_size(r->degree);
-    if (n <= nfit) return INFINITY;
+    if (n <= nfit || !isfinite(s2)) return INFINITY;
     double h = 0.0;
     for (size_t i = 0; i < n; i++) {
         const double *q = nbr + 3 * i;
@@ -267,13 +339,20 @@ static double normal_sd(const jf_result *r, double sigma, const double p[3],
         }
         for (size_t i = c; i < nn; i++) var += z[i] * z[i];
     }
-    double s2 = sigma * sigma * (double)n / (double)(n - nfit);
     /* Floor: when the residual is a sizeable fraction of the radius the
      * neighbourhood is a blob of noise whose PCA frame follows the noise
      * and whose residual underestimates it; its normal is then uncertain
      * by about sigma / h whatever n is. */
     double sd = sqrt(s2 * var) / h, fl = sqrt(s2) / h;
-    return fl > jf__scale_floor && fl > sd ? fl : sd;
+    return fl > scale_floor && fl > sd ? fl : sd;
+}
+
+/* Unbiased residual variance of a fit of r->degree to n points whose RMS
+ * (or MAD) residual is sigma: n residuals, N_d coefficients. */
+static double unbiased_var(const jf_result *r, double sigma, size_t n)
+{
+    size_t nfit = jf_jet_size(r->degree);
+    return n > nfit ? sigma * sigma * (double)n / (double)(n - nfit) : INFINITY;
 }
 
 static double angle(const double a[3], const double b[3])
@@ -282,12 +361,96 @@ static double angle(const double a[3], const double b[3])
     return acos(d > 1.0 ? 1.0 : d);
 }
 
-double jf__scale_tau = JF_SCALE_TAU; /* tuning hooks for bench_pcpnet */
-double jf__scale_target = JF_SCALE_TARGET;
-double jf__scale_floor = 0.3;
+static double scale_tau = JF_SCALE_TAU;
+static double scale_target = JF_SCALE_TARGET;
+
+/* Bench-only setter of the tuning constants above (tests/bench_pcpnet.cpp
+ * measures them); not in jetfit.h, not thread-safe: call before fitting.
+ * name: "scale_tau", "scale_target", "scale_floor" or "degree_tau".
+ * Returns 0, or -1 for an unknown name. */
+int jf__robust_tune(const char *name, double v);
+int jf__robust_tune(const char *name, double v)
+{
+    if (!strcmp(name, "scale_tau")) scale_tau = v;
+    else if (!strcmp(name, "scale_target")) scale_target = v;
+    else if (!strcmp(name, "scale_floor")) scale_floor = v;
+    else if (!strcmp(name, "degree_tau")) degree_tau = v;
+    else if (!strcmp(name, "degree_sdmin")) degree_sdmin = v;
+    else return -1;
+    return 0;
+}
 /* A normal whose standard deviation exceeds this (radians) is noise: it
  * cannot reveal a bias, so it takes no part in the interval test. */
 #define SD_MEANINGFUL 0.3
+
+/* Degree selection (params.degree_select = dmin): the same interval logic
+ * over the degree instead of K.  The top degree D has the least bias and
+ * the most variance; degree d < D is accepted while its normal lies within
+ * tau (sd_d + sd_j) of the normal of every higher accepted degree j, and
+ * the lowest accepted degree is kept.  All sd use the noise variance of
+ * the degree-D fit (its residual is the least inflated by truncation
+ * error).  Noise on a small neighbourhood makes sd_D large, so the plane
+ * or quadric wins; on clean data sd_D is tiny and any bias of a lower
+ * degree rejects it.  *sigma: the noise scale of the returned fit. */
+static jf_status fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
+                            const double *nbr, size_t n, double *buf, jf_result *out,
+                            double *sigma)
+{
+    double neff, dw = pr->dist_weight;
+    if (pr->degree_select <= 0 || pr->fit != JF_FIT_APPROX)
+        return fit_robust(f, pr, p, nbr, n, buf, dw, out, sigma, &neff);
+    /* The chain, least bias first: [distance-weighted degree D,] degree D,
+     * D - 1, ..., degree_select. */
+    jf_result top;
+    double sg;
+    jf_status st = fit_robust(f, pr, p, nbr, n, buf, 0.0, &top, &sg, &neff);
+    if (st != JF_OK || !usable(&top)) {
+        *out = top;
+        *sigma = sg;
+        return st;
+    }
+    double s2 = unbiased_var(&top, sg, n);
+    double nrm[JF_MAX_DEGREE + 2][3], sd[JF_MAX_DEGREE + 2];
+    int acc = 0;
+    double sd_top = normal_sd(&top, s2, p, nbr, n);
+    if (dw > 0.0) {
+        jf_result rw;
+        double sgw;
+        if ((st = fit_robust(f, pr, p, nbr, n, buf, dw, &rw, &sgw, &neff)) != JF_OK) return st;
+        if (usable(&rw) && rw.degree == top.degree) {
+            memcpy(nrm[acc], rw.normal, sizeof nrm[acc]);
+            /* weighted least squares: the variance grows by n / n_eff */
+            sd[acc++] = sd_top * sqrt((double)n / (neff > 1.0 ? neff : 1.0));
+            *out = rw;
+            *sigma = sgw;
+            if (!isfinite(s2) || !(angle(top.normal, rw.normal) <= degree_tau * (sd[0] + sd_top)))
+                return JF_OK;
+        }
+    }
+    memcpy(nrm[acc], top.normal, sizeof nrm[acc]);
+    sd[acc++] = sd_top;
+    *out = top;
+    *sigma = sg;
+    if (!isfinite(s2) || top.degree <= pr->degree_select) return JF_OK;
+    if (!(sd_top >= degree_sdmin)) return JF_OK; /* precise enough: keep D */
+    for (int d = top.degree - 1; d >= pr->degree_select; d--) {
+        jf_fitter *g = tl_fitter(pr, d);
+        if (!g) return JF_ERR_NOMEM;
+        jf_result r;
+        if ((st = fit_robust(g, pr, p, nbr, n, buf, 0.0, &r, &sg, &neff)) != JF_OK) return st;
+        if (!usable(&r)) break;
+        double s = normal_sd(&r, s2, p, nbr, n);
+        int ok = 1;
+        for (int j = 0; j < acc && ok; j++) ok = angle(r.normal, nrm[j]) <= degree_tau * (s + sd[j]);
+        if (!ok) break;
+        memcpy(nrm[acc], r.normal, sizeof nrm[acc]);
+        sd[acc++] = s;
+        r.status |= top.status & JF_PT_FEW_NEIGHBORS;
+        *out = r;
+        *sigma = sg;
+    }
+    return JF_OK;
+}
 
 /* Scale selection by the intersection of confidence intervals (Lepski's
  * method, as in Katkovnik's ICI rule): walk the candidates from the
@@ -303,16 +466,18 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
 {
     if (!f || !p || !out || (n && !nbr)) return JF_ERR_INVALID;
     const jf_params *pr = jf_fitter_params(f);
-    if (pr->robust == JF_ROBUST_NONE && pr->nscales <= 0)
+    if (pr->robust == JF_ROBUST_NONE && pr->nscales <= 0 && pr->degree_select <= 0 &&
+        !(pr->dist_weight > 0.0))
         return jf_fit_point(f, p, nbr, n, out);
 
-    double stackbuf[3 * STACK_N];
+    double stackbuf[4 * STACK_N];
     double *buf = stackbuf;
-    if (n > STACK_N && pr->robust != JF_ROBUST_NONE && !(buf = tl_get(3 * n)))
+    if (n > STACK_N && (pr->robust != JF_ROBUST_NONE || pr->dist_weight > 0.0) &&
+        !(buf = tl_get(4 * n)))
         return JF_ERR_NOMEM;
 
     double sigma;
-    if (pr->nscales <= 0) return fit_robust(f, pr, p, nbr, n, buf, out, &sigma);
+    if (pr->nscales <= 0) return fit_select(f, pr, p, nbr, n, buf, out, &sigma);
 
     /* Candidate sizes: scales[] clamped to n, ascending, distinct. */
     size_t ks[8];
@@ -327,7 +492,7 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
     int acc = 0, best = -1;
     for (int i = 0; i < nk; i++) {
         jf_result r;
-        jf_status st = fit_robust(f, pr, p, nbr, ks[i], buf, &r, &sigma);
+        jf_status st = fit_select(f, pr, p, nbr, ks[i], buf, &r, &sigma);
         if (st != JF_OK) return st;
         if (!usable(&r)) {
             if (best < 0) *out = r; /* nothing better yet: report this one */
@@ -335,16 +500,16 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
         }
         size_t used = r.n_used > 0 ? (size_t)r.n_used : ks[i];
         (void)used;
-        double s = normal_sd(&r, sigma, p, nbr, ks[i]);
+        double s = normal_sd(&r, unbiased_var(&r, sigma, ks[i]), p, nbr, ks[i]);
         int ok = 1;
         for (int j = 0; j < acc && ok; j++)
-            ok = !(sd[j] < SD_MEANINGFUL) || angle(r.normal, nrm[j]) <= jf__scale_tau * (s + sd[j]);
+            ok = !(sd[j] < SD_MEANINGFUL) || angle(r.normal, nrm[j]) <= scale_tau * (s + sd[j]);
         if (!ok) break;
         memcpy(nrm[acc], r.normal, sizeof nrm[acc]);
         sd[acc++] = s;
         *out = r;
         best = i;
-        if (s <= jf__scale_target) break; /* precise enough: stop growing */
+        if (s <= scale_target) break; /* precise enough: stop growing */
     }
     if (best >= 0 && best != nk - 1) out->status |= JF_PT_SCALE_SELECTED;
     return JF_OK;

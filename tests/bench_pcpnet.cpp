@@ -14,7 +14,12 @@
 // points, Point_set_processing_3/internal/Neighbor_query.h); jetfit's K
 // counts the point itself (K points).
 // Usage: bench_pcpnet [DATA_DIR] [--quick] [--no-cgal] [--no-fixed]
-//   [--sweep "K,deg,robust ..."] [--tau X] [--floor X] [--target X]
+//   [--sweep "K,deg,robust[,dsel] ..."] [--tau X] [--floor X] [--target X]
+//   [--dtau X] [--distw X] [--same-points] [--levels L1,L2,..] [--cgal-k K]
+// --same-points: jetfit fits K + 1 points like CGAL (default: K, the query
+// included); --distw X: dist_weight of the --sweep configurations;
+// --dtau: degree-selection interval width; --levels: only these noise
+// levels; --cgal-k: CGAL at this K only (its K = 450 runs take minutes);
 // --quick: clean shape and the largest noise only, K = 18 and 112;
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
 // 0/1/2 = none/huber/tukey; with --no-fixed only those run); --tau,
@@ -38,9 +43,9 @@
 
 #include "jetfit.h"
 
-extern "C" double jf__scale_tau;    // src/robust.c: scale-selection interval width
-extern "C" double jf__scale_target; // ... and the normal sd that is enough
-extern "C" double jf__scale_floor;  // ... sigma/h above which sd >= sigma/h
+// src/robust.c's bench-only setter of its tuning constants (scale_tau,
+// scale_target, scale_floor, degree_tau).
+extern "C" int jf__robust_tune(const char *name, double v);
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 typedef Kernel::Point_3 Point;
@@ -107,12 +112,24 @@ struct Config {
     jf_robust_mode robust;
     int nscales;
     size_t scales[8];
+    int dsel; // jf_params.degree_select (0 = off)
+    double distw; // jf_params.dist_weight (0 = off)
 };
 
+// --same-points: jetfit fits K + 1 points (the query and K neighbours), the
+// neighbourhood CGAL uses for its k = K; every scale likewise + 1.
+static size_t g_extra = 0;
+static double g_distw = 0; // --distw: jf_params.dist_weight of the sweep configs
+
 // jetfit on the .pidx points; returns the RMS angle, fills secs.
-static double run_jetfit(const Study &s, const jf_index *ix, const Config &c, double *secs,
+static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, double *secs,
                          size_t *flagged)
 {
+    Config c = c0;
+    c.k += g_extra;
+    for (int i = 0; i < c.nscales; i++) c.scales[i] += g_extra;
+    *secs = 0;
+    *flagged = 0;
     jf_params p;
     jf_params_init(&p);
     p.degree = c.degree;
@@ -120,6 +137,8 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c, do
     p.robust = c.robust;
     p.nscales = c.nscales;
     for (int i = 0; i < c.nscales; i++) p.scales[i] = c.scales[i];
+    p.degree_select = c.dsel;
+    p.dist_weight = c.distw;
     jf_fitter *f = nullptr;
     const char *bad = nullptr;
     if (jf_params_validate(&p, &bad) != JF_OK || jf_fitter_create(&p, &f) != JF_OK) {
@@ -177,17 +196,27 @@ int main(int argc, char **argv)
 {
     std::string dir = JF_SHARED_DATA "/pcpnet";
     bool quick = false, no_cgal = false, no_fixed = false;
-    const char *sweep = nullptr; // "K,deg,robust K,deg,robust ...": extra fixed configs
+    const char *sweep = nullptr; // "K,deg,robust[,dsel] ...": extra fixed configs
+    const char *only_levels = nullptr; // "0,0.012": a subset of the noise levels
+    bool same_points = false;    // jetfit fits K + 1 points, CGAL's neighbourhood
+    size_t cgal_k = 0;           // run CGAL at this K only (0 = every K)
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
         else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
-        else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__scale_tau = std::atof(argv[++i]);
-        else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__scale_target = std::atof(argv[++i]);
-        else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__scale_floor = std::atof(argv[++i]);
+        else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__robust_tune("scale_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__robust_tune("scale_target", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__robust_tune("scale_floor", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dtau") && i + 1 < argc) jf__robust_tune("degree_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dsdmin") && i + 1 < argc) jf__robust_tune("degree_sdmin", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--distw") && i + 1 < argc) g_distw = std::atof(argv[++i]);
+        else if (!std::strcmp(argv[i], "--same-points")) same_points = true;
+        else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) only_levels = argv[++i];
         else if (!std::strcmp(argv[i], "--sweep") && i + 1 < argc) sweep = argv[++i];
         else dir = argv[i];
     }
+    if (same_points) g_extra = 1;
     jf_eval_table tx, tn, ti;
     if (!load(dir + "/armadillo100k.xyz", tx) || !load(dir + "/armadillo100k.normals", tn) ||
         !load(dir + "/armadillo100k.pidx", ti))
@@ -216,6 +245,15 @@ int main(int argc, char **argv)
         levels = {0.0, 0.012};
         ks = {18, 112};
     }
+    if (only_levels) {
+        levels.clear();
+        for (const char *q = only_levels; *q;) {
+            char *e;
+            levels.push_back(std::strtod(q, &e));
+            if (e == q) break;
+            q = *e == ',' ? e + 1 : e;
+        }
+    }
     std::printf("%-8s %-34s %5s %4s %9s %9s %s\n", "noise", "method", "K", "deg", "rms_deg",
                 "time_s", "flagged");
     for (double lv : levels) {
@@ -229,12 +267,15 @@ int main(int argc, char **argv)
         std::vector<Config> cfg;
         for (size_t k : ks)
             for (int d = 2; d <= 3 && !no_fixed; d++)
-                cfg.push_back({"jetfit", d, k, JF_ROBUST_NONE, 0, {0}});
+                cfg.push_back({"jetfit", d, k, JF_ROBUST_NONE, 0, {0}, 0, 0});
+        for (size_t k : ks)
+            for (int d = 2; d <= 3 && !no_fixed; d++)
+                cfg.push_back({"jetfit degree-select", d, k, JF_ROBUST_NONE, 0, {0}, 1, 0});
         size_t kmax = ks.back();
         // --sweep "K,deg,robust ..." (robust 0/1/2 = none/huber/tukey);
         // K may be a scale set "12/18/36" (scale selection, the last the largest)
         for (const char *q = sweep; q && *q;) {
-            Config c = {"jetfit sweep", 2, 0, JF_ROBUST_NONE, 0, {0}};
+            Config c = {"jetfit sweep", 2, 0, JF_ROBUST_NONE, 0, {0}, 0, 0};
             int d, rb, used = 0;
             unsigned long k;
             while (std::sscanf(q, "%lu%n", &k, &used) == 1) {
@@ -247,21 +288,25 @@ int main(int argc, char **argv)
             if (std::sscanf(q, ",%d,%d%n", &d, &rb, &used) != 2) break;
             c.degree = d;
             c.robust = (jf_robust_mode)rb;
+            q += used;
+            int ds = 0;
+            if (std::sscanf(q, ",%d%n", &ds, &used) == 1) q += used;
+            c.dsel = ds;
+            c.distw = g_distw;
             if (c.nscales == 1) c.nscales = 0;
             cfg.push_back(c);
-            q += used;
             while (*q == ' ') q++;
         }
         for (size_t k : ks)
             for (int d = 2; d <= 3 && !no_fixed; d++)
-                cfg.push_back({"jetfit huber", d, k, JF_ROBUST_HUBER, 0, {0}});
+                cfg.push_back({"jetfit", d, k, JF_ROBUST_HUBER, 0, {0}, 0, 0});
         for (int d = 2; d <= 3 && !(no_fixed && sweep); d++) {
             cfg.push_back({"jetfit scales 18/36/112/225/450", d, kmax, JF_ROBUST_NONE, 5,
-                           {18, 36, 112, 225, 450}});
-            cfg.push_back({"jetfit scales 18/36/112/225/450 huber", d, kmax, JF_ROBUST_HUBER, 5,
-                           {18, 36, 112, 225, 450}});
-            cfg.push_back({"jetfit scales 18/36/112/225/450 tukey", d, kmax, JF_ROBUST_TUKEY, 5,
-                           {18, 36, 112, 225, 450}});
+                           {18, 36, 112, 225, 450}, 0, 0});
+            cfg.push_back({"jetfit scales 18/36/112/225/450", d, kmax, JF_ROBUST_HUBER, 5,
+                           {18, 36, 112, 225, 450}, 0, 0});
+            cfg.push_back({"jetfit scales 18/36/112/225/450", d, kmax, JF_ROBUST_TUKEY, 5,
+                           {18, 36, 112, 225, 450}, 0, 0});
         }
         for (const Config &c : cfg) {
             Config cc = c;
@@ -286,12 +331,17 @@ int main(int argc, char **argv)
                     std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), " %s",
                                   cc.robust == JF_ROBUST_TUKEY ? "tukey" : "huber");
             }
+            if (cc.dsel && !std::strstr(name, "degree-select"))
+                std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), " dsel%d", cc.dsel);
+            if (cc.distw > 0)
+                std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), " dw%g", cc.distw);
             std::printf("%-8g %-34s %5zu %4d %9.3f %9.3f %zu  (median %.2f p95 %.2f)\n", lv, name,
                         cc.k, cc.degree, r, secs, fl, g_median, g_p95);
             std::fflush(stdout);
         }
         for (size_t k : ks) {
             if (no_cgal) break;
+            if (cgal_k && k != cgal_k) continue;
             for (int d = 2; d <= 3; d++) {
                 double secs, r = run_cgal(s, true, d, k, &secs);
                 std::printf("%-8g %-34s %5zu %4d %9.3f %9.3f -\n", lv, "CGAL jet_estimate_normals", k,
