@@ -20,6 +20,13 @@
  *    truncation error of a too-large neighbourhood moves the normal out.
  *    tau = 1 chosen on PCPNet's armadillo (tests/bench_pcpnet.cpp).
  *
+ *  - degree selection (params.degree_select): the same interval rule over
+ *    the degree (fit_select()); lower-degree fitters live per thread.
+ *
+ *  - distance weights (params.dist_weight): Gaussian weights on the
+ *    distance to p, combined with the IRLS weights; with degree selection
+ *    the weighted fit heads the chain of candidates.
+ *
  * No allocation per point: the residual/weight buffers live on the stack
  * up to STACK_N neighbours; above that, one heap buffer per thread (C11
  * tss, freed at thread exit) grown only when a larger n is first seen. */
@@ -44,13 +51,20 @@
 #ifndef JF_SCALE_TARGET
 #define JF_SCALE_TARGET 0.0
 #endif
-/* Width of the degree-selection intervals, in standard deviations. */
+/* Degree selection: interval width in standard deviations (1; 0.5 and 2
+ * were worse on PCPNet's armadillo overall), and the normal sd (radians)
+ * below which the top degree is kept without trying lower ones (0.15:
+ * clean K=18 d3 6.22 -> 6.17 deg, noise 0.00125 K=112 d3 15.05 -> 14.81,
+ * other cells within 0.07; bench_pcpnet --same-points --dsdmin). */
 #ifndef JF_DEGREE_TAU
 #define JF_DEGREE_TAU 1.0
 #endif
+#ifndef JF_DEGREE_SDMIN
+#define JF_DEGREE_SDMIN 0.15
+#endif
 
 static double degree_tau = JF_DEGREE_TAU;
-static double degree_sdmin = 0.0;
+static double degree_sdmin = JF_DEGREE_SDMIN;
 
 /* ---- per-thread state: fallback buffer for n > STACK_N, and the fitters
  * of the lower degrees tried by degree selection (created on first use,
@@ -423,6 +437,7 @@ static jf_status fit_select(jf_fitter *f, const jf_params *pr, const double p[3]
             sd[acc++] = sd_top * sqrt((double)n / (neff > 1.0 ? neff : 1.0));
             *out = rw;
             *sigma = sgw;
+            if (!(sd_top >= degree_sdmin)) return JF_OK; /* precise enough */
             if (!isfinite(s2) || !(angle(top.normal, rw.normal) <= degree_tau * (sd[0] + sd_top)))
                 return JF_OK;
         }
