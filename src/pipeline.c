@@ -21,6 +21,7 @@
 
 #include <omp.h>
 
+#include "fitter_internal.h"
 #include "jetfit.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
@@ -79,54 +80,22 @@ typedef struct {
 } nbctx;
 
 /* Smallest-eigenvalue eigenvector of the centred covariance of pts (m
- * points): cyclic Jacobi on the 3x3 symmetric matrix.  Returns 0 if the
- * points span less than a plane (no unique normal). */
+ * points), by the core's 3x3 eigen-solver.  Returns 0 if the points span
+ * less than a plane (no unique normal). */
 static int pca_normal(const double *pts, size_t m, double nrm[3])
 {
-    double c[3] = {0, 0, 0}, a[3][3] = {{0}}, v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    double c[3] = {0, 0, 0}, a[9] = {0}, eval[3], evec[9];
     if (m < 3) return 0;
     for (size_t i = 0; i < m; i++)
         for (int j = 0; j < 3; j++) c[j] += pts[3 * i + j];
     for (int j = 0; j < 3; j++) c[j] /= (double)m;
     for (size_t i = 0; i < m; i++) /* second pass: centred (no cancellation) */
         for (int r = 0; r < 3; r++)
-            for (int s = 0; s < 3; s++)
-                a[r][s] += (pts[3 * i + r] - c[r]) * (pts[3 * i + s] - c[s]);
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
-        if (off <= 1e-300 || off <= 1e-18 * (fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2])))
-            break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                if (a[p][q] == 0) continue;
-                double th = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
-                double cs = 1 / sqrt(t * t + 1), sn = t * cs;
-                for (int k = 0; k < 3; k++) { /* A <- A J */
-                    double x = a[k][p], y = a[k][q];
-                    a[k][p] = cs * x - sn * y;
-                    a[k][q] = sn * x + cs * y;
-                }
-                for (int k = 0; k < 3; k++) { /* A <- J^T A */
-                    double x = a[p][k], y = a[q][k];
-                    a[p][k] = cs * x - sn * y;
-                    a[q][k] = sn * x + cs * y;
-                }
-                for (int k = 0; k < 3; k++) { /* V <- V J */
-                    double x = v[k][p], y = v[k][q];
-                    v[k][p] = cs * x - sn * y;
-                    v[k][q] = sn * x + cs * y;
-                }
-            }
-    }
-    int lo = 0, hi = 0;
-    for (int j = 1; j < 3; j++) {
-        if (a[j][j] < a[lo][lo]) lo = j;
-        if (a[j][j] > a[hi][hi]) hi = j;
-    }
-    int mid = 3 - lo - hi;
-    if (lo == hi || !(a[mid][mid] > 1e-24 * a[hi][hi])) return 0; /* collinear */
-    for (int j = 0; j < 3; j++) nrm[j] = v[j][lo];
+            for (int t = 0; t < 3; t++)
+                a[3 * r + t] += (pts[3 * i + r] - c[r]) * (pts[3 * i + t] - c[t]);
+    jf__eig3(a, eval, evec);
+    if (!(eval[1] > 1e-24 * eval[2])) return 0; /* collinear */
+    memcpy(nrm, evec, sizeof(double[3]));
     return 1;
 }
 
