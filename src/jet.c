@@ -246,12 +246,29 @@ static int gsl_svd(jf_fitter *f, size_t rows, size_t cols, int tr, int gr)
     return rc == GSL_SUCCESS ? 0 : -1;
 }
 
+/* kappa = s_max / s_min of the singular values s (+Inf when singular).
+ * Returns -1 when one is not finite (overflow in M', e.g. huge weights:
+ * no fit), 1 when M' is rank deficient (s_min <= s_max rows eps), else 0. */
+static int cond_of(const double *s, size_t rows, size_t cols, double *cond)
+{
+    double smax = 0, smin = INFINITY;
+    for (size_t j = 0; j < cols; j++) {
+        if (!isfinite(s[j])) {
+            *cond = NAN;
+            return -1;
+        }
+        smax = fmax(smax, s[j]);
+        smin = fmin(smin, s[j]);
+    }
+    *cond = smax / smin;
+    return !(smax > 0) || smin <= smax * (double)rows * DBL_EPSILON ? 1 : 0;
+}
+
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
 {
     /* 1. Householder QR: M' = QR, rhs <- Q^T rhs.  2. SVD of the small
      * triangle R (same singular values as M').  3. Y = R^-1 rhs. */
     householder_qr(f->m, f->rhs, rows, cols, f->perm, f->tmp, f->work);
-    double smax = 0, smin = INFINITY;
 #if !defined(JF_GSL_SVD) && !defined(JF_SVD_GSLJ)
     /* X = R^T, column-major, into f->x: column j of X is row j of R,
      * R_ji = m[i*rows + j] for i >= j.  Jacobi on R^T (rows of R) converges
@@ -261,16 +278,8 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
     for (size_t j = 0; j < cols; j++)
         for (size_t i = 0; i < cols; i++) f->x[j * cols + i] = i >= j ? f->m[i * rows + j] : 0.0;
     if (jacobi_svd(f->x, f->v, f->s, cols) == 0) {
-        for (size_t j = 0; j < cols; j++) {
-            if (!isfinite(f->s[j])) { /* overflow in M' (huge weights): no fit */
-                *cond = NAN;
-                return -1;
-            }
-            smax = fmax(smax, f->s[j]);
-            smin = fmin(smin, f->s[j]);
-        }
-        *cond = smax / smin; /* +Inf when singular */
-        if (!(smax > 0) || smin <= smax * (double)rows * DBL_EPSILON) return 1;
+        int rc = cond_of(f->s, rows, cols, cond);
+        if (rc != 0) return rc;
         /* R = V S U^T with U S = X: Y = R^-1 rhs = sum_j x_j (v_j . rhs) / s_j^2 */
         for (size_t i = 0; i < cols; i++) f->tmp[i] = 0.0;
         for (size_t j = 0; j < cols; j++) {
@@ -295,16 +304,8 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
             return -1;
         }
     }
-    for (size_t j = 0; j < cols; j++) {
-        if (!isfinite(f->s[j])) { /* overflow in M' (huge weights): no fit */
-            *cond = NAN;
-            return -1;
-        }
-        smax = fmax(smax, f->s[j]);
-        smin = fmin(smin, f->s[j]);
-    }
-    *cond = smax / smin; /* +Inf when singular */
-    if (!(smax > 0) || smin <= smax * (double)rows * DBL_EPSILON) return 1;
+    int rc = cond_of(f->s, rows, cols, cond);
+    if (rc != 0) return rc;
     /* R = L S T^T, L = U, T = V (A = R) or L = V, T = U (A = R^T):
      * Y = T S^-1 L^T rhs (gsl_linalg_SV_solve would allocate) */
     const double *l = tr ? f->v : f->x, *t = tr ? f->x : f->v;
