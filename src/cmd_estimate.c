@@ -44,6 +44,13 @@ static void usage(FILE *f)
         "                        pca (PCA of knn:16) | input (default poles)\n"
         "  --robust MODE         none | huber | tukey (default none)\n"
         "  --scales K1,K2,...    per-point scale selection among these K (default off)\n"
+        "  --degree-select DMIN  per-point degree choice in DMIN..degree: the lowest\n"
+        "                        degree whose normal agrees with every higher one\n"
+        "                        within their uncertainty (noisy data, small K;\n"
+        "                        default off)\n"
+        "  --dist-weight C       Gaussian weights on the distance to the point,\n"
+        "                        sigma = C x the farthest neighbour (clean data:\n"
+        "                        0.3-0.4; default off)\n"
         "  --columns X,Y,Z[,NX,NY,NZ]\n"
         "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
         "                        (default: x y z first, normals in 3..5 if 6 columns)\n"
@@ -331,6 +338,14 @@ int jf_cmd_estimate(int argc, char **argv)
                 o.params.scales[j] = (size_t)list[j];
             }
             o.params.nscales = m;
+        } else if (!strcmp(name, "--degree-select")) {
+            if (parse_int(val, 1, JF_MAX_DEGREE, &iv))
+                return bad_option(name, val, "expected a degree 1..9");
+            o.params.degree_select = iv;
+        } else if (!strcmp(name, "--dist-weight")) {
+            if (parse_double(val, &dv) || !(dv > 0) || !isfinite(dv))
+                return bad_option(name, val, "expected a positive number");
+            o.params.dist_weight = dv;
         } else if (!strcmp(name, "--columns")) {
             int m = parse_list(val, list, 6);
             if (m != 3 && m != 6) return bad_option(name, val, "expected 3 or 6 column numbers");
@@ -363,6 +378,8 @@ int jf_cmd_estimate(int argc, char **argv)
     for (int j = 0; j < o.params.nscales; j++)
         if (o.params.scales[j] > need) need = o.params.scales[j];
     if (need > o.params.max_neighbors) o.params.max_neighbors = need;
+    if (o.params.degree_select > o.params.degree)
+        return bad_option("--degree-select", "", "must not exceed --degree");
     const char *bad = NULL;
     if (jf_params_validate(&o.params, &bad) != JF_OK)
         return bad_option("parameters", bad ? bad : "?", "invalid combination");
