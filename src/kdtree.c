@@ -103,10 +103,15 @@ typedef struct {
     double *pts;
     uint32_t *id;
     kd_node *nodes;
-    size_t used;
 } kd_builder;
 
-static void build_node(kd_builder *b, size_t ni, size_t begin, size_t end)
+#define KD_TASK_MIN 65536 /* subtrees at least this big build as OpenMP tasks */
+
+/* Builds node ni over [begin, end); its descendants take the node slots
+ * from `next` on, in depth-first order (children side by side, the left
+ * subtree's before the right's), so the layout does not depend on which
+ * thread builds which subtree.  Large subtrees run as OpenMP tasks. */
+static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end, size_t next)
 {
     kd_node *nd = &b->nodes[ni];
     size_t cnt = end - begin;
@@ -133,15 +138,16 @@ static void build_node(kd_builder *b, size_t ni, size_t begin, size_t end)
     double lmax = p[3 * begin + dim];
     for (size_t i = begin + 1; i < mid; i++)
         if (p[3 * i + dim] > lmax) lmax = p[3 * i + dim];
-    size_t child = b->used;
-    b->used += 2;
-    nd = &b->nodes[ni];
+    size_t child = next;
     nd->lo = lmax;
     nd->hi = p[3 * mid + dim]; /* the selected element is the right minimum */
     nd->first = (uint32_t)child;
     nd->dim = (uint32_t)dim;
-    build_node(b, child, begin, mid);
-    build_node(b, child + 1, mid, end);
+    size_t right_next = child + 2 + count_nodes(mid - begin) - 1;
+#pragma omp task if (cnt >= KD_TASK_MIN) default(none) firstprivate(b, child, begin, mid)
+    build_node(b, child, begin, mid, child + 2);
+    build_node(b, child + 1, mid, end, right_next);
+#pragma omp taskwait
 }
 
 static int finite3(const double *p)
@@ -187,12 +193,11 @@ jf_status jf_index_build(const double *xyz, size_t n, jf_index **out)
             if (v > ix->bbox[3 + d]) ix->bbox[3 + d] = v;
         }
     if (m) {
-        kd_builder b = {ix->pts, ix->id, ix->nodes, 1};
-        build_node(&b, 0, 0, m);
-        if (b.used != ix->nnodes) {
-            jf_index_free(ix);
-            return JF_ERR_INTERNAL;
-        }
+        const kd_builder b = {ix->pts, ix->id, ix->nodes};
+        const kd_builder *bp = &b;
+#pragma omp parallel if (m >= 2 * KD_TASK_MIN) default(none) shared(bp, m)
+#pragma omp single
+        build_node(bp, 0, 0, m, 1);
     }
     *out = ix;
     return JF_OK;
