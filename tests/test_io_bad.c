@@ -15,18 +15,7 @@
 #include "io_internal.h"
 #include "jetfit.h"
 
-static char tmpdir[64];
-
-static const char *fixture(const char *name, const void *data, size_t len)
-{
-    static char path[256];
-    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
-    FILE *f = fopen(path, "wb");
-    ck_assert_ptr_nonnull(f);
-    ck_assert_uint_eq(fwrite(data, 1, len, f), len);
-    fclose(f);
-    return path;
-}
+#include "test_io_util.h"
 
 /* Reads `name` holding `s`; expects status `st` and a message holding
  * the file name and every one of the (up to 3) fragments. */
@@ -57,15 +46,7 @@ static void bad(const char *name, const char *s, size_t len, jf_status st,
 
 static void setup(void)
 {
-    strcpy(tmpdir, "/tmp/jf_io_bad_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
-}
-
-static void teardown(void)
-{
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    ck_assert_int_eq(system(cmd), 0);
+    tmpdir_setup("/tmp/jf_io_bad_XXXXXX");
 }
 
 START_TEST(files)

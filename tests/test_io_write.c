@@ -15,7 +15,7 @@
 #include "io_internal.h"
 #include "jetfit.h"
 
-static char tmpdir[64];
+#include "test_io_util.h"
 
 static const char *tpath(const char *name)
 {
@@ -50,15 +50,7 @@ static char *slurp(const char *p, size_t *len)
 
 static void setup(void)
 {
-    strcpy(tmpdir, "/tmp/jf_io_write_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
-}
-
-static void teardown(void)
-{
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    ck_assert_int_eq(system(cmd), 0);
+    tmpdir_setup("/tmp/jf_io_write_XXXXXX");
 }
 
 static uint64_t rng = 0x9e3779b97f4a7c15u;

@@ -10,26 +10,8 @@
 
 /* ---------------------------------------------------------------- helpers */
 
-static uint64_t rng_state = 88172645463325252ULL;
-static double urand(void) /* xorshift64*: reproducible, in [0, 1) */
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
-}
-
-typedef struct {
-    double d;
-    uint32_t i;
-} pair;
-
-static int cmp_pair(const void *a, const void *b)
-{
-    const pair *x = a, *y = b;
-    if (x->d != y->d) return x->d < y->d ? -1 : 1;
-    return (x->i > y->i) - (x->i < y->i);
-}
+#define JF_TEST_SEED 88172645463325252ULL
+#include "test_rand.h"
 
 /* Merge sort by (d2, index): the sanitizers' qsort interceptor is slow. */
 static void sort_pairs(pair *a, size_t n)

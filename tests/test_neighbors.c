@@ -8,26 +8,8 @@
 
 #include "jetfit.h"
 
-static uint64_t rng_state = 0x9E3779B97F4A7C15ULL;
-static double urand(void)
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
-}
-
-typedef struct {
-    double d;
-    uint32_t i;
-} pair;
-
-static int cmp_pair(const void *a, const void *b)
-{
-    const pair *x = a, *y = b;
-    if (x->d != y->d) return x->d < y->d ? -1 : 1;
-    return (x->i > y->i) - (x->i < y->i);
-}
+#define JF_TEST_SEED 0x9E3779B97F4A7C15ULL
+#include "test_rand.h"
 
 static size_t brute(const double *xyz, size_t n, const double q[3], pair *out)
 {
