@@ -208,6 +208,24 @@ static jf_status face_index(ply *h, jf_uvec *fi, double v, size_t line,
     return JF_OK;
 }
 
+/* One value of type `t` of the current row: binary from h->p, or the next
+ * token [*ts, *te) of the ascii line [*q, le).  Returns VAL_OK, or which
+ * failure it was. */
+enum { VAL_OK, VAL_TRUNCATED, VAL_SHORT_ROW, VAL_NOT_NUMBER };
+static int read_value(ply *h, int t, int swap, const char **q, const char *le,
+                      const char **ts, const char **te, int *found, double *v)
+{
+    if (h->format) {
+        if ((size_t)(h->end - h->p) < type_size[t]) return VAL_TRUNCATED;
+        *v = load(h->p, t, swap);
+        h->p += type_size[t];
+        return VAL_OK;
+    }
+    if (!jf_next_token(q, le, 0, ts, te)) return VAL_SHORT_ROW;
+    (*found)++;
+    return jf_parse_double(*ts, *te, v) ? VAL_OK : VAL_NOT_NUMBER;
+}
+
 static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                            jf_cloud *c, jf_uvec *fi)
 {
@@ -241,17 +259,10 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
             int list = pr->count_type != T_NONE;
             double v = 0;
             if (list) {
-                if (h->format) {
-                    if ((size_t)(h->end - h->p) < type_size[pr->count_type])
-                        goto truncated;
-                    v = load(h->p, pr->count_type, swap);
-                    h->p += type_size[pr->count_type];
-                } else {
-                    if (!jf_next_token(&q, le, 0, &ts, &te))
-                        goto short_row;
-                    found++;
-                    if (!jf_parse_double(ts, te, &v))
-                        goto not_number;
+                switch (read_value(h, pr->count_type, swap, &q, le, &ts, &te, &found, &v)) {
+                case VAL_TRUNCATED: goto truncated;
+                case VAL_SHORT_ROW: goto short_row;
+                case VAL_NOT_NUMBER: goto not_number;
                 }
                 if (!(v >= 0 && v <= 4294967295.0) || v != (double)(uint64_t)v)
                     return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, line,
@@ -278,17 +289,10 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                 }
             }
             for (uint64_t i = 0; i < items; i++) {
-                if (h->format) {
-                    if ((size_t)(h->end - h->p) < type_size[pr->type])
-                        goto truncated;
-                    v = load(h->p, pr->type, swap);
-                    h->p += type_size[pr->type];
-                } else {
-                    if (!jf_next_token(&q, le, 0, &ts, &te))
-                        goto short_row;
-                    found++;
-                    if (!jf_parse_double(ts, te, &v))
-                        goto not_number;
+                switch (read_value(h, pr->type, swap, &q, le, &ts, &te, &found, &v)) {
+                case VAL_TRUNCATED: goto truncated;
+                case VAL_SHORT_ROW: goto short_row;
+                case VAL_NOT_NUMBER: goto not_number;
                 }
                 if (list && k == pl->face_list) {
                     jf_status st = face_index(h, fi, v, line, r);
