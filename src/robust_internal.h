@@ -1,0 +1,58 @@
+/* robust_internal.h -- shared by robust.c (IRLS, per-thread state),
+ * select.c (a normal's uncertainty, degree selection) and scale.c (scale
+ * selection, jf_fit_point_full).  Not part of the public API. */
+#ifndef JF_ROBUST_INTERNAL_H
+#define JF_ROBUST_INTERNAL_H
+
+#include <stddef.h>
+
+#include "jetfit.h"
+
+/* Neighbourhoods up to this size use the caller's stack for the 4n
+ * doubles of residuals and weights; larger ones a per-thread buffer. */
+#define JF_STACK_N 512
+
+/* Tuning constants of the selection rules (defaults in robust.c). */
+typedef struct {
+    double scale_tau;    /* scale selection: interval width, in sd */
+    double scale_target; /* scale selection: stop once sd is below (rad) */
+    double scale_floor;  /* normal sd floor: sigma/h above this is a blob */
+    double degree_tau;   /* degree selection: interval width, in sd */
+    double degree_sdmin; /* degree selection: keep the top degree below */
+} jf__knobs;
+extern jf__knobs jf__knob;
+
+/* Bench-only setter of a jf__knob field by name; 0, or -1 if unknown. */
+int jf__robust_tune(const char *name, double v);
+
+/* Neither failed nor non-finite: the fit's quantities can be used. */
+int jf__usable(const jf_result *r);
+
+/* This thread's scratch of at least `need` doubles (NULL: out of memory),
+ * and its fitter of degree d with pr's other fitting parameters. */
+double *jf__tl_buf(size_t need);
+jf_fitter *jf__tl_fitter(const jf_params *pr, int d);
+
+/* One fit of the first n neighbours, distance-weighted when dist_c > 0
+ * and reweighted when pr->robust asks.  buf: 4n doubles.  *sigma: noise
+ * scale of the final fit; *neff: Kish's effective sample size. */
+jf_status jf__fit_robust(jf_fitter *f, const jf_params *pr, const double p[3],
+                         const double *nbr, size_t n, double *buf, double dist_c,
+                         jf_result *out, double *sigma, double *neff);
+
+/* Standard deviation (radians) of the normal of fit r of n points with
+ * noise variance s2; INFINITY when undefined. */
+double jf__normal_sd(const jf_result *r, double s2, const double p[3], const double *nbr,
+                     size_t n);
+/* Unbiased residual variance of r from its residual scale sigma. */
+double jf__unbiased_var(const jf_result *r, double sigma, size_t n);
+/* Angle (radians) between two unoriented unit vectors. */
+double jf__angle(const double a[3], const double b[3]);
+
+/* The fit with degree selection and distance weights as pr asks (the
+ * plain or reweighted fit when neither is set). */
+jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
+                         const double *nbr, size_t n, double *buf, jf_result *out,
+                         double *sigma);
+
+#endif
