@@ -6,7 +6,7 @@
  * the samples (two-pass centred covariance) gives the x axis (largest
  * variance: the tangent estimate, sign pinned to its largest-|component|
  * positive), y = x turned by +90 degrees; precondition with h = mean |x_i|
- * (§2.3); QR + SVD (jet.c); adaptive degree as for surfaces.  With
+ * (§2.3); QR + SVD (solve.c); adaptive degree as for surfaces.  With
  * f' = B1, f'' = 2 B2, f''' = 6 B3 at x = 0:
  *   k     = f'' / (1 + f'^2)^(3/2)                        (§4)
  *   dk/ds = [f''' (1 + f'^2) - 3 f' f''^2] / (1 + f'^2)^3

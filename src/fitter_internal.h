@@ -1,5 +1,5 @@
 /* fitter_internal.h -- the jf_fitter workspace and the helpers shared by
- * frame.c, jet.c, monge.c and curve.c (not part of the public API). */
+ * frame.c, jet.c, solve.c, monge.c and curve.c (not part of the public API). */
 #ifndef JF_FITTER_INTERNAL_H
 #define JF_FITTER_INTERNAL_H
 
@@ -68,13 +68,14 @@ void jf__quantities(const double *a, int deg, int monge_degree,
 /* Sets every quantity of out to NaN (FAILED / NONFINITE rows). */
 void jf__result_nan(jf_result *out);
 
-/* jet.c */
+/* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
- * by pivoted QR, then an SVD of the cols x cols R (jet.c); fills f->s, f->sol, *cond; returns 0, 1 if the matrix is
- * rank deficient (sigma_min <= sigma_max * max(rows,cols) * DBL_EPSILON),
+ * by pivoted QR, then an SVD of the cols x cols R; fills f->s, f->sol,
+ * *cond; returns 0, 1 if the matrix is rank deficient (sigma_min <= sigma_max * max(rows,cols) * DBL_EPSILON),
  * -1 on a GSL failure. */
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
+/* jet.c */
 /* Makes GSL return error codes instead of aborting (once per process). */
 void jf__gsl_init(void);
 
