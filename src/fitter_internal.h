@@ -70,8 +70,10 @@ void jf__result_nan(jf_result *out);
 
 /* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
- * by pivoted QR, then an SVD of the cols x cols R; fills f->s, f->sol,
- * *cond; returns 0, 1 if the matrix is rank deficient (sigma_min <= sigma_max * max(rows,cols) * DBL_EPSILON),
+ * by pivoted QR, then (kappa <= 1e3) the eigenvalues of R^T R and a
+ * back-substitution, or an SVD of the cols x cols R; fills f->sol, *cond
+ * (f->m, f->x, f->v, f->s, f->work are scratch); returns 0, 1 if the
+ * matrix is rank deficient (sigma_min <= sigma_max * rows * DBL_EPSILON),
  * -1 on a GSL failure. */
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
 

@@ -388,6 +388,71 @@ START_TEST(test_solver_vs_gsl)
 }
 END_TEST
 
+/* The solver's fast path (kappa from the eigenvalues of R^T R, solution
+ * by back-substitution; taken for kappa <= 1e3 away from max_cond) against
+ * GSL's SVD: kappa to 1e-9 and the solution to ~kappa eps on matrices with
+ * kappa from ~3 to ~3e3 (both sides of the switch to the Jacobi SVD);
+ * and the adaptive degree's verdict (cond > max_cond) the same as the
+ * SVD's when max_cond is within 1e-12 of kappa on either side (the fast
+ * path's kappa is off by up to ~1e-11 there: it must not decide). */
+START_TEST(test_solver_fast_path)
+{
+    jf_params p;
+    jf_params_init(&p);
+    p.degree = 3;
+    p.max_neighbors = 64;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    rng_state = 99;
+    const size_t shapes[3][2] = {{16, 6}, {32, 10}, {10, 10}};
+    double a0[64 * 10], b0[64];
+    for (int t = 0; t < 60; t++) {
+        size_t rows = shapes[t % 3][0], cols = shapes[t % 3][1];
+        gsl_matrix *a = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
+        gsl_vector *sv = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
+        gsl_vector *b = gsl_vector_alloc(rows), *x = gsl_vector_alloc(cols);
+        double grade = pow(10.0, -0.1 * (double)(t % 30)); /* column scales 1 .. grade */
+        for (size_t j = 0; j < cols; j++) {
+            double sc = pow(grade, (double)j / (double)(cols - 1));
+            for (size_t i = 0; i < rows; i++) {
+                a0[j * rows + i] = sc * (2 * urand() - 1);
+                gsl_matrix_set(a, i, j, a0[j * rows + i]);
+            }
+        }
+        for (size_t i = 0; i < rows; i++) gsl_vector_set(b, i, b0[i] = 2 * urand() - 1);
+        ck_assert_int_eq(gsl_linalg_SV_decomp(a, v, sv, w), 0);
+        ck_assert_int_eq(gsl_linalg_SV_solve(a, v, sv, b, x), 0);
+        double gcond = gsl_vector_get(sv, 0) / gsl_vector_get(sv, cols - 1);
+        double xn = 0;
+        for (size_t j = 0; j < cols; j++) xn = fmax(xn, fabs(gsl_vector_get(x, j)));
+        /* max_cond: off, just above kappa, just below kappa */
+        const double maxc[3] = {INFINITY, gcond * (1 + 1e-12), gcond * (1 - 1e-12)};
+        for (int u = 0; u < 3; u++) {
+            memcpy(f->m, a0, rows * cols * sizeof *a0);
+            memcpy(f->rhs, b0, rows * sizeof *b0);
+            f->p.max_cond = maxc[u];
+            double cond;
+            ck_assert_int_eq(jf__svd_solve(f, rows, cols, &cond), 0);
+            ck_assert_msg(fabs(cond - gcond) <= 1e-9 * gcond, "t %d cond %.17g gsl %.17g", t,
+                          cond, gcond);
+            if (u == 1) ck_assert_msg(cond <= maxc[u], "t %d: %.17g > %.17g", t, cond, maxc[u]);
+            if (u == 2) ck_assert_msg(cond > maxc[u], "t %d: %.17g <= %.17g", t, cond, maxc[u]);
+            for (size_t j = 0; j < cols; j++)
+                ck_assert_msg(fabs(f->sol[j] - gsl_vector_get(x, j)) <= 1e-14 * gcond * xn,
+                              "t %d sol %zu: %.17g gsl %.17g (cond %g)", t, j, f->sol[j],
+                              gsl_vector_get(x, j), gcond);
+        }
+        gsl_matrix_free(a);
+        gsl_matrix_free(v);
+        gsl_vector_free(sv);
+        gsl_vector_free(w);
+        gsl_vector_free(b);
+        gsl_vector_free(x);
+    }
+    jf_fitter_free(f);
+}
+END_TEST
+
 START_TEST(test_params)
 {
     jf_params p;
@@ -457,6 +522,7 @@ int main(void)
     tcase_add_test(tc, test_no_hidden_state);
     tcase_add_test(tc, test_params);
     tcase_add_test(tc, test_solver_vs_gsl);
+    tcase_add_test(tc, test_solver_fast_path);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
