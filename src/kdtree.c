@@ -9,9 +9,12 @@
  *    of its left half and the smallest of its right half along its axis
  *    (as nanoflann does), so the gap between the halves prunes too.
  *  - query: depth first, nearer child first; a bounded max-heap of
- *    (d2, index) pairs lives in the caller's buffers.  Order is the
- *    lexicographic (d2, original index), so ties go to the smaller index and
- *    results never depend on the tree's shape.
+ *    (d2, position in tree order) pairs lives in the caller's buffers,
+ *    positions turned into original indices at the end (and, for the
+ *    pipeline, the points' coordinates copied from the tree's storage:
+ *    index_internal.h).  Order is the lexicographic (d2, original index),
+ *    so ties go to the smaller index and results never depend on the
+ *    tree's shape.
  *  - exactness: the lower bound of a cell is g0*g0 + g1*g1 + g2*g2 with
  *    g_i <= |q_i - p_i| computed by the same rounded operations as a point's
  *    distance, so (rounding being monotonic) it never exceeds the distance of
@@ -22,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "index_internal.h"
 #include "jetfit.h"
 
 #define KD_LEAF 24          /* largest leaf: 12..24 points (measured best
@@ -223,91 +227,104 @@ size_t jf_index_memory(const jf_index *ix)
 
 /* ---------------------------------------------------------------- query */
 
+size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t **id)
+{
+    if (pts) *pts = ix ? ix->pts : NULL;
+    if (id) *id = ix ? ix->id : NULL;
+    return ix ? ix->m : 0;
+}
+
+/* The candidates are kept as positions in the tree's storage (so their
+ * coordinates can be copied from it at the end) and compared in the order
+ * of (d2, original index): the index is looked up only on equal d2. */
 typedef struct {
     const jf_index *ix;
     double q[3];
     double *hd;       /* heap keys: squared distances                     */
-    uint32_t *hi;     /* heap values: original indices                    */
+    uint32_t *hp;     /* heap values: positions in tree order             */
     size_t cap, cnt;
     int sorted;       /* small k: a sorted array instead of the heap     */
-    double worst_d;   /* (worst_d, worst_i): the pair a candidate must beat */
-    uint32_t worst_i;
+    double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
+    uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
 } kd_query;
 
-/* (d, i) < (hd[a], hi[a]) in the (distance, index) order */
-#define KD_LESS(d, i, da, ia) ((d) < (da) || ((d) == (da) && (i) < (ia)))
+/* (d, position p) < (da, position pa) in the (distance, index) order */
+#define KD_LESS(id, d, p, da, pa) ((d) < (da) || ((d) == (da) && (id)[p] < (id)[pa]))
 
-static void heap_sift_down(double *hd, uint32_t *hi, size_t cnt, size_t k)
+static void heap_sift_down(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt, size_t k)
 {
     double d = hd[k];
-    uint32_t id = hi[k];
+    uint32_t pos = hp[k];
     for (;;) {
         size_t c = 2 * k + 1;
         if (c >= cnt) break;
-        if (c + 1 < cnt && KD_LESS(hd[c], hi[c], hd[c + 1], hi[c + 1])) c++;
-        if (!KD_LESS(d, id, hd[c], hi[c])) break;
+        if (c + 1 < cnt && KD_LESS(id, hd[c], hp[c], hd[c + 1], hp[c + 1])) c++;
+        if (!KD_LESS(id, d, pos, hd[c], hp[c])) break;
         hd[k] = hd[c];
-        hi[k] = hi[c];
+        hp[k] = hp[c];
         k = c;
     }
     hd[k] = d;
-    hi[k] = id;
+    hp[k] = pos;
 }
 
-static void heap_push(kd_query *s, double d, uint32_t id)
+static void heap_push(kd_query *s, double d, uint32_t pos)
 {
+    const uint32_t *id = s->ix->id;
     if (s->cnt < s->cap) {
         size_t k = s->cnt++;
         while (k > 0) {
             size_t p = (k - 1) / 2;
-            if (!KD_LESS(s->hd[p], s->hi[p], d, id)) break;
+            if (!KD_LESS(id, s->hd[p], s->hp[p], d, pos)) break;
             s->hd[k] = s->hd[p];
-            s->hi[k] = s->hi[p];
+            s->hp[k] = s->hp[p];
             k = p;
         }
         s->hd[k] = d;
-        s->hi[k] = id;
+        s->hp[k] = pos;
         if (s->cnt < s->cap) return; /* not full: the bound stays open */
     } else {
         s->hd[0] = d;
-        s->hi[0] = id;
-        heap_sift_down(s->hd, s->hi, s->cnt, 0);
+        s->hp[0] = pos;
+        heap_sift_down(id, s->hd, s->hp, s->cnt, 0);
     }
     s->worst_d = s->hd[0];
-    s->worst_i = s->hi[0];
+    s->worst_p = s->hp[0];
 }
 
 /* Small k: insertion into the sorted prefix (short, predictable moves
  * beat the heap's data-dependent sifts). */
-static void sorted_push(kd_query *s, double d, uint32_t id)
+static void sorted_push(kd_query *s, double d, uint32_t pos)
 {
+    const uint32_t *id = s->ix->id;
     size_t j = s->cnt < s->cap ? s->cnt++ : s->cap - 1;
-    while (j > 0 && KD_LESS(d, id, s->hd[j - 1], s->hi[j - 1])) {
+    while (j > 0 && KD_LESS(id, d, pos, s->hd[j - 1], s->hp[j - 1])) {
         s->hd[j] = s->hd[j - 1];
-        s->hi[j] = s->hi[j - 1];
+        s->hp[j] = s->hp[j - 1];
         j--;
     }
     s->hd[j] = d;
-    s->hi[j] = id;
+    s->hp[j] = pos;
     if (s->cnt == s->cap) {
         s->worst_d = s->hd[s->cap - 1];
-        s->worst_i = s->hi[s->cap - 1];
+        s->worst_p = s->hp[s->cap - 1];
     }
 }
 
 static void scan_leaf(kd_query *s, const kd_node *nd)
 {
-    const double *p = s->ix->pts + 3 * (size_t)nd->first;
-    const uint32_t *id = s->ix->id + nd->first;
-    uint32_t cnt = nd->dim >> 2;
+    const uint32_t first = nd->first, cnt = nd->dim >> 2;
+    const double *p = s->ix->pts + 3 * (size_t)first;
+    const uint32_t *id = s->ix->id;
     double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2];
     for (uint32_t j = 0; j < cnt; j++, p += 3) {
         double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
         double d = dx * dx + dy * dy + dz * dz;
         if (d > s->worst_d) continue; /* the common case, decided fast */
-        if (KD_LESS(d, id[j], s->worst_d, s->worst_i)) {
-            if (s->sorted) sorted_push(s, d, id[j]);
-            else heap_push(s, d, id[j]);
+        /* on a tie, the smaller index wins; no worst yet: any index */
+        if (d < s->worst_d || s->worst_p == UINT32_MAX || id[first + j] < id[s->worst_p]) {
+            if (s->sorted) sorted_push(s, d, first + j);
+            else heap_push(s, d, first + j);
         }
     }
 }
@@ -387,22 +404,21 @@ static void run_query(kd_query *s)
     /* heap sort: repeatedly move the worst to the end */
     for (size_t end = s->cnt; end > 1; end--) {
         double td = s->hd[0];
-        uint32_t ti = s->hi[0];
+        uint32_t tp = s->hp[0];
         s->hd[0] = s->hd[end - 1];
-        s->hi[0] = s->hi[end - 1];
+        s->hp[0] = s->hp[end - 1];
         s->hd[end - 1] = td;
-        s->hi[end - 1] = ti;
-        heap_sift_down(s->hd, s->hi, end - 1, 0);
+        s->hp[end - 1] = tp;
+        heap_sift_down(ix->id, s->hd, s->hp, end - 1, 0);
     }
 }
 
-static jf_status query_common(const jf_index *ix, const double q[3],
-                              size_t k, double bound, uint32_t *idx,
-                              double *d2, size_t *found)
+jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
+                          uint32_t *idx, double *d2, double *xyz, size_t *found)
 {
     if (found) *found = 0;
     if (!ix || !q || !found || (k && !idx)) return JF_ERR_INVALID;
-    if (!finite3(q)) return JF_ERR_INVALID;
+    if (!finite3(q) || !(bound >= 0)) return JF_ERR_INVALID;
     if (k > ix->m) k = ix->m;
     double stack_keys[KD_STACK_KEYS];
     double *keys = d2;
@@ -410,10 +426,16 @@ static jf_status query_common(const jf_index *ix, const double q[3],
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
+    /* idx holds positions during the search, indices after */
     kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  idx,
                   k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX};
     run_query(&s);
     if (keys != d2 && keys != stack_keys) free(keys);
+    for (size_t j = 0; j < s.cnt; j++) {
+        const uint32_t pos = idx[j];
+        if (xyz) memcpy(xyz + 3 * j, ix->pts + 3 * (size_t)pos, 3 * sizeof(double));
+        idx[j] = ix->id[pos];
+    }
     *found = s.cnt;
     return JF_OK;
 }
@@ -421,7 +443,7 @@ static jf_status query_common(const jf_index *ix, const double q[3],
 jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,
                        uint32_t *idx, double *d2, size_t *found)
 {
-    return query_common(ix, q, k, INFINITY, idx, d2, found);
+    return jf__index_query(ix, q, k, INFINITY, idx, d2, NULL, found);
 }
 
 jf_status jf_index_radius(const jf_index *ix, const double q[3], double r,
@@ -430,6 +452,6 @@ jf_status jf_index_radius(const jf_index *ix, const double q[3], double r,
 {
     if (found) *found = 0;
     if (!(r >= 0) || !isfinite(r)) return JF_ERR_INVALID;
-    /* inclusive: (r*r, UINT32_MAX) is beaten by every d2 <= r*r */
-    return query_common(ix, q, max, r * r, idx, d2, found);
+    /* inclusive: a candidate at d2 == r*r beats the open bound (r*r, none) */
+    return jf__index_query(ix, q, max, r * r, idx, d2, NULL, found);
 }

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "index_internal.h"
 #include "jetfit.h"
 
 /* Parses a positive decimal integer ending at `end` (or at ','/'\0'). */
@@ -141,30 +142,38 @@ char *jf_nb_format(const jf_nb_spec *s, char *buf, size_t len)
     return buf;
 }
 
-jf_status jf_nb_query(const jf_index *ix, const jf_nb_spec *s,
-                      size_t min_count, const double q[3], uint32_t *idx,
-                      double *d2, size_t cap, size_t *found)
+jf_status jf__nb_query_xyz(const jf_index *ix, const jf_nb_spec *s, size_t min_count,
+                           const double q[3], uint32_t *idx, double *d2, double *xyz,
+                           size_t cap, size_t *found)
 {
     if (found) *found = 0;
     if (!ix || !s || !q || !found || (cap && !idx)) return JF_ERR_INVALID;
     switch (s->kind) {
     case JF_NB_KNN:
         if (!s->k) return JF_ERR_INVALID;
-        return jf_index_knn(ix, q, s->k < cap ? s->k : cap, idx, d2, found);
+        return jf__index_query(ix, q, s->k < cap ? s->k : cap, INFINITY, idx, d2, xyz, found);
     case JF_NB_RADIUS:
-        return jf_index_radius(ix, q, s->r, cap, idx, d2, found);
+        if (!(s->r >= 0) || !isfinite(s->r)) return JF_ERR_INVALID;
+        return jf__index_query(ix, q, cap, s->r * s->r, idx, d2, xyz, found);
     case JF_NB_KNN_RADIUS: {
-        if (!s->k) return JF_ERR_INVALID;
+        if (!s->k || !(s->r >= 0) || !isfinite(s->r)) return JF_ERR_INVALID;
         size_t want = s->k < cap ? s->k : cap;
         /* K bounds the result even in the fallback */
         size_t floor = min_count < want ? min_count : want;
-        jf_status st = jf_index_radius(ix, q, s->r, want, idx, d2, found);
+        jf_status st = jf__index_query(ix, q, want, s->r * s->r, idx, d2, xyz, found);
         if (st != JF_OK || *found >= floor) return st;
-        return jf_index_knn(ix, q, floor, idx, d2, found);
+        return jf__index_query(ix, q, floor, INFINITY, idx, d2, xyz, found);
     }
     default:
         return JF_ERR_INVALID; /* rings: jf_nb_query_mesh; natural: bridge */
     }
+}
+
+jf_status jf_nb_query(const jf_index *ix, const jf_nb_spec *s,
+                      size_t min_count, const double q[3], uint32_t *idx,
+                      double *d2, size_t cap, size_t *found)
+{
+    return jf__nb_query_xyz(ix, s, min_count, q, idx, d2, NULL, cap, found);
 }
 
 jf_status jf_nb_query_mesh(const jf_mesh *m, const double *xyz,

@@ -22,6 +22,7 @@
 #include <omp.h>
 
 #include "fitter_internal.h"
+#include "index_internal.h"
 #include "jetfit.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
@@ -154,14 +155,18 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     return st;
 }
 
-/* Neighbourhood of point i into idx[0..cap-1]; *flags gets per-point
- * flags (few neighbours, the natural normal's source, failure). */
-static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, uint32_t *idx,
-                          double *d2, size_t *found, unsigned *flags)
+/* Neighbourhood of point i (at p) into idx[0..cap-1] and, from the k-d
+ * tree's own storage, their coordinates into xyz (*gathered = 1; other
+ * kinds leave that to the caller); *flags gets per-point flags (few
+ * neighbours, the natural normal's source, failure). */
+static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const double *p,
+                          uint32_t *idx, double *d2, double *xyz, int *gathered, size_t *found,
+                          unsigned *flags)
 {
     jf_status st;
     *found = 0;
     *flags = 0;
+    *gathered = 0;
     switch (x->nb->kind) {
     case JF_NB_RINGS:
         st = jf_nb_query_mesh(x->mesh, x->xyz, x->nb, x->min_count, x->fit, (uint32_t)i, idx,
@@ -180,7 +185,8 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, uint32_t 
         st = jf_natural_neighbors(x->nt, ws, i, x->nrm + 3 * i, x->want, idx, x->cap, found);
         break;
     default:
-        st = jf_nb_query(x->ix, x->nb, x->min_count, x->xyz + 3 * i, idx, d2, x->cap, found);
+        st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
+        *gathered = 1;
     }
     if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
     return st;
@@ -230,9 +236,9 @@ static void keep_edges(const nbctx *x, size_t i, const uint32_t *idx, size_t fou
     while (m < x->gk) row[m++] = UINT32_MAX;
 }
 
-static jf_status fit_one(worker *w, const nbctx *x, size_t i, jf_result *out)
+/* Point i, at p (its coordinates, from the input or the tree's copy). */
+static jf_status fit_one(worker *w, const nbctx *x, size_t i, const double *p, jf_result *out)
 {
-    const double *p = x->xyz + 3 * i;
     if (x->graph) keep_edges(x, i, NULL, 0);
     if (!finite3(p)) {
         nan_result(out, JF_PT_NONFINITE);
@@ -240,14 +246,15 @@ static jf_status fit_one(worker *w, const nbctx *x, size_t i, jf_result *out)
     }
     size_t found = 0;
     unsigned flags = 0;
-    jf_status st = nb_query(x, w->nws, i, w->idx, w->d2, &found, &flags);
+    int gathered = 0;
+    jf_status st = nb_query(x, w->nws, i, p, w->idx, w->d2, w->coords, &gathered, &found, &flags);
     if (st != JF_OK) return st;
     if (x->graph) keep_edges(x, i, w->idx, found);
     if (flags & JF_PT_FAILED) {
         nan_result(out, flags);
         return JF_OK;
     }
-    for (size_t j = 0; j < found; j++)
+    for (size_t j = 0; !gathered && j < found; j++)
         memcpy(w->coords + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
     st = jf_fit_point_full(w->fit, p, w->coords, found, out);
     out->status |= flags;
@@ -348,19 +355,36 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
             goto out;
         }
     }
-    order = malloc(n * sizeof *order);
-    if (!order) {
-        st = JF_ERR_NOMEM;
-        set_err(err, "out of memory (point order)");
-        goto out;
-    }
-    if ((st = jf_spatial_order(c->xyz, n, order)) != JF_OK) {
-        set_err(err, "spatial order failed");
-        goto out;
+    /* the walk (step 2): where the neighbourhoods come from the k-d tree,
+     * its leaf order over its own copy of the points, so a point and its
+     * neighbours are read from a few adjacent leaves (the non-finite points,
+     * not in the tree, get their row here); else the Morton order */
+    const uint32_t *walk;
+    const double *walk_xyz = NULL;
+    size_t nwalk = n;
+    if (nb.kind <= JF_NB_KNN_RADIUS) {
+        nwalk = jf__index_points(ix, &walk_xyz, &walk);
+        for (size_t i = 0; nwalk < n && i < n; i++)
+            if (!finite3(c->xyz + 3 * i)) {
+                if (x.graph) keep_edges(&x, i, NULL, 0);
+                nan_result(&out[i], JF_PT_NONFINITE);
+            }
+    } else {
+        order = malloc(n * sizeof *order);
+        if (!order) {
+            st = JF_ERR_NOMEM;
+            set_err(err, "out of memory (point order)");
+            goto out;
+        }
+        if ((st = jf_spatial_order(c->xyz, n, order)) != JF_OK) {
+            set_err(err, "spatial order failed");
+            goto out;
+        }
+        walk = order;
     }
 
     /* step 2 */
-    size_t nchunks = (n + CHUNK - 1) / CHUNK, done = 0;
+    size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = n - nwalk;
     jf_status failed = JF_OK;
 #pragma omp parallel num_threads(nt)
     {
@@ -376,9 +400,12 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
 #pragma omp atomic read
             seen = failed;
             if (seen != JF_OK || wst != JF_OK) continue;
-            size_t beg = ch * CHUNK, end = beg + CHUNK < n ? beg + CHUNK : n;
-            for (size_t k = beg; k < end && wst == JF_OK; k++)
-                wst = fit_one(&w, &x, order[k], &out[order[k]]);
+            size_t beg = ch * CHUNK, end = beg + CHUNK < nwalk ? beg + CHUNK : nwalk;
+            for (size_t k = beg; k < end && wst == JF_OK; k++) {
+                const size_t i = walk[k];
+                const double *pt = walk_xyz ? walk_xyz + 3 * k : c->xyz + 3 * i;
+                wst = fit_one(&w, &x, i, pt, &out[i]);
+            }
             if (wst != JF_OK) {
 #pragma omp atomic write
                 failed = wst;

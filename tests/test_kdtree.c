@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "index_internal.h"
 #include "jetfit.h"
 
 /* ---------------------------------------------------------------- helpers */
@@ -56,6 +57,7 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
     pair *ref = malloc((n + 1) * sizeof *ref);
     uint32_t *idx = malloc((n + 8) * sizeof *idx);
     double *d2 = malloc((n + 8) * sizeof *d2);
+    double *pts = malloc(3 * (n + 8) * sizeof *pts);
     size_t m = brute(xyz, n, q, ref);
     const size_t ks[] = {1, 2, 5, 16, 33, 100, n, n + 7};
     for (size_t t = 0; t < sizeof ks / sizeof ks[0]; t++) {
@@ -66,6 +68,15 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
         for (size_t j = 0; j < found; j++) {
             ck_assert_uint_eq(idx[j], ref[j].i);
             ck_assert(d2[j] == ref[j].d);
+        }
+        /* the pipeline's variant: same points, and their coordinates
+         * (from the tree's copy) bit for bit those of the input */
+        found = 99;
+        ck_assert_int_eq(jf__index_query(ix, q, k, INFINITY, idx, NULL, pts, &found), JF_OK);
+        ck_assert_uint_eq(found, want);
+        for (size_t j = 0; j < found; j++) {
+            ck_assert_uint_eq(idx[j], ref[j].i);
+            ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3])) == 0);
         }
     }
     /* radius: inclusive, capped to the nearest `max` */
@@ -87,12 +98,22 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
                     ck_assert_uint_eq(idx[j], ref[j].i);
                     ck_assert(d2[j] <= r2);
                 }
+                found = 99;
+                ck_assert_int_eq(jf__index_query(ix, q, maxes[u], r2, idx, d2, pts, &found),
+                                 JF_OK);
+                ck_assert_uint_eq(found, want);
+                for (size_t j = 0; j < found; j++) {
+                    ck_assert_uint_eq(idx[j], ref[j].i);
+                    ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j],
+                                     sizeof(double[3])) == 0);
+                }
             }
         }
     }
     free(ref);
     free(idx);
     free(d2);
+    free(pts);
 }
 
 static void check_cloud(const double *xyz, size_t n, size_t nq_random)
@@ -104,6 +125,18 @@ static void check_cloud(const double *xyz, size_t n, size_t nq_random)
         finite += isfinite(xyz[3 * i]) && isfinite(xyz[3 * i + 1]) &&
                   isfinite(xyz[3 * i + 2]);
     ck_assert_uint_eq(jf_index_size(ix), finite);
+    /* the tree's storage: each finite point once, with its coordinates */
+    const double *tp;
+    const uint32_t *tid;
+    ck_assert_uint_eq(jf__index_points(ix, &tp, &tid), finite);
+    unsigned char *seen = calloc(n + 1, 1);
+    for (size_t t = 0; t < finite; t++) {
+        ck_assert_uint_lt(tid[t], n);
+        ck_assert(!seen[tid[t]]);
+        seen[tid[t]] = 1;
+        ck_assert(memcmp(tp + 3 * t, xyz + 3 * (size_t)tid[t], sizeof(double[3])) == 0);
+    }
+    free(seen);
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (size_t i = 0; i < n; i++)
         for (int d = 0; d < 3; d++)

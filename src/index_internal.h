@@ -1,0 +1,32 @@
+/* index_internal.h -- the k-d tree's own point storage, for the pipeline
+ * (not part of the public API).  The tree keeps a contiguous copy of the
+ * finite points in leaf order; walking the cloud in that order and taking
+ * neighbour coordinates from that copy keeps a neighbourhood's reads in a
+ * few adjacent leaves instead of scattered over the input array. */
+#ifndef JF_INDEX_INTERNAL_H
+#define JF_INDEX_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jetfit.h"
+
+/* The m = jf_index_size(ix) indexed points in the tree's leaf order (a
+ * spatially coherent order, as the Morton order): *pts their 3m
+ * coordinates, *id their indices in the input.  Owned by the index.
+ * Returns m. */
+size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t **id);
+
+/* jf_index_knn (bound = INFINITY) or jf_index_radius (bound = r*r, r >= 0)
+ * with the same results, and also the coordinates of the found points,
+ * nearest first, to xyz (3 per point, caller-owned) unless NULL. */
+jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
+                          uint32_t *idx, double *d2, double *xyz, size_t *found);
+
+/* neighbors.c: jf_nb_query, and the coordinates of the neighbours to xyz
+ * (3 * cap entries, caller-owned) unless NULL. */
+jf_status jf__nb_query_xyz(const jf_index *ix, const jf_nb_spec *s, size_t min_count,
+                           const double q[3], uint32_t *idx, double *d2, double *xyz,
+                           size_t cap, size_t *found);
+
+#endif /* JF_INDEX_INTERNAL_H */
