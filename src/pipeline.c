@@ -5,10 +5,13 @@
  *  1. Build what the neighbourhood needs once: the k-d tree (non-finite
  *     points are left out of it: nobody's neighbour), the mesh adjacency
  *     (rings), or the Delaunay triangulation and a tangent-plane normal
- *     per point (natural, §5.1); and a Z-order of the points.
- *  2. Threads take chunks of the Z-order (consecutive queries touch the
- *     same tree nodes and coordinates: cache friendly); each thread owns a
- *     fitter and buffers made once, so nothing is allocated per point.
+ *     per point (natural, §5.1); and a walk: the k-d tree's leaf order
+ *     for its neighbourhoods, else a Z-order of the points.
+ *  2. Threads take chunks of the walk (consecutive queries touch the same
+ *     tree nodes and coordinates: cache friendly; k-NN and radius
+ *     neighbours are read from the tree's contiguous copy of the points,
+ *     not gathered from the input array); each thread owns a fitter and
+ *     buffers made once, so nothing is allocated per point.
  *     Result i is stored at out[i] (input order), and each result depends
  *     only on its own neighbourhood (sorted, ties by index): any thread
  *     count gives the same bits.
