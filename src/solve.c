@@ -38,6 +38,13 @@ static inline double dot(const double *x, const double *y, size_t n)
     return (s0 + s1) + (s2 + s3);
 }
 
+/* y += a x; y and x are distinct columns (restrict: no run-time overlap
+ * test before the vectorised loop) */
+static inline void axpy(double *restrict y, const double *restrict x, double a, size_t n)
+{
+    for (size_t i = 0; i < n; i++) y[i] += a * x[i];
+}
+
 /* Householder QR with column pivoting (Businger & Golub; Golub & Van Loan
  * §5.4.1) of the rows x cols matrix a, stored column-major (column j at
  * a + j*rows, contiguous for the inner loops), applied to b in the same
@@ -91,7 +98,7 @@ static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *
         for (size_t j = k + 1; j <= cols; j++) { /* j == cols: the rhs */
             double *aj = j < cols ? a + j * rows : b;
             const double sdot = tau * dot(ak + k, aj + k, rows - k);
-            for (size_t i = k; i < rows; i++) aj[i] -= sdot * ak[i];
+            axpy(aj + k, ak + k, -sdot, rows - k);
             if (j < cols) nrm[j] -= aj[k] * aj[k];
         }
         ak[k] = alpha;
@@ -294,9 +301,15 @@ static int fast_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
     const double *m = f->m; /* R_ij = m[j*rows + i], i <= j */
     double *g = f->x;
     if (cols > 55) return -1;
-    for (size_t i = 0; i < cols; i++)
-        for (size_t j = i; j < cols; j++) /* (R^T R)_ij = sum_{t<=i} R_ti R_tj */
-            g[i * cols + j] = g[j * cols + i] = dot(m + i * rows, m + j * rows, i + 1);
+    for (size_t i = 0; i < cols; i++) {
+        const double *ri = m + i * rows;
+        for (size_t j = i; j < cols; j++) { /* (R^T R)_ij = sum_{t<=i} R_ti R_tj */
+            const double *rj = m + j * rows;
+            double t = 0; /* short: plain loop, dot()'s set-up costs more */
+            for (size_t k = 0; k <= i; k++) t += ri[k] * rj[k];
+            g[i * cols + j] = g[j * cols + i] = t;
+        }
+    }
     if (sym_eigvals(g, cols, f->s, f->work) != 0) return -1;
     double lmax = 0, lmin = INFINITY;
     for (size_t j = 0; j < cols; j++) {
