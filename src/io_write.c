@@ -162,7 +162,8 @@ static int32_t to_i32(double v)
 {
     if (!(v >= -2147483648.0 && v <= 2147483647.0))
         return INT32_MIN;
-    return (int32_t)lround(v);
+    int32_t t = (int32_t)v; /* the usual integer value: no lround call */
+    return (double)t == v ? t : (int32_t)lround(v);
 }
 
 static jf_status write_header(jf_writer *w)
@@ -294,7 +295,25 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
     if (!o)
         return f->st;
     char *o0 = o;
-    if (w->fmt == FMT_PLY && !w->ascii) {
+    if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
+        /* the usual case, kept tight (it runs serially, once per point):
+         * fixed-size copies, no per-value memcpy call */
+        for (size_t j = 0; j < w->ncols; j++) {
+            const double v = vals[j];
+            if (w->types[j] == JF_COL_F64) {
+                memcpy(o, &v, 8);
+                o += 8;
+            } else if (w->types[j] == JF_COL_F32) {
+                float x = (float)v;
+                memcpy(o, &x, 4);
+                o += 4;
+            } else {
+                int32_t x = to_i32(v);
+                memcpy(o, &x, 4);
+                o += 4;
+            }
+        }
+    } else if (w->fmt == FMT_PLY && !w->ascii) {
         int little = host_little();
         for (size_t j = 0; j < w->ncols; j++) {
             unsigned char b[8];
