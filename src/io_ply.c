@@ -170,21 +170,22 @@ static jf_status parse_header(ply *h, const char *buf, size_t len,
 static double load(const unsigned char *p, int type, int swap)
 {
     unsigned char b[8];
-    unsigned n = type_size[type];
-    if (swap)
+    if (swap) {
+        unsigned n = type_size[type];
         for (unsigned i = 0; i < n; i++)
             b[i] = p[n - 1 - i];
-    else
-        memcpy(b, p, n);
+        p = b;
+    }
+    /* fixed-size copies (inlined loads, no memcpy call per value) */
     switch (type) {
-    case T_I8: { int8_t v; memcpy(&v, b, 1); return v; }
-    case T_U8: return b[0];
-    case T_I16: { int16_t v; memcpy(&v, b, 2); return v; }
-    case T_U16: { uint16_t v; memcpy(&v, b, 2); return v; }
-    case T_I32: { int32_t v; memcpy(&v, b, 4); return v; }
-    case T_U32: { uint32_t v; memcpy(&v, b, 4); return v; }
-    case T_F32: { float v; memcpy(&v, b, 4); return v; }
-    default: { double v; memcpy(&v, b, 8); return v; }
+    case T_I8: { int8_t v; memcpy(&v, p, 1); return v; }
+    case T_U8: return p[0];
+    case T_I16: { int16_t v; memcpy(&v, p, 2); return v; }
+    case T_U16: { uint16_t v; memcpy(&v, p, 2); return v; }
+    case T_I32: { int32_t v; memcpy(&v, p, 4); return v; }
+    case T_U32: { uint32_t v; memcpy(&v, p, 4); return v; }
+    case T_F32: { float v; memcpy(&v, p, 4); return v; }
+    default: { double v; memcpy(&v, p, 8); return v; }
     }
 }
 
@@ -234,6 +235,24 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
         const uint16_t one = 1;
         int little = *(const unsigned char *)&one == 1;
         swap = (h->format == 1) != little;
+    }
+    /* binary rows of scalar properties only (the usual vertex element) and
+     * all there: fixed offsets, no per-value dispatch (a truncated file
+     * takes the general loop below, which names the row) */
+    if (h->format) {
+        size_t row = 0, off[MAX_PROPS];
+        int scalar = 1;
+        for (int k = 0; k < el->nprops; k++) {
+            scalar &= el->props[k].count_type == T_NONE;
+            off[k] = row;
+            row += type_size[el->props[k].type];
+        }
+        if (scalar && row && (uint64_t)(h->end - h->p) / row >= el->count) {
+            for (uint64_t r = 0; r < el->count; r++, h->p += row)
+                for (int k = 0; k < el->nprops; k++)
+                    if (pl->dst[k]) pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
+            return JF_OK;
+        }
     }
     const char *tag = h->format ? "element " : "";
     for (uint64_t r = 0; r < el->count; r++) {
