@@ -843,13 +843,15 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
 /* Fits every point of c (out has c->n entries, caller-owned; out[i]
  * belongs to point i): builds what the neighbourhood needs (k-d tree,
  * mesh adjacency, or Delaunay triangulation and tangent-plane normals),
- * fits the points in Z-order with one fitter per thread
- * (jf_fit_point_full), then orients.  Non-finite points get
+ * fits the points with one fitter per thread (jf_fit_point_full) in a
+ * cache-friendly order (knn/radius: the k-d tree's leaf order, the
+ * neighbours' coordinates read from the tree's own copy; rings, natural:
+ * Z-order), then orients.  Non-finite points get
  * JF_PT_NONFINITE and NaN values and are nobody's neighbour; a point
  * whose neighbourhood is smaller than asked gets JF_PT_FEW_NEIGHBORS.
  * The results are bit-identical for any thread count.  Peak memory
- * besides c and out: about 40 bytes per point (knn/radius: k-d tree and
- * order; rings: the adjacency; natural: the bridge's ~100 + 28), plus
+ * besides c and out: about 40 bytes per point (knn/radius: the k-d tree;
+ * rings: the adjacency and order; natural: the bridge's ~100 + 28), plus
  * 4 * orient_k for mst, which runs on the fit's own neighbourhoods (the
  * orient_k nearest of each).  Measured at 1M points, knn:16, the whole
  * command peaks at 271-278 MB (1-2 threads), 305 MB with mst.
