@@ -11,6 +11,11 @@
 
 #include "jetfit.h"
 
+/* jf_index_build on `threads` OpenMP threads (<= 0: the OpenMP default,
+ * as jf_index_build), so that jf_estimate's thread count holds for the
+ * tree's build too.  The tree is the same for any count. */
+jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_index **out);
+
 /* The m = jf_index_size(ix) indexed points in the tree's leaf order (a
  * spatially coherent order, as the Morton order): *pts their 3m
  * coordinates, *id their indices in the input.  Owned by the index.

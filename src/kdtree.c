@@ -25,6 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "index_internal.h"
 #include "jetfit.h"
 
@@ -161,6 +163,11 @@ static int finite3(const double *p)
 
 jf_status jf_index_build(const double *xyz, size_t n, jf_index **out)
 {
+    return jf__index_build_threads(xyz, n, 0, out);
+}
+
+jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_index **out)
+{
     if (!out) return JF_ERR_INVALID;
     *out = NULL;
     if (!xyz && n) return JF_ERR_INVALID;
@@ -199,7 +206,8 @@ jf_status jf_index_build(const double *xyz, size_t n, jf_index **out)
     if (m) {
         const kd_builder b = {ix->pts, ix->id, ix->nodes};
         const kd_builder *bp = &b;
-#pragma omp parallel if (m >= 2 * KD_TASK_MIN) default(none) shared(bp, m)
+        const int nt = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel if (m >= 2 * KD_TASK_MIN) num_threads(nt) default(none) shared(bp, m)
 #pragma omp single
         build_node(bp, 0, 0, m, 1);
     }

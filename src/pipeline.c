@@ -331,7 +331,7 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     uint32_t *order = NULL;
     int need_index = nb.kind <= JF_NB_KNN_RADIUS ||
                      (o->nb.kind == JF_NB_NATURAL && o->normal == JF_NORMAL_PCA);
-    if (need_index && (st = jf_index_build(c->xyz, n, &ix)) != JF_OK) {
+    if (need_index && (st = jf__index_build_threads(c->xyz, n, nt, &ix)) != JF_OK) {
         set_err(err, "building the k-d tree failed");
         goto out;
     }

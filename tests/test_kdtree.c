@@ -365,6 +365,30 @@ START_TEST(knn_threads_agree)
 }
 END_TEST
 
+START_TEST(build_threads_same_tree)
+{
+    /* large enough for the parallel build (subtrees of >= 65536 points as
+     * tasks): 1, 2 and 3 threads lay out the same tree */
+    size_t n = 150000;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = urand();
+    xyz[3 * 77] = NAN; /* left out of the tree */
+    jf_index *ix[3];
+    const double *pts[3];
+    const uint32_t *id[3];
+    for (int t = 0; t < 3; t++) {
+        ck_assert_int_eq(jf__index_build_threads(xyz, n, t + 1, &ix[t]), JF_OK);
+        ck_assert_uint_eq(jf__index_points(ix[t], &pts[t], &id[t]), n - 1);
+    }
+    for (int t = 1; t < 3; t++) {
+        ck_assert(memcmp(pts[0], pts[t], 3 * (n - 1) * sizeof(double)) == 0);
+        ck_assert(memcmp(id[0], id[t], (n - 1) * sizeof(uint32_t)) == 0);
+    }
+    for (int t = 0; t < 3; t++) jf_index_free(ix[t]);
+    free(xyz);
+}
+END_TEST
+
 /* ---------------------------------------------------------------- order */
 
 START_TEST(order_is_permutation)
@@ -444,6 +468,7 @@ static Suite *kdtree_suite(void)
     tcase_add_test(tc, knn_edge_cases);
     tcase_add_test(tc, knn_large_k_without_d2);
     tcase_add_test(tc, knn_threads_agree);
+    tcase_add_test(tc, build_threads_same_tree);
     tcase_add_test(tc, index_memory_small);
     suite_add_tcase(s, tc);
     TCase *to = tcase_create("order");
