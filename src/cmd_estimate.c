@@ -431,11 +431,24 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    double row[32];
-    for (size_t i = 0; i < c.n; i++) {
-        make_row(c.xyz + 3 * i, &r[i], monge, row);
-        if (jf_writer_row(w, row) != JF_OK) break;
+    /* rows built and formatted in parallel, a block at a time (16 MB) */
+    enum { BLOCK = 65536 };
+    double *rows = malloc((c.n < BLOCK ? c.n : BLOCK) * ncols * sizeof *rows);
+    if (!rows) {
+        fprintf(stderr, "jetfit: out of memory (output rows)\n");
+        jf_writer_abort(w);
+        free(r);
+        jf_cloud_free(&c);
+        return 1;
     }
+    for (size_t b0 = 0; b0 < c.n; b0 += BLOCK) {
+        const long nb = (long)(c.n - b0 < BLOCK ? c.n - b0 : BLOCK);
+#pragma omp parallel for num_threads(o.threads > 0 ? o.threads : omp_get_max_threads())
+        for (long k = 0; k < nb; k++)
+            make_row(c.xyz + 3 * (b0 + (size_t)k), &r[b0 + (size_t)k], monge, rows + (size_t)k * ncols);
+        if (jf_writer_rows(w, rows, (size_t)nb, o.threads) != JF_OK) break;
+    }
+    free(rows);
     /* commit reports a failed row too, and removes the temporary */
     st = jf_writer_commit(w, &err);
     if (st != JF_OK) {

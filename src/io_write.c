@@ -18,6 +18,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <omp.h>
+
 /* ---- buffered temporary file ------------------------------------------ */
 
 #define BUF_CAP (1u << 20)
@@ -279,21 +281,10 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
     return JF_OK;
 }
 
-jf_status jf_writer_row(jf_writer *w, const double *vals)
+/* One row, formatted into o (room for ncols * 32 + 2 bytes); returns the
+ * number of bytes.  Reads w only: safe from several threads at once. */
+static size_t format_row(const jf_writer *w, const double *vals, char *o)
 {
-    if (!w || !vals)
-        return JF_ERR_INVALID;
-    wfile *f = &w->f;
-    if (f->st != JF_OK)
-        return f->st;
-    if (!w->header_done && write_header(w) != JF_OK)
-        return f->st;
-    if (w->rows == w->nrows)
-        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
-                       w->nrows);
-    char *o = wf_room(f, w->ncols * 32 + 2);
-    if (!o)
-        return f->st;
     char *o0 = o;
     if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
         /* the usual case, kept tight (it runs serially, once per point):
@@ -358,9 +349,79 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
         }
         *o++ = '\n';
     }
-    f->len += (size_t)(o - o0);
+    return (size_t)(o - o0);
+}
+
+jf_status jf_writer_row(jf_writer *w, const double *vals)
+{
+    if (!w || !vals)
+        return JF_ERR_INVALID;
+    wfile *f = &w->f;
+    if (f->st != JF_OK)
+        return f->st;
+    if (!w->header_done && write_header(w) != JF_OK)
+        return f->st;
+    if (w->rows == w->nrows)
+        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
+                       w->nrows);
+    char *o = wf_room(f, w->ncols * 32 + 2);
+    if (!o)
+        return f->st;
+    f->len += format_row(w, vals, o);
     w->rows++;
     return JF_OK;
+}
+
+/* Rows formatted per thread and round by jf_writer_rows. */
+#define ROWS_BLOCK 4096
+
+jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
+                         int threads)
+{
+    if (!w || (nrows && !vals))
+        return JF_ERR_INVALID;
+    wfile *f = &w->f;
+    if (f->st != JF_OK)
+        return f->st;
+    if (!w->header_done && write_header(w) != JF_OK)
+        return f->st;
+    if (nrows > w->nrows - w->rows)
+        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
+                       w->nrows);
+    const int nt = threads > 0 ? threads : omp_get_max_threads();
+    const size_t row_max = w->ncols * 32 + 2, slot = ROWS_BLOCK * row_max;
+    char *scratch = malloc((size_t)nt * slot);
+    size_t *len = malloc((size_t)nt * sizeof *len);
+    if (!scratch || !len) {
+        free(scratch);
+        free(len);
+        return wf_fail(f, JF_ERR_NOMEM, "out of memory");
+    }
+    /* each round: thread t formats the t-th block of ROWS_BLOCK rows into
+     * its slot, then the slots go out in order, unbuffered */
+    for (size_t r0 = 0; r0 < nrows && f->st == JF_OK;
+         r0 += (size_t)nt * ROWS_BLOCK) {
+#pragma omp parallel for num_threads(nt) schedule(static, 1)
+        for (int t = 0; t < nt; t++) {
+            size_t a = r0 + (size_t)t * ROWS_BLOCK, b = a + ROWS_BLOCK;
+            char *o = scratch + (size_t)t * slot;
+            len[t] = 0;
+            for (size_t r = a; r < b && r < nrows; r++)
+                len[t] += format_row(w, vals + r * w->ncols, o + len[t]);
+        }
+        for (int t = 0; t < nt && wf_flush(f) == JF_OK; t++) {
+            f->len = len[t]; /* wf_flush writes buf[0..len) */
+            char *keep = f->buf;
+            f->buf = scratch + (size_t)t * slot;
+            wf_flush(f);
+            f->buf = keep;
+        }
+    }
+    free(scratch);
+    free(len);
+    if (f->st == JF_OK)
+        w->rows += nrows;
+    return f->st;
 }
 
 static jf_status write_faces(jf_writer *w)

@@ -602,6 +602,15 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
  * and commit reports it. */
 jf_status jf_writer_row(jf_writer *w, const double *vals);
 
+/* Appends nrows rows, vals[r * ncols + j] (row-major), exactly as nrows
+ * calls of jf_writer_row would, formatting them on `threads` OpenMP
+ * threads (<= 0: the OpenMP default) and writing them in order.  Writing
+ * is otherwise serial: this is what keeps it off the critical path of a
+ * parallel run (text output above all).  Allocates about threads x 4096
+ * x (32 ncols + 2) bytes for the call.  Same errors as jf_writer_row. */
+jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
+                         int threads);
+
 /* Flushes, closes, checks the row count and renames the temporary onto
  * the final name.  Frees w whatever happens (w may be NULL: invalid).
  * On failure the temporary is removed and err says why. */
