@@ -7,7 +7,8 @@
 //                                  JF_BUILD_DIR/jetfit)
 //
 // Every contender runs in its own child process (fork), so its peak
-// memory (wait4's ru_maxrss) is its own:
+// memory (wait4's ru_maxrss) is its own, and starts with no output file
+// from an earlier contender (deleting one costs ~0.1 s in the kernel):
 //  - jetfit estimate --threads 1 / 2 (exec of the built binary);
 //  - CGAL end to end: read_PLY, k-d tree (Orthogonal_k_neighbor_search),
 //    Monge_via_jet_fitting per point (query point first), binary PLY out
@@ -87,6 +88,10 @@ struct Run {
 
 template <class F> static Run in_child(F f)
 {
+    // every contender writes a new file: replacing the previous run's
+    // 100+ MB output would charge its deletion to whoever comes next
+    for (const char *o : {"jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
+        std::remove((g_dir + "/" + o).c_str());
     std::fflush(nullptr);
     auto t0 = std::chrono::steady_clock::now();
     pid_t pid = fork();
