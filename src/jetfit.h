@@ -863,7 +863,8 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * rings: the adjacency and order; natural: the bridge's ~100 + 28), plus
  * 4 * orient_k for mst, which runs on the fit's own neighbourhoods (the
  * orient_k nearest of each).  Measured at 1M points, knn:16, the whole
- * command peaks at 271-278 MB (1-2 threads), 305 MB with mst.
+ * command peaks at 263-264 MiB (1-2 threads; bench_estimate), 294 MiB
+ * with mst.
  * Returns JF_OK, JF_ERR_INVALID (bad options, rings without faces,
  * orient/normal input without normals; err says which), JF_ERR_NOMEM,
  * JF_ERR_FORMAT (bad face indices), or the failing stage's status; err
