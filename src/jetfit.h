@@ -261,14 +261,19 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *  - params.degree_select = dmin >= 1: per-point choice of the degree among
  *    degree..dmin by the same interval logic (noise variance from the
  *    top-degree fit): a lower degree is kept while its normal stays within
- *    1 sd (sum of both) of every higher degree's; out->degree tells the
- *    degree used (at 1, k1/k2 are NaN as for any 1-jet).  With noise on a
- *    small K the plane or quadric wins, on clean data the full degree.
+ *    1.5 sd (sum of both) of every higher degree's, and none is tried when
+ *    the top degree's sd is below 0.2 rad (a noise-dominated neighbourhood
+ *    has sd >= noise / radius, that floor shrinking like sqrt(50 / n)
+ *    above 50 points); out->degree tells the degree used (at 1, k1/k2 are
+ *    NaN as for any 1-jet).  With noise on a small K the plane or quadric
+ *    wins, on clean data or large K the full degree.
  *  - params.dist_weight = c > 0: Gaussian weights exp(-d^2 / (2 (c dmax)^2))
  *    on each neighbour's distance d to p (dmax: the farthest); with
  *    degree_select the weighted top-degree fit heads the chain (kept
  *    unless the unweighted normal agrees within the intervals).  Lowers
- *    truncation error on clean data, costs variance under noise.
+ *    truncation error on clean data, costs variance under noise.  The
+ *    command's --robust-normals is degree_select 1 with dist_weight 0.55
+ *    (README: below CGAL's jet in every PCPNet cell).
  * The degree-selection fitters of lower degrees are created once per thread
  * (on first use; recreated only when the parameters change) and freed at
  * thread exit.  Defaults (off) and constants: README, bench_pcpnet.

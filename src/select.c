@@ -114,7 +114,12 @@ double jf__angle(const double a[3], const double b[3])
  * the degree-D fit (its residual is the least inflated by truncation
  * error).  Noise on a small neighbourhood makes sd_D large, so the plane
  * or quadric wins; on clean data sd_D is tiny and any bias of a lower
- * degree rejects it.  *sigma: the noise scale of the returned fit. */
+ * degree rejects it.  The sd here (select_sd) shrinks the blob floor with
+ * n, so that a large noisy neighbourhood, whose normal is precise, keeps
+ * its (weighted) top degree instead of the plane, whose bias there
+ * (creases, thin parts) exceeds the top degree's variance: PCPNet's
+ * armadillo at K = 450 with noise 0.006, 26.33 -> 25.58 deg at degree 3.
+ * *sigma: the noise scale of the returned fit. */
 jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
                          const double *nbr, size_t n, double *buf, jf_result *out,
                          double *sigma)
