@@ -28,11 +28,10 @@
 
 /* Tuning constants of the selection rules (select.c, scale.c), one place
  * so that the bench-only setter below reaches them all. */
-/* Width of the scale-selection confidence intervals, in standard
- * deviations (see jf_fit_point_full); chosen by measurement
- * (tests/bench_pcpnet.cpp, README). */
-#ifndef JF_SCALE_TAU
-#define JF_SCALE_TAU 1.0
+/* Scale selection's weight of the variance in its MSE estimate (scale.c:
+ * 2, by measurement on the §6.1 surface; README). */
+#ifndef JF_SCALE_VARW
+#define JF_SCALE_VARW 2.0
 #endif
 #ifndef JF_SCALE_TARGET
 #define JF_SCALE_TARGET 0.0
@@ -55,7 +54,7 @@
 #define JF_DEGREE_FLOOR_N 50.0
 #endif
 
-jf__knobs jf__knob = {JF_SCALE_TAU, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN,
+jf__knobs jf__knob = {JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN,
                       JF_DEGREE_FLOOR_N};
 
 /* Bench-only setter of the knobs (tests/bench_pcpnet.cpp measures them);
@@ -63,7 +62,7 @@ jf__knobs jf__knob = {JF_SCALE_TAU, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGR
  * of jf__knobs.  Returns 0, or -1 for an unknown name. */
 int jf__robust_tune(const char *name, double v)
 {
-    if (!strcmp(name, "scale_tau")) jf__knob.scale_tau = v;
+    if (!strcmp(name, "scale_varw")) jf__knob.scale_varw = v;
     else if (!strcmp(name, "scale_target")) jf__knob.scale_target = v;
     else if (!strcmp(name, "scale_floor")) jf__knob.scale_floor = v;
     else if (!strcmp(name, "degree_tau")) jf__knob.degree_tau = v;

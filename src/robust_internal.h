@@ -14,7 +14,7 @@
 
 /* Tuning constants of the selection rules (defaults in robust.c). */
 typedef struct {
-    double scale_tau;    /* scale selection: interval width, in sd */
+    double scale_varw;   /* scale selection: weight of the variance */
     double scale_target; /* scale selection: stop once sd is below (rad) */
     double scale_floor;  /* normal sd floor: sigma/h above this is a blob */
     double degree_tau;   /* degree selection: interval width, in sd */

@@ -106,8 +106,8 @@ double jf__angle(const double a[3], const double b[3])
     return acos(d > 1.0 ? 1.0 : d);
 }
 
-/* Degree selection (params.degree_select = dmin): the same interval logic
- * over the degree instead of K.  The top degree D has the least bias and
+/* Degree selection (params.degree_select = dmin): an interval rule
+ * over the degree.  The top degree D has the least bias and
  * the most variance; degree d < D is accepted while its normal lies within
  * tau (sd_d + sd_j) of the normal of every higher accepted degree j, and
  * the lowest accepted degree is kept.  All sd use the noise variance of

@@ -14,7 +14,7 @@
 // points, Point_set_processing_3/internal/Neighbor_query.h); jetfit's K
 // counts the point itself (K points).
 // Usage: bench_pcpnet [DATA_DIR] [--quick] [--no-cgal] [--no-fixed]
-//   [--sweep "K,deg,robust[,dsel] ..."] [--tau X] [--floor X] [--target X]
+//   [--sweep "K,deg,robust[,dsel] ..."] [--varw X] [--floor X] [--target X]
 //   [--dtau X] [--dsdmin X] [--dfloorn X] [--distw X] [--same-points]
 //   [--levels L1,L2,..] [--cgal-k K]
 // --same-points: jetfit fits K + 1 points like CGAL (default: K, the query
@@ -25,7 +25,7 @@
 // levels; --cgal-k: CGAL at this K only (its K = 450 runs take minutes);
 // --quick: clean shape and the largest noise only, K = 18 and 112;
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
-// 0/1/2 = none/huber/tukey; with --no-fixed only those run); --tau,
+// 0/1/2 = none/huber/tukey; with --no-fixed only those run); --varw,
 // --floor, --target override the scale-selection constants of robust.c.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
@@ -46,7 +46,7 @@
 
 #include "jetfit.h"
 
-// src/robust.c's bench-only setter of its tuning constants (scale_tau,
+// src/robust.c's bench-only setter of its tuning constants (scale_varw,
 // scale_target, scale_floor, degree_tau, degree_sdmin, degree_floor_n).
 extern "C" int jf__robust_tune(const char *name, double v);
 
@@ -207,7 +207,7 @@ int main(int argc, char **argv)
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
         else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
-        else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__robust_tune("scale_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--varw") && i + 1 < argc) jf__robust_tune("scale_varw", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__robust_tune("scale_target", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__robust_tune("scale_floor", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--dtau") && i + 1 < argc) jf__robust_tune("degree_tau", std::atof(argv[++i]));
