@@ -51,6 +51,9 @@ static void usage(FILE *f)
         "  --dist-weight C       Gaussian weights on the distance to the point,\n"
         "                        sigma = C x the farthest neighbour (clean data:\n"
         "                        0.3-0.4; default off)\n"
+        "  --robust-normals      preset for normals on data of unknown noise:\n"
+        "                        --degree-select 1 --dist-weight 0.55 (later flags\n"
+        "                        override; measured on PCPNet, see README)\n"
         "  --columns X,Y,Z[,NX,NY,NZ]\n"
         "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
         "                        (default: x y z first, normals in 3..5 if 6 columns)\n"
@@ -255,6 +258,13 @@ int jf_cmd_estimate(int argc, char **argv)
         }
         if (!strcmp(a, "--ascii")) {
             ascii = 1;
+            continue;
+        }
+        if (!strcmp(a, "--robust-normals")) {
+            /* the preset measured on PCPNet (README): degree selection
+             * down to the plane, headed by the weighted top-degree fit */
+            o.params.degree_select = 1;
+            o.params.dist_weight = 0.55;
             continue;
         }
         if (a[0] != '-' || !a[1]) {

@@ -245,7 +245,8 @@ jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n);
 /* The parameters the fitter was created with. */
 const jf_params *jf_fitter_params(const jf_fitter *f);
 
-/* The full per-point fit used by the command (src/robust.c).
+/* The full per-point fit used by the command (src/scale.c, robust.c,
+ * select.c).
  *  - params.robust: iteratively reweighted least squares on the height
  *    residuals; scale s = 1.4826 median|r|; Huber (c = 1.345 s) or Tukey
  *    (c = 4.685 s, after two Huber steps) weights; at most robust_iters
@@ -254,21 +255,28 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *    than N_n + 1 points keep a weight) JF_PT_ROBUST_NOCONV.
  *  - params.scales: per-point choice of K among scales[] (the first K of
  *    nbr, which must be sorted nearest first; K > n is clamped to n) by
- *    the intersection of confidence intervals: K grows while its normal
- *    stays within 1 standard deviation (sum of both) of every smaller K's
- *    normal; JF_PT_SCALE_SELECTED when the chosen K is not the largest.
+ *    least estimated mean squared error of the normal: squared bias from
+ *    the difference to a fit one degree higher on the same K points and
+ *    to each smaller K's normal (less their noise), plus twice the
+ *    normal's variance; costs two fits per candidate.
+ *    JF_PT_SCALE_SELECTED when the chosen K is not the largest.
  *    out->n_used tells the K used.
  *  - params.degree_select = dmin >= 1: per-point choice of the degree among
- *    degree..dmin by the same interval logic (noise variance from the
+ *    degree..dmin by an interval rule (noise variance from the
  *    top-degree fit): a lower degree is kept while its normal stays within
- *    1 sd (sum of both) of every higher degree's; out->degree tells the
- *    degree used (at 1, k1/k2 are NaN as for any 1-jet).  With noise on a
- *    small K the plane or quadric wins, on clean data the full degree.
+ *    1.5 sd (sum of both) of every higher degree's, and none is tried when
+ *    the top degree's sd is below 0.2 rad (a noise-dominated neighbourhood
+ *    has sd >= noise / radius, that floor shrinking like sqrt(50 / n)
+ *    above 50 points); out->degree tells the degree used (at 1, k1/k2 are
+ *    NaN as for any 1-jet).  With noise on a small K the plane or quadric
+ *    wins, on clean data or large K the full degree.
  *  - params.dist_weight = c > 0: Gaussian weights exp(-d^2 / (2 (c dmax)^2))
  *    on each neighbour's distance d to p (dmax: the farthest); with
  *    degree_select the weighted top-degree fit heads the chain (kept
  *    unless the unweighted normal agrees within the intervals).  Lowers
- *    truncation error on clean data, costs variance under noise.
+ *    truncation error on clean data, costs variance under noise.  The
+ *    command's --robust-normals is degree_select 1 with dist_weight 0.55
+ *    (README: below CGAL's jet in every PCPNet cell on the same points).
  * The degree-selection fitters of lower degrees are created once per thread
  * (on first use; recreated only when the parameters change) and freed at
  * thread exit.  Defaults (off) and constants: README, bench_pcpnet.

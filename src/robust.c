@@ -28,39 +28,46 @@
 
 /* Tuning constants of the selection rules (select.c, scale.c), one place
  * so that the bench-only setter below reaches them all. */
-/* Width of the scale-selection confidence intervals, in standard
- * deviations (see jf_fit_point_full); chosen by measurement
- * (tests/bench_pcpnet.cpp, README). */
-#ifndef JF_SCALE_TAU
-#define JF_SCALE_TAU 1.0
+/* Scale selection's weight of the variance in its MSE estimate (scale.c:
+ * 2, by measurement on the §6.1 surface; README). */
+#ifndef JF_SCALE_VARW
+#define JF_SCALE_VARW 2.0
 #endif
 #ifndef JF_SCALE_TARGET
 #define JF_SCALE_TARGET 0.0
 #endif
-/* Degree selection: interval width in standard deviations (1; 0.5 and 2
- * were worse on PCPNet's armadillo overall), and the normal sd (radians)
- * below which the top degree is kept without trying lower ones (0.15:
- * clean K=18 d3 6.22 -> 6.17 deg, noise 0.00125 K=112 d3 15.05 -> 14.81,
- * other cells within 0.07; bench_pcpnet --same-points --dsdmin). */
+/* Degree selection: interval width in standard deviations, the normal sd
+ * (radians) below which the top degree is kept without trying lower ones,
+ * and the size above which the blob floor of the sd (select.c) shrinks
+ * like 1/sqrt(n).  Chosen together with --robust-normals' distance weight
+ * (0.55) on PCPNet's armadillo, the one set of the sweep below CGAL's jet
+ * in all 24 cells with the widest margin (1.5 / 0.2 / 50; the earlier
+ * 1 / 0.15 / no shrink lost 2 cells by up to 0.44 deg; bench_pcpnet
+ * --same-points --dtau --dsdmin --dfloorn, README). */
 #ifndef JF_DEGREE_TAU
-#define JF_DEGREE_TAU 1.0
+#define JF_DEGREE_TAU 1.5
 #endif
 #ifndef JF_DEGREE_SDMIN
-#define JF_DEGREE_SDMIN 0.15
+#define JF_DEGREE_SDMIN 0.2
+#endif
+#ifndef JF_DEGREE_FLOOR_N
+#define JF_DEGREE_FLOOR_N 50.0
 #endif
 
-jf__knobs jf__knob = {JF_SCALE_TAU, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN};
+jf__knobs jf__knob = {JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN,
+                      JF_DEGREE_FLOOR_N};
 
 /* Bench-only setter of the knobs (tests/bench_pcpnet.cpp measures them);
  * not in jetfit.h, not thread-safe: call before fitting.  name: a field
  * of jf__knobs.  Returns 0, or -1 for an unknown name. */
 int jf__robust_tune(const char *name, double v)
 {
-    if (!strcmp(name, "scale_tau")) jf__knob.scale_tau = v;
+    if (!strcmp(name, "scale_varw")) jf__knob.scale_varw = v;
     else if (!strcmp(name, "scale_target")) jf__knob.scale_target = v;
     else if (!strcmp(name, "scale_floor")) jf__knob.scale_floor = v;
     else if (!strcmp(name, "degree_tau")) jf__knob.degree_tau = v;
     else if (!strcmp(name, "degree_sdmin")) jf__knob.degree_sdmin = v;
+    else if (!strcmp(name, "degree_floor_n")) jf__knob.degree_floor_n = v;
     else return -1;
     return 0;
 }

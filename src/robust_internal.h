@@ -14,11 +14,13 @@
 
 /* Tuning constants of the selection rules (defaults in robust.c). */
 typedef struct {
-    double scale_tau;    /* scale selection: interval width, in sd */
+    double scale_varw;   /* scale selection: weight of the variance */
     double scale_target; /* scale selection: stop once sd is below (rad) */
     double scale_floor;  /* normal sd floor: sigma/h above this is a blob */
     double degree_tau;   /* degree selection: interval width, in sd */
     double degree_sdmin; /* degree selection: keep the top degree below */
+    double degree_floor_n; /* degree selection: the blob floor shrinks as
+                              sqrt(degree_floor_n / n) above this n */
 } jf__knobs;
 extern jf__knobs jf__knob;
 

@@ -14,15 +14,18 @@
 // points, Point_set_processing_3/internal/Neighbor_query.h); jetfit's K
 // counts the point itself (K points).
 // Usage: bench_pcpnet [DATA_DIR] [--quick] [--no-cgal] [--no-fixed]
-//   [--sweep "K,deg,robust[,dsel] ..."] [--tau X] [--floor X] [--target X]
-//   [--dtau X] [--distw X] [--same-points] [--levels L1,L2,..] [--cgal-k K]
+//   [--sweep "K,deg,robust[,dsel] ..."] [--varw X] [--floor X] [--target X]
+//   [--dtau X] [--dsdmin X] [--dfloorn X] [--distw X] [--same-points]
+//   [--levels L1,L2,..] [--cgal-k K]
 // --same-points: jetfit fits K + 1 points like CGAL (default: K, the query
 // included); --distw X: dist_weight of the --sweep configurations;
-// --dtau: degree-selection interval width; --levels: only these noise
+// --dtau, --dsdmin, --dfloorn: the degree-selection knobs of robust.c
+// (interval width, sd below which the top degree is kept, size above
+// which the blob floor shrinks); --levels: only these noise
 // levels; --cgal-k: CGAL at this K only (its K = 450 runs take minutes);
 // --quick: clean shape and the largest noise only, K = 18 and 112;
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
-// 0/1/2 = none/huber/tukey; with --no-fixed only those run); --tau,
+// 0/1/2 = none/huber/tukey; with --no-fixed only those run); --varw,
 // --floor, --target override the scale-selection constants of robust.c.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
@@ -43,8 +46,8 @@
 
 #include "jetfit.h"
 
-// src/robust.c's bench-only setter of its tuning constants (scale_tau,
-// scale_target, scale_floor, degree_tau).
+// src/robust.c's bench-only setter of its tuning constants (scale_varw,
+// scale_target, scale_floor, degree_tau, degree_sdmin, degree_floor_n).
 extern "C" int jf__robust_tune(const char *name, double v);
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
@@ -204,11 +207,12 @@ int main(int argc, char **argv)
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
         else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
-        else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc) jf__robust_tune("scale_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--varw") && i + 1 < argc) jf__robust_tune("scale_varw", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__robust_tune("scale_target", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__robust_tune("scale_floor", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--dtau") && i + 1 < argc) jf__robust_tune("degree_tau", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--dsdmin") && i + 1 < argc) jf__robust_tune("degree_sdmin", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dfloorn") && i + 1 < argc) jf__robust_tune("degree_floor_n", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--distw") && i + 1 < argc) g_distw = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--same-points")) same_points = true;
         else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
