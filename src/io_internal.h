@@ -131,4 +131,43 @@ int jf_zvec_reserve(size_t **v, size_t *cap, size_t want);
 /* Largest number of points a cloud may hold (indices are uint32). */
 #define JF_MAX_POINTS ((size_t)UINT32_MAX - 1)
 
+
+/* ---- the buffered output file (io_wfile.c) ---- */
+
+/* An output file in the making: buffered writes to a temporary beside the
+ * final name; the first failure sticks in st/err and later calls do
+ * nothing. */
+typedef struct {
+    int fd;
+    char *tmp, *final;
+    char *buf;
+    size_t len, cap;
+    jf_status st;
+    jf_error err;
+} jf_wfile;
+
+/* Opens the temporary for `path` (buffer >= min_cap bytes). */
+jf_status jf_wf_open(jf_wfile *f, const char *path, size_t min_cap);
+/* Records the first failure (message "FINAL: reason"); returns f->st. */
+jf_status jf_wf_fail(jf_wfile *f, jf_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Writes the buffer out. */
+jf_status jf_wf_flush(jf_wfile *f);
+/* Appends the string s. */
+jf_status jf_wf_puts(jf_wfile *f, const char *s);
+/* Frees f; on success (st OK) renames the temporary onto the final name,
+ * else removes it.  Returns the final status and fills err. */
+jf_status jf_wf_close(jf_wfile *f, jf_error *err);
+
+/* Room for `need` more bytes in the buffer (need <= cap). */
+static inline char *jf_wf_room(jf_wfile *f, size_t need)
+{
+    if (f->cap - f->len < need && jf_wf_flush(f) != JF_OK)
+        return NULL;
+    return f->buf + f->len;
+}
+
 #endif /* JF_IO_INTERNAL_H */

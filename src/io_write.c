@@ -1,11 +1,10 @@
 /*
  * io_write.c -- the table writer (jf_writer_*) and jf_cloud_write.
  *
- * design: output goes to a buffer (1 MiB, one write(2) per flush) feeding a
- * temporary ".NAME.tmp.PID" beside the final file; commit closes it and
- * renames it onto NAME, any failure or abort unlinks it, so a reader never
- * sees a partial file under the final name.  Doubles are written exactly
- * as "%.17g" would write them (jf_fmt_g17, io_fmt.c).
+ * design: output goes through a jf_wfile (io_wfile.c: a temporary file
+ * beside the final one, renamed onto it only on success), so a reader
+ * never sees a partial file under the final name.  Doubles are written
+ * exactly as "%.17g" would write them (jf_fmt_g17, io_fmt.c).
  */
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
@@ -20,130 +19,12 @@
 
 #include <omp.h>
 
-/* ---- buffered temporary file ------------------------------------------ */
-
-#define BUF_CAP (1u << 20)
-
-typedef struct {
-    int fd;
-    char *tmp, *final;
-    char *buf;
-    size_t len, cap;
-    jf_status st;
-    jf_error err;
-} wfile;
-
-static jf_status wf_fail(wfile *f, jf_status st, const char *fmt, ...)
-{
-    if (f->st != JF_OK)
-        return f->st;
-    f->st = st;
-    char why[256];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(why, sizeof why, fmt, ap);
-    va_end(ap);
-    jf_io_fail(&f->err, st, f->final ? f->final : "(output)", 0, "%s", why);
-    return st;
-}
-
-static jf_status wf_open(wfile *f, const char *path, size_t min_cap)
-{
-    memset(f, 0, sizeof *f);
-    f->fd = -1;
-    const char *slash = strrchr(path, '/');
-    size_t dirlen = slash ? (size_t)(slash - path + 1) : 0;
-    const char *base = path + dirlen;
-    size_t n = strlen(path) + 48;
-    f->final = strdup(path);
-    f->tmp = malloc(n);
-    f->cap = min_cap > BUF_CAP ? min_cap : BUF_CAP;
-    f->buf = malloc(f->cap);
-    if (!f->final || !f->tmp || !f->buf) {
-        return wf_fail(f, JF_ERR_NOMEM, "out of memory");
-    }
-    if (!*base)
-        return wf_fail(f, JF_ERR_INVALID, "no file name");
-    snprintf(f->tmp, n, "%.*s.%s.tmp.%ld", (int)dirlen, path, base,
-             (long)getpid());
-    f->fd = open(f->tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (f->fd < 0)
-        return wf_fail(f, JF_ERR_IO, "cannot create %s: %s", f->tmp,
-                       strerror(errno));
-    return JF_OK;
-}
-
-static jf_status wf_flush(wfile *f)
-{
-    size_t done = 0;
-    while (f->st == JF_OK && done < f->len) {
-        ssize_t w = write(f->fd, f->buf + done, f->len - done);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            return wf_fail(f, JF_ERR_IO, "write failed: %s",
-                           w < 0 ? strerror(errno) : "no progress");
-        done += (size_t)w;
-    }
-    f->len = 0;
-    return f->st;
-}
-
-/* Room for `need` more bytes in the buffer (need <= cap). */
-static inline char *wf_room(wfile *f, size_t need)
-{
-    if (f->cap - f->len < need && wf_flush(f) != JF_OK)
-        return NULL;
-    return f->buf + f->len;
-}
-
-static jf_status wf_puts(wfile *f, const char *s)
-{
-    size_t n = strlen(s);
-    while (n) {
-        char *o = wf_room(f, 1);
-        if (!o)
-            return f->st;
-        size_t k = f->cap - f->len < n ? f->cap - f->len : n;
-        memcpy(o, s, k);
-        f->len += k;
-        s += k;
-        n -= k;
-    }
-    return f->st;
-}
-
-/* Frees f; on success (st OK) renames the temporary onto the final name,
- * else removes it.  Returns the final status and fills err. */
-static jf_status wf_close(wfile *f, jf_error *err)
-{
-    jf_status st = f->st;
-    if (st == JF_OK)
-        st = wf_flush(f);
-    if (f->fd >= 0 && close(f->fd) != 0 && st == JF_OK)
-        st = wf_fail(f, JF_ERR_IO, "close failed: %s", strerror(errno));
-    f->fd = -1;
-    if (st == JF_OK && (!f->tmp || rename(f->tmp, f->final) != 0))
-        st = wf_fail(f, JF_ERR_IO, "cannot rename %s onto it: %s", f->tmp,
-                     strerror(errno));
-    if (st != JF_OK && f->tmp)
-        unlink(f->tmp);
-    if (err)
-        *err = f->err;
-    if (err && st == JF_ERR_NOMEM && !f->err.msg[0])
-        snprintf(err->msg, sizeof err->msg, "out of memory");
-    free(f->tmp);
-    free(f->final);
-    free(f->buf);
-    return st;
-}
-
 /* ---- the table writer ------------------------------------------------- */
 
 enum { FMT_PLY, FMT_CSV, FMT_XYZ };
 
 struct jf_writer {
-    wfile f;
+    jf_wfile f;
     int fmt, ascii;
     size_t ncols, nrows, rows;
     jf_col_type *types;
@@ -170,38 +51,38 @@ static int32_t to_i32(double v)
 
 static jf_status write_header(jf_writer *w)
 {
-    wfile *f = &w->f;
+    jf_wfile *f = &w->f;
     static const char *const ply_t[] = {"double", "float", "int"};
     char line[128];
     w->header_done = 1;
     if (w->fmt == FMT_PLY) {
         snprintf(line, sizeof line, "ply\nformat %s 1.0\n",
                  w->ascii ? "ascii" : "binary_little_endian");
-        wf_puts(f, line);
-        wf_puts(f, "comment written by jetfit " JF_VERSION_STRING "\n");
+        jf_wf_puts(f, line);
+        jf_wf_puts(f, "comment written by jetfit " JF_VERSION_STRING "\n");
         snprintf(line, sizeof line, "element vertex %zu\n", w->nrows);
-        wf_puts(f, line);
+        jf_wf_puts(f, line);
         for (size_t j = 0; j < w->ncols; j++) {
-            wf_puts(f, "property ");
-            wf_puts(f, ply_t[w->types[j]]);
-            wf_puts(f, " ");
-            wf_puts(f, w->names[j]);
-            wf_puts(f, "\n");
+            jf_wf_puts(f, "property ");
+            jf_wf_puts(f, ply_t[w->types[j]]);
+            jf_wf_puts(f, " ");
+            jf_wf_puts(f, w->names[j]);
+            jf_wf_puts(f, "\n");
         }
         if (w->foff) {
             snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
-            wf_puts(f, line);
-            wf_puts(f, "property list uchar int vertex_indices\n");
+            jf_wf_puts(f, line);
+            jf_wf_puts(f, "property list uchar int vertex_indices\n");
         }
-        return wf_puts(f, "end_header\n");
+        return jf_wf_puts(f, "end_header\n");
     }
-    wf_puts(f, w->fmt == FMT_CSV ? "" : "# ");
+    jf_wf_puts(f, w->fmt == FMT_CSV ? "" : "# ");
     for (size_t j = 0; j < w->ncols; j++) {
         if (j)
-            wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
-        wf_puts(f, w->names[j]);
+            jf_wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
+        jf_wf_puts(f, w->names[j]);
     }
-    return wf_puts(f, "\n");
+    return jf_wf_puts(f, "\n");
 }
 
 jf_status jf_writer_open(const char *path, const jf_column *cols,
@@ -242,11 +123,11 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     w->names = calloc(ncols, sizeof *w->names);
     jf_status st = JF_OK;
     /* a row takes at most 32 bytes per value */
-    if (wf_open(&w->f, path, ncols * 32 + 64) != JF_OK)
+    if (jf_wf_open(&w->f, path, ncols * 32 + 64) != JF_OK)
         st = w->f.st != JF_OK ? w->f.st : JF_ERR_NOMEM;
     for (size_t j = 0; st == JF_OK && j < ncols; j++) {
         if (!w->types || !w->names || !(w->names[j] = strdup(cols[j].name)))
-            st = wf_fail(&w->f, JF_ERR_NOMEM, "out of memory");
+            st = jf_wf_fail(&w->f, JF_ERR_NOMEM, "out of memory");
         else
             w->types[j] = cols[j].type;
     }
@@ -356,15 +237,15 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
 {
     if (!w || !vals)
         return JF_ERR_INVALID;
-    wfile *f = &w->f;
+    jf_wfile *f = &w->f;
     if (f->st != JF_OK)
         return f->st;
     if (!w->header_done && write_header(w) != JF_OK)
         return f->st;
     if (w->rows == w->nrows)
-        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
+        return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
                        w->nrows);
-    char *o = wf_room(f, w->ncols * 32 + 2);
+    char *o = jf_wf_room(f, w->ncols * 32 + 2);
     if (!o)
         return f->st;
     f->len += format_row(w, vals, o);
@@ -380,13 +261,13 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
 {
     if (!w || (nrows && !vals))
         return JF_ERR_INVALID;
-    wfile *f = &w->f;
+    jf_wfile *f = &w->f;
     if (f->st != JF_OK)
         return f->st;
     if (!w->header_done && write_header(w) != JF_OK)
         return f->st;
     if (nrows > w->nrows - w->rows)
-        return wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
+        return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
                        w->nrows);
     const int nt = threads > 0 ? threads : omp_get_max_threads();
     const size_t row_max = w->ncols * 32 + 2, slot = ROWS_BLOCK * row_max;
@@ -395,7 +276,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (!scratch || !len) {
         free(scratch);
         free(len);
-        return wf_fail(f, JF_ERR_NOMEM, "out of memory");
+        return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
     }
     /* each round: thread t formats the t-th block of ROWS_BLOCK rows into
      * its slot, then the slots go out in order, unbuffered */
@@ -409,11 +290,11 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
             for (size_t r = a; r < b && r < nrows; r++)
                 len[t] += format_row(w, vals + r * w->ncols, o + len[t]);
         }
-        for (int t = 0; t < nt && wf_flush(f) == JF_OK; t++) {
-            f->len = len[t]; /* wf_flush writes buf[0..len) */
+        for (int t = 0; t < nt && jf_wf_flush(f) == JF_OK; t++) {
+            f->len = len[t]; /* jf_wf_flush writes buf[0..len) */
             char *keep = f->buf;
             f->buf = scratch + (size_t)t * slot;
-            wf_flush(f);
+            jf_wf_flush(f);
             f->buf = keep;
         }
     }
@@ -426,11 +307,11 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
 
 static jf_status write_faces(jf_writer *w)
 {
-    wfile *f = &w->f;
+    jf_wfile *f = &w->f;
     int little = host_little();
     for (size_t i = 0; i < w->nfaces && f->st == JF_OK; i++) {
         size_t k = w->foff[i + 1] - w->foff[i];
-        char *o = wf_room(f, 16 * k + 8);
+        char *o = jf_wf_room(f, 16 * k + 8);
         if (!o)
             break;
         char *o0 = o;
@@ -461,15 +342,15 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
 {
     if (!w)
         return JF_ERR_INVALID;
-    wfile *f = &w->f;
+    jf_wfile *f = &w->f;
     if (f->st == JF_OK && !w->header_done)
         write_header(w);
     if (f->st == JF_OK && w->rows != w->nrows)
-        wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced",
+        jf_wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced",
                 w->rows, w->nrows);
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
-    jf_status st = wf_close(f, err);
+    jf_status st = jf_wf_close(f, err);
     for (size_t j = 0; w->names && j < w->ncols; j++)
         free(w->names[j]);
     free(w->names);
@@ -483,8 +364,8 @@ void jf_writer_abort(jf_writer *w)
     if (!w)
         return;
     if (w->f.st == JF_OK)
-        w->f.st = JF_ERR_INVALID; /* makes wf_close remove the temporary */
-    wf_close(&w->f, NULL);
+        w->f.st = JF_ERR_INVALID; /* makes jf_wf_close remove the temporary */
+    jf_wf_close(&w->f, NULL);
     for (size_t j = 0; w->names && j < w->ncols; j++)
         free(w->names[j]);
     free(w->names);
@@ -496,16 +377,16 @@ void jf_writer_abort(jf_writer *w)
 
 static jf_status write_off(const char *path, const jf_cloud *c, jf_error *err)
 {
-    wfile f;
-    if (wf_open(&f, path, 4096) != JF_OK)
-        return wf_close(&f, err);
+    jf_wfile f;
+    if (jf_wf_open(&f, path, 4096) != JF_OK)
+        return jf_wf_close(&f, err);
     char line[96];
-    wf_puts(&f, c->nrm ? "NOFF\n" : "OFF\n");
+    jf_wf_puts(&f, c->nrm ? "NOFF\n" : "OFF\n");
     snprintf(line, sizeof line, "%zu %zu 0\n", c->n, c->nfaces);
-    wf_puts(&f, line);
+    jf_wf_puts(&f, line);
     int nc = c->nrm ? 6 : 3;
     for (size_t i = 0; i < c->n && f.st == JF_OK; i++) {
-        char *o = wf_room(&f, 6 * 32 + 2);
+        char *o = jf_wf_room(&f, 6 * 32 + 2);
         if (!o)
             break;
         char *o0 = o;
@@ -520,10 +401,10 @@ static jf_status write_off(const char *path, const jf_cloud *c, jf_error *err)
     for (size_t i = 0; i < c->nfaces && f.st == JF_OK; i++) {
         size_t k = c->face_off[i + 1] - c->face_off[i];
         if (k > 1000000) {
-            wf_fail(&f, JF_ERR_INVALID, "face %zu: bad offsets", i);
+            jf_wf_fail(&f, JF_ERR_INVALID, "face %zu: bad offsets", i);
             break;
         }
-        char *o = wf_room(&f, 12 * k + 24);
+        char *o = jf_wf_room(&f, 12 * k + 24);
         if (!o)
             break;
         char *o0 = o;
@@ -535,7 +416,7 @@ static jf_status write_off(const char *path, const jf_cloud *c, jf_error *err)
         *o++ = '\n';
         f.len += (size_t)(o - o0);
     }
-    return wf_close(&f, err);
+    return jf_wf_close(&f, err);
 }
 
 jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
