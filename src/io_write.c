@@ -233,18 +233,27 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
     return (size_t)(o - o0);
 }
 
-jf_status jf_writer_row(jf_writer *w, const double *vals)
+/* The writer can take nrows more rows: no earlier failure, the header
+ * written, no more rows than announced. */
+static jf_status ready_for(jf_writer *w, size_t nrows)
 {
-    if (!w || !vals)
-        return JF_ERR_INVALID;
     jf_wfile *f = &w->f;
     if (f->st != JF_OK)
         return f->st;
     if (!w->header_done && write_header(w) != JF_OK)
         return f->st;
-    if (w->rows == w->nrows)
-        return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
-                       w->nrows);
+    if (nrows > w->nrows - w->rows)
+        return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced", w->nrows);
+    return JF_OK;
+}
+
+jf_status jf_writer_row(jf_writer *w, const double *vals)
+{
+    if (!w || !vals)
+        return JF_ERR_INVALID;
+    jf_wfile *f = &w->f;
+    if (ready_for(w, 1) != JF_OK)
+        return f->st;
     char *o = jf_wf_room(f, w->ncols * 32 + 2);
     if (!o)
         return f->st;
@@ -262,13 +271,8 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (!w || (nrows && !vals))
         return JF_ERR_INVALID;
     jf_wfile *f = &w->f;
-    if (f->st != JF_OK)
+    if (ready_for(w, nrows) != JF_OK)
         return f->st;
-    if (!w->header_done && write_header(w) != JF_OK)
-        return f->st;
-    if (nrows > w->nrows - w->rows)
-        return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced",
-                       w->nrows);
     const int nt = threads > 0 ? threads : omp_get_max_threads();
     const size_t row_max = w->ncols * 32 + 2, slot = ROWS_BLOCK * row_max;
     char *scratch = malloc((size_t)nt * slot);
