@@ -28,10 +28,10 @@ struct jf_fitter {
     uint32_t *order;  /* maxn indices of usable points, nearest first  */
     double *m;        /* maxn*maxc scaled Vandermonde M', column-major  */
     double *v;        /* maxc*maxc right singular vectors              */
-    double *x;        /* maxc*maxc R of M' = QR, then U of its SVD      */
-    double *s;        /* maxc singular values                          */
-    double *work;     /* maxc GSL scratch                              */
-    double *rhs;      /* maxn right-hand side                          */
+    double *x;        /* maxc*maxc R^T R, or R (R^T) then its SVD      */
+    double *s;        /* maxc singular values (or their squares)       */
+    double *work;     /* maxc scratch (QR norms, eigen, GSL)           */
+    double *rhs;      /* maxn right-hand side, then Q^T of it          */
     double *sol;      /* maxc scaled solution Y                        */
     double coef[JF_CURVE_COLS > 55 ? JF_CURVE_COLS : 55]; /* jet A_ij  */
     int perm[55];     /* column pivoting of the QR                     */
@@ -71,10 +71,12 @@ void jf__result_nan(jf_result *out);
 /* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
  * by pivoted QR, then (kappa <= 1e3) the eigenvalues of R^T R and a
- * back-substitution, or an SVD of the cols x cols R; fills f->sol, *cond
- * (f->m, f->x, f->v, f->s, f->work are scratch); returns 0, 1 if the
- * matrix is rank deficient (sigma_min <= sigma_max * rows * DBL_EPSILON),
- * -1 on a GSL failure. */
+ * back-substitution, or an SVD of the cols x cols R; fills f->sol, *cond,
+ * and leaves Q^T rhs in f->rhs (its rows cols.. are the residual, jet.c);
+ * f->m, f->x, f->v, f->s, f->work, f->perm, f->tmp are scratch.  Returns
+ * 0, 1 if the matrix is rank deficient (sigma_min <= sigma_max * rows *
+ * DBL_EPSILON), -1 when no SVD was had (GSL failure, or a singular value
+ * not finite). */
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
 /* jet.c */

@@ -172,8 +172,9 @@ static jf_status get_neighbours(const nbsrc *src, uint32_t u, uint32_t *nb, size
     return JF_OK;
 }
 
-/* design: Prim over the k-NN graph, neighbours queried again when a point
- * is popped (memory O(n): no adjacency is stored).
+/* design: Prim over the k-NN graph, neighbours queried again (or read
+ * from the caller's lists) when a point is popped (memory O(n): no
+ * adjacency is stored here).
  *  1. Seeds in order of decreasing z.  A seed is oriented by its lightest
  *     already-oriented k-NN neighbour if it has one (k-NN is not symmetric:
  *     this recovers the edges only the other end lists), else it starts a
@@ -183,6 +184,9 @@ static jf_status get_neighbours(const nbsrc *src, uint32_t u, uint32_t *nb, size
  *  A seed with no orientable neighbour gets JF_PT_ORIENT_UNKNOWN. */
 static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *src)
 {
+    if (n && (!res || !xyz || !(src->ix || src->g))) return JF_ERR_INVALID;
+    if (src->k < 1 || src->k > 1024) return JF_ERR_INVALID;
+    if (n >= DONE) return JF_ERR_TOO_LARGE;
     size_t k = src->k;
     mheap h = {0};
     uint32_t *parent = malloc((n ? n : 1) * sizeof *parent);
@@ -273,9 +277,6 @@ out:
 jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
                         const jf_index *ix, size_t k)
 {
-    if (n && (!res || !xyz || !ix)) return JF_ERR_INVALID;
-    if (k < 1 || k > 1024) return JF_ERR_INVALID;
-    if (n >= DONE) return JF_ERR_TOO_LARGE;
     nbsrc src = {ix, NULL, xyz, k};
     return prim(res, xyz, n, &src);
 }
@@ -283,9 +284,6 @@ jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
 jf_status jf_orient_mst_graph(jf_result *res, const double *xyz, size_t n,
                               const uint32_t *nbr, size_t k)
 {
-    if (n && (!res || !xyz || !nbr)) return JF_ERR_INVALID;
-    if (k < 1 || k > 1024) return JF_ERR_INVALID;
-    if (n >= DONE) return JF_ERR_TOO_LARGE;
     nbsrc src = {NULL, nbr, xyz, k};
     return prim(res, xyz, n, &src);
 }

@@ -53,10 +53,9 @@ static void nan_result(jf_result *r, unsigned status)
 {
     memset(r, 0, sizeof *r);
     r->status = status;
-    r->cond = r->residual = r->k1 = r->k2 = NAN;
-    for (int j = 0; j < 3; j++) r->pca_eval[j] = r->normal[j] = r->d1[j] = r->d2[j] = NAN;
-    for (int j = 0; j < 4; j++) r->b[j] = NAN;
-    for (int j = 0; j < 5; j++) r->c[j] = NAN;
+    r->cond = r->residual = NAN;
+    for (int j = 0; j < 3; j++) r->pca_eval[j] = NAN;
+    jf__result_nan(r);
 }
 
 static int finite3(const double *p)
@@ -158,18 +157,16 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     return st;
 }
 
-/* Neighbourhood of point i (at p) into idx[0..cap-1] and, from the k-d
- * tree's own storage, their coordinates into xyz (*gathered = 1; other
- * kinds leave that to the caller); *flags gets per-point flags (few
- * neighbours, the natural normal's source, failure). */
+/* Neighbourhood of point i (at p) into idx[0..cap-1] and, for the k-d
+ * tree's kinds (knn, radius), their coordinates from its own storage into
+ * xyz (other kinds leave that to the caller); *flags gets per-point flags
+ * (few neighbours, the natural normal's source, failure). */
 static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const double *p,
-                          uint32_t *idx, double *d2, double *xyz, int *gathered, size_t *found,
-                          unsigned *flags)
+                          uint32_t *idx, double *d2, double *xyz, size_t *found, unsigned *flags)
 {
     jf_status st;
     *found = 0;
     *flags = 0;
-    *gathered = 0;
     switch (x->nb->kind) {
     case JF_NB_RINGS:
         st = jf_nb_query_mesh(x->mesh, x->xyz, x->nb, x->min_count, x->fit, (uint32_t)i, idx,
@@ -185,11 +182,10 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
             *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
             return JF_OK;
         }
-        st = jf_natural_neighbors(x->nt, ws, i, x->nrm + 3 * i, x->want, idx, x->cap, found);
+        st = jf_natural_neighbors(x->nt, ws, i, m, x->want, idx, x->cap, found);
         break;
     default:
         st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
-        *gathered = 1;
     }
     if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
     return st;
@@ -239,24 +235,30 @@ static void keep_edges(const nbctx *x, size_t i, const uint32_t *idx, size_t fou
     while (m < x->gk) row[m++] = UINT32_MAX;
 }
 
+/* The row of a point with a non-finite coordinate (and no graph edges). */
+static void nonfinite_row(const nbctx *x, size_t i, jf_result *out)
+{
+    if (x->graph) keep_edges(x, i, NULL, 0);
+    nan_result(out, JF_PT_NONFINITE);
+}
+
 /* Point i, at p (its coordinates, from the input or the tree's copy). */
 static jf_status fit_one(worker *w, const nbctx *x, size_t i, const double *p, jf_result *out)
 {
-    if (x->graph) keep_edges(x, i, NULL, 0);
     if (!finite3(p)) {
-        nan_result(out, JF_PT_NONFINITE);
+        nonfinite_row(x, i, out);
         return JF_OK;
     }
     size_t found = 0;
     unsigned flags = 0;
-    int gathered = 0;
-    jf_status st = nb_query(x, w->nws, i, p, w->idx, w->d2, w->coords, &gathered, &found, &flags);
+    jf_status st = nb_query(x, w->nws, i, p, w->idx, w->d2, w->coords, &found, &flags);
     if (st != JF_OK) return st;
     if (x->graph) keep_edges(x, i, w->idx, found);
     if (flags & JF_PT_FAILED) {
         nan_result(out, flags);
         return JF_OK;
     }
+    const int gathered = x->nb->kind <= JF_NB_KNN_RADIUS; /* by nb_query */
     for (size_t j = 0; !gathered && j < found; j++)
         memcpy(w->coords + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
     st = jf_fit_point_full(w->fit, p, w->coords, found, out);
@@ -368,10 +370,7 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     if (nb.kind <= JF_NB_KNN_RADIUS) {
         nwalk = jf__index_points(ix, &walk_xyz, &walk);
         for (size_t i = 0; nwalk < n && i < n; i++)
-            if (!finite3(c->xyz + 3 * i)) {
-                if (x.graph) keep_edges(&x, i, NULL, 0);
-                nan_result(&out[i], JF_PT_NONFINITE);
-            }
+            if (!finite3(c->xyz + 3 * i)) nonfinite_row(&x, i, &out[i]);
     } else {
         order = malloc(n * sizeof *order);
         if (!order) {
