@@ -156,6 +156,8 @@ jf_status jf_wf_fail(jf_wfile *f, jf_status st, const char *fmt, ...)
     ;
 /* Writes the buffer out. */
 jf_status jf_wf_flush(jf_wfile *f);
+/* Writes the buffer out, then [p, p + n) straight to the file. */
+jf_status jf_wf_write(jf_wfile *f, const char *p, size_t n);
 /* Appends the string s. */
 jf_status jf_wf_puts(jf_wfile *f, const char *s);
 /* Frees f; on success (st OK) renames the temporary onto the final name,

@@ -56,20 +56,34 @@ jf_status jf_wf_open(jf_wfile *f, const char *path, size_t min_cap)
     return JF_OK;
 }
 
-jf_status jf_wf_flush(jf_wfile *f)
+/* Writes all of [p, p + n) to the file (short writes retried). */
+static jf_status write_all(jf_wfile *f, const char *p, size_t n)
 {
     size_t done = 0;
-    while (f->st == JF_OK && done < f->len) {
-        ssize_t w = write(f->fd, f->buf + done, f->len - done);
+    while (f->st == JF_OK && done < n) {
+        ssize_t w = write(f->fd, p + done, n - done);
         if (w < 0 && errno == EINTR)
             continue;
         if (w <= 0)
             return jf_wf_fail(f, JF_ERR_IO, "write failed: %s",
-                           w < 0 ? strerror(errno) : "no progress");
+                              w < 0 ? strerror(errno) : "no progress");
         done += (size_t)w;
     }
+    return f->st;
+}
+
+jf_status jf_wf_flush(jf_wfile *f)
+{
+    write_all(f, f->buf, f->len);
     f->len = 0;
     return f->st;
+}
+
+jf_status jf_wf_write(jf_wfile *f, const char *p, size_t n)
+{
+    if (jf_wf_flush(f) != JF_OK)
+        return f->st;
+    return write_all(f, p, n);
 }
 
 jf_status jf_wf_puts(jf_wfile *f, const char *s)

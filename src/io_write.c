@@ -9,13 +9,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <omp.h>
 
@@ -168,8 +165,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
 {
     char *o0 = o;
     if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
-        /* the usual case, kept tight (it runs serially, once per point):
-         * fixed-size copies, no per-value memcpy call */
+        /* the usual case, kept tight (it runs once per point): fixed-size
+         * copies, no per-value memcpy call */
         for (size_t j = 0; j < w->ncols; j++) {
             const double v = vals[j];
             if (w->types[j] == JF_COL_F64) {
@@ -294,13 +291,8 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
             for (size_t r = a; r < b && r < nrows; r++)
                 len[t] += format_row(w, vals + r * w->ncols, o + len[t]);
         }
-        for (int t = 0; t < nt && jf_wf_flush(f) == JF_OK; t++) {
-            f->len = len[t]; /* jf_wf_flush writes buf[0..len) */
-            char *keep = f->buf;
-            f->buf = scratch + (size_t)t * slot;
-            jf_wf_flush(f);
-            f->buf = keep;
-        }
+        for (int t = 0; t < nt && f->st == JF_OK; t++)
+            jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
     }
     free(scratch);
     free(len);
@@ -342,6 +334,16 @@ static jf_status write_faces(jf_writer *w)
     return f->st;
 }
 
+/* Frees the writer itself (its file is closed by jf_wf_close). */
+static void free_writer(jf_writer *w)
+{
+    for (size_t j = 0; w->names && j < w->ncols; j++)
+        free(w->names[j]);
+    free(w->names);
+    free(w->types);
+    free(w);
+}
+
 jf_status jf_writer_commit(jf_writer *w, jf_error *err)
 {
     if (!w)
@@ -355,11 +357,7 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
     jf_status st = jf_wf_close(f, err);
-    for (size_t j = 0; w->names && j < w->ncols; j++)
-        free(w->names[j]);
-    free(w->names);
-    free(w->types);
-    free(w);
+    free_writer(w);
     return st;
 }
 
@@ -370,11 +368,7 @@ void jf_writer_abort(jf_writer *w)
     if (w->f.st == JF_OK)
         w->f.st = JF_ERR_INVALID; /* makes jf_wf_close remove the temporary */
     jf_wf_close(&w->f, NULL);
-    for (size_t j = 0; w->names && j < w->ncols; j++)
-        free(w->names[j]);
-    free(w->names);
-    free(w->types);
-    free(w);
+    free_writer(w);
 }
 
 /* ---- clouds and meshes -------------------------------------------------- */
