@@ -402,11 +402,6 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     if (!orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
-    if (c.n == 0) {
-        fprintf(stderr, "jetfit: %s: no points\n", in);
-        jf_cloud_free(&c);
-        return 1;
-    }
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[32];

@@ -217,9 +217,10 @@ int jf_cmd_render(int argc, char **argv)
     size_t n = t.nrows, nc = t.ncols;
     double *val = malloc(n * sizeof *val), *tmp = malloc(n * sizeof *tmp);
     unsigned char *take = calloc(n, 1);
-    if (!val || !tmp || !take) {
+    by_depth *ord = malloc(n * sizeof *ord); /* painter's order, below */
+    if (!val || !tmp || !take || !ord) {
         fprintf(stderr, "jetfit render: out of memory\n");
-        free(val), free(tmp), free(take);
+        free(val), free(tmp), free(take), free(ord);
         jf_eval_table_free(&t);
         return 1;
     }
@@ -237,7 +238,10 @@ int jf_cmd_render(int argc, char **argv)
         if (isfinite(val[i]))
             tmp[nfin++] = val[i];
         double s[2];
-        project(r + c.x, rotx, rotz, s);
+        ord[i].depth = project(r + c.x, rotx, rotz, s);
+        ord[i].i = i;
+        if (!isfinite(ord[i].depth))
+            ord[i].depth = -INFINITY;
         for (int k = 0; k < 2; k++)
             if (isfinite(s[k])) {
                 smin[k] = fmin(smin[k], s[k]);
@@ -255,20 +259,6 @@ int jf_cmd_render(int argc, char **argv)
         vhi = vlo + 1e-12 + fabs(vlo) * 1e-6;
     /* painter's order: far points first, so near ones cover them
      * (gnuplot does not depth-sort points) */
-    by_depth *ord = malloc(n * sizeof *ord);
-    for (size_t i = 0; ord && i < n; i++) {
-        double s[2];
-        ord[i].depth = project(t.v + i * nc + c.x, rotx, rotz, s);
-        ord[i].i = i;
-        if (!isfinite(ord[i].depth))
-            ord[i].depth = -INFINITY;
-    }
-    if (!ord) {
-        fprintf(stderr, "jetfit render: out of memory\n");
-        free(val), free(tmp), free(take);
-        jf_eval_table_free(&t);
-        return 1;
-    }
     qsort(ord, n, sizeof *ord, cmp_depth);
     /* glyphs: the nearest point of each cell of a g x g screen grid */
     double span = fmax(smax[0] - smin[0], smax[1] - smin[1]);
@@ -299,14 +289,14 @@ int jf_cmd_render(int argc, char **argv)
 
     if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
         fprintf(stderr, "jetfit render: gnuplot not found (Debian package gnuplot-nox)\n");
-        free(val), free(tmp), free(take);
+        free(val), free(tmp), free(take), free(ord);
         jf_eval_table_free(&t);
         return 1;
     }
     FILE *gp = popen("gnuplot", "w");
     if (!gp) {
         fprintf(stderr, "jetfit render: cannot run gnuplot: %s\n", strerror(errno));
-        free(val), free(tmp), free(take);
+        free(val), free(tmp), free(take), free(ord);
         jf_eval_table_free(&t);
         return 1;
     }
