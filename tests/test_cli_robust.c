@@ -43,16 +43,23 @@ static double median_normal_err(const char *path, int degree, size_t *lowered)
     return e[n / 2];
 }
 
-START_TEST(degree_select_on_noise)
+/* The §6.1 surface on a SIDE x SIDE grid (seed 7) with uniform noise of
+ * 2% of the unit domain, as .xyz. */
+static void write_noisy(const char *path)
 {
     static double xyz[3 * SIDE * SIDE];
     cli_surface61(SIDE, xyz, 7);
-    unsigned long long s = 99; /* uniform noise of 2% of the unit domain */
+    unsigned long long s = 99;
     for (size_t i = 0; i < 3 * SIDE * SIDE; i++) {
         s = s * 6364136223846793005ULL + 1442695040888963407ULL;
         xyz[i] += 0.02 * ((double)(s >> 11) / 9007199254740992.0 - 0.5);
     }
-    cli_write_xyz(cli_path("noisy.xyz"), xyz, NULL, SIDE * SIDE);
+    cli_write_xyz(path, xyz, NULL, SIDE * SIDE);
+}
+
+START_TEST(degree_select_on_noise)
+{
+    write_noisy(cli_path("noisy.xyz"));
     ck_assert_int_eq(cli_run("estimate", cli_path("noisy.xyz"), "-o", cli_path("a.csv"),
                              "--neighbors", "knn:18", "--degree", "3", "--quiet", NULL), 0);
     ck_assert_int_eq(cli_run("estimate", cli_path("noisy.xyz"), "-o", cli_path("b.csv"),
@@ -113,14 +120,7 @@ START_TEST(robust_normals_preset)
     ck_assert_int_eq(pclose(h), 0);
     ck_assert_msg(strstr(help, "--robust-normals"), "not in --help");
 
-    static double xyz[3 * SIDE * SIDE];
-    cli_surface61(SIDE, xyz, 7);
-    unsigned long long s = 99; /* uniform noise of 2% of the unit domain */
-    for (size_t i = 0; i < 3 * SIDE * SIDE; i++) {
-        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-        xyz[i] += 0.02 * ((double)(s >> 11) / 9007199254740992.0 - 0.5);
-    }
-    cli_write_xyz(cli_path("noisy.xyz"), xyz, NULL, SIDE * SIDE);
+    write_noisy(cli_path("noisy.xyz"));
     const char *k18[] = {"--neighbors", "knn:18", "--degree", "3", "--quiet"};
     ck_assert_int_eq(cli_run("estimate", cli_path("noisy.xyz"), "-o", cli_path("a.csv"), k18[0],
                              k18[1], k18[2], k18[3], k18[4], NULL), 0);

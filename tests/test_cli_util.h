@@ -78,18 +78,25 @@ static inline int cli_count_files(void)
     return n;
 }
 
+/* Fills argv with `jetfit FIRST ...` from a NULL-terminated list (at most
+ * 62 arguments kept), itself NULL-terminated. */
+static inline void cli_argv(const char *argv[64], const char *first, va_list ap)
+{
+    int argc = 0;
+    argv[argc++] = JETFIT_BIN;
+    for (const char *a = first; a && argc < 63; a = va_arg(ap, const char *)) argv[argc++] = a;
+    argv[argc] = NULL;
+}
+
 /* Runs `jetfit ARGS...` (NULL-terminated), stdout to /dev/null, stderr
  * captured in cli_err.  Returns the exit status (or 128 + signal). */
 static inline int cli_run(const char *first, ...)
 {
     const char *argv[64];
-    int argc = 0;
     va_list ap;
-    argv[argc++] = JETFIT_BIN;
     va_start(ap, first);
-    for (const char *a = first; a && argc < 63; a = va_arg(ap, const char *)) argv[argc++] = a;
+    cli_argv(argv, first, ap);
     va_end(ap);
-    argv[argc] = NULL;
     char errpath[512];
     snprintf(errpath, sizeof errpath, "%s.stderr", cli_dir);
     fflush(NULL);
@@ -129,13 +136,10 @@ char *ptsname(int fd);
 static inline int cli_run_tty(const char *first, ...)
 {
     const char *argv[64];
-    int argc = 0;
     va_list ap;
-    argv[argc++] = JETFIT_BIN;
     va_start(ap, first);
-    for (const char *a = first; a && argc < 63; a = va_arg(ap, const char *)) argv[argc++] = a;
+    cli_argv(argv, first, ap);
     va_end(ap);
-    argv[argc] = NULL;
     int m = posix_openpt(O_RDWR | O_NOCTTY);
     if (m < 0 || grantpt(m) || unlockpt(m)) return -1;
     const char *slave = ptsname(m);
