@@ -30,9 +30,7 @@ char *jf_fmt_uint(char *o, uint64_t v)
  * 0 <= k <= 27 (5^27 m < 2^116: exact in 128 bits); 0 if out of reach. */
 static int scaled(uint64_t m, int q, int k, uint64_t *out, uint64_t *fl)
 {
-    unsigned __int128 p = m;
-    for (int i = 0; i < k; i++)
-        p *= 5;
+    unsigned __int128 p = (unsigned __int128)m * jf_pow5(k);
     int s = q + k; /* |v| * 10^k = p * 2^s */
     if (s >= 0) {
         if (s > 10)

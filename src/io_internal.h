@@ -58,6 +58,16 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
  * integers; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
 
+/* 5^k for 0 <= k <= 27 (5^27 < 2^63): the exact decimal paths of
+ * jf_parse_double and jf_fmt_g17. */
+static inline uint64_t jf_pow5(int k)
+{
+    uint64_t p = 1;
+    while (k--)
+        p *= 5;
+    return p;
+}
+
 /* Writes v exactly as printf("%.17g", v) does, except NaN -> "nan"
  * (never "-nan"); at most 24 bytes, no NUL.  Returns the end. */
 char *jf_fmt_g17(char *out, double v);

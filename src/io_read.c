@@ -117,15 +117,6 @@ static int slow_double(const char *s, const char *e, double *out)
     return 1;
 }
 
-/* 5^0 .. 5^27 (5^27 < 2^63). */
-static uint64_t pow5(int k)
-{
-    uint64_t p = 1;
-    while (k--)
-        p *= 5;
-    return p;
-}
-
 /* m 10^e10 correctly rounded, for m < 2^64, |e10| <= 27, by exact 128-bit
  * integer arithmetic (the digits a %.17g writer produces); 0 if the result
  * would be subnormal (left to strtod). */
@@ -135,12 +126,12 @@ static int wide_double(uint64_t m, int e10, double *out)
         return 0;
     if (e10 >= 0) {
         /* m 5^e < 2^127: exact; one rounding in the conversion */
-        unsigned __int128 p = (unsigned __int128)m * pow5(e10);
+        unsigned __int128 p = (unsigned __int128)m * jf_pow5(e10);
         *out = ldexp((double)p, e10);
         return 1;
     }
     int k = -e10, lz = __builtin_clzll(m);
-    uint64_t d = pow5(k);
+    uint64_t d = jf_pow5(k);
     /* q = floor(m 2^(lz+63) / 5^k) has >= 64 bits; a sticky last bit for a
      * non-zero remainder makes the one rounding to 53 bits exact */
     unsigned __int128 num = (unsigned __int128)(m << lz) << 63;
