@@ -320,6 +320,51 @@ START_TEST(test_no_hidden_state)
 }
 END_TEST
 
+/* A random rows x cols least-squares problem and GSL's answer: column j of
+ * A scaled by grade^(j / (cols-1)), entries of A (column by column) then
+ * of b uniform in [-1, 1) from urand(), stored column-major in a (leading
+ * dimension rows) and in b; GSL's Golub-Reinsch SVD solution into x.
+ * Returns GSL's kappa; *xn = max |x_j|. */
+static double gsl_graded_lsq(size_t rows, size_t cols, double grade, double *a, double *b,
+                             double *x, double *xn)
+{
+    gsl_matrix *ga = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
+    gsl_vector *sv = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
+    gsl_vector *gb = gsl_vector_alloc(rows), *gx = gsl_vector_alloc(cols);
+    for (size_t j = 0; j < cols; j++) {
+        double sc = pow(grade, (double)j / (double)(cols - 1));
+        for (size_t i = 0; i < rows; i++) {
+            a[j * rows + i] = sc * (2 * urand() - 1);
+            gsl_matrix_set(ga, i, j, a[j * rows + i]);
+        }
+    }
+    for (size_t i = 0; i < rows; i++) gsl_vector_set(gb, i, b[i] = 2 * urand() - 1);
+    ck_assert_int_eq(gsl_linalg_SV_decomp(ga, v, sv, w), 0);
+    ck_assert_int_eq(gsl_linalg_SV_solve(ga, v, sv, gb, gx), 0);
+    double gcond = gsl_vector_get(sv, 0) / gsl_vector_get(sv, cols - 1);
+    *xn = 0;
+    for (size_t j = 0; j < cols; j++) {
+        x[j] = gsl_vector_get(gx, j);
+        *xn = fmax(*xn, fabs(x[j]));
+    }
+    gsl_matrix_free(ga);
+    gsl_matrix_free(v);
+    gsl_vector_free(sv);
+    gsl_vector_free(w);
+    gsl_vector_free(gb);
+    gsl_vector_free(gx);
+    return gcond;
+}
+
+/* The solver's solution f->sol agrees with GSL's x to ~ kappa eps. */
+static void check_sol(const jf_fitter *f, const double *x, size_t cols, double gcond, double xn,
+                      int t)
+{
+    for (size_t j = 0; j < cols; j++)
+        ck_assert_msg(fabs(f->sol[j] - x[j]) <= 1e-14 * gcond * xn,
+                      "t %d sol %zu: %.17g gsl %.17g (cond %g)", t, j, f->sol[j], x[j], gcond);
+}
+
 /* The solver (pivoted Householder QR + one-sided Jacobi SVD of R) against
  * GSL's Golub-Reinsch SVD of the whole matrix: kappa and the least-squares
  * solution on random tall matrices with graded columns (kappa up to
@@ -337,43 +382,14 @@ START_TEST(test_solver_vs_gsl)
     const size_t shapes[4][2] = {{6, 6}, {16, 6}, {32, 10}, {64, 15}};
     for (int t = 0; t < 40; t++) {
         size_t rows = shapes[t % 4][0], cols = shapes[t % 4][1];
-        gsl_matrix *a = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
-        gsl_vector *sv = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
-        gsl_vector *b = gsl_vector_alloc(rows), *x = gsl_vector_alloc(cols);
         double grade = pow(10.0, -(double)(t % 11)); /* column scales 1 .. grade */
-        for (size_t j = 0; j < cols; j++) {
-            double sc = pow(grade, (double)j / (double)(cols - 1));
-            for (size_t i = 0; i < rows; i++) {
-                double e = sc * (2 * urand() - 1);
-                gsl_matrix_set(a, i, j, e);
-                f->m[j * rows + i] = e;
-            }
-        }
-        for (size_t i = 0; i < rows; i++) {
-            double e = 2 * urand() - 1;
-            gsl_vector_set(b, i, e);
-            f->rhs[i] = e;
-        }
+        double x[15], xn;
+        double gcond = gsl_graded_lsq(rows, cols, grade, f->m, f->rhs, x, &xn);
         double cond;
         int rc = jf__svd_solve(f, rows, cols, &cond);
-        ck_assert_int_eq(gsl_linalg_SV_decomp(a, v, sv, w), 0);
-        ck_assert_int_eq(gsl_linalg_SV_solve(a, v, sv, b, x), 0);
-        double gcond = gsl_vector_get(sv, 0) / gsl_vector_get(sv, cols - 1);
         ck_assert_int_eq(rc, 0);
         ck_assert_msg(fabs(cond - gcond) <= 1e-8 * gcond, "cond %g gsl %g", cond, gcond);
-        /* solutions agree to ~ kappa eps */
-        double xn = 0;
-        for (size_t j = 0; j < cols; j++) xn = fmax(xn, fabs(gsl_vector_get(x, j)));
-        for (size_t j = 0; j < cols; j++)
-            ck_assert_msg(fabs(f->sol[j] - gsl_vector_get(x, j)) <= 1e-14 * gcond * xn,
-                          "t %d sol %zu: %.17g gsl %.17g (cond %g)", t, j, f->sol[j],
-                          gsl_vector_get(x, j), gcond);
-        gsl_matrix_free(a);
-        gsl_matrix_free(v);
-        gsl_vector_free(sv);
-        gsl_vector_free(w);
-        gsl_vector_free(b);
-        gsl_vector_free(x);
+        check_sol(f, x, cols, gcond, xn, t);
     }
     /* rank deficient: column 3 = column 1 */
     for (size_t i = 0; i < 16; i++) {
@@ -408,23 +424,9 @@ START_TEST(test_solver_fast_path)
     double a0[64 * 10], b0[64];
     for (int t = 0; t < 60; t++) {
         size_t rows = shapes[t % 3][0], cols = shapes[t % 3][1];
-        gsl_matrix *a = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
-        gsl_vector *sv = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
-        gsl_vector *b = gsl_vector_alloc(rows), *x = gsl_vector_alloc(cols);
         double grade = pow(10.0, -0.1 * (double)(t % 30)); /* column scales 1 .. grade */
-        for (size_t j = 0; j < cols; j++) {
-            double sc = pow(grade, (double)j / (double)(cols - 1));
-            for (size_t i = 0; i < rows; i++) {
-                a0[j * rows + i] = sc * (2 * urand() - 1);
-                gsl_matrix_set(a, i, j, a0[j * rows + i]);
-            }
-        }
-        for (size_t i = 0; i < rows; i++) gsl_vector_set(b, i, b0[i] = 2 * urand() - 1);
-        ck_assert_int_eq(gsl_linalg_SV_decomp(a, v, sv, w), 0);
-        ck_assert_int_eq(gsl_linalg_SV_solve(a, v, sv, b, x), 0);
-        double gcond = gsl_vector_get(sv, 0) / gsl_vector_get(sv, cols - 1);
-        double xn = 0;
-        for (size_t j = 0; j < cols; j++) xn = fmax(xn, fabs(gsl_vector_get(x, j)));
+        double x[10], xn;
+        double gcond = gsl_graded_lsq(rows, cols, grade, a0, b0, x, &xn);
         /* max_cond: off, just above kappa, just below kappa */
         const double maxc[3] = {INFINITY, gcond * (1 + 1e-12), gcond * (1 - 1e-12)};
         for (int u = 0; u < 3; u++) {
@@ -437,17 +439,8 @@ START_TEST(test_solver_fast_path)
                           cond, gcond);
             if (u == 1) ck_assert_msg(cond <= maxc[u], "t %d: %.17g > %.17g", t, cond, maxc[u]);
             if (u == 2) ck_assert_msg(cond > maxc[u], "t %d: %.17g <= %.17g", t, cond, maxc[u]);
-            for (size_t j = 0; j < cols; j++)
-                ck_assert_msg(fabs(f->sol[j] - gsl_vector_get(x, j)) <= 1e-14 * gcond * xn,
-                              "t %d sol %zu: %.17g gsl %.17g (cond %g)", t, j, f->sol[j],
-                              gsl_vector_get(x, j), gcond);
+            check_sol(f, x, cols, gcond, xn, t);
         }
-        gsl_matrix_free(a);
-        gsl_matrix_free(v);
-        gsl_vector_free(sv);
-        gsl_vector_free(w);
-        gsl_vector_free(b);
-        gsl_vector_free(x);
     }
     jf_fitter_free(f);
 }

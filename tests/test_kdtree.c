@@ -50,6 +50,22 @@ static size_t brute(const double *xyz, size_t n, const double q[3], pair *out)
     return m;
 }
 
+/* The pipeline's variant jf__index_query (up to max points within r2):
+ * `want` points, the same as ref's, with their coordinates (from the
+ * tree's copy) bit for bit those of the input. */
+static void check_index_query(const jf_index *ix, const double *xyz, const double q[3],
+                              size_t max, double r2, const pair *ref, size_t want,
+                              uint32_t *idx, double *d2, double *pts)
+{
+    size_t found = 99;
+    ck_assert_int_eq(jf__index_query(ix, q, max, r2, idx, d2, pts, &found), JF_OK);
+    ck_assert_uint_eq(found, want);
+    for (size_t j = 0; j < found; j++) {
+        ck_assert_uint_eq(idx[j], ref[j].i);
+        ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3])) == 0);
+    }
+}
+
 /* Checks knn for every k in ks and radius for a few r at query q. */
 static void check_query(const jf_index *ix, const double *xyz, size_t n,
                         const double q[3])
@@ -69,15 +85,7 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
             ck_assert_uint_eq(idx[j], ref[j].i);
             ck_assert(d2[j] == ref[j].d);
         }
-        /* the pipeline's variant: same points, and their coordinates
-         * (from the tree's copy) bit for bit those of the input */
-        found = 99;
-        ck_assert_int_eq(jf__index_query(ix, q, k, INFINITY, idx, NULL, pts, &found), JF_OK);
-        ck_assert_uint_eq(found, want);
-        for (size_t j = 0; j < found; j++) {
-            ck_assert_uint_eq(idx[j], ref[j].i);
-            ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3])) == 0);
-        }
+        check_index_query(ix, xyz, q, k, INFINITY, ref, want, idx, NULL, pts);
     }
     /* radius: inclusive, capped to the nearest `max` */
     if (m) {
@@ -98,15 +106,7 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
                     ck_assert_uint_eq(idx[j], ref[j].i);
                     ck_assert(d2[j] <= r2);
                 }
-                found = 99;
-                ck_assert_int_eq(jf__index_query(ix, q, maxes[u], r2, idx, d2, pts, &found),
-                                 JF_OK);
-                ck_assert_uint_eq(found, want);
-                for (size_t j = 0; j < found; j++) {
-                    ck_assert_uint_eq(idx[j], ref[j].i);
-                    ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j],
-                                     sizeof(double[3])) == 0);
-                }
+                check_index_query(ix, xyz, q, maxes[u], r2, ref, want, idx, d2, pts);
             }
         }
     }

@@ -172,6 +172,18 @@ START_TEST(random_samples_lie_on_surface)
 }
 END_TEST
 
+/* Normal of face f of s (not unit): (v1 - v0) x (v2 - v0). */
+static void face_normal(const jf_sample *s, size_t f, double nf[3])
+{
+    const uint32_t *t = s->face_idx + 3 * f;
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = s->xyz[3 * t[1] + k] - s->xyz[3 * t[0] + k];
+        e2[k] = s->xyz[3 * t[2] + k] - s->xyz[3 * t[0] + k];
+    }
+    cross3(e1, e2, nf);
+}
+
 /* Every edge in exactly two faces (closed) and outward face normals. */
 START_TEST(closed_meshes_are_closed_and_outward)
 {
@@ -186,13 +198,10 @@ START_TEST(closed_meshes_are_closed_and_outward)
         int *cnt = calloc(s.n * s.n, sizeof *cnt);
         for (size_t f = 0; f < s.nfaces; f++) {
             const uint32_t *t = s.face_idx + 3 * f;
-            double e1[3], e2[3], nf[3], c[3];
-            for (int k = 0; k < 3; k++) {
-                e1[k] = s.xyz[3 * t[1] + k] - s.xyz[3 * t[0] + k];
-                e2[k] = s.xyz[3 * t[2] + k] - s.xyz[3 * t[0] + k];
+            double nf[3], c[3];
+            for (int k = 0; k < 3; k++)
                 c[k] = s.xyz[3 * t[0] + k] + s.xyz[3 * t[1] + k] + s.xyz[3 * t[2] + k];
-            }
-            cross3(e1, e2, nf);
+            face_normal(&s, f, nf);
             ck_assert_msg(dot3(nf, c) > 0, "face %zu inward", f);
             for (int k = 0; k < 3; k++)
                 cnt[t[k] * s.n + t[(k + 1) % 3]]++; /* directed edges */
@@ -207,8 +216,9 @@ START_TEST(closed_meshes_are_closed_and_outward)
 }
 END_TEST
 
-/* The open cylinder: faces outward (normal . (x, y, 0) > 0), a seam
- * joined: every vertex in some face, (2 pi R / h) x (2 / h + 1) vertices. */
+/* The open cylinder: faces outward (normal . (x, y, 0) > 0), the seam
+ * joined: (2 pi R / h) x (2 / h + 1) vertices, no column twice, and the
+ * seam's cells among the 2 (2 pi R / h) (2 / h) faces. */
 START_TEST(cylinder_mesh_outward)
 {
     jf_rng r;
@@ -219,12 +229,8 @@ START_TEST(cylinder_mesh_outward)
     ck_assert_uint_eq(s.nfaces, 2 * 31 * 20);
     for (size_t f = 0; f < s.nfaces; f++) {
         const uint32_t *t = s.face_idx + 3 * f;
-        double e1[3], e2[3], nf[3];
-        for (int k = 0; k < 3; k++) {
-            e1[k] = s.xyz[3 * t[1] + k] - s.xyz[3 * t[0] + k];
-            e2[k] = s.xyz[3 * t[2] + k] - s.xyz[3 * t[0] + k];
-        }
-        cross3(e1, e2, nf);
+        double nf[3];
+        face_normal(&s, f, nf);
         ck_assert(nf[0] * s.xyz[3 * t[0]] + nf[1] * s.xyz[3 * t[0] + 1] > 0);
     }
     jf_sample_free(&s);
