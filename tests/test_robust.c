@@ -133,8 +133,9 @@ typedef struct {
     size_t nflag;       /* rows with the given flag */
 } errs;
 
-/* Fits `nq` query points of the inner region |u|,|v| < 0.3 (jet fits are
- * one-sided at the border) with params p from their kmax nearest. */
+/* Fits every 7th point of the inner region |u|,|v| <= region (jet fits are
+ * one-sided at the border) with params p from their kmax nearest; nflag:
+ * the rows with `flag`. */
 static double region = 0.3;
 static size_t n_lowered; /* fits of run() at a degree below p->degree */
 static errs run(const cloud *c, const jf_params *p, size_t kmax, unsigned flag)
@@ -314,7 +315,6 @@ START_TEST(scale_selection_top_degree_and_degree_select)
     p.scales[0] = 64;
     p.scales[1] = 128;
     p.scales[2] = 256;
-    n_lowered = 0;
     errs e = run(&c, &p, 256, JF_PT_FAILED);
     if (verbose()) printf("degree 9 + scales: median normal %.3g deg\n", e.med_normal);
     ck_assert_uint_eq(e.nflag, 0);
@@ -331,9 +331,6 @@ START_TEST(scale_selection_top_degree_and_degree_select)
 }
 END_TEST
 
-/* 5% outliers: Tukey reweighting keeps the median curvature error within
- * 1.5x of the plain fit of the outlier-free cloud; the plain fit with the
- * outliers does not (so the test can fail). */
 /* Degree selection on the §6.1 surface with 0.5% noise (of the bbox
  * diagonal, per axis) and K = 18: a cubic on 18 noisy points is dominated
  * by noise, a lower degree is not, so selecting per point among degrees
@@ -342,9 +339,8 @@ END_TEST
  * cubic, whose normal is the most accurate there. */
 START_TEST(degree_selection_noise_and_clean)
 {
-    const double diag = sqrt(2.0 + 0.3 * 0.3);
     region = 0.4;
-    cloud c = make_cloud(50, 0.005 * diag, 0, 0, 3);
+    cloud c = make_cloud(50, 0.005 * DIAG61, 0, 0, 3);
     jf_params p;
     jf_params_init(&p);
     p.degree = 3;
@@ -433,6 +429,9 @@ START_TEST(new_params_validated)
 }
 END_TEST
 
+/* 5% outliers: Tukey reweighting keeps the median curvature error within
+ * 1.5x of the plain fit of the outlier-free cloud; the plain fit with the
+ * outliers does not (so the test can fail). */
 START_TEST(reweighting_suppresses_outliers)
 {
     const double sigma = 0.0002;
@@ -619,8 +618,7 @@ START_TEST(robust_normals_preset)
     free(e.xyz);
     free(e.uv);
 
-    const double diag = sqrt(2.0 + 0.3 * 0.3);
-    cloud c = make_cloud(50, 0.005 * diag, 0, 0, 3);
+    cloud c = make_cloud(50, 0.005 * DIAG61, 0, 0, 3);
     p.degree = 3;
     p.degree_select = 0;
     p.dist_weight = 0.0;
