@@ -111,6 +111,15 @@ typedef struct {
     size_t n;
 } bins;
 
+/* Sine of the angle between two unit normals (orientation ignored). */
+static double normal_dev(const double *a, const double *b)
+{
+    double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                   a[0] * b[1] - a[1] * b[0]};
+    double s = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    return isfinite(s) ? s : 1.0;  /* a failed fit: worst possible */
+}
+
 /* Error of a fit at data point p of the 6.1 graph: for degree >= 2 the
  * curvature error max(|dk1|, |dk2|) / max(|k1|, |k2|); with normal != 0
  * (degree 2 against degree 1, which has no curvature) the sine of the
@@ -121,13 +130,7 @@ static double err61(const jf_result *r, const double *p, int normal)
     truth61(p[0], p[1], n, &k1, &k2);
     jf_result o = *r;
     jf_result_orient(&o, n);
-    if (normal) {
-        double c[3] = {o.normal[1] * n[2] - o.normal[2] * n[1],
-                       o.normal[2] * n[0] - o.normal[0] * n[2],
-                       o.normal[0] * n[1] - o.normal[1] * n[0]};
-        double e = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        return isfinite(e) ? e : 1.0;
-    }
+    if (normal) return normal_dev(o.normal, n);
     double s = fmax(fabs(k1), fabs(k2));
     double e = fmax(fabs(o.k1 - k1), fabs(o.k2 - k2)) / s;
     return isfinite(e) ? e : INFINITY;  /* a failed fit sorts last */
@@ -135,15 +138,6 @@ static double err61(const jf_result *r, const double *p, int normal)
 
 /* The adaptive rule with threshold T on these fits: the degree-d error
  * where kappa <= T, the degree-(d-1) error elsewhere. */
-/* Sine of the angle between two unit normals (orientation ignored). */
-static double normal_dev(const double *a, const double *b)
-{
-    double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                   a[0] * b[1] - a[1] * b[0]};
-    double s = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    return isfinite(s) ? s : 1.0;  /* a failed fit: worst possible */
-}
-
 static void print_policy(int d, const bins *B, double *tmp)
 {
     static const double T[7] = {1e2, 1e3, 1e4, 1e5, 1e6, 1e8, INFINITY};

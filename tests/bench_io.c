@@ -203,7 +203,7 @@ typedef struct {
     int kind;
     const char *ext;
     int ascii;
-    size_t count; /* points or rows per run (0: N) */
+    size_t count; /* 0: N points per run; else N / 10 rows (the tables) */
 } step;
 
 static double run(const step *s)

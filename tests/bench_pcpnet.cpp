@@ -84,28 +84,22 @@ struct Study {
 };
 
 static double g_median, g_p95; // of the last rms_angle call
-static double rms_angle(const Study &s, const std::vector<double> &nrm, size_t *nonfinite)
+static double rms_angle(const Study &s, const std::vector<double> &nrm)
 {
     std::vector<double> all;
     double sum = 0;
-    size_t m = 0;
-    *nonfinite = 0;
     for (size_t j = 0; j < s.pidx.size(); j++) {
         uint32_t i = s.pidx[j];
         double a = jf_normal_angle_deg(&nrm[3 * j], &s.gt[3 * i]);
-        if (!std::isfinite(a)) {
-            (*nonfinite)++;
-            a = 90.0; // an unfitted point counts as the worst angle
-        }
+        if (!std::isfinite(a)) a = 90.0; // an unfitted point counts as the worst angle
         sum += a * a;
         all.push_back(a);
-        m++;
     }
     jf_err_stats st;
     jf_err_stats_compute(all.data(), all.size(), &st);
     g_median = st.median;
     g_p95 = st.p95;
-    return std::sqrt(sum / (double)m);
+    return std::sqrt(sum / (double)all.size());
 }
 
 struct Config {
@@ -150,7 +144,6 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
     }
     std::vector<uint32_t> idx(c.k);
     std::vector<double> nbr(3 * c.k), nrm(3 * s.pidx.size());
-    *flagged = 0;
     double t0 = now();
     for (size_t j = 0; j < s.pidx.size(); j++) {
         const double *q = &s.xyz[3 * s.pidx[j]];
@@ -165,8 +158,7 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
     }
     *secs = now() - t0;
     jf_fitter_free(f);
-    size_t nf;
-    return rms_angle(s, nrm, &nf);
+    return rms_angle(s, nrm);
 }
 
 // CGAL on the whole cloud; the RMS on the .pidx points.
@@ -191,8 +183,7 @@ static double run_cgal(const Study &s, bool jet, int degree, size_t k, double *s
         nrm[3 * j + 1] = v.y();
         nrm[3 * j + 2] = v.z();
     }
-    size_t nf;
-    return rms_angle(s, nrm, &nf);
+    return rms_angle(s, nrm);
 }
 
 int main(int argc, char **argv)
