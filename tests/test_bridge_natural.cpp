@@ -111,15 +111,29 @@ END_TEST
 START_TEST(planar_grid_lifted) { check_planar(1e-7); }
 END_TEST
 
+// jf_natural_normals of the cloud p by `src` on `threads` threads: normals,
+// flags and (rel not NULL) reliabilities, one per point.
+static void natural_normals(const std::vector<double> &p, jf_normal_source src, int threads,
+                            std::vector<double> &nrm, std::vector<unsigned> &fl,
+                            std::vector<double> *rel) {
+    size_t np = p.size() / 3;
+    jf_natural *nt;
+    ck_assert_int_eq(jf_natural_create(p.data(), np, &nt), JF_OK);
+    nrm.assign(3 * np, 0.0);
+    fl.assign(np, 0);
+    if (rel) rel->assign(np, 0.0);
+    ck_assert_int_eq(jf_natural_normals(nt, src, threads, nrm.data(), fl.data(), rel ? rel->data() : NULL),
+                     JF_OK);
+    jf_natural_free(nt);
+}
+
 // Random sphere samples: pole normals within 1 degree of the radial one.
 START_TEST(sphere_poles) {
     std::vector<double> p = sphere(10000, 0.0, 3);
     size_t np = p.size() / 3;
-    jf_natural *nt;
-    ck_assert_int_eq(jf_natural_create(p.data(), np, &nt), JF_OK);
-    std::vector<double> nrm(3 * np), rel(np);
-    std::vector<unsigned> fl(np, 0);
-    ck_assert_int_eq(jf_natural_normals(nt, JF_NORMAL_POLES, 2, nrm.data(), fl.data(), rel.data()), JF_OK);
+    std::vector<double> nrm, rel;
+    std::vector<unsigned> fl;
+    natural_normals(p, JF_NORMAL_POLES, 2, nrm, fl, &rel);
     double worst = 0, minrel = 1e300;
     size_t poles = 0;
     for (size_t i = 0; i < np; i++) {
@@ -130,7 +144,6 @@ START_TEST(sphere_poles) {
     std::printf("sphere 10k: %zu poles, worst %.4f deg, min reliability %.2f\n", poles, worst, minrel);
     ck_assert_uint_eq(poles, np);
     ck_assert_double_lt(worst, 1.0);
-    jf_natural_free(nt);
 }
 END_TEST
 
@@ -143,11 +156,9 @@ static double ellipsoid_mean_error(size_t n, double *worst) {
     const double ax[3] = {1.0, 0.8, 0.6};
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) p[3 * i + k] *= ax[k], t[3 * i + k] = p[3 * i + k] / (ax[k] * ax[k]);
-    jf_natural *nt;
-    ck_assert_int_eq(jf_natural_create(p.data(), n, &nt), JF_OK);
-    std::vector<double> nrm(3 * n);
-    std::vector<unsigned> fl(n, 0);
-    ck_assert_int_eq(jf_natural_normals(nt, JF_NORMAL_POLES, 2, nrm.data(), fl.data(), NULL), JF_OK);
+    std::vector<double> nrm;
+    std::vector<unsigned> fl;
+    natural_normals(p, JF_NORMAL_POLES, 2, nrm, fl, NULL);
     double sum = 0;
     *worst = 0;
     for (size_t i = 0; i < n; i++) {
@@ -155,7 +166,6 @@ static double ellipsoid_mean_error(size_t n, double *worst) {
         double a = angle_deg(&nrm[3 * i], &t[3 * i]);
         sum += a, *worst = std::max(*worst, a);
     }
-    jf_natural_free(nt);
     return sum / n;
 }
 
@@ -183,18 +193,15 @@ START_TEST(mincirc_regular_grid) {
         for (int j = 0; j < 30; j++)
             for (int k = 0; k < 3; k++) p.push_back(5.0 + 0.01 * (i * a[k] + j * b[k]));
     size_t np = p.size() / 3;
-    jf_natural *nt;
-    ck_assert_int_eq(jf_natural_create(p.data(), np, &nt), JF_OK);
-    std::vector<double> nrm(3 * np);
-    std::vector<unsigned> fl(np, 0);
-    ck_assert_int_eq(jf_natural_normals(nt, JF_NORMAL_MINCIRC, 1, nrm.data(), fl.data(), NULL), JF_OK);
+    std::vector<double> nrm;
+    std::vector<unsigned> fl;
+    natural_normals(p, JF_NORMAL_MINCIRC, 1, nrm, fl, NULL);
     double worst = 0;
     for (size_t i = 0; i < np; i++) {
         ck_assert_uint_eq(fl[i], JF_PT_NORMAL_MINCIRC);
         worst = std::max(worst, angle_deg(&nrm[3 * i], n0));
     }
     ck_assert_double_lt(worst, 1e-6);
-    jf_natural_free(nt);
 }
 END_TEST
 
