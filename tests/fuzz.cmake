@@ -7,14 +7,14 @@ if(JF_FUZZ)
             "-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
   endif()
   set(JF_FUZZ_READER_SOURCES
-      ${PROJECT_SOURCE_DIR}/src/io_read.c ${PROJECT_SOURCE_DIR}/src/io_ply.c
-      ${PROJECT_SOURCE_DIR}/src/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io_off.c)
+      ${PROJECT_SOURCE_DIR}/src/io/io_read.c ${PROJECT_SOURCE_DIR}/src/io/io_ply.c
+      ${PROJECT_SOURCE_DIR}/src/io/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io/io_off.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
   foreach(reader ply xyz off)
     add_executable(fuzz_${reader} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_${reader}.c
                    ${JF_FUZZ_READER_SOURCES})
-    target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src)
+    target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/src/io)
     target_compile_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
     target_link_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
   endforeach()

@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../cgal_bridge/cgal_bridge.h"
+#include "cgal_bridge.h"
 #include "jetfit.h"
 
 #define NONE UINT32_MAX
