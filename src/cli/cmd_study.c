@@ -424,6 +424,8 @@ static void record_command(jf_study *s, int argc, char **argv)
     size_t u = (size_t)snprintf(s->command, sizeof s->command, "jetfit");
     for (int i = 0; i < argc && u < sizeof s->command; i++) {
         const char *a = argv[i];
+        /* how it ran, not what it studies: the report shows the study */
+        if (!strcmp(a, "--resume") || !strcmp(a, "--quiet") || !strcmp(a, "-q")) continue;
         int plain = *a != '\0';
         for (const char *p = a; *p; p++)
             if (!isalnum((unsigned char)*p) && !strchr("-_.,:/=+", *p)) plain = 0;
@@ -663,7 +665,7 @@ int jf_cmd_study(int argc, char **argv)
         return rc < 0 ? 0 : rc;
     }
     jf_study *s = &c.s;
-    record_command(s, argc - 1, argv + 1);
+    record_command(s, argc, argv);
     char msg[4200];
     if (!c.is_surface && load_input(&c)) goto fail;
     if (s->subset) {

@@ -1,5 +1,6 @@
 /* study_plot.c -- `jetfit study`'s PNGs through gnuplot (pngcairo), one
- * gnuplot process for all of them, data inline ($blocks):
+ * gnuplot process for all of them (run without a shell), data inline
+ * ($blocks):
  *   normal.png     median normal angle against noise, one line per
  *                  setting, error bars = spread over the repeats
  *   curvature.png  k1 and k2 median errors against noise, likewise
@@ -11,12 +12,14 @@
  * User text (labels hold --neighbors and --flags text; DIR is a path)
  * reaches gnuplot only inside single-quoted strings with ' doubled, where
  * gnuplot expands nothing (double-quoted strings would run backquotes). */
-#define _POSIX_C_SOURCE 200809L /* popen, pclose */
+#define _POSIX_C_SOURCE 200809L /* fdopen, fileno */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "jetfit.h"
 #include "study.h"
@@ -214,9 +217,33 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
         snprintf(msg, len, "gnuplot not found (Debian package gnuplot-nox)");
         return -1;
     }
-    FILE *gp = popen("gnuplot", "w");
+    /* gnuplot's stderr kept aside: its warnings (a single noise level
+     * makes an empty x range) are not the user's business, its error is */
+    FILE *log = tmpfile();
+    int fd[2];
+    if (!log || pipe(fd)) {
+        if (log) fclose(log);
+        snprintf(msg, len, "cannot run gnuplot: %s", strerror(errno));
+        return -1;
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fd[0], 0);
+        dup2(fileno(log), 1);
+        dup2(fileno(log), 2);
+        close(fd[0]);
+        close(fd[1]);
+        execlp("gnuplot", "gnuplot", (char *)NULL);
+        _exit(127);
+    }
+    close(fd[0]);
+    FILE *gp = pid > 0 ? fdopen(fd[1], "w") : NULL;
     if (!gp) {
-        snprintf(msg, len, "cannot run gnuplot");
+        if (pid > 0) waitpid(pid, NULL, 0);
+        else close(fd[1]);
+        fclose(log);
+        snprintf(msg, len, "cannot run gnuplot: %s", strerror(errno));
         return -1;
     }
     int ax = jf_study_noise_axis(s);
@@ -257,7 +284,9 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
         fprintf(gp, "unset output\n");
         made[2] = 1;
     }
-    int rc = pclose(gp);
+    fclose(gp);
+    int rc = 0;
+    if (waitpid(pid, &rc, 0) != pid) rc = -1;
     int n = 0, bad = rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0;
     for (int p = 0; p < 3; p++) {
         jf_study_path(dir, names[p], 1, tmp, sizeof tmp);
@@ -266,8 +295,19 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
         else remove(tmp);
     }
     if (bad) {
-        snprintf(msg, len, "gnuplot failed (exit status %d)", rc);
+        /* the first line of gnuplot's that says what went wrong */
+        char line[512], why[512] = "";
+        rewind(log);
+        while (fgets(line, sizeof line, log))
+            if (strstr(line, "rror") || strstr(line, "annot")) {
+                line[strcspn(line, "\n")] = '\0';
+                snprintf(why, sizeof why, "%s", line);
+                break;
+            }
+        fclose(log);
+        snprintf(msg, len, "gnuplot failed%s%s", why[0] ? ": " : "", why);
         return -1;
     }
+    fclose(log);
     return n;
 }

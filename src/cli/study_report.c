@@ -90,10 +90,14 @@ static const char style_script[] =
     "    th.addEventListener('click',function(){sortBy(th);});});});\n"
     "</script>\n";
 
-static void head_cells(FILE *f, const char *const *names, int n, int text_cols)
+static void head_cells(FILE *f, const char *const *names, int n)
 {
     fputs("<thead><tr>", f);
-    for (int i = 0; i < n; i++) fprintf(f, "<th%s>%s</th>", i < text_cols ? " class=\"t\"" : "", names[i]);
+    for (int i = 0; i < n; i++) {
+        int text = !strcmp(names[i], "metric") || !strcmp(names[i], "strategy") ||
+                   !strcmp(names[i], "flags") || !strcmp(names[i], "status");
+        fprintf(f, "<th%s>%s</th>", text ? " class=\"t\"" : "", names[i]);
+    }
     fputs("</tr></thead>\n<tbody>\n", f);
 }
 
@@ -117,7 +121,7 @@ static void best_table(FILE *f, const jf_study *s)
     static const char *const h[] = {"metric", "noise", "noise_uniform", "outliers", "strategy",
                                     "degree", "flags", "mean", "sd", "repeats"};
     fputs("<table id=\"best\" class=\"sortable\">\n", f);
-    head_cells(f, h, 10, 1);
+    head_cells(f, h, 10);
     jf_study_key lvl = {0};
     for (lvl.noise = 0; lvl.noise < s->nnoise; lvl.noise++)
         for (lvl.noise_u = 0; lvl.noise_u < s->nnoise_u; lvl.noise_u++)
@@ -151,7 +155,7 @@ static void summary_table(FILE *f, const jf_study *s)
     }
     h[6 + 2 * JF_M_COUNT] = "repeats";
     fputs("<table id=\"summary\" class=\"sortable\">\n", f);
-    head_cells(f, h, 7 + 2 * JF_M_COUNT, 1);
+    head_cells(f, h, 7 + 2 * JF_M_COUNT);
     for (size_t i = 0; i < s->ncells; i++) {
         const jf_study_key *k = &s->cell[i].key;
         if (k->repeat) continue;
@@ -182,7 +186,7 @@ static void cells_table(FILE *f, const jf_study *s)
     for (int m = 0; m < JF_M_COUNT; m++) h[8 + m] = jf_study_metric[m];
     for (int i = 0; i < 7; i++) h[8 + JF_M_COUNT + i] = b[i];
     fputs("<table id=\"cells\" class=\"sortable\">\n", f);
-    head_cells(f, h, 8 + JF_M_COUNT + 7, 1);
+    head_cells(f, h, 8 + JF_M_COUNT + 7);
     for (size_t i = 0; i < s->ncells; i++) {
         const jf_study_cell *c = &s->cell[i];
         if (!c->done) continue;
