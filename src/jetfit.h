@@ -52,7 +52,8 @@ typedef enum {
                                the file can hold                          */
     JF_ERR_NUMERIC = 6,     /* a numerical routine failed                */
     JF_ERR_UNSUPPORTED = 7, /* feature not built in (e.g. no CGAL)       */
-    JF_ERR_INTERNAL = 8     /* a bug: please report                      */
+    JF_ERR_INTERNAL = 8,    /* a bug: please report                      */
+    JF_ERR_CANCELLED = 9    /* the caller's cancel hook asked to stop    */
 } jf_status;
 
 /* Static English name of a status; never NULL. */
@@ -837,6 +838,17 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
  * hundred points apart, and once with done == total. */
 typedef void (*jf_progress_fn)(void *user, size_t done, size_t total);
 
+/* Cancellation hook: returns nonzero to stop.  Polled on the thread that
+ * called jf_estimate only (never concurrently): after each block of a few
+ * hundred points that thread fits, and between the stages (index or
+ * triangulation, fitting, orientation).  Once it says stop, every thread
+ * leaves the fit after its current block and jf_estimate returns
+ * JF_ERR_CANCELLED (out is then partly filled).  A stage that is not
+ * split into blocks (the natural neighbours' Delaunay triangulation, the
+ * mst orientation) runs to its end first.  The command's Ctrl-C and the
+ * Python module's KeyboardInterrupt go through it. */
+typedef int (*jf_cancel_fn)(void *user);
+
 typedef struct {
     jf_params params;        /* the fit (params.max_neighbors must hold
                                 the neighbourhood: knn K, rings N, ...)  */
@@ -852,6 +864,8 @@ typedef struct {
     int threads;             /* <= 0: all cores (OpenMP default)        */
     jf_progress_fn progress; /* may be NULL                             */
     void *progress_user;
+    jf_cancel_fn cancel;     /* may be NULL (jf_cancel_fn)              */
+    void *cancel_user;
 } jf_estimate_opts;
 
 /* Fills defaults.  Never fails. */
@@ -875,6 +889,7 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * with mst.
  * Returns JF_OK, JF_ERR_INVALID (bad options, rings without faces,
  * orient/normal input without normals; err says which), JF_ERR_NOMEM,
+ * JF_ERR_CANCELLED (o->cancel said stop),
  * JF_ERR_FORMAT (bad face indices), or the failing stage's status; err
  * (may be NULL) gets one line.  Thread-safe on distinct outputs. */
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
