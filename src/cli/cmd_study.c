@@ -18,6 +18,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,6 +91,22 @@ static double now_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Ctrl-C (SIGINT) or SIGTERM: the running cell stops at its next block
+ * (jf_estimate_opts.cancel), the finished ones stay in study.csv. */
+static volatile sig_atomic_t stop_asked;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_asked = 1;
+}
+
+static int cancel_hook(void *user)
+{
+    (void)user;
+    return stop_asked != 0;
 }
 
 /* ---- lists ---- */
@@ -355,8 +372,9 @@ static void progress(void *user, size_t done, size_t total)
 
 /* ---- one cell ---- */
 
-static void run_cell(study_cmd *c, jf_study_cell *cl, const jf_sample *smp, const double *truth5,
-                     jf_result *res, double *err[3], study_progress *pp)
+/* Runs one cell into cl; -1 if it was cancelled (cl stays undone). */
+static int run_cell(study_cmd *c, jf_study_cell *cl, const jf_sample *smp, const double *truth5,
+                    jf_result *res, double *err[3], study_progress *pp)
 {
     const jf_study *s = &c->s;
     jf_estimate_opts o = c->setting[setting_of(s, &cl->key)];
@@ -371,9 +389,11 @@ static void run_cell(study_cmd *c, jf_study_cell *cl, const jf_sample *smp, cons
         o.progress = progress;
         o.progress_user = pp;
     }
+    o.cancel = cancel_hook;
     jf_error e = {{0}};
     double t0 = now_s();
     jf_status st = jf_estimate(&cloud, &o, res, &e);
+    if (st == JF_ERR_CANCELLED || stop_asked) return -1;
     cl->seconds = now_s() - t0;
     cl->points_per_s = cl->seconds > 0 ? (double)smp->n / cl->seconds : NAN;
     cl->done = 1;
@@ -382,7 +402,7 @@ static void run_cell(study_cmd *c, jf_study_cell *cl, const jf_sample *smp, cons
         for (char *q = cl->status; *q; q++)
             if (*q == '\n' || *q == '\r') *q = ' ';
         for (int m = 0; m < JF_M_COUNT; m++) cl->m[m] = NAN;
-        return;
+        return 0;
     }
     snprintf(cl->status, sizeof cl->status, "ok");
     cl->ok = cl->lowered = cl->failed = cl->flagged = 0;
@@ -415,6 +435,7 @@ static void run_cell(study_cmd *c, jf_study_cell *cl, const jf_sample *smp, cons
     cl->m[JF_M_K1_P95] = b.p95;
     cl->m[JF_M_K2_MEDIAN] = d.median;
     cl->m[JF_M_K2_P95] = d.p95;
+    return 0;
 }
 
 /* ---- options ---- */
@@ -705,13 +726,19 @@ int jf_cmd_study(int argc, char **argv)
     size_t nfailed = 0;
     int werr = 0;
     /* one draw per (noise level, repeat): a run of nsetting cells */
-    for (size_t g = 0; g < s->ncells && !werr; g += (size_t)c.nsetting) {
+    struct sigaction sa, old_int, old_term;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+    for (size_t g = 0; g < s->ncells && !werr && !stop_asked; g += (size_t)c.nsetting) {
         int todo = 0;
         for (int j = 0; j < c.nsetting; j++) todo |= !s->cell[g + (size_t)j].done;
         if (!todo) continue;
         jf_sample smp;
         jf_status st = make_draw(&c, &s->cell[g].key, &smp, truth5);
-        for (int j = 0; j < c.nsetting && !werr; j++) {
+        for (int j = 0; j < c.nsetting && !werr && !stop_asked; j++) {
             jf_study_cell *cl = &s->cell[g + (size_t)j];
             if (cl->done) continue;
             char label[200];
@@ -727,8 +754,8 @@ int jf_cmd_study(int argc, char **argv)
                 snprintf(cl->status, sizeof cl->status, "failed: cannot make the draw: %s", jf_strerror(st));
                 for (int m = 0; m < JF_M_COUNT; m++) cl->m[m] = NAN;
                 cl->seconds = cl->points_per_s = NAN;
-            } else {
-                run_cell(&c, cl, &smp, truth5, res, err, show ? &pg : NULL);
+            } else if (run_cell(&c, cl, &smp, truth5, res, err, show ? &pg : NULL)) {
+                break; /* interrupted */
             }
             pg.units_done += n;
             if (strcmp(cl->status, "ok")) {
@@ -742,8 +769,18 @@ int jf_cmd_study(int argc, char **argv)
         }
         jf_sample_free(&smp);
     }
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     if (show && pg.cell_no) fputc('\n', stderr);
     free(res), free(truth5), free(err[0]), free(err[1]), free(err[2]);
+    if (stop_asked && !werr) {
+        size_t done = 0;
+        for (size_t i = 0; i < s->ncells; i++) done += s->cell[i].done != 0;
+        fprintf(stderr, "jetfit study: interrupted: %zu of %zu cells in %s/study.csv; the same "
+                        "command with --resume goes on\n", done, s->ncells, c.dir);
+        free_cmd(&c);
+        return 130;
+    }
     if (werr || jf_study_write_best(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;

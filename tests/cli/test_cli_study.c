@@ -9,7 +9,9 @@
  *  - report.html opened in headless Chromium has the expected rows and
  *    images, and its screenshot is not blank (skipped, with the reason
  *    printed, when /usr/bin/chromium is not installed);
- *  - bad input: one line, no DIR; a failing cell is recorded, the rest go on. */
+ *  - Ctrl-C cancels the running cell and keeps the finished ones;
+ *  - bad input: one line, no DIR; a failing cell is recorded, the rest go
+ *    on; one progress line with an ETA for the whole study. */
 #include <check.h>
 #include <signal.h>
 #include <time.h>
@@ -354,6 +356,55 @@ START_TEST(resume_after_kill_gives_the_same_files)
     snprintf(pa, sizeof pa, "%s/report.html", a);
     snprintf(pb, sizeof pb, "%s/report.html", b);
     same_but_timing(pa, pb, "<td>");
+    /* Ctrl-C: the running cell is cancelled, the finished ones are kept,
+     * exit 130 and one line saying how to go on; resuming completes it */
+    char c[600];
+    snprintf(c, sizeof c, "%s", cli_path("c"));
+    argv_b[4] = c;
+    argv_b[15] = NULL;
+    snprintf(pb, sizeof pb, "%s/study.csv", c);
+    char errpath[700];
+    snprintf(errpath, sizeof errpath, "%s", cli_path("c.stderr"));
+    fflush(NULL);
+    pid = fork();
+    if (pid == 0) {
+        int fe = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644), fo = open("/dev/null", O_WRONLY);
+        dup2(fo, 1);
+        dup2(fe, 2);
+        execv(argv_b[0], (char *const *)argv_b);
+        _exit(127);
+    }
+    int sent = 0;
+    for (int t = 0; t < 120000; t++) {
+        if (lines_in(pb) >= 2) {
+            kill(pid, SIGINT);
+            sent = 1;
+            break;
+        }
+        if (waitpid(pid, &status, WNOHANG) == pid) break;
+        struct timespec ts = {0, 1000000};
+        nanosleep(&ts, NULL);
+    }
+    ck_assert_msg(sent, "the study ended before it was interrupted");
+    waitpid(pid, &status, 0);
+    ck_assert_msg(WIFEXITED(status) && WEXITSTATUS(status) == 130, "status %d", status);
+    char *said = slurp(errpath, NULL);
+    unlink(errpath);
+    ck_assert_msg(said && strstr(said, "interrupted") && strstr(said, "--resume") &&
+                  count_str(said, "\n") == 1, "%s", said ? said : "");
+    free(said);
+    kept = lines_in(pb) - 1;
+    ck_assert_msg(kept >= 1 && kept < 8, "%d cells after Ctrl-C", kept);
+    argv_b[15] = "--resume";
+    ck_assert_msg(run_to(NULL, argv_b) == 0, "resume: %s", cli_err);
+    snprintf(pa, sizeof pa, "%s/study.csv", a);
+    same_but_timing(pa, pb, ",");
+    snprintf(pa, sizeof pa, "%s/best.csv", a);
+    snprintf(pb, sizeof pb, "%s/best.csv", c);
+    ck_assert_msg(same_file(pa, pb), "best.csv differs after Ctrl-C and --resume");
+    const char *rm[] = {"/bin/rm", "-rf", c, NULL};
+    run_to(NULL, rm);
+
     /* no temporary left in either folder */
     const char *files[] = {"study.csv", "best.csv", "report.html", "normal.png",
                            "curvature.png", "k.png"};
@@ -525,6 +576,25 @@ START_TEST(failing_cell_recorded_study_goes_on)
 }
 END_TEST
 
+START_TEST(one_progress_line_with_eta)
+{
+    cli_setup();
+    const char *dir = cli_path("st");
+    int rc = cli_run_tty("study", "exp", "-o", dir, "--n", "3000", "--neighbors",
+                         "knn:16;knn:32", "--noise", "0;0.01", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    /* redrawn in place (\r) for the whole study, then the summary */
+    ck_assert_msg(strstr(cli_err, "ETA") && strstr(cli_err, "cell 4/4") &&
+                  strstr(cli_err, "100.0%") && strstr(cli_err, "4 cells (4 run, 0 failed)"),
+                  "%s", cli_err);
+    ck_assert_int_eq(count_str(cli_err, "\n"), 2);
+    ck_assert_int_ge(count_str(cli_err, "\r"), 4 + 2);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_study");
@@ -535,6 +605,7 @@ int main(void)
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
+    tcase_add_test(t, one_progress_line_with_eta);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);
     srunner_run_all(r, CK_NORMAL);
