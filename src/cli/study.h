@@ -1,5 +1,6 @@
 /* study.h -- `jetfit study`'s table, shared by its files: cmd_study.c (the
- * command: options, cells, running them), study_csv.c (study.csv, best.csv,
+ * command: cells, draws, running them), study_args.c (the command line),
+ * study_csv.c (study.csv, best.csv,
  * means over repeats), study_plot.c (gnuplot PNGs), study_report.c (the
  * self-contained report.html). */
 #ifndef JF_STUDY_H

@@ -163,6 +163,39 @@ static void expect_same(const char *study_text, const char *eval_tok, const char
     ck_assert_msg(!strcmp(b, eval_tok), "%s: study %s (%s), eval %s", what, study_text, b, eval_tok);
 }
 
+/* Runs `estimate` on input with row c's strategy, degree and flag set,
+ * then `eval` against truth (and subset), and checks c's numbers against
+ * what eval prints. */
+static void check_cell(const csv_row *h, const csv_row *c, const char *input, const char *truth,
+                       const char *subset)
+{
+    static const char *const mname[7] = {"normal_rms", "normal_median", "normal_p95",
+                                         "k1_median", "k1_p95", "k2_median", "k2_p95"};
+    char est[600], evo[600]; /* not cli_path: its 8 buffers hold the caller's */
+    snprintf(est, sizeof est, "%s/e.ply", cli_dir);
+    snprintf(evo, sizeof evo, "%s/eval.txt", cli_dir);
+    const char *e[32] = {JETFIT_BIN, "estimate", input, "-o", est, "--neighbors",
+                         c->f[col(h, "strategy")], "--degree", c->f[col(h, "degree")],
+                         "--threads", "2", "--quiet"};
+    int ne = 12;
+    char fl[256];
+    snprintf(fl, sizeof fl, "%s", c->f[col(h, "flags")]);
+    for (char *t = strtok(fl, " "); t; t = strtok(NULL, " ")) e[ne++] = t;
+    e[ne] = NULL;
+    ck_assert_msg(run_to(NULL, e) == 0, "estimate: %s", cli_err);
+    const char *v[] = {JETFIT_BIN, "eval", est, truth, subset ? "--subset" : NULL, subset, NULL};
+    ck_assert_msg(run_to(evo, v) == 0, "eval: %s", cli_err);
+    char *out = slurp(evo, NULL);
+    char tn[7][32], t1[7][32], t2[7][32];
+    eval_row(out, "normal_deg", tn);
+    eval_row(out, "k1_rel", t1);
+    eval_row(out, "k2_rel", t2);
+    free(out);
+    ck_assert_str_eq(c->f[col(h, "normal_n")], tn[0]);
+    const char *want[7] = {tn[2], tn[4], tn[5], t1[4], t1[5], t2[4], t2[5]};
+    for (int m = 0; m < 7; m++) expect_same(c->f[col(h, mname[m])], want[m], mname[m]);
+}
+
 START_TEST(study_equals_generate_estimate_eval)
 {
     cli_setup();
@@ -179,16 +212,10 @@ START_TEST(study_equals_generate_estimate_eval)
     csv_row *r = read_csv(path, &nr);
     ck_assert_int_eq(nr, 1 + 2 * 2 * 3 * 2 * 2 * 2); /* header + cells */
     const csv_row *h = &r[0];
-    int cs = col(h, "strategy"), cd = col(h, "degree"), cf = col(h, "flags"),
-        cn = col(h, "noise"), co = col(h, "outliers"), cseed = col(h, "seed"),
+    int cn = col(h, "noise"), co = col(h, "outliers"), cseed = col(h, "seed"),
         cst = col(h, "status"), cnn = col(h, "normal_n");
-    int cm[7];
-    const char *mname[7] = {"normal_rms", "normal_median", "normal_p95", "k1_median", "k1_p95",
-                            "k2_median", "k2_p95"};
-    for (int m = 0; m < 7; m++) cm[m] = col(h, mname[m]);
     char last_draw[128] = "";
-    const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply"), *est = cli_path("e.ply"),
-               *evo = cli_path("eval.txt");
+    const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply");
     for (int i = 1; i < nr; i++) {
         const csv_row *c = &r[i];
         ck_assert_str_eq(c->f[cst], "ok");
@@ -202,31 +229,7 @@ START_TEST(study_equals_generate_estimate_eval)
             ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
             snprintf(last_draw, sizeof last_draw, "%s", draw);
         }
-        /* the estimate: the cell's strategy, degree and flag set */
-        const char *e[32] = {JETFIT_BIN, "estimate", gen, "-o", est, "--neighbors", c->f[cs],
-                             "--degree", c->f[cd], "--threads", "2", "--quiet"};
-        int ne = 12;
-        char fl[256];
-        snprintf(fl, sizeof fl, "%s", c->f[cf]);
-        for (char *t = strtok(fl, " "); t; t = strtok(NULL, " ")) e[ne++] = t;
-        e[ne] = NULL;
-        ck_assert_msg(run_to(NULL, e) == 0, "estimate: %s", cli_err);
-        const char *v[] = {JETFIT_BIN, "eval", est, truth, NULL};
-        ck_assert_msg(run_to(evo, v) == 0, "eval: %s", cli_err);
-        char *out = slurp(evo, NULL);
-        char tn[7][32], t1[7][32], t2[7][32];
-        eval_row(out, "normal_deg", tn);
-        eval_row(out, "k1_rel", t1);
-        eval_row(out, "k2_rel", t2);
-        free(out);
-        ck_assert_str_eq(c->f[cnn], tn[0]);
-        expect_same(c->f[cm[0]], tn[2], "normal_rms");
-        expect_same(c->f[cm[1]], tn[4], "normal_median");
-        expect_same(c->f[cm[2]], tn[5], "normal_p95");
-        expect_same(c->f[cm[3]], t1[4], "k1_median");
-        expect_same(c->f[cm[4]], t1[5], "k1_p95");
-        expect_same(c->f[cm[5]], t2[4], "k2_median");
-        expect_same(c->f[cm[6]], t2[5], "k2_p95");
+        check_cell(h, c, gen, truth, NULL);
     }
     /* the outliers' truth rows are NaN: fewer points measured */
     int with_out = 0;
@@ -237,6 +240,37 @@ START_TEST(study_equals_generate_estimate_eval)
         }
     ck_assert(with_out);
     free_csv(r, nr);
+    cli_teardown();
+}
+END_TEST
+
+/* INPUT --truth --subset: the same numbers as estimate + eval --subset */
+START_TEST(study_of_an_input_equals_estimate_eval_subset)
+{
+    cli_setup();
+    const char *in = cli_path("in.ply"), *truth = cli_path("t.csv"), *sub = cli_path("s.pidx");
+    ck_assert_int_eq(cli_run("generate", "ellipsoid", "--n", "1200", "--noise", "0.003", "--seed",
+                             "5", "-o", in, "--truth", truth, NULL), 0);
+    FILE *f = fopen(sub, "w");
+    for (int i = 0; i < 1200; i += 3) fprintf(f, "%d\n", i);
+    fclose(f);
+    const char *dir = cli_path("st");
+    int rc = cli_run("study", in, "--truth", truth, "--subset", sub, "-o", dir, "--neighbors",
+                     "knn:12;natural:24", "--degree", "2;4", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    char path[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 2 * 2);
+    for (int i = 1; i < nr; i++) {
+        ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
+        ck_assert_str_eq(r[i].f[col(&r[0], "normal_n")], "400");
+        check_cell(&r[0], &r[i], in, truth, sub);
+    }
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
     cli_teardown();
 }
 END_TEST
@@ -601,6 +635,7 @@ int main(void)
     TCase *t = tcase_create("study");
     tcase_set_timeout(t, 600);
     tcase_add_test(t, study_equals_generate_estimate_eval);
+    tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
