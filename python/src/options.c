@@ -20,7 +20,7 @@ static int bad(const jf_cli_bad *b)
 /* Text of a float that reads back to the same double (repr's rule). */
 static int float_text(double d, char *buf, size_t len)
 {
-    char *s = PyOS_double_to_string(d, 'r', 0, 0, NULL);
+    char *s = PyOS_double_to_string(d, 'r', 0, Py_DTSF_ADD_DOT_0, NULL);
     if (!s) return -1;
     snprintf(buf, len, "%s", s);
     PyMem_Free(s);
