@@ -15,6 +15,7 @@ static const struct {
     {"convergence", jf_cmd_convergence, "the paper's §6.1 experiment"},
     {"render", jf_cmd_render, "a PNG of a result coloured by curvature"},
     {"eval", jf_cmd_eval, "errors of a result against ground truth"},
+    {"study", jf_cmd_study, "neighbourhoods x degrees x flags x noise: table, plots, report"},
 };
 
 static void usage(FILE *out)
