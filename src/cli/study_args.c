@@ -203,11 +203,6 @@ static int make_settings(jf_study_args *c)
 
 /* Setting index of a key (its position in make_settings' loops). */
 
-int jf_study_setting(const jf_study *s, const jf_study_key *k)
-{
-    return (k->strategy * s->ndegree + k->degree) * s->nflags + k->flags;
-}
-
 
 static void record_command(jf_study *s, int argc, char **argv)
 {

@@ -33,9 +33,6 @@ typedef struct {
  * (printed); or the exit status of a bad option (2), its line printed. */
 int jf_study_args_parse(jf_study_args *c, int argc, char **argv);
 
-/* Index of a key's setting in c->setting. */
-int jf_study_setting(const jf_study *s, const jf_study_key *k);
-
 /* Frees what parse and cmd_study.c allocated. */
 void jf_study_args_free(jf_study_args *c);
 
