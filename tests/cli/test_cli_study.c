@@ -629,6 +629,36 @@ START_TEST(one_progress_line_with_eta)
 }
 END_TEST
 
+/* A folder name with quotes, a backquote command and HTML: gnuplot gets it
+ * single-quoted (no command runs), the page escapes it. */
+START_TEST(user_text_stays_text)
+{
+    cli_setup();
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/it's \"`touch jf_study_pwned`\" <b>", cli_dir);
+    unlink("jf_study_pwned");
+    int rc = cli_run("study", "exp", "-o", dir, "--n", "600", "--neighbors", "knn:12;knn:24",
+                     "--noise", "0;0.01", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    ck_assert_msg(access("jf_study_pwned", F_OK) != 0, "gnuplot ran the backquoted command");
+    unlink("jf_study_pwned");
+    char path[800];
+    int have_gnuplot = system("command -v gnuplot >/dev/null 2>&1") == 0;
+    snprintf(path, sizeof path, "%s/k.png", dir);
+    ck_assert_int_eq(cli_exists(path), have_gnuplot);
+    snprintf(path, sizeof path, "%s/report.html", dir);
+    char *html = slurp(path, NULL);
+    ck_assert(html != NULL);
+    ck_assert_msg(!strstr(html, "<b>") && strstr(html, "&quot;`touch jf_study_pwned`&quot; &lt;b&gt;") &&
+                      strstr(html, "it&#39;"),
+                  "the folder name is not escaped in the page");
+    free(html);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_study");
@@ -641,6 +671,7 @@ int main(void)
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
     tcase_add_test(t, one_progress_line_with_eta);
+    tcase_add_test(t, user_text_stays_text);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);
     srunner_run_all(r, CK_NORMAL);
