@@ -6,7 +6,8 @@
  *  - a study killed (SIGKILL) after some cells and resumed gives the files
  *    of an uninterrupted run (study.csv but its timing columns, best.csv,
  *    the PNGs byte for byte, report.html but its timing cells);
- *  - an INPUT with --truth and --subset: estimate + eval --subset;
+ *  - an INPUT with --truth and --subset: estimate + eval --subset; a
+ *    SURFACE --mesh (rings): generate --mesh + estimate + eval;
  *  - report.html opened in headless Chromium has the expected rows and
  *    images, a click sorts a column both ways, and its screenshot is not
  *    blank (skipped, with the reason printed, when /usr/bin/chromium is
@@ -270,6 +271,36 @@ START_TEST(study_of_an_input_equals_estimate_eval_subset)
         ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
         ck_assert_str_eq(r[i].f[col(&r[0], "normal_n")], "400");
         check_cell(&r[0], &r[i], in, truth, sub);
+    }
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
+/* SURFACE --mesh: rings on generate --mesh's grid, the same numbers */
+START_TEST(mesh_study_equals_generate_mesh)
+{
+    cli_setup();
+    const char *dir = cli_path("st");
+    int rc = cli_run("study", "paraboloid", "--mesh", "--n", "900", "-o", dir, "--neighbors",
+                     "rings;rings:20;knn:12", "--noise", "0;0.003", "--seed", "4", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    char path[600], gen[600], truth[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    snprintf(gen, sizeof gen, "%s/g.ply", cli_dir);
+    snprintf(truth, sizeof truth, "%s/t.ply", cli_dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 3 * 2);
+    for (int i = 1; i < nr; i++) {
+        const char *g[] = {JETFIT_BIN, "generate", "paraboloid", "--mesh", "--n", "900", "--seed",
+                           r[i].f[col(&r[0], "seed")], "--noise", r[i].f[col(&r[0], "noise")],
+                           "-o", gen, "--truth", truth, NULL};
+        ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
+        ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
+        check_cell(&r[0], &r[i], gen, truth, NULL);
     }
     free_csv(r, nr);
     const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
@@ -714,6 +745,7 @@ int main(void)
     tcase_set_timeout(t, 600);
     tcase_add_test(t, study_equals_generate_estimate_eval);
     tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
+    tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
