@@ -76,7 +76,7 @@ static int make_cells(jf_study_args *c)
                                 jf_study_cell *cl = &s->cell[i++];
                                 cl->key = k;
                                 cl->seed = s->seed + (unsigned long long)k.repeat;
-                                cl->points = c->is_surface ? c->npoints : c->cloud.n;
+                                cl->points = c->ndraw;
                             }
     return 0;
 }
@@ -94,7 +94,10 @@ static jf_status make_draw(const jf_study_args *c, const jf_study_key *k, jf_sam
     jf_rng_seed(&rng, (uint64_t)(s->seed + (unsigned long long)k->repeat));
     jf_status st;
     memset(smp, 0, sizeof *smp);
-    if (c->is_surface) {
+    if (c->is_surface && c->mesh) {
+        st = jf_sample_grid(c->surf, jf_sample_grid_h_for(c->surf, c->npoints), 0.9, 1, &rng, smp);
+        if (st) return st;
+    } else if (c->is_surface) {
         st = jf_sample_random(c->surf, c->npoints, JF_DENSITY_UNIFORM, &rng, smp);
         if (st) return st;
     } else {
@@ -165,7 +168,8 @@ static int run_cell(jf_study_args *c, jf_study_cell *cl, const jf_sample *smp, c
 {
     const jf_study *s = &c->s;
     jf_estimate_opts o = c->setting[jf_study_setting(s, &cl->key)];
-    jf_cloud cloud = {.n = smp->n, .xyz = smp->xyz};
+    jf_cloud cloud = {.n = smp->n, .xyz = smp->xyz, .nfaces = smp->nfaces,
+                      .face_off = smp->face_off, .face_idx = smp->face_idx};
     if (!c->is_surface) {
         cloud.nrm = c->cloud.nrm;
         cloud.nfaces = c->cloud.nfaces;
@@ -296,9 +300,25 @@ int jf_cmd_study(int argc, char **argv)
     jf_study *s = &c.s;
     char msg[4200];
     if (!c.is_surface && load_input(&c)) goto fail;
+    c.ndraw = c.is_surface ? c.npoints : c.cloud.n;
+    if (c.mesh) {
+        /* a grid's vertex count follows from N and the surface (the
+         * perturbation moves vertices only): make one to count them */
+        jf_sample probe;
+        jf_rng rng;
+        jf_rng_seed(&rng, s->seed);
+        jf_status st = jf_sample_grid(c.surf, jf_sample_grid_h_for(c.surf, c.npoints), 0.9, 0,
+                                      &rng, &probe);
+        if (st != JF_OK) {
+            fprintf(stderr, "jetfit: %s --mesh --n %zu: %s\n", s->input, c.npoints,
+                    jf_strerror(st));
+            goto fail;
+        }
+        c.ndraw = probe.n;
+        jf_sample_free(&probe);
+    }
     if (s->subset) {
-        size_t n = c.is_surface ? c.npoints : c.cloud.n;
-        if (jf_cli_subset_load(s->subset, n, &c.sel, &c.nsel, msg, sizeof msg)) {
+        if (jf_cli_subset_load(s->subset, c.ndraw, &c.sel, &c.nsel, msg, sizeof msg)) {
             fprintf(stderr, "jetfit: %s\n", msg);
             goto fail;
         }
@@ -314,7 +334,7 @@ int jf_cmd_study(int argc, char **argv)
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;
     }
-    size_t n = c.is_surface ? c.npoints : c.cloud.n, nsel = c.sel ? c.nsel : n;
+    size_t n = c.ndraw, nsel = c.sel ? c.nsel : n;
     jf_result *res = malloc(n * sizeof *res);
     double *truth5 = malloc(5 * n * sizeof *truth5), *err[3];
     for (int q = 0; q < 3; q++) err[q] = malloc((nsel ? nsel : 1) * sizeof *err[q]);

@@ -42,6 +42,8 @@ static void usage(FILE *f)
         "  --repeat R            noise draws per level (default 1): mean and spread\n"
         "  --seed S              seed of repeat 0 (default 1); repeat r uses S + r\n"
         "  --n N                 SURFACE: points (default %d)\n"
+        "  --mesh                SURFACE: a perturbed triangulated grid of about N\n"
+        "                        vertices, as generate --mesh (rings need it)\n"
         "  --subset IDX          only these 0-based rows count (as eval --subset)\n"
         "  --metrics LIST        best.csv's metrics (default all): normal_rms,\n"
         "                        normal_median, normal_p95, k1_median, k1_p95,\n"
@@ -252,6 +254,10 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
             c->quiet = 1;
             continue;
         }
+        if (!strcmp(a, "--mesh")) {
+            c->mesh = 1;
+            continue;
+        }
         if (jf_cli_est_takes_value(a) == 0) {
             jf_cli_bad bad;
             (void)jf_cli_est_option(&c->base, a, NULL, &bad);
@@ -311,8 +317,8 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
             return bad_opt("SURFACE", pos, "not a surface (exp, paraboloid, revolution, sphere, ellipsoid, cylinder); an INPUT file needs --truth");
         c->is_surface = 1;
         if (!c->npoints) c->npoints = JF_STUDY_DEFAULT_N;
-    } else if (c->npoints) {
-        return bad_opt("--n", "", "applies to a SURFACE, not to INPUT --truth");
+    } else if (c->npoints || c->mesh) {
+        return bad_opt(c->mesh ? "--mesh" : "--n", "", "applies to a SURFACE, not to INPUT --truth");
     }
     /* the lists */
     int ns = split_list(c->nb_text, ";", &c->strat_block);

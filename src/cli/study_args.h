@@ -16,8 +16,9 @@ typedef struct {
     const char *dir, *nb_text, *deg_text, *flags_text, *metrics_text;
     char **strat_block, **flags_block;
     jf_surface surf;
-    int is_surface, quiet, resume;
-    size_t npoints;
+    int is_surface, mesh, quiet, resume;
+    size_t npoints;              /* --n                                */
+    size_t ndraw;                /* points of each draw (cmd_study.c)  */
     jf_cli_est base;             /* options outside --flags           */
     jf_estimate_opts *setting;   /* strategy x degree x flags, in the
                                     order of jf_study_setting         */

@@ -6,12 +6,16 @@
  *  - a study killed (SIGKILL) after some cells and resumed gives the files
  *    of an uninterrupted run (study.csv but its timing columns, best.csv,
  *    the PNGs byte for byte, report.html but its timing cells);
+ *  - an INPUT with --truth and --subset: estimate + eval --subset; a
+ *    SURFACE --mesh (rings): generate --mesh + estimate + eval;
  *  - report.html opened in headless Chromium has the expected rows and
- *    images, and its screenshot is not blank (skipped, with the reason
- *    printed, when /usr/bin/chromium is not installed);
+ *    images, a click sorts a column both ways, and its screenshot is not
+ *    blank (skipped, with the reason printed, when /usr/bin/chromium is
+ *    not installed);
  *  - Ctrl-C cancels the running cell and keeps the finished ones;
  *  - bad input: one line, no DIR; a failing cell is recorded, the rest go
- *    on; one progress line with an ETA for the whole study. */
+ *    on; one progress line with an ETA for the whole study; user text
+ *    (a folder name) runs nothing through gnuplot and is escaped. */
 #include <check.h>
 #include <signal.h>
 #include <time.h>
@@ -275,6 +279,36 @@ START_TEST(study_of_an_input_equals_estimate_eval_subset)
 }
 END_TEST
 
+/* SURFACE --mesh: rings on generate --mesh's grid, the same numbers */
+START_TEST(mesh_study_equals_generate_mesh)
+{
+    cli_setup();
+    const char *dir = cli_path("st");
+    int rc = cli_run("study", "paraboloid", "--mesh", "--n", "900", "-o", dir, "--neighbors",
+                     "rings;rings:20;knn:12", "--noise", "0;0.003", "--seed", "4", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    char path[600], gen[600], truth[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    snprintf(gen, sizeof gen, "%s/g.ply", cli_dir);
+    snprintf(truth, sizeof truth, "%s/t.ply", cli_dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 3 * 2);
+    for (int i = 1; i < nr; i++) {
+        const char *g[] = {JETFIT_BIN, "generate", "paraboloid", "--mesh", "--n", "900", "--seed",
+                           r[i].f[col(&r[0], "seed")], "--noise", r[i].f[col(&r[0], "noise")],
+                           "-o", gen, "--truth", truth, NULL};
+        ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
+        ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
+        check_cell(&r[0], &r[i], gen, truth, NULL);
+    }
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
 /* ---- resume after a real interruption ---- */
 
 static int lines_in(const char *path)
@@ -459,7 +493,15 @@ END_TEST
 
 /* Runs headless Chromium on file://page with one more argument (what to
  * produce), a fresh profile, no network; stdout into out (or NULL). */
+static int chromium_flag(const char *page, const char *what, const char *out, const char *extra);
+
 static int chromium(const char *page, const char *what, const char *out)
+{
+    return chromium_flag(page, what, out, "--disable-sync");
+}
+
+/* As chromium(), with one more flag (or a repeated harmless one). */
+static int chromium_flag(const char *page, const char *what, const char *out, const char *extra)
 {
     char url[700], ud[600];
     snprintf(url, sizeof url, "file://%s", page);
@@ -467,7 +509,8 @@ static int chromium(const char *page, const char *what, const char *out)
     const char *argv[] = {"/usr/bin/timeout", "120", CHROMIUM, "--headless", "--no-sandbox",
                           "--disable-gpu", "--disable-quic", "--no-first-run",
                           "--disable-background-networking", "--disable-component-update",
-                          "--disable-sync", ud, "--window-size=1200,1600", what, url, NULL};
+                          "--disable-sync", extra, ud, "--window-size=1200,1600", what, url,
+                          NULL};
     int rc = run_to(out, argv);
     /* the profile is a tree: remove it with the tool made for that */
     const char *rm[] = {"/bin/rm", "-rf", cli_path("profile"), NULL};
@@ -509,6 +552,42 @@ START_TEST(report_opens_in_chromium)
     ck_assert_int_eq(count_str(d, "src=\"data:image/png;base64,"), have_gnuplot ? 3 : 0);
     ck_assert_msg(strstr(d, "http://") == NULL && strstr(d, "https://") == NULL,
                   "the page refers to the network");
+    free(d);
+    /* sorting: a page frames the report, clicks the normal_median heading
+     * twice and copies the column out (file:// frames need
+     * --allow-file-access-from-files to be read by their parent) */
+    const char *wrap = cli_path("sort.html");
+    cli_write_text(wrap,
+        "<!DOCTYPE html><html><body><pre id=\"out\"></pre>\n"
+        "<iframe id=\"f\" src=\"st/report.html\" onload=\"go()\"></iframe><script>\n"
+        "function column(d, c) { return Array.prototype.map.call(\n"
+        "  d.querySelectorAll('#cells tbody tr'), function (r) { return r.cells[c].textContent; }).join(' '); }\n"
+        "function go() {\n"
+        "  var d = document.getElementById('f').contentDocument;\n"
+        "  var hs = d.querySelectorAll('#cells thead th'), c = -1;\n"
+        "  for (var i = 0; i < hs.length; i++) if (hs[i].textContent === 'normal_median') c = i;\n"
+        "  hs[c].click(); var up = column(d, c); hs[c].click(); var down = column(d, c);\n"
+        "  document.getElementById('out').textContent = '\\nASC ' + up + '\\nDESC ' + down + '\\n';\n"
+        "}\n</script></body></html>\n");
+    ck_assert_msg(chromium_flag(wrap, "--dump-dom", dom, "--allow-file-access-from-files") == 0,
+                  "chromium: %s", cli_err);
+    d = slurp(dom, NULL);
+    char *asc = strstr(d, "\nASC "), *desc = strstr(d, "\nDESC ");
+    ck_assert_msg(asc && desc, "the sorting page did not run");
+    for (int pass = 0; pass < 2; pass++) {
+        char *p = (pass ? desc : asc) + (pass ? 6 : 5), *end;
+        double prev = pass ? INFINITY : -INFINITY;
+        int n = 0;
+        for (;;) {
+            double v = strtod(p, &end);
+            if (end == p) break;
+            ck_assert_msg(pass ? v <= prev : v >= prev, "not sorted at %g after %g", v, prev);
+            prev = v;
+            p = end;
+            n++;
+        }
+        ck_assert_int_eq(n, 3 * 2 * 3 * 2);
+    }
     free(d);
     /* a screenshot of the page, beside one of an empty page of the same
      * size: plots and tables make a much larger PNG than white */
@@ -666,6 +745,7 @@ int main(void)
     tcase_set_timeout(t, 600);
     tcase_add_test(t, study_equals_generate_estimate_eval);
     tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
+    tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
