@@ -14,13 +14,23 @@
 
 void jf_gp_quote(FILE *gp, const char *s)
 {
+    /* gnuplot 5.4 reads a string that starts with a doubled quote, as in
+     * 'QQx' with Q a quote, as an empty one: leading quotes are joined on
+     * as "'" (a double-quoted string holding no backquote expands nothing) */
+    size_t lead = strspn(s, "'");
+    if (lead)
+        fputc('(', gp);
+    for (size_t k = 0; k < lead; k++)
+        fputs("\"'\".", gp);
     fputc('\'', gp);
-    for (; *s; s++) {
+    for (s += lead; *s; s++) {
         if (*s == '\'')
             fputc('\'', gp);
         fputc((unsigned char)*s < 0x20 || *s == 0x7f ? ' ' : *s, gp);
     }
     fputc('\'', gp);
+    if (lead)
+        fputc(')', gp);
 }
 
 int jf_gp_open(jf_gp *g, char *msg, size_t len)

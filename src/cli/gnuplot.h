@@ -19,7 +19,8 @@ int jf_gp_open(jf_gp *g, char *msg, size_t len);
 int jf_gp_close(jf_gp *g, char *msg, size_t len);
 /* Writes s as a gnuplot single-quoted string: gnuplot expands nothing
  * there (a double-quoted string would run `backquoted` commands); ' is
- * doubled and control characters (a newline would end the command) become
- * blanks. */
+ * doubled (leading quotes joined on as "'", see gnuplot.c) and control
+ * characters (a newline would end the command) become blanks.  The result
+ * is a string expression: fine after set output, set title, plot's title. */
 void jf_gp_quote(FILE *gp, const char *s);
 #endif
