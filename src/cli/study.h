@@ -1,5 +1,6 @@
 /* study.h -- `jetfit study`'s table, shared by its files: cmd_study.c (the
- * command: options, cells, running them), study_csv.c (study.csv, best.csv,
+ * command: cells, draws, running them), study_args.c (the command line),
+ * study_csv.c (study.csv, best.csv,
  * means over repeats), study_plot.c (gnuplot PNGs), study_report.c (the
  * self-contained report.html). */
 #ifndef JF_STUDY_H
@@ -56,6 +57,13 @@ typedef struct {
     jf_study_cell *cell;
     size_t ncells;
 } jf_study;
+
+/* The plan's order (cmd_study.c makes the cells in it): noise, noise
+ * uniform, outliers, repeat, strategy, degree, flags, the last fastest.
+ * jf_study_setting: the key's setting among strategy x degree x flags;
+ * jf_study_cell_index: the key's cell in s->cell. */
+int jf_study_setting(const jf_study *s, const jf_study_key *k);
+size_t jf_study_cell_index(const jf_study *s, const jf_study_key *k);
 
 /* The cell's setting as one label, "knn:16 d2 --robust-normals". */
 void jf_study_label(const jf_study *s, const jf_study_key *k, char *buf, size_t len);

@@ -218,6 +218,7 @@ int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len)
         int okn = n == (int)NCOL;
         for (size_t j = 0; okn && j < NCOL; j++)
             if (j != 0 && j != 2 && j != NKEY + JF_M_COUNT + 4) okn = !num(fld[j], &v[j]);
+        unsigned long long seed = okn ? strtoull(fld[7], NULL, 10) : 0; /* > 2^53 too */
         if (!okn) {
             snprintf(msg, len, "%s:%zu: malformed row (%d fields, expected %zu)", path, lineno,
                      n, NCOL);
@@ -237,7 +238,7 @@ int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len)
         /* a row of another plan (other lists, seed or size) is dropped */
         for (size_t i = 0; i < s->ncells; i++) {
             jf_study_cell *c = &s->cell[i];
-            if (memcmp(&c->key, &k, sizeof k) || c->done || (double)c->seed != v[7] ||
+            if (memcmp(&c->key, &k, sizeof k) || c->done || c->seed != seed ||
                 (double)c->points != v[8])
                 continue;
             c->normal_n = (size_t)v[9];
@@ -262,47 +263,57 @@ int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len)
 
 /* ---- means over repeats, best.csv ---- */
 
+int jf_study_setting(const jf_study *s, const jf_study_key *k)
+{
+    return (k->strategy * s->ndegree + k->degree) * s->nflags + k->flags;
+}
+
+size_t jf_study_cell_index(const jf_study *s, const jf_study_key *k)
+{
+    size_t lvl = ((size_t)k->noise * (size_t)s->nnoise_u + (size_t)k->noise_u) *
+                     (size_t)s->noutliers + (size_t)k->outliers;
+    size_t nset = (size_t)s->nstrategy * (size_t)s->ndegree * (size_t)s->nflags;
+    return (lvl * (size_t)s->repeat + (size_t)k->repeat) * nset + (size_t)jf_study_setting(s, k);
+}
+
 void jf_study_mean(const jf_study *s, const jf_study_key *k, int metric, jf_study_stat *out)
 {
     double sum = 0, sum2 = 0;
     int n = 0;
-    for (size_t i = 0; i < s->ncells; i++) {
-        const jf_study_cell *c = &s->cell[i];
-        jf_study_key a = c->key;
-        a.repeat = k->repeat;
-        if (!c->done || memcmp(&a, k, sizeof a) || !isfinite(c->m[metric])) continue;
+    jf_study_key q = *k;
+    for (q.repeat = 0; q.repeat < s->repeat; q.repeat++) {
+        const jf_study_cell *c = &s->cell[jf_study_cell_index(s, &q)];
+        if (!c->done || !isfinite(c->m[metric])) continue;
         sum += c->m[metric];
         n++;
     }
     out->n = n;
     out->mean = n ? sum / n : NAN;
-    for (size_t i = 0; n > 1 && i < s->ncells; i++) {
-        const jf_study_cell *c = &s->cell[i];
-        jf_study_key a = c->key;
-        a.repeat = k->repeat;
-        if (!c->done || memcmp(&a, k, sizeof a) || !isfinite(c->m[metric])) continue;
+    for (q.repeat = 0; n > 1 && q.repeat < s->repeat; q.repeat++) {
+        const jf_study_cell *c = &s->cell[jf_study_cell_index(s, &q)];
+        if (!c->done || !isfinite(c->m[metric])) continue;
         sum2 += (c->m[metric] - out->mean) * (c->m[metric] - out->mean);
     }
     out->sd = n > 1 ? sqrt(sum2 / (n - 1)) : n ? 0.0 : NAN;
 }
 
 int jf_study_best(const jf_study *s, const jf_study_key *lvl, int metric, jf_study_key *best,
-                   jf_study_stat *bs)
+                  jf_study_stat *bs)
 {
     int any = 0;
-    for (size_t i = 0; i < s->ncells; i++) {
-        jf_study_key k = s->cell[i].key;
-        if (k.repeat || k.noise != lvl->noise || k.noise_u != lvl->noise_u ||
-            k.outliers != lvl->outliers)
-            continue;
-        jf_study_stat st;
-        jf_study_mean(s, &k, metric, &st);
-        if (st.n && (!any || st.mean < bs->mean)) {
-            *best = k;
-            *bs = st;
-            any = 1;
-        }
-    }
+    jf_study_key k = *lvl;
+    k.repeat = 0;
+    for (k.strategy = 0; k.strategy < s->nstrategy; k.strategy++)
+        for (k.degree = 0; k.degree < s->ndegree; k.degree++)
+            for (k.flags = 0; k.flags < s->nflags; k.flags++) {
+                jf_study_stat st;
+                jf_study_mean(s, &k, metric, &st);
+                if (st.n && (!any || st.mean < bs->mean)) {
+                    *best = k;
+                    *bs = st;
+                    any = 1;
+                }
+            }
     return any;
 }
 

@@ -6,12 +6,16 @@
  *  - a study killed (SIGKILL) after some cells and resumed gives the files
  *    of an uninterrupted run (study.csv but its timing columns, best.csv,
  *    the PNGs byte for byte, report.html but its timing cells);
+ *  - an INPUT with --truth and --subset: estimate + eval --subset; a
+ *    SURFACE --mesh (rings): generate --mesh + estimate + eval;
  *  - report.html opened in headless Chromium has the expected rows and
- *    images, and its screenshot is not blank (skipped, with the reason
- *    printed, when /usr/bin/chromium is not installed);
+ *    images, a click sorts a column both ways, and its screenshot is not
+ *    blank (skipped, with the reason printed, when /usr/bin/chromium is
+ *    not installed);
  *  - Ctrl-C cancels the running cell and keeps the finished ones;
  *  - bad input: one line, no DIR; a failing cell is recorded, the rest go
- *    on; one progress line with an ETA for the whole study. */
+ *    on; one progress line with an ETA for the whole study; user text
+ *    (a folder name) runs nothing through gnuplot and is escaped. */
 #include <check.h>
 #include <signal.h>
 #include <time.h>
@@ -163,6 +167,39 @@ static void expect_same(const char *study_text, const char *eval_tok, const char
     ck_assert_msg(!strcmp(b, eval_tok), "%s: study %s (%s), eval %s", what, study_text, b, eval_tok);
 }
 
+/* Runs `estimate` on input with row c's strategy, degree and flag set,
+ * then `eval` against truth (and subset), and checks c's numbers against
+ * what eval prints. */
+static void check_cell(const csv_row *h, const csv_row *c, const char *input, const char *truth,
+                       const char *subset)
+{
+    static const char *const mname[7] = {"normal_rms", "normal_median", "normal_p95",
+                                         "k1_median", "k1_p95", "k2_median", "k2_p95"};
+    char est[600], evo[600]; /* not cli_path: its 8 buffers hold the caller's */
+    snprintf(est, sizeof est, "%s/e.ply", cli_dir);
+    snprintf(evo, sizeof evo, "%s/eval.txt", cli_dir);
+    const char *e[32] = {JETFIT_BIN, "estimate", input, "-o", est, "--neighbors",
+                         c->f[col(h, "strategy")], "--degree", c->f[col(h, "degree")],
+                         "--threads", "2", "--quiet"};
+    int ne = 12;
+    char fl[256];
+    snprintf(fl, sizeof fl, "%s", c->f[col(h, "flags")]);
+    for (char *t = strtok(fl, " "); t; t = strtok(NULL, " ")) e[ne++] = t;
+    e[ne] = NULL;
+    ck_assert_msg(run_to(NULL, e) == 0, "estimate: %s", cli_err);
+    const char *v[] = {JETFIT_BIN, "eval", est, truth, subset ? "--subset" : NULL, subset, NULL};
+    ck_assert_msg(run_to(evo, v) == 0, "eval: %s", cli_err);
+    char *out = slurp(evo, NULL);
+    char tn[7][32], t1[7][32], t2[7][32];
+    eval_row(out, "normal_deg", tn);
+    eval_row(out, "k1_rel", t1);
+    eval_row(out, "k2_rel", t2);
+    free(out);
+    ck_assert_str_eq(c->f[col(h, "normal_n")], tn[0]);
+    const char *want[7] = {tn[2], tn[4], tn[5], t1[4], t1[5], t2[4], t2[5]};
+    for (int m = 0; m < 7; m++) expect_same(c->f[col(h, mname[m])], want[m], mname[m]);
+}
+
 START_TEST(study_equals_generate_estimate_eval)
 {
     cli_setup();
@@ -179,16 +216,10 @@ START_TEST(study_equals_generate_estimate_eval)
     csv_row *r = read_csv(path, &nr);
     ck_assert_int_eq(nr, 1 + 2 * 2 * 3 * 2 * 2 * 2); /* header + cells */
     const csv_row *h = &r[0];
-    int cs = col(h, "strategy"), cd = col(h, "degree"), cf = col(h, "flags"),
-        cn = col(h, "noise"), co = col(h, "outliers"), cseed = col(h, "seed"),
+    int cn = col(h, "noise"), co = col(h, "outliers"), cseed = col(h, "seed"),
         cst = col(h, "status"), cnn = col(h, "normal_n");
-    int cm[7];
-    const char *mname[7] = {"normal_rms", "normal_median", "normal_p95", "k1_median", "k1_p95",
-                            "k2_median", "k2_p95"};
-    for (int m = 0; m < 7; m++) cm[m] = col(h, mname[m]);
     char last_draw[128] = "";
-    const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply"), *est = cli_path("e.ply"),
-               *evo = cli_path("eval.txt");
+    const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply");
     for (int i = 1; i < nr; i++) {
         const csv_row *c = &r[i];
         ck_assert_str_eq(c->f[cst], "ok");
@@ -202,31 +233,7 @@ START_TEST(study_equals_generate_estimate_eval)
             ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
             snprintf(last_draw, sizeof last_draw, "%s", draw);
         }
-        /* the estimate: the cell's strategy, degree and flag set */
-        const char *e[32] = {JETFIT_BIN, "estimate", gen, "-o", est, "--neighbors", c->f[cs],
-                             "--degree", c->f[cd], "--threads", "2", "--quiet"};
-        int ne = 12;
-        char fl[256];
-        snprintf(fl, sizeof fl, "%s", c->f[cf]);
-        for (char *t = strtok(fl, " "); t; t = strtok(NULL, " ")) e[ne++] = t;
-        e[ne] = NULL;
-        ck_assert_msg(run_to(NULL, e) == 0, "estimate: %s", cli_err);
-        const char *v[] = {JETFIT_BIN, "eval", est, truth, NULL};
-        ck_assert_msg(run_to(evo, v) == 0, "eval: %s", cli_err);
-        char *out = slurp(evo, NULL);
-        char tn[7][32], t1[7][32], t2[7][32];
-        eval_row(out, "normal_deg", tn);
-        eval_row(out, "k1_rel", t1);
-        eval_row(out, "k2_rel", t2);
-        free(out);
-        ck_assert_str_eq(c->f[cnn], tn[0]);
-        expect_same(c->f[cm[0]], tn[2], "normal_rms");
-        expect_same(c->f[cm[1]], tn[4], "normal_median");
-        expect_same(c->f[cm[2]], tn[5], "normal_p95");
-        expect_same(c->f[cm[3]], t1[4], "k1_median");
-        expect_same(c->f[cm[4]], t1[5], "k1_p95");
-        expect_same(c->f[cm[5]], t2[4], "k2_median");
-        expect_same(c->f[cm[6]], t2[5], "k2_p95");
+        check_cell(h, c, gen, truth, NULL);
     }
     /* the outliers' truth rows are NaN: fewer points measured */
     int with_out = 0;
@@ -237,6 +244,67 @@ START_TEST(study_equals_generate_estimate_eval)
         }
     ck_assert(with_out);
     free_csv(r, nr);
+    cli_teardown();
+}
+END_TEST
+
+/* INPUT --truth --subset: the same numbers as estimate + eval --subset */
+START_TEST(study_of_an_input_equals_estimate_eval_subset)
+{
+    cli_setup();
+    const char *in = cli_path("in.ply"), *truth = cli_path("t.csv"), *sub = cli_path("s.pidx");
+    ck_assert_int_eq(cli_run("generate", "ellipsoid", "--n", "1200", "--noise", "0.003", "--seed",
+                             "5", "-o", in, "--truth", truth, NULL), 0);
+    FILE *f = fopen(sub, "w");
+    for (int i = 0; i < 1200; i += 3) fprintf(f, "%d\n", i);
+    fclose(f);
+    const char *dir = cli_path("st");
+    int rc = cli_run("study", in, "--truth", truth, "--subset", sub, "-o", dir, "--neighbors",
+                     "knn:12;natural:24", "--degree", "2;4", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    char path[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 2 * 2);
+    for (int i = 1; i < nr; i++) {
+        ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
+        ck_assert_str_eq(r[i].f[col(&r[0], "normal_n")], "400");
+        check_cell(&r[0], &r[i], in, truth, sub);
+    }
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
+/* SURFACE --mesh: rings on generate --mesh's grid, the same numbers */
+START_TEST(mesh_study_equals_generate_mesh)
+{
+    cli_setup();
+    const char *dir = cli_path("st");
+    int rc = cli_run("study", "paraboloid", "--mesh", "--n", "900", "-o", dir, "--neighbors",
+                     "rings;rings:20;knn:12", "--noise", "0;0.003", "--seed", "4", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    char path[600], gen[600], truth[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    snprintf(gen, sizeof gen, "%s/g.ply", cli_dir);
+    snprintf(truth, sizeof truth, "%s/t.ply", cli_dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 3 * 2);
+    for (int i = 1; i < nr; i++) {
+        const char *g[] = {JETFIT_BIN, "generate", "paraboloid", "--mesh", "--n", "900", "--seed",
+                           r[i].f[col(&r[0], "seed")], "--noise", r[i].f[col(&r[0], "noise")],
+                           "-o", gen, "--truth", truth, NULL};
+        ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
+        ck_assert_str_eq(r[i].f[col(&r[0], "status")], "ok");
+        check_cell(&r[0], &r[i], gen, truth, NULL);
+    }
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
     cli_teardown();
 }
 END_TEST
@@ -425,7 +493,15 @@ END_TEST
 
 /* Runs headless Chromium on file://page with one more argument (what to
  * produce), a fresh profile, no network; stdout into out (or NULL). */
+static int chromium_flag(const char *page, const char *what, const char *out, const char *extra);
+
 static int chromium(const char *page, const char *what, const char *out)
+{
+    return chromium_flag(page, what, out, "--disable-sync");
+}
+
+/* As chromium(), with one more flag (or a repeated harmless one). */
+static int chromium_flag(const char *page, const char *what, const char *out, const char *extra)
 {
     char url[700], ud[600];
     snprintf(url, sizeof url, "file://%s", page);
@@ -433,7 +509,8 @@ static int chromium(const char *page, const char *what, const char *out)
     const char *argv[] = {"/usr/bin/timeout", "120", CHROMIUM, "--headless", "--no-sandbox",
                           "--disable-gpu", "--disable-quic", "--no-first-run",
                           "--disable-background-networking", "--disable-component-update",
-                          "--disable-sync", ud, "--window-size=1200,1600", what, url, NULL};
+                          "--disable-sync", extra, ud, "--window-size=1200,1600", what, url,
+                          NULL};
     int rc = run_to(out, argv);
     /* the profile is a tree: remove it with the tool made for that */
     const char *rm[] = {"/bin/rm", "-rf", cli_path("profile"), NULL};
@@ -475,6 +552,42 @@ START_TEST(report_opens_in_chromium)
     ck_assert_int_eq(count_str(d, "src=\"data:image/png;base64,"), have_gnuplot ? 3 : 0);
     ck_assert_msg(strstr(d, "http://") == NULL && strstr(d, "https://") == NULL,
                   "the page refers to the network");
+    free(d);
+    /* sorting: a page frames the report, clicks the normal_median heading
+     * twice and copies the column out (file:// frames need
+     * --allow-file-access-from-files to be read by their parent) */
+    const char *wrap = cli_path("sort.html");
+    cli_write_text(wrap,
+        "<!DOCTYPE html><html><body><pre id=\"out\"></pre>\n"
+        "<iframe id=\"f\" src=\"st/report.html\" onload=\"go()\"></iframe><script>\n"
+        "function column(d, c) { return Array.prototype.map.call(\n"
+        "  d.querySelectorAll('#cells tbody tr'), function (r) { return r.cells[c].textContent; }).join(' '); }\n"
+        "function go() {\n"
+        "  var d = document.getElementById('f').contentDocument;\n"
+        "  var hs = d.querySelectorAll('#cells thead th'), c = -1;\n"
+        "  for (var i = 0; i < hs.length; i++) if (hs[i].textContent === 'normal_median') c = i;\n"
+        "  hs[c].click(); var up = column(d, c); hs[c].click(); var down = column(d, c);\n"
+        "  document.getElementById('out').textContent = '\\nASC ' + up + '\\nDESC ' + down + '\\n';\n"
+        "}\n</script></body></html>\n");
+    ck_assert_msg(chromium_flag(wrap, "--dump-dom", dom, "--allow-file-access-from-files") == 0,
+                  "chromium: %s", cli_err);
+    d = slurp(dom, NULL);
+    char *asc = strstr(d, "\nASC "), *desc = strstr(d, "\nDESC ");
+    ck_assert_msg(asc && desc, "the sorting page did not run");
+    for (int pass = 0; pass < 2; pass++) {
+        char *p = (pass ? desc : asc) + (pass ? 6 : 5), *end;
+        double prev = pass ? INFINITY : -INFINITY;
+        int n = 0;
+        for (;;) {
+            double v = strtod(p, &end);
+            if (end == p) break;
+            ck_assert_msg(pass ? v <= prev : v >= prev, "not sorted at %g after %g", v, prev);
+            prev = v;
+            p = end;
+            n++;
+        }
+        ck_assert_int_eq(n, 3 * 2 * 3 * 2);
+    }
     free(d);
     /* a screenshot of the page, beside one of an empty page of the same
      * size: plots and tables make a much larger PNG than white */
@@ -595,17 +708,50 @@ START_TEST(one_progress_line_with_eta)
 }
 END_TEST
 
+/* A folder name with quotes, a backquote command and HTML: gnuplot gets it
+ * single-quoted (no command runs), the page escapes it. */
+START_TEST(user_text_stays_text)
+{
+    cli_setup();
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/it's \"`touch jf_study_pwned`\" <b>", cli_dir);
+    unlink("jf_study_pwned");
+    int rc = cli_run("study", "exp", "-o", dir, "--n", "600", "--neighbors", "knn:12;knn:24",
+                     "--noise", "0;0.01", "--quiet", NULL);
+    ck_assert_msg(rc == 0, "%s", cli_err);
+    ck_assert_msg(access("jf_study_pwned", F_OK) != 0, "gnuplot ran the backquoted command");
+    unlink("jf_study_pwned");
+    char path[800];
+    int have_gnuplot = system("command -v gnuplot >/dev/null 2>&1") == 0;
+    snprintf(path, sizeof path, "%s/k.png", dir);
+    ck_assert_int_eq(cli_exists(path), have_gnuplot);
+    snprintf(path, sizeof path, "%s/report.html", dir);
+    char *html = slurp(path, NULL);
+    ck_assert(html != NULL);
+    ck_assert_msg(!strstr(html, "<b>") && strstr(html, "&quot;`touch jf_study_pwned`&quot; &lt;b&gt;") &&
+                      strstr(html, "it&#39;"),
+                  "the folder name is not escaped in the page");
+    free(html);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_study");
     TCase *t = tcase_create("study");
     tcase_set_timeout(t, 600);
     tcase_add_test(t, study_equals_generate_estimate_eval);
+    tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
+    tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
     tcase_add_test(t, one_progress_line_with_eta);
+    tcase_add_test(t, user_text_stays_text);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);
     srunner_run_all(r, CK_NORMAL);
