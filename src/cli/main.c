@@ -2,6 +2,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <gsl/gsl_version.h>
+
+#include "cgal_bridge.h"
 #include "cmd.h"
 #include "jetfit.h"
 
@@ -17,6 +20,22 @@ static const struct {
     {"eval", jf_cmd_eval, "errors of a result against ground truth"},
     {"study", jf_cmd_study, "neighbourhoods x degrees x flags x noise: table, plots, report"},
 };
+
+/* The OpenMP specification version from _OPENMP's date (yyyymm). */
+static const char *openmp_version(void)
+{
+#ifdef _OPENMP
+    static const struct { long date; const char *v; } specs[] = {
+        {202111, "5.2"}, {202011, "5.1"}, {201811, "5.0"}, {201511, "4.5"},
+        {201307, "4.0"}, {201107, "3.1"}, {200805, "3.0"}};
+    for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++)
+        if (_OPENMP >= specs[i].date)
+            return specs[i].v;
+    return "before 3.0";
+#else
+    return "none";
+#endif
+}
 
 static void usage(FILE *out)
 {
@@ -38,6 +57,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "--version")) {
         printf("jetfit %s\n", jf_version());
+        printf("built with CGAL %s, GSL %s, OpenMP %s\n", jfb_cgal_version(), GSL_VERSION,
+               openmp_version());
         return 0;
     }
     for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)
