@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 TOP = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-BUILD_PY = os.path.join(TOP, "build", "python")
-if BUILD_PY not in sys.path and os.path.isdir(BUILD_PY):
-    sys.path.insert(0, BUILD_PY)
-
-import jetfit  # noqa: E402  (after the path above)
+try:  # PYTHONPATH or installed first; else the default build tree
+    import jetfit
+except ImportError:
+    sys.path.insert(0, os.path.join(TOP, "build", "python"))
+    import jetfit
 
 JETFIT_BIN = os.environ.get("JETFIT_BIN", os.path.join(TOP, "build", "jetfit"))
 
