@@ -516,6 +516,9 @@ typedef struct {
     size_t nfaces;       /* mesh faces (0 for a cloud)                 */
     size_t *face_off;    /* nfaces+1 offsets into face_idx, or NULL    */
     uint32_t *face_idx;  /* polygon vertex indices, or NULL            */
+    size_t nbad;         /* text rows that did not parse, kept as NaN
+                            points (jf_read_opts.bad_rows = skip)      */
+    size_t bad_line[10]; /* the first min(nbad, 10) of their lines     */
 } jf_cloud;
 
 typedef struct {
@@ -529,6 +532,11 @@ typedef struct {
                             header names x,y,z[,nx,ny,nz] (any case).
                             x,y,z must be all set or all -1; normals
                             likewise.                                  */
+    int bad_rows;        /* text formats: 0 (default) an unparsable row
+                            is an error; 1 it is kept as a row of NaN
+                            (so every later row keeps its index; the
+                            pipeline marks it nonfinite) and counted in
+                            jf_cloud.nbad / bad_line                   */
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */

@@ -234,7 +234,11 @@ int jf_cmd_estimate(int argc, char **argv)
             val = eq + 1;
         } else {
             snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc) return bad_option(a, "", "needs a value");
+            if (i + 1 >= argc)
+                return strcmp(name, "-o") && strcmp(name, "--output") &&
+                               jf_cli_est_takes_value(name) != 1
+                           ? bad_option("unknown option", a, "not an option of estimate")
+                           : bad_option(a, "", "needs a value");
             val = argv[++i];
         }
         if (!strcmp(name, "-o") || !strcmp(name, "--output")) {

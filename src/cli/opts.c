@@ -174,7 +174,7 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
         }
     } else { /* --threads */
         if (jf_cli_parse_int(val, 1, 4096, &iv))
-            return bad_(bad, name, val, "expected a positive integer");
+            return bad_(bad, name, val, "expected an integer from 1 to 4096 (the limit)");
         o->threads = iv;
     }
     return 0;
