@@ -105,6 +105,7 @@ char *jf_point_status_str(unsigned status, char *buf, size_t len);
 /* ------------------------------------------------------------------ */
 #define JF_MAX_DEGREE 9         /* largest jet degree (N_9 = 55)       */
 #define JF_MAX_MONGE_DEGREE 4
+#define JF_MAX_NEIGHBORS ((size_t)1 << 20) /* largest neighbourhood a fit takes */
 
 typedef enum { JF_FIT_APPROX = 0, JF_FIT_INTERP = 1 } jf_fit_mode;
 typedef enum { JF_FRAME_PCA = 0, JF_FRAME_AXIS = 1 } jf_frame_mode;
