@@ -91,6 +91,8 @@ PyMODINIT_FUNC PyInit__jetfit(void)
         goto fail;
     }
     if (PyModule_AddStringConstant(m, "__version__", jf_version()) < 0) goto fail;
+    /* which OpenMP runtime the module runs on (python/CMakeLists.txt) */
+    if (PyModule_AddStringConstant(m, "OPENMP_RUNTIME", JF_PY_OPENMP) < 0) goto fail;
     return m;
 fail:
     Py_DECREF(m);
