@@ -829,6 +829,40 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
                            size_t *ring_end);
 
 /* ------------------------------------------------------------------ */
+/* Output files that appear whole or not at all (src/io/io_tmpfile.c)  */
+/* ------------------------------------------------------------------ */
+/* Every writer of the library goes through this; it is public so that a
+ * program writing its own files (a picture, a report) gets the same
+ * guarantees.  The temporary is created beside the final file, under an
+ * unpredictable name, exclusively (a planted file or link is never
+ * followed), even for a final name near the 255-byte limit.  A final path
+ * that is a symbolic link is written through to its target (as cp does).
+ * The new file keeps the mode of the file it replaces, else 0666 less the
+ * umask. */
+typedef struct {
+    int fd;          /* write here (open, O_WRONLY)                    */
+    char *tmp;       /* the temporary's path                           */
+    char *target;    /* the file that commit replaces                  */
+    int slot;        /* internal: its place in the signal-safe list    */
+} jf_tmpfile;
+
+/* Creates the temporary for `final`.  JF_OK, or JF_ERR_IO / _INVALID /
+ * _NOMEM with err "FINAL: reason" and *t holding nothing.  Thread-safe. */
+jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err);
+/* Closes the temporary and renames it onto its target; on failure removes
+ * it.  Either way *t holds nothing afterwards. */
+jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err);
+/* Closes and removes the temporary (t may be NULL or empty). */
+void jf_tmpfile_discard(jf_tmpfile *t);
+/* Removes every temporary of this process that is not yet committed or
+ * discarded: unlink(2) only, async-signal-safe, for a SIGINT/SIGTERM
+ * handler. */
+void jf_tmpfiles_remove_all(void);
+/* 1 when a and b name the same existing file (device and inode, links
+ * followed), else 0. */
+int jf_same_file(const char *a, const char *b);
+
+/* ------------------------------------------------------------------ */
 /* Estimation pipeline (src/pipeline.c): a whole cloud, with OpenMP    */
 /* ------------------------------------------------------------------ */
 #define JF_ESTIMATE_DEFAULT_K 32   /* knn:32, the command's default    */

@@ -254,6 +254,13 @@ int jf_cmd_estimate(int argc, char **argv)
 
     double t0 = now_s();
     jf_cloud c = {0};
+    /* writing over the input would lose its other columns (and, renamed
+     * over it, the input itself) */
+    if (jf_same_file(in, out)) {
+        fprintf(stderr, "jetfit: %s: is the input file (%s); write the result to another file\n",
+                out, in);
+        return 1;
+    }
     jf_status st = jf_cloud_read(in, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));

@@ -1,6 +1,9 @@
-/* main.c -- `jetfit SUBCOMMAND ...`: dispatch to src/cmd_*.c. */
+/* main.c -- `jetfit SUBCOMMAND ...`: dispatch to src/cli/cmd_*.c. */
+#define _POSIX_C_SOURCE 200809L /* sigaction */
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <gsl/gsl_version.h>
 
@@ -45,8 +48,27 @@ static void usage(FILE *out)
     fprintf(out, "\n  --help       this list\n  --version    print the version\n");
 }
 
+/* SIGINT, SIGTERM, SIGHUP: no temporary output file is left behind, and
+ * the exit status says which signal (128 + its number: 130, 143, 129). */
+static void on_fatal_signal(int sig)
+{
+    jf_tmpfiles_remove_all();
+    _exit(128 + sig);
+}
+
 int main(int argc, char **argv)
 {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_fatal_signal;
+    sigemptyset(&sa.sa_mask);
+    int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction old;
+        /* an ignored signal (nohup, a shell's background job) stays ignored */
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
+            sigaction(sigs[i], &sa, NULL);
+    }
     if (argc < 2) {
         usage(stderr);
         return 2;

@@ -21,20 +21,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "gnuplot.h"
 #include "jetfit.h"
 #include "study.h"
-
-/* s as a gnuplot single-quoted string: ' doubled, control characters
- * (a newline would end the command) as blanks. */
-static void gq(FILE *gp, const char *s)
-{
-    fputc('\'', gp);
-    for (; *s; s++) {
-        if (*s == '\'') fputc('\'', gp);
-        fputc((unsigned char)*s < 0x20 || *s == 0x7f ? ' ' : *s, gp);
-    }
-    fputc('\'', gp);
-}
 
 /* Line i's look: gnuplot's 8 colours, then the next dash and point. */
 static const char *style(int i)
@@ -103,7 +92,7 @@ static int noise_lines(FILE *gp, const jf_study *s, int m, int first_block)
                 jf_study_label(s, &k, label, sizeof label);
                 fprintf(gp, nl ? ", \\\n  " : "plot ");
                 fprintf(gp, "$b%d using 1:2:3 with yerrorlines %s title ", blk, style(nl));
-                gq(gp, label);
+                jf_gp_quote(gp, label);
                 nl++;
             }
     if (nl) fputc('\n', gp);
@@ -182,7 +171,7 @@ static int k_lines(FILE *gp, const jf_study *s, int mode)
                                  s->degree[k.degree], fl[0] ? " " : "", fl, axis_val(s, ax, i));
                         fprintf(gp, nl ? ", \\\n  " : "plot ");
                         fprintf(gp, "$k%d using 1:2:3 with yerrorlines %s title ", blk, style(nl));
-                        gq(gp, label);
+                        jf_gp_quote(gp, label);
                     }
                     nl += pts >= 2;
                     blk++;
@@ -199,7 +188,7 @@ static void set_output(FILE *gp, const char *dir, const char *name)
     char tmp[4096];
     jf_study_path(dir, name, 1, tmp, sizeof tmp);
     fprintf(gp, "set output ");
-    gq(gp, tmp);
+    jf_gp_quote(gp, tmp);
     fputc('\n', gp);
 }
 
@@ -249,7 +238,7 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
     int ax = jf_study_noise_axis(s);
     fprintf(gp, "set terminal pngcairo size 960,600 font ',10' noenhanced\n"
                 "set grid\nset key outside right top\nset xlabel ");
-    gq(gp, axis_name[ax]);
+    jf_gp_quote(gp, axis_name[ax]);
     fputc('\n', gp);
     int nset = s->nstrategy * s->ndegree * s->nflags;
 

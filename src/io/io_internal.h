@@ -148,8 +148,9 @@ int jf_zvec_reserve(size_t **v, size_t *cap, size_t want);
  * final name; the first failure sticks in st/err and later calls do
  * nothing. */
 typedef struct {
-    int fd;
-    char *tmp, *final;
+    int fd;              /* t.fd                                     */
+    jf_tmpfile t;        /* the temporary (io_tmpfile.c)             */
+    char *final;
     char *buf;
     size_t len, cap;
     jf_status st;

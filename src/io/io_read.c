@@ -17,7 +17,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -323,52 +322,51 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "unknown file extension (expected .ply, .xyz, "
                           ".pts, .txt, .csv or .off)");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK: a FIFO or device must not block the open; only regular
+     * files are read.  The file is read (not mapped): a file that shrinks
+     * while it is read is an I/O error, never a SIGBUS. */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0)
         return jf_io_fail(err, JF_ERR_IO, path, 0, "cannot open: %s",
                           strerror(errno));
     struct stat sb;
     if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
         close(fd);
-        return jf_io_fail(err, JF_ERR_IO, path, 0, "not a regular file");
+        return jf_io_fail(err, JF_ERR_IO, path, 0,
+                          "not a regular file (a folder, FIFO or device)");
     }
     size_t len = (size_t)sb.st_size;
     if (len == 0) {
         close(fd);
         return jf_io_fail(err, JF_ERR_FORMAT, path, 0, "empty file");
     }
-    char *buf = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
-    int mapped = buf != MAP_FAILED;
-    if (!mapped) {
-        /* e.g. a file system without mmap: read it whole */
-        buf = malloc(len);
-        if (!buf) {
-            close(fd);
-            return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
-                              "out of memory reading %zu bytes", len);
+    char *buf = malloc(len);
+    if (!buf) {
+        close(fd);
+        return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
+                          "out of memory reading %zu bytes", len);
+    }
+    size_t got = 0;
+    int e = 0;
+    while (got < len) {
+        ssize_t r = read(fd, buf + got, len - got > (1u << 30) ? (1u << 30) : len - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            e = r < 0 ? errno : 0;
+            break;
         }
-        size_t got = 0;
-        while (got < len) {
-            ssize_t r = read(fd, buf + got, len - got);
-            if (r < 0 && errno == EINTR)
-                continue;
-            if (r <= 0)
-                break;
-            got += (size_t)r;
-        }
-        if (got < len) {
-            free(buf);
-            close(fd);
-            return jf_io_fail(err, JF_ERR_IO, path, 0, "read failed");
-        }
-    } else {
-        posix_madvise(buf, len, POSIX_MADV_SEQUENTIAL);
+        got += (size_t)r;
     }
     close(fd);
-    jf_status st = jf_cloud_read_mem(buf, len, fmt, path, o, c, err);
-    if (mapped)
-        munmap(buf, len);
-    else
+    if (got < len) {
         free(buf);
+        if (e)
+            return jf_io_fail(err, JF_ERR_IO, path, 0, "read failed: %s", strerror(e));
+        return jf_io_fail(err, JF_ERR_IO, path, 0,
+                          "the file shrank while it was read (%zu of %zu bytes)", got, len);
+    }
+    jf_status st = jf_cloud_read_mem(buf, len, fmt, path, o, c, err);
+    free(buf);
     return st;
 }
