@@ -191,3 +191,20 @@ def test_library_errors_keep_the_commands_words():
         jetfit.estimate_mesh(v, np.array([[0.0, 1.0, 2.0]]))
     with pytest.raises(TypeError, match="not both"):
         jetfit.estimate_mesh(v, [[0, 1, 2]], 5, neighbors="rings")
+
+
+def test_signature_defaults_are_the_defaults():
+    """help()'s signatures (the C docstrings) name the real keywords, and
+    passing every documented default changes nothing."""
+    import inspect
+    for f, args in [(jetfit.estimate, (BASE,)),
+                    (jetfit.estimate_mesh, (BASE[:3], [[0, 1, 2]]))]:
+        params = inspect.signature(f).parameters
+        kw = {k: p.default for k, p in params.items() if p.default is not inspect.Parameter.empty}
+        if f is jetfit.estimate_mesh:
+            kw.pop("rings")
+        assert f(*args, **kw).as_structured().tobytes() == f(*args).as_structured().tobytes()
+    params = inspect.signature(jetfit.fit_jet).parameters
+    kw = {k: p.default for k, p in params.items() if p.default is not inspect.Parameter.empty}
+    a, b = jetfit.fit_jet(BASE[:20], **kw), jetfit.fit_jet(BASE[:20])
+    assert a.k1 == b.k1 and a.cond == b.cond and (a.normal == b.normal).all()
