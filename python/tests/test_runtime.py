@@ -146,3 +146,22 @@ def test_estimate_in_a_forked_child(open3d_first):
     os.kill(pid, signal.SIGKILL)
     os.waitpid(pid, 0)
     pytest.fail("the forked child hung in OpenMP")
+
+
+def test_concurrent_estimates_from_python_threads():
+    """Several Python threads estimating at once (each call its own OpenMP
+    team, the GIL released) get the single-call bits."""
+    pts = [fib_sphere(8000, r) for r in (1.0, 2.0, 3.0, 4.0)]
+    want = [jetfit.estimate(p, neighbors="knn:12", threads=2).as_structured().tobytes()
+            for p in pts]
+    got = [None] * len(pts)
+
+    def work(i):
+        got[i] = jetfit.estimate(pts[i], neighbors="knn:12", threads=2).as_structured().tobytes()
+
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(len(pts))]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert got == want
