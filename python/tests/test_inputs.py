@@ -124,6 +124,8 @@ def cmd_words(*args):
 @pytest.mark.parametrize("kw,flags", [
     ({"degree": 12}, ["--degree", "12"]),
     ({"degree": 0}, ["--degree", "0"]),
+    ({"degree": 10**30}, ["--degree", str(10**30)]),
+    ({"degree": np.int64(-3)}, ["--degree", "-3"]),
     ({"neighbors": "knn:0"}, ["--neighbors", "knn:0"]),
     ({"neighbors": "cube:3"}, ["--neighbors", "cube:3"]),
     ({"fit": "exact"}, ["--fit", "exact"]),
@@ -185,6 +187,8 @@ def test_library_errors_keep_the_commands_words():
         jetfit.estimate_mesh(v, [[0, 1, 7]])
     with pytest.raises(ValueError, match="faces: face 0: vertex index -1 out of range"):
         jetfit.estimate_mesh(v, np.array([[0, 1, -1]]))
+    with pytest.raises(ValueError, match="faces: face 1 has 2 vertices"):
+        jetfit.estimate_mesh(v, [[0, 1, 2], [0, 1]])
     with pytest.raises(ValueError, match="k >= 3"):
         jetfit.estimate_mesh(v, np.array([[0, 1]]))
     with pytest.raises(TypeError, match="faces: expected an integer array"):
