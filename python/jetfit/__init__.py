@@ -18,11 +18,13 @@ OSError) carries the command's "FILE:LINE: reason".  The GIL is released
 while estimating; Ctrl-C raises KeyboardInterrupt within a fraction of a
 second.
 """
-from ._jetfit import (STATUS, FileError, Jet, Result, __version__, estimate,
-                      estimate_mesh, fit_jet, read, write)
+from ._jetfit import (OPENMP_RUNTIME, STATUS, FileError, Jet, Result,
+                      __version__, estimate, estimate_mesh, fit_jet, read,
+                      write)
 
 __all__ = ["estimate", "estimate_mesh", "fit_jet", "read", "write", "Result",
-           "Jet", "STATUS", "FileError", "__version__", "status_names"]
+           "Jet", "STATUS", "FileError", "__version__", "OPENMP_RUNTIME",
+           "status_names"]
 
 
 def status_names(status):

@@ -123,6 +123,11 @@ static int faces_lists(PyObject *obj, jf_cloud *c)
             NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED, NULL);
         if (!p) goto fail;
         size_t k = (size_t)PyArray_DIM(p, 0);
+        if (k < 3) {
+            Py_DECREF(p);
+            PyErr_Format(PyExc_ValueError, "faces: face %zu has %zu vertices (3 or more)", f, k);
+            goto fail;
+        }
         if (total + k > cap) {
             size_t ncap = 2 * (total + k) + 16;
             uint32_t *g = PyMem_Realloc(c->face_idx, ncap * sizeof *g);

@@ -17,6 +17,8 @@
  * points when they are float64 C-contiguous. */
 #include <time.h>
 
+#include <omp.h>
+
 #include "jfpy.h"
 
 typedef struct {
@@ -62,7 +64,8 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
     o->cancel_user = &cx;
     cx.ts = PyEval_SaveThread();
     jf_status st = jf_estimate(c, o, res, &err);
-    if (st == JF_OK) jf_py_result_fill(result, res, c->n);
+    if (st == JF_OK)
+        jf_py_result_fill(result, res, c->n, o->threads > 0 ? o->threads : omp_get_max_threads());
     PyEval_RestoreThread(cx.ts);
     PyMem_RawFree(res);
     if (st != JF_OK) {

@@ -72,8 +72,9 @@ extern PyTypeObject jf_py_ResultType;
 /* A Result of n rows for Monge degree `monge` with its arrays allocated
  * (b, c None below 3, 4); keeps points and faces (may be NULL). */
 PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *faces);
-/* Copies res[0..n-1] into the Result's arrays (no Python calls). */
-void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n);
+/* Copies res[0..n-1] into the Result's arrays on `threads` OpenMP threads
+ * (<= 0: all cores); no Python calls. */
+void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads);
 /* The output file's columns and rows, as the command writes them. */
 size_t jf_py_result_columns(PyObject *result, jf_column *cols);
 int jf_py_result_monge(PyObject *result);

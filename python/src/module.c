@@ -45,17 +45,55 @@ static PyObject *status_dict(void)
     return d;
 }
 
+/* Docstrings: the first lines are the signature (CPython's __text_signature__
+ * convention, so help() and inspect.signature show it); docs/python.md is
+ * the manual. */
+PyDoc_STRVAR(estimate_doc,
+"estimate(points, *, neighbors='knn:32', degree=2, monge_degree=None, fit='approx', "
+"frame='pca', max_cond=1000, orient=None, normals=None, normal=None, robust=None, "
+"scales=None, degree_select=None, dist_weight=None, robust_normals=False, threads=None)\n"
+"--\n\n"
+"Normals, principal curvatures and directions and Monge coefficients of every\n"
+"point of an (N, 3) array, as `jetfit estimate` computes them (same options,\n"
+"same defaults, same bits).  Returns a Result.  A C-contiguous float64 array\n"
+"is not copied.  Bad option values raise ValueError with the command's words.\n"
+"The GIL is released; Ctrl-C raises KeyboardInterrupt.");
+
+PyDoc_STRVAR(estimate_mesh_doc,
+"estimate_mesh(vertices, faces, rings=None, *, neighbors=None, degree=2, "
+"monge_degree=None, fit='approx', frame='pca', max_cond=1000, orient=None, "
+"normals=None, normal=None, robust=None, scales=None, degree_select=None, "
+"dist_weight=None, robust_normals=False, threads=None)\n"
+"--\n\n"
+"estimate() on a mesh: faces is an (M, k) integer array or a sequence of\n"
+"polygons; rings=None is the command's `rings`, rings=N is `rings:N`.");
+
+PyDoc_STRVAR(read_doc,
+"read(path, *, columns=None)\n--\n\n"
+"Reads a cloud or mesh with the command's readers: (points (N, 3) float64,\n"
+"normals or None, faces or None, attributes dict).  Errors raise\n"
+"jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");
+
+PyDoc_STRVAR(write_doc,
+"write(path, result, *, points=None, faces=None, ascii=False, threads=None)\n--\n\n"
+"Writes the command's output file of a Result (.ply, .csv, .xyz, .txt), byte\n"
+"for byte; through a temporary renamed at the end.");
+
+PyDoc_STRVAR(fit_jet_doc,
+"fit_jet(neighbors, degree=2, *, monge_degree=None, fit='approx', frame='pca', "
+"max_cond=1000, point=None, weights=None)\n--\n\n"
+"One osculating jet on an (n, 3) neighbourhood at point (default: its first\n"
+"row), optionally weighted.  Returns a jetfit.Jet.");
+
 static PyMethodDef methods[] = {
     {"estimate", (PyCFunction)(void (*)(void))jf_py_estimate, METH_VARARGS | METH_KEYWORDS,
-     "estimate(points, neighbors='knn:32', ...) -> Result (see jetfit.estimate)"},
+     estimate_doc},
     {"estimate_mesh", (PyCFunction)(void (*)(void))jf_py_estimate_mesh,
-     METH_VARARGS | METH_KEYWORDS, "estimate_mesh(vertices, faces, rings=None, ...) -> Result"},
-    {"read", (PyCFunction)(void (*)(void))jf_py_read, METH_VARARGS | METH_KEYWORDS,
-     "read(path, columns=None) -> (points, normals, faces, attributes)"},
-    {"write", (PyCFunction)(void (*)(void))jf_py_write, METH_VARARGS | METH_KEYWORDS,
-     "write(path, result, points=None, faces=None, ascii=False, threads=None)"},
+     METH_VARARGS | METH_KEYWORDS, estimate_mesh_doc},
+    {"read", (PyCFunction)(void (*)(void))jf_py_read, METH_VARARGS | METH_KEYWORDS, read_doc},
+    {"write", (PyCFunction)(void (*)(void))jf_py_write, METH_VARARGS | METH_KEYWORDS, write_doc},
     {"fit_jet", (PyCFunction)(void (*)(void))jf_py_fit_jet, METH_VARARGS | METH_KEYWORDS,
-     "fit_jet(neighbors, degree=2, ...) -> Jet"},
+     fit_jet_doc},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef moddef = {PyModuleDef_HEAD_INIT, "_jetfit",
@@ -91,6 +129,8 @@ PyMODINIT_FUNC PyInit__jetfit(void)
         goto fail;
     }
     if (PyModule_AddStringConstant(m, "__version__", jf_version()) < 0) goto fail;
+    /* which OpenMP runtime the module runs on (python/CMakeLists.txt) */
+    if (PyModule_AddStringConstant(m, "OPENMP_RUNTIME", JF_PY_OPENMP) < 0) goto fail;
     return m;
 fail:
     Py_DECREF(m);

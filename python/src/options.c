@@ -41,12 +41,13 @@ static int number_text(PyObject *v, int kind, const char *kw, char *buf, size_t 
         }
     }
     if (PyLong_Check(v) || PyArray_IsScalar(v, Integer)) {
-        int over = 0;
-        long long x = PyLong_AsLongLongAndOverflow(v, &over);
-        if (x == -1 && PyErr_Occurred()) return -1;
-        if (over) x = over > 0 ? LLONG_MAX : LLONG_MIN; /* rejected by the range */
-        snprintf(buf, len, "%lld", x);
-        return 0;
+        /* its decimal digits, whatever its size: the parser judges them */
+        PyObject *i = PyNumber_Index(v), *t = i ? PyObject_Str(i) : NULL;
+        const char *u = t ? PyUnicode_AsUTF8(t) : NULL;
+        if (u) snprintf(buf, len, "%s", u);
+        Py_XDECREF(i);
+        Py_XDECREF(t);
+        return u ? 0 : -1;
     }
     double d = PyFloat_AsDouble(v);
     if (d == -1 && PyErr_Occurred()) return -1;

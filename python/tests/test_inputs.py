@@ -124,6 +124,8 @@ def cmd_words(*args):
 @pytest.mark.parametrize("kw,flags", [
     ({"degree": 12}, ["--degree", "12"]),
     ({"degree": 0}, ["--degree", "0"]),
+    ({"degree": 10**30}, ["--degree", str(10**30)]),
+    ({"degree": np.int64(-3)}, ["--degree", "-3"]),
     ({"neighbors": "knn:0"}, ["--neighbors", "knn:0"]),
     ({"neighbors": "cube:3"}, ["--neighbors", "cube:3"]),
     ({"fit": "exact"}, ["--fit", "exact"]),
@@ -185,9 +187,28 @@ def test_library_errors_keep_the_commands_words():
         jetfit.estimate_mesh(v, [[0, 1, 7]])
     with pytest.raises(ValueError, match="faces: face 0: vertex index -1 out of range"):
         jetfit.estimate_mesh(v, np.array([[0, 1, -1]]))
+    with pytest.raises(ValueError, match="faces: face 1 has 2 vertices"):
+        jetfit.estimate_mesh(v, [[0, 1, 2], [0, 1]])
     with pytest.raises(ValueError, match="k >= 3"):
         jetfit.estimate_mesh(v, np.array([[0, 1]]))
     with pytest.raises(TypeError, match="faces: expected an integer array"):
         jetfit.estimate_mesh(v, np.array([[0.0, 1.0, 2.0]]))
     with pytest.raises(TypeError, match="not both"):
         jetfit.estimate_mesh(v, [[0, 1, 2]], 5, neighbors="rings")
+
+
+def test_signature_defaults_are_the_defaults():
+    """help()'s signatures (the C docstrings) name the real keywords, and
+    passing every documented default changes nothing."""
+    import inspect
+    for f, args in [(jetfit.estimate, (BASE,)),
+                    (jetfit.estimate_mesh, (BASE[:3], [[0, 1, 2]]))]:
+        params = inspect.signature(f).parameters
+        kw = {k: p.default for k, p in params.items() if p.default is not inspect.Parameter.empty}
+        if f is jetfit.estimate_mesh:
+            kw.pop("rings")
+        assert f(*args, **kw).as_structured().tobytes() == f(*args).as_structured().tobytes()
+    params = inspect.signature(jetfit.fit_jet).parameters
+    kw = {k: p.default for k, p in params.items() if p.default is not inspect.Parameter.empty}
+    a, b = jetfit.fit_jet(BASE[:20], **kw), jetfit.fit_jet(BASE[:20])
+    assert a.k1 == b.k1 and a.cond == b.cond and (a.normal == b.normal).all()

@@ -115,3 +115,53 @@ def test_ctrl_c_interrupts_within_a_second():
     jetfit.estimate(pts[:30000], **LONG_KW)
     per_30k = time.monotonic() - t2
     assert 10 * per_30k > 2 * (t1 - t0), (per_30k, t1 - t0)
+
+
+@pytest.mark.skipif(jetfit.OPENMP_RUNTIME != "libomp",
+                    reason="built on GCC's libgomp, which cannot run OpenMP in a forked child")
+@pytest.mark.parametrize("open3d_first", [False, True], ids=["after-jetfit", "after-open3d"])
+def test_estimate_in_a_forked_child(open3d_first):
+    """multiprocessing's fork: a child forked after the parent ran OpenMP
+    (jetfit's own estimate, or Open3D's import) estimates on 2 threads and
+    gets the parent's bits."""
+    if open3d_first:
+        pytest.importorskip("open3d", reason="python3-open3d is not installed")
+    pts = fib_sphere(20000)
+    a = jetfit.estimate(pts, neighbors="knn:12", threads=2).as_structured().tobytes()
+    pid = os.fork()
+    if pid == 0:
+        code = 3
+        try:
+            b = jetfit.estimate(pts, neighbors="knn:12", threads=2).as_structured().tobytes()
+            code = 0 if b == a else 4
+        finally:
+            os._exit(code)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            assert os.waitstatus_to_exitcode(status) == 0
+            return
+        time.sleep(0.05)
+    os.kill(pid, signal.SIGKILL)
+    os.waitpid(pid, 0)
+    pytest.fail("the forked child hung in OpenMP")
+
+
+def test_concurrent_estimates_from_python_threads():
+    """Several Python threads estimating at once (each call its own OpenMP
+    team, the GIL released) get the single-call bits."""
+    pts = [fib_sphere(8000, r) for r in (1.0, 2.0, 3.0, 4.0)]
+    want = [jetfit.estimate(p, neighbors="knn:12", threads=2).as_structured().tobytes()
+            for p in pts]
+    got = [None] * len(pts)
+
+    def work(i):
+        got[i] = jetfit.estimate(pts[i], neighbors="knn:12", threads=2).as_structured().tobytes()
+
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(len(pts))]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert got == want
