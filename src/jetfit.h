@@ -105,6 +105,7 @@ char *jf_point_status_str(unsigned status, char *buf, size_t len);
 /* ------------------------------------------------------------------ */
 #define JF_MAX_DEGREE 9         /* largest jet degree (N_9 = 55)       */
 #define JF_MAX_MONGE_DEGREE 4
+#define JF_MAX_NEIGHBORS ((size_t)1 << 20) /* largest neighbourhood a fit takes */
 
 typedef enum { JF_FIT_APPROX = 0, JF_FIT_INTERP = 1 } jf_fit_mode;
 typedef enum { JF_FRAME_PCA = 0, JF_FRAME_AXIS = 1 } jf_frame_mode;
@@ -516,6 +517,9 @@ typedef struct {
     size_t nfaces;       /* mesh faces (0 for a cloud)                 */
     size_t *face_off;    /* nfaces+1 offsets into face_idx, or NULL    */
     uint32_t *face_idx;  /* polygon vertex indices, or NULL            */
+    size_t nbad;         /* text rows that did not parse, kept as NaN
+                            points (jf_read_opts.bad_rows = skip)      */
+    size_t bad_line[10]; /* the first min(nbad, 10) of their lines     */
 } jf_cloud;
 
 typedef struct {
@@ -529,6 +533,11 @@ typedef struct {
                             header names x,y,z[,nx,ny,nz] (any case).
                             x,y,z must be all set or all -1; normals
                             likewise.                                  */
+    int bad_rows;        /* text formats: 0 (default) an unparsable row
+                            is an error; 1 it is kept as a row of NaN
+                            (so every later row keeps its index; the
+                            pipeline marks it nonfinite) and counted in
+                            jf_cloud.nbad / bad_line                   */
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */

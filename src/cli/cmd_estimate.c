@@ -57,6 +57,9 @@ static void usage(FILE *f)
         "  --columns X,Y,Z[,NX,NY,NZ]\n"
         "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
         "                        (default: x y z first, normals in 3..5 if 6 columns)\n"
+        "  --bad-rows MODE       text input: error (default) stops at the first\n"
+        "                        unparsable row; skip keeps it as a NaN row (status\n"
+        "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
         "  --quiet               no progress line, no summary\n"
@@ -111,7 +114,7 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void summary(const jf_result *r, size_t n, double secs, const char *out)
+static void summary(const jf_result *r, size_t n, size_t nbad, double secs, const char *out)
 {
     size_t flags[32] = {0}, ok = 0, deg[JF_MAX_DEGREE + 1] = {0};
     for (size_t i = 0; i < n; i++) {
@@ -145,6 +148,8 @@ static void summary(const jf_result *r, size_t n, double secs, const char *out)
                 c[(m - 1) / 2], c[(size_t)(0.9 * (double)(m - 1))],
                 c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
     free(c);
+    if (nbad)
+        fprintf(stderr, "  bad rows: %zu (kept as NaN rows, status nonfinite)\n", nbad);
     fprintf(stderr, "  output: %s\n", out);
 }
 
@@ -234,7 +239,11 @@ int jf_cmd_estimate(int argc, char **argv)
             val = eq + 1;
         } else {
             snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc) return bad_option(a, "", "needs a value");
+            if (i + 1 >= argc)
+                return strcmp(name, "-o") && strcmp(name, "--output") &&
+                               jf_cli_est_takes_value(name) != 1
+                           ? bad_option("unknown option", a, "not an option of estimate")
+                           : bad_option(a, "", "needs a value");
             val = argv[++i];
         }
         if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
@@ -265,6 +274,16 @@ int jf_cmd_estimate(int argc, char **argv)
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;
+    }
+    if (c.nbad) {
+        /* --bad-rows skip: say which rows, so the user can look at them */
+        char lines[160] = "";
+        size_t shown = c.nbad < 10 ? c.nbad : 10, len = 0;
+        for (size_t k = 0; k < shown && len < sizeof lines; k++)
+            len += (size_t)snprintf(lines + len, sizeof lines - len, "%s%zu", k ? ", " : "",
+                                    c.bad_line[k]);
+        fprintf(stderr, "jetfit: %s: %zu unparsable rows kept as NaN rows (status nonfinite), "
+                        "lines %s%s\n", in, c.nbad, lines, c.nbad > shown ? ", ..." : "");
     }
     if (!e.orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
 
@@ -327,7 +346,7 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    if (!quiet) summary(r, c.n, now_s() - t0, out);
+    if (!quiet) summary(r, c.n, c.nbad, now_s() - t0, out);
     free(r);
     jf_cloud_free(&c);
     return 0;

@@ -20,7 +20,11 @@ static void usage(FILE *out)
         "               k1 k2 and status are used when present)\n"
         "  TRUTH        a truth file with columns nx ny nz [k1 k2] (jetfit generate),\n"
         "               or PCPNet data: SHAPE.normals or SHAPE.xyz (reads\n"
-        "               SHAPE.normals and, when present, SHAPE.curv)\n"
+        "               SHAPE.normals and, when present, SHAPE.curv), or a reference\n"
+        "               result of the same cloud.  The points must be RESULT's:\n"
+        "               a reference result's x y z exactly (1e-9 of the diagonal),\n"
+        "               generate's noise-free x y z within 5%% (median); PCPNet's\n"
+        "               .normals have no coordinates, so rows are matched by order only\n"
         "  --subset IDX only the rows whose 0-based indices IDX lists (e.g. .pidx)\n"
         "  --by-status  the same table for each status value of RESULT\n"
         "\n"
@@ -124,6 +128,10 @@ int jf_cmd_eval(int argc, char **argv)
     if (ntruth != res.nrows) {
         fprintf(stderr, "jetfit eval: %s has %zu rows, %s has %zu\n", res_path, res.nrows,
                 truth_path, ntruth);
+        goto done;
+    }
+    if (jf_cli_truth_coords_check(truth_path, &res, msg, sizeof msg)) {
+        fprintf(stderr, "jetfit eval: %s\n", msg);
         goto done;
     }
     if (subset_path) {

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <unistd.h>
 #include "eval_errors.h"
 #include "jetfit.h"
 
@@ -158,4 +159,94 @@ void jf_cli_point_errors(const double n[3], double k1, double k2, const double t
     e[JF_Q_K2REL] = er[1];
     e[JF_Q_K1ABS] = ea[0];
     e[JF_Q_K2ABS] = ea[1];
+}
+
+/* Are RESULT's points TRUTH's points?  A result scored against another
+ * cloud's truth with the same row count would report nonsense.  A truth
+ * written by `estimate` (a reference result: it has a status column)
+ * holds the same input points: each coordinate must agree within 1e-9 of
+ * the bounding-box diagonal.  generate's truth holds the noise-free
+ * points: the median distance must stay under 5% of the diagonal (1%
+ * Gaussian noise moves a point about 1.7%; another cloud, about half the
+ * diagonal).  No x y z in TRUTH (PCPNet .normals): nothing to check. */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+int jf_cli_truth_coords_check(const char *truth_path, const jf_eval_table *res, char *msg,
+                              size_t len)
+{
+    const char *path = truth_path;
+    char buf[4096];
+    if (ends_with(path, ".normals") || ends_with(path, ".xyz")) {
+        sibling(path, ".normals", buf, sizeof buf);
+        if (!access(buf, F_OK))
+            return 0; /* PCPNet: no coordinates beside the normals */
+    }
+    jf_eval_table t;
+    if (load(path, &t, msg, len))
+        return -1;
+    int tx[3] = {jf_eval_table_col(&t, "x"), jf_eval_table_col(&t, "y"),
+                 jf_eval_table_col(&t, "z")};
+    int rx[3] = {jf_eval_table_col(res, "x"), jf_eval_table_col(res, "y"),
+                 jf_eval_table_col(res, "z")};
+    int rc = 0;
+    if (tx[0] < 0 || tx[1] < 0 || tx[2] < 0 || rx[0] < 0 || rx[1] < 0 || rx[2] < 0 ||
+        t.nrows != res->nrows || t.nrows == 0) {
+        jf_eval_table_free(&t);
+        return 0;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < res->nrows; i++)
+        for (int a = 0; a < 3; a++) {
+            double v = res->v[i * res->ncols + rx[a]];
+            if (isfinite(v)) {
+                lo[a] = v < lo[a] ? v : lo[a];
+                hi[a] = v > hi[a] ? v : hi[a];
+            }
+        }
+    double diag = 0;
+    for (int a = 0; a < 3; a++)
+        diag += hi[a] > lo[a] ? (hi[a] - lo[a]) * (hi[a] - lo[a]) : 0;
+    diag = sqrt(diag);
+    int exact = jf_eval_table_col(&t, "status") >= 0;
+    double *d = malloc(t.nrows * sizeof *d);
+    size_t nd = 0, worst = 0;
+    double worst_d = -1;
+    for (size_t i = 0; d && i < t.nrows; i++) {
+        double s = 0;
+        for (int a = 0; a < 3; a++) {
+            double u = res->v[i * res->ncols + rx[a]] - t.v[i * t.ncols + tx[a]];
+            s += u * u;
+        }
+        if (!isfinite(s))
+            continue; /* a nonfinite input point, or an outlier's NaN */
+        s = sqrt(s);
+        d[nd++] = s;
+        if (s > worst_d)
+            worst_d = s, worst = i;
+    }
+    if (!d) {
+        snprintf(msg, len, "out of memory");
+        rc = -1;
+    } else if (exact && worst_d > 1e-9 * diag) {
+        snprintf(msg, len, "%s: row %zu: point differs from the result's by %.3g (%.3g of the "
+                           "bounding-box diagonal): not the same cloud",
+                 path, worst, worst_d, diag > 0 ? worst_d / diag : INFINITY);
+        rc = -1;
+    } else if (!exact && nd) {
+        qsort(d, nd, sizeof *d, cmp_double);
+        double med = d[nd / 2];
+        if (med > 0.05 * diag) {
+            snprintf(msg, len, "%s: its points are not the result's (median distance %.3g, "
+                               "%.1f%% of the bounding-box diagonal): not the same cloud",
+                     path, med, diag > 0 ? 100 * med / diag : INFINITY);
+            rc = -1;
+        }
+    }
+    free(d);
+    jf_eval_table_free(&t);
+    return rc;
 }

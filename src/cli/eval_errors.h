@@ -8,6 +8,8 @@
 
 #include <stddef.h>
 
+#include "jetfit.h"
+
 enum { JF_Q_NORMAL, JF_Q_K1REL, JF_Q_K2REL, JF_Q_K1ABS, JF_Q_K2ABS, JF_NQ };
 extern const char *const jf_q_name[JF_NQ]; /* "normal_deg", "k1_rel", ... */
 
@@ -27,5 +29,11 @@ int jf_cli_subset_load(const char *path, size_t nrows, size_t **sel, size_t *nse
  * with_k). */
 void jf_cli_point_errors(const double n[3], double k1, double k2, const double t[5], int with_k,
                          double e[JF_NQ]);
+
+/* 0 when RESULT's x y z are TRUTH's (exactly, 1e-9 of the diagonal, for a
+ * reference result; median within 5% for generate's noise-free truth), or
+ * TRUTH has no coordinates (PCPNet); -1 with msg otherwise. */
+int jf_cli_truth_coords_check(const char *truth_path, const jf_eval_table *res, char *msg,
+                              size_t len);
 
 #endif

@@ -63,7 +63,7 @@ void jf_cli_est_init(jf_cli_est *e)
 static const char *const valued[] = {
     "--neighbors", "--neighbours", "--degree", "--monge-degree", "--fit", "--frame",
     "--max-cond", "--orient", "--normal", "--robust", "--scales", "--degree-select",
-    "--dist-weight", "--columns", "--threads"};
+    "--dist-weight", "--columns", "--threads", "--bad-rows"};
 
 int jf_cli_est_takes_value(const char *name)
 {
@@ -172,9 +172,13 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
                 return bad_(bad, name, val, "expected 0-based column numbers");
             e->ro.columns[j] = (int)list[j];
         }
+    } else if (!strcmp(name, "--bad-rows")) {
+        if (!strcmp(val, "error")) e->ro.bad_rows = 0;
+        else if (!strcmp(val, "skip")) e->ro.bad_rows = 1;
+        else return bad_(bad, name, val, "expected error or skip");
     } else { /* --threads */
         if (jf_cli_parse_int(val, 1, 4096, &iv))
-            return bad_(bad, name, val, "expected a positive integer");
+            return bad_(bad, name, val, "expected an integer from 1 to 4096 (the limit)");
         o->threads = iv;
     }
     return 0;
@@ -195,6 +199,11 @@ int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad)
     size_t need = o->nb.kind == JF_NB_KNN || o->nb.kind == JF_NB_KNN_RADIUS ? o->nb.k : o->nb.n;
     for (int j = 0; j < o->params.nscales; j++)
         if (o->params.scales[j] > need) need = o->params.scales[j];
+    if (need > JF_MAX_NEIGHBORS) {
+        static char why2[96];
+        snprintf(why2, sizeof why2, "K (or N) is too large: at most %zu", JF_MAX_NEIGHBORS);
+        return bad_(bad, "--neighbors", e->nbspec, why2);
+    }
     if (need > o->params.max_neighbors) o->params.max_neighbors = need;
     if (o->params.degree_select > o->params.degree)
         return bad_(bad, "--degree-select", "", "must not exceed --degree");

@@ -84,7 +84,8 @@ typedef struct {
     size_t line;          /* number of the line last returned */
 } jf_text;
 
-/* Next line as [*ls, *le) without '\n' and a trailing '\r'.  0 at end. */
+/* Next line as [*ls, *le) without its end: '\n', "\r\n", or a lone '\r'
+ * (old Mac exports end lines with CR only).  0 at end. */
 static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
 {
     if (t->p >= t->end)
@@ -93,8 +94,13 @@ static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
     const char *nl = memchr(s, '\n', (size_t)(t->end - s));
     const char *e = nl ? nl : t->end;
     t->p = nl ? nl + 1 : t->end;
-    if (e > s && e[-1] == '\r')
-        e--;
+    const char *cr = memchr(s, '\r', (size_t)(e - s));
+    if (cr && cr + 1 < e) { /* a lone CR ends the line */
+        e = cr;
+        t->p = cr + 1;
+    } else if (cr) {
+        e--; /* CRLF, or a CR at the very end */
+    }
     t->line++;
     *ls = s;
     *le = e;

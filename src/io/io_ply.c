@@ -155,6 +155,11 @@ static jf_status parse_header(ply *h, const char *buf, size_t len,
                                   "INTTYPE TYPE NAME\")");
             memcpy(pr->name, ns, (size_t)(ne - ns));
             pr->name[ne - ns] = '\0';
+            for (int k = 0; k < el->nprops; k++)
+                if (!strcmp(el->props[k].name, pr->name))
+                    return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                      "property '%s' appears twice in element %s", pr->name,
+                                      el->name);
             el->nprops++;
             continue;
         }
@@ -471,6 +476,20 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     }
     if (st == JF_OK && !seen_vertex)
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no vertex element");
+    /* ascii: data after the last element means a count smaller than the
+     * rows -- points would be dropped or read as faces */
+    if (st == JF_OK && h->format == 0) {
+        const char *ls, *le;
+        while (jf_text_line(&h->tx, &ls, &le)) {
+            const char *q = ls, *ts, *te;
+            if (jf_next_token(&q, le, 0, &ts, &te)) {
+                st = jf_io_fail(err, JF_ERR_FORMAT, name, h->tx.line,
+                                "data after the last element: an element count in the "
+                                "header is smaller than the rows in the file");
+                break;
+            }
+        }
+    }
     /* faces listed before the vertices: check their indices now */
     for (size_t f = 0; st == JF_OK && f < c->nfaces; f++)
         for (size_t k = c->face_off[f]; k < c->face_off[f + 1]; k++)

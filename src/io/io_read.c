@@ -30,6 +30,7 @@ void jf_read_opts_init(jf_read_opts *o)
         return;
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
+    o->bad_rows = 0;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -280,6 +281,17 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         err->msg[0] = '\0';
     if (len == 0)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "empty file");
+    if (fmt == JF_FMT_XYZ || fmt == JF_FMT_PTS || fmt == JF_FMT_CSV || fmt == JF_FMT_OFF) {
+        /* a NUL is named as such, not reported as a strange number */
+        const char *z = memchr(buf, '\0', len);
+        if (z) {
+            size_t line = 1;
+            for (const char *q = buf; (q = memchr(q, '\n', (size_t)(z - q))) != NULL; q++)
+                line++;
+            return jf_io_fail(err, JF_ERR_FORMAT, name, line,
+                              "a NUL byte (binary data in a text file?)");
+        }
+    }
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:

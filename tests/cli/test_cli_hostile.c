@@ -293,6 +293,60 @@ START_TEST(render_failure_keeps_old)
 }
 END_TEST
 
+/* 9, 10: the messages a user fixing a command line needs (before:
+ * "needs a value" for an unknown last option, no limit named, and an
+ * invalid "parameters" line for a huge K); --bad-rows skip keeps the
+ * rows aligned and says which lines (before: no such option). */
+START_TEST(messages)
+{
+    const char *in = sphere(300), *out = cli_path("m.xyz");
+    ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--bogus", NULL), 2);
+    ck_assert_ptr_nonnull(strstr(cli_err, "unknown option"));
+    ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--threads", "5000", NULL), 2);
+    ck_assert_ptr_nonnull(strstr(cli_err, "4096"));
+    ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--neighbors", "knn:5000000000", NULL), 2);
+    ck_assert_ptr_nonnull(strstr(cli_err, "too large: at most 1048576"));
+    ck_assert(!cli_exists(out));
+
+    const char *g = cli_path("g.xyz");
+    write_file(g, "0 0 0\n1 0 0\n0 1 0\nbad row here\n1 1 0.1\n0.5 0.5 0\n2 0 0.2\n0 2 0.1\n");
+    ck_assert_int_eq(cli_run("estimate", g, "-o", out, NULL), 1);
+    ck_assert_ptr_nonnull(strstr(cli_err, "g.xyz:4:"));
+    ck_assert_int_eq(cli_run("estimate", g, "-o", out, "--bad-rows", "skip", NULL), 0);
+    ck_assert_ptr_nonnull(strstr(cli_err, "1 unparsable rows kept as NaN rows"));
+    ck_assert_ptr_nonnull(strstr(cli_err, "lines 4"));
+    ck_assert_ptr_nonnull(strstr(cli_err, "bad rows: 1"));
+    jf_eval_table t;
+    cli_read(out, &t);
+    ck_assert_uint_eq(t.nrows, 8);
+    ck_assert((unsigned)cli_val(&t, 3, "status") & JF_PT_NONFINITE);
+    ck_assert(cli_val(&t, 4, "x") == 1 && cli_val(&t, 4, "z") == 0.1);
+    jf_eval_table_free(&t);
+}
+END_TEST
+
+/* 8: eval of a result against another cloud's truth with the same row
+ * count (before: 60 degrees of "error", rc 0). */
+START_TEST(eval_other_cloud)
+{
+    const char *a = cli_path("a.xyz"), *b = cli_path("b.xyz");
+    const char *ta = cli_path("ta.csv"), *tb = cli_path("tb.csv");
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "2000", "--noise", "0.005", "--seed",
+                             "1", "-o", a, "--truth", ta, NULL), 0);
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "2000", "--seed", "2", "-o", b,
+                             "--truth", tb, NULL), 0);
+    const char *ra = cli_path("ra.csv"), *rb = cli_path("rb.csv");
+    ck_assert_int_eq(cli_run("estimate", a, "-o", ra, "--quiet", NULL), 0);
+    ck_assert_int_eq(cli_run("estimate", b, "-o", rb, "--quiet", NULL), 0);
+    ck_assert_int_eq(cli_run("eval", ra, ta, NULL), 0);  /* noisy vs its own truth */
+    ck_assert_int_eq(cli_run("eval", ra, tb, NULL), 1);  /* another cloud's truth */
+    ck_assert_ptr_nonnull(strstr(cli_err, "not the same cloud"));
+    ck_assert_int_eq(cli_run("eval", ra, rb, NULL), 1);  /* another cloud's result */
+    ck_assert_ptr_nonnull(strstr(cli_err, "not the same cloud"));
+    ck_assert_int_eq(cli_run("eval", rb, rb, NULL), 0);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_hostile");
@@ -307,6 +361,8 @@ int main(void)
     tcase_add_test(tc, output_is_input);
     tcase_add_test(tc, signals_leave_nothing);
     tcase_add_test(tc, render_failure_keeps_old);
+    tcase_add_test(tc, messages);
+    tcase_add_test(tc, eval_other_cloud);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

