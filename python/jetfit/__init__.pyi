@@ -79,7 +79,8 @@ def fit_jet(neighbors: _Points, degree: Optional[int] = 2, *,
             point: Optional[npt.ArrayLike] = None,
             weights: Optional[npt.ArrayLike] = None) -> Jet: ...
 
-def read(path: _Path, *, columns: Optional[Sequence[int]] = None) -> Tuple[
+def read(path: _Path, *, columns: Optional[Sequence[int]] = None,
+         bad_rows: Optional[str] = None) -> Tuple[
         npt.NDArray[np.float64], Optional[npt.NDArray[np.float64]],
         Optional[Union[npt.NDArray[np.int32], List[npt.NDArray[np.int32]]]],
         Dict[str, np.ndarray]]: ...

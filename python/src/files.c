@@ -39,16 +39,17 @@ static PyObject *file_error(jf_status st, const jf_error *err, const char *path)
 PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
-    static char *kwl[] = {"path", "columns", NULL};
-    PyObject *pathobj, *columns = NULL;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$O:read", kwl, PyUnicode_FSConverter, &pathobj,
-                                     &columns))
+    static char *kwl[] = {"path", "columns", "bad_rows", NULL};
+    PyObject *pathobj, *columns = NULL, *bad_rows = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$OO:read", kwl, PyUnicode_FSConverter, &pathobj,
+                                     &columns, &bad_rows))
         return NULL;
     const char *path = PyBytes_AS_STRING(pathobj);
     jf_py_opts po;
     jf_cli_est_init(&po.e);
     po.used = 0;
-    if (jf_py_opt(&po, "--columns", "columns", columns, JF_PY_LIST)) {
+    if (jf_py_opt(&po, "--columns", "columns", columns, JF_PY_LIST) ||
+        jf_py_opt(&po, "--bad-rows", "bad_rows", bad_rows, JF_PY_STR)) {
         Py_DECREF(pathobj);
         return NULL;
     }
@@ -62,6 +63,21 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
         file_error(st, &err, path);
         Py_DECREF(pathobj);
         return NULL;
+    }
+    if (c.nbad) {
+        /* bad_rows="skip": the command's line, as a warning */
+        char lines[160] = "";
+        size_t shown = c.nbad < 10 ? c.nbad : 10, len = 0;
+        for (size_t k = 0; k < shown && len < sizeof lines; k++)
+            len += (size_t)snprintf(lines + len, sizeof lines - len, "%s%zu", k ? ", " : "",
+                                    c.bad_line[k]);
+        if (PyErr_WarnFormat(PyExc_RuntimeWarning, 1,
+                             "%s: %zu unparsable rows kept as NaN rows (status nonfinite), "
+                             "lines %s%s", path, c.nbad, lines, c.nbad > shown ? ", ..." : "") < 0) {
+            jf_cloud_free(&c);
+            Py_DECREF(pathobj);
+            return NULL;
+        }
     }
     Py_DECREF(pathobj);
     PyObject *pts = NULL, *nrm = NULL, *faces = NULL, *attrs = NULL, *out = NULL;

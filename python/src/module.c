@@ -69,7 +69,7 @@ PyDoc_STRVAR(estimate_mesh_doc,
 "polygons; rings=None is the command's `rings`, rings=N is `rings:N`.");
 
 PyDoc_STRVAR(read_doc,
-"read(path, *, columns=None)\n--\n\n"
+"read(path, *, columns=None, bad_rows=None)\n--\n\n"
 "Reads a cloud or mesh with the command's readers: (points (N, 3) float64,\n"
 "normals or None, faces or None, attributes dict).  Errors raise\n"
 "jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");

@@ -97,3 +97,19 @@ def test_failed_write_leaves_old_file(tmp_path):
 def test_write_needs_points():
     with pytest.raises(TypeError):
         jetfit.write("x.ply", "not a result")
+
+
+def test_read_bad_rows(tmp_path, cmd):
+    f = tmp_path / "b.xyz"
+    f.write_text("0 0 0\n1 0 0\n1 x 0\n0 1 0\n")
+    rc, err = cmd("estimate", f, "-o", tmp_path / "o.ply", check=False)
+    with pytest.raises(jetfit.FileError) as e:
+        jetfit.read(str(f))
+    assert "jetfit: " + str(e.value) == err.strip()
+    rc, err = cmd("estimate", f, "-o", tmp_path / "o.ply", "--bad-rows", "skip", "--quiet")
+    with pytest.warns(RuntimeWarning) as w:
+        pts, _, _, _ = jetfit.read(str(f), bad_rows="skip")
+    assert "jetfit: " + str(w[0].message) in err
+    assert pts.shape == (4, 3) and np.isnan(pts[2]).all() and (pts[3] == [0, 1, 0]).all()
+    with pytest.raises(ValueError, match="^--bad-rows 'keep': "):
+        jetfit.read(str(f), bad_rows="keep")
