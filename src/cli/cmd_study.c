@@ -15,6 +15,7 @@
  * its finished cells and --resume skips them.  The command line:
  * study_args.c; the files: study_csv.c, study_plot.c, study_report.c. */
 #define _POSIX_C_SOURCE 200809L /* mkdir, isatty, strdup */
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -270,15 +271,25 @@ static int prepare_dir(const char *dir)
         fprintf(stderr, "jetfit: %s: %s\n", dir, strerror(errno));
         return 1;
     }
-    static const char *const ours[] = {".study.csv.tmp.", ".best.csv.tmp.", ".normal.png.tmp.",
-                                       ".curvature.png.tmp.", ".k.png.tmp.", ".report.html.tmp."};
+    /* jf_tmpfile names: ".NAME.RANDOM.tmp", RANDOM a few letters and
+     * digits (io_tmpfile.c) */
+    static const char *const ours[] = {"study.csv", "best.csv", "normal.png", "curvature.png",
+                                       "k.png", "report.html"};
     DIR *d = opendir(dir);
     struct dirent *en;
     while (d && (en = readdir(d))) {
+        const char *nm = en->d_name;
+        size_t ln = strlen(nm);
         for (size_t k = 0; k < sizeof ours / sizeof ours[0]; k++) {
-            if (strncmp(en->d_name, ours[k], strlen(ours[k]))) continue;
+            size_t lo = strlen(ours[k]), mid = ln > lo + 6 ? ln - lo - 6 : 0;
+            if (nm[0] != '.' || mid < 6 || mid > 16 || strncmp(nm + 1, ours[k], lo) ||
+                nm[1 + lo] != '.' || strcmp(nm + ln - 4, ".tmp"))
+                continue;
+            int plain = 1;
+            for (size_t j = 2 + lo; j < 2 + lo + mid; j++) plain &= isalnum((unsigned char)nm[j]) != 0;
+            if (!plain) continue;
             char p[4096];
-            snprintf(p, sizeof p, "%s/%s", dir, en->d_name);
+            snprintf(p, sizeof p, "%s/%s", dir, nm);
             remove(p);
         }
     }

@@ -7,6 +7,9 @@
 #define JF_STUDY_H
 
 #include <stddef.h>
+#include <stdio.h>
+
+#include "jetfit.h"
 
 /* The metrics a cell reports (study.csv columns, best.csv's `metric`):
  * the unoriented normal angle in degrees and PCPNet's relative curvature
@@ -82,8 +85,9 @@ void jf_study_mean(const jf_study *s, const jf_study_key *k, int metric, jf_stud
 int jf_study_best(const jf_study *s, const jf_study_key *lvl, int metric, jf_study_key *best,
                   jf_study_stat *bs);
 
-/* Files of DIR, each through "DIR/.NAME.tmp.PID" and rename: 0, or -1
- * with one line in msg. */
+/* Files of DIR, each written to a jf_tmpfile (exclusive, unpredictable
+ * name, removed on a signal) and renamed whole: 0, or -1 with one line in
+ * msg. */
 int jf_study_write_csv(const jf_study *s, const char *dir, char *msg, size_t len);
 int jf_study_write_best(const jf_study *s, const char *dir, char *msg, size_t len);
 /* Marks the cells found in DIR/study.csv as done, with its values;
@@ -99,10 +103,17 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len);
  * in DIR.  0, or -1 with msg. */
 int jf_study_report(const jf_study *s, const char *dir, char *msg, size_t len);
 
-/* Helpers shared by the writers: "DIR/NAME" and its temporary; commit
- * renames (or removes on failure). */
-void jf_study_path(const char *dir, const char *name, int tmp, char *buf, size_t len);
-int jf_study_commit(FILE *f, const char *dir, const char *name, char *msg, size_t len);
+/* Helpers shared by the writers: "DIR/NAME"; an output of DIR as a
+ * stdio stream over a jf_tmpfile, committed (renamed onto DIR/NAME) or,
+ * after an error, discarded. */
+void jf_study_path(const char *dir, const char *name, char *buf, size_t len);
+typedef struct {
+    jf_tmpfile t;
+    FILE *f;
+    char final[4096];
+} jf_study_out;
+int jf_study_out_open(jf_study_out *o, const char *dir, const char *name, char *msg, size_t len);
+int jf_study_out_commit(jf_study_out *o, char *msg, size_t len);
 
 /* Which noise list the plots put on x: the first with several values
  * (noise, noise_uniform, outliers), else noise: 0, 1, 2. */

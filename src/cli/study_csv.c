@@ -3,7 +3,7 @@
  * shortest text that reads back to the same double, so a resumed study
  * rewrites the rows it kept byte for byte), reading it back for --resume,
  * means over repeats, and DIR/best.csv. */
-#define _POSIX_C_SOURCE 200809L /* getpid */
+#define _POSIX_C_SOURCE 200809L /* getline, dup, fdopen */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -24,34 +24,47 @@ static const char *const head_tail[] = {"ok", "lowered", "failed", "flagged", "s
 #define NTAIL (sizeof head_tail / sizeof head_tail[0])
 #define NCOL (NKEY + JF_M_COUNT + NTAIL)
 
-void jf_study_path(const char *dir, const char *name, int tmp, char *buf, size_t len)
+void jf_study_path(const char *dir, const char *name, char *buf, size_t len)
 {
-    if (tmp) snprintf(buf, len, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
-    else snprintf(buf, len, "%s/%s", dir, name);
+    snprintf(buf, len, "%s/%s", dir, name);
 }
 
-int jf_study_commit(FILE *f, const char *dir, const char *name, char *msg, size_t len)
+int jf_study_out_open(jf_study_out *o, const char *dir, const char *name, char *msg, size_t len)
 {
-    char tmp[4096], fin[4096];
-    jf_study_path(dir, name, 1, tmp, sizeof tmp);
-    jf_study_path(dir, name, 0, fin, sizeof fin);
-    int bad = ferror(f);
-    if (fclose(f)) bad = 1;
-    if (bad || rename(tmp, fin)) {
-        snprintf(msg, len, "%s: %s", fin, strerror(bad ? EIO : errno));
-        remove(tmp);
+    jf_error e = {{0}};
+    jf_study_path(dir, name, o->final, sizeof o->final);
+    if (jf_tmpfile_open(o->final, &o->t, &e) != JF_OK) {
+        snprintf(msg, len, "%s", e.msg[0] ? e.msg : o->final);
+        return -1;
+    }
+    /* a stream on a copy of the descriptor: commit closes the original */
+    int fd = dup(o->t.fd);
+    o->f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    if (!o->f) {
+        snprintf(msg, len, "%s: %s", o->final, strerror(errno));
+        if (fd >= 0) close(fd);
+        jf_tmpfile_discard(&o->t);
         return -1;
     }
     return 0;
 }
 
-static FILE *open_tmp(const char *dir, const char *name, char *msg, size_t len)
+int jf_study_out_commit(jf_study_out *o, char *msg, size_t len)
 {
-    char tmp[4096];
-    jf_study_path(dir, name, 1, tmp, sizeof tmp);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) snprintf(msg, len, "%s: %s", tmp, strerror(errno));
-    return f;
+    jf_error e = {{0}};
+    int bad = ferror(o->f);
+    if (fclose(o->f)) bad = 1;
+    o->f = NULL;
+    if (bad) {
+        snprintf(msg, len, "%s: %s", o->final, strerror(errno ? errno : EIO));
+        jf_tmpfile_discard(&o->t);
+        return -1;
+    }
+    if (jf_tmpfile_commit(&o->t, o->final, &e) != JF_OK) {
+        snprintf(msg, len, "%s", e.msg[0] ? e.msg : o->final);
+        return -1;
+    }
+    return 0;
 }
 
 /* The shortest of %.15g..%.17g that reads back exactly; "nan", "inf". */
@@ -118,15 +131,16 @@ static void put_row(FILE *f, const jf_study *s, const jf_study_cell *c)
 
 int jf_study_write_csv(const jf_study *s, const char *dir, char *msg, size_t len)
 {
-    FILE *f = open_tmp(dir, "study.csv", msg, len);
-    if (!f) return -1;
+    jf_study_out o;
+    if (jf_study_out_open(&o, dir, "study.csv", msg, len)) return -1;
+    FILE *f = o.f;
     for (size_t j = 0; j < NKEY; j++) fprintf(f, "%s%s", j ? "," : "", head_key[j]);
     for (int m = 0; m < JF_M_COUNT; m++) fprintf(f, ",%s", jf_study_metric[m]);
     for (size_t j = 0; j < NTAIL; j++) fprintf(f, ",%s", head_tail[j]);
     fputc('\n', f);
     for (size_t i = 0; i < s->ncells; i++)
         if (s->cell[i].done) put_row(f, s, &s->cell[i]);
-    return jf_study_commit(f, dir, "study.csv", msg, len);
+    return jf_study_out_commit(&o, msg, len);
 }
 
 /* ---- reading study.csv back (--resume) ---- */
@@ -187,7 +201,7 @@ static int num(const char *t, double *v)
 int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len)
 {
     char path[4096];
-    jf_study_path(dir, "study.csv", 0, path, sizeof path);
+    jf_study_path(dir, "study.csv", path, sizeof path);
     FILE *f = fopen(path, "rb");
     if (!f) {
         if (errno == ENOENT) return 0;
@@ -319,8 +333,9 @@ int jf_study_best(const jf_study *s, const jf_study_key *lvl, int metric, jf_stu
 
 int jf_study_write_best(const jf_study *s, const char *dir, char *msg, size_t len)
 {
-    FILE *f = open_tmp(dir, "best.csv", msg, len);
-    if (!f) return -1;
+    jf_study_out o;
+    if (jf_study_out_open(&o, dir, "best.csv", msg, len)) return -1;
+    FILE *f = o.f;
     fputs("noise,noise_uniform,outliers,metric,strategy,degree,flags,mean,sd,repeats\n", f);
     jf_study_key lvl = {0};
     for (lvl.noise = 0; lvl.noise < s->nnoise; lvl.noise++)
@@ -345,7 +360,7 @@ int jf_study_write_best(const jf_study *s, const char *dir, char *msg, size_t le
                     put_num(f, st.sd);
                     fprintf(f, ",%d\n", st.n);
                 }
-    return jf_study_commit(f, dir, "best.csv", msg, len);
+    return jf_study_out_commit(&o, msg, len);
 }
 
 int jf_study_noise_axis(const jf_study *s)

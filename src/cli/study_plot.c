@@ -1,6 +1,6 @@
 /* study_plot.c -- `jetfit study`'s PNGs through gnuplot (pngcairo), one
- * gnuplot process for all of them (run without a shell), data inline
- * ($blocks):
+ * gnuplot process for all of them (gnuplot.c: no shell, its messages kept
+ * aside), data inline ($blocks), each PNG drawn into a jf_tmpfile:
  *   normal.png     median normal angle against noise, one line per
  *                  setting, error bars = spread over the repeats
  *   curvature.png  k1 and k2 median errors against noise, likewise
@@ -10,16 +10,12 @@
  * The noise axis is the first list with several values (noise,
  * noise_uniform, outliers); the other two are held at their first value.
  * User text (labels hold --neighbors and --flags text; DIR is a path)
- * reaches gnuplot only inside single-quoted strings with ' doubled, where
- * gnuplot expands nothing (double-quoted strings would run backquotes). */
-#define _POSIX_C_SOURCE 200809L /* fdopen, fileno */
-#include <errno.h>
+ * reaches gnuplot only through jf_gp_quote, where gnuplot expands nothing
+ * (double-quoted strings would run backquotes). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "gnuplot.h"
 #include "jetfit.h"
@@ -183,12 +179,10 @@ static int k_lines(FILE *gp, const jf_study *s, int mode)
     return nl;
 }
 
-static void set_output(FILE *gp, const char *dir, const char *name)
+static void set_output(FILE *gp, const jf_tmpfile *t)
 {
-    char tmp[4096];
-    jf_study_path(dir, name, 1, tmp, sizeof tmp);
     fprintf(gp, "set output ");
-    jf_gp_quote(gp, tmp);
+    jf_gp_quote(gp, t->tmp);
     fputc('\n', gp);
 }
 
@@ -196,45 +190,28 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
 {
     static const char *const names[3] = {"normal.png", "curvature.png", "k.png"};
     int made[3] = {0, 0, 0};
-    char path[4096], tmp[4096];
+    char path[3][4096];
+    jf_tmpfile tf[3];
+    jf_error e = {{0}};
     /* a previous study's plots must not outlive this one's table */
     for (int p = 0; p < 3; p++) {
-        jf_study_path(dir, names[p], 0, path, sizeof path);
-        remove(path);
+        jf_study_path(dir, names[p], path[p], sizeof path[p]);
+        remove(path[p]);
     }
-    if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        snprintf(msg, len, "gnuplot not found (Debian package gnuplot-nox)");
+    /* gnuplot draws into temporaries made here (exclusive, unpredictable
+     * names), renamed once it has succeeded */
+    for (int p = 0; p < 3; p++)
+        if (jf_tmpfile_open(path[p], &tf[p], &e) != JF_OK) {
+            for (int q = 0; q < p; q++) jf_tmpfile_discard(&tf[q]);
+            snprintf(msg, len, "%s", e.msg);
+            return -1;
+        }
+    jf_gp g;
+    if (jf_gp_open(&g, msg, len)) {
+        for (int p = 0; p < 3; p++) jf_tmpfile_discard(&tf[p]);
         return -1;
     }
-    /* gnuplot's stderr kept aside: its warnings (a single noise level
-     * makes an empty x range) are not the user's business, its error is */
-    FILE *log = tmpfile();
-    int fd[2];
-    if (!log || pipe(fd)) {
-        if (log) fclose(log);
-        snprintf(msg, len, "cannot run gnuplot: %s", strerror(errno));
-        return -1;
-    }
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(fd[0], 0);
-        dup2(fileno(log), 1);
-        dup2(fileno(log), 2);
-        close(fd[0]);
-        close(fd[1]);
-        execlp("gnuplot", "gnuplot", (char *)NULL);
-        _exit(127);
-    }
-    close(fd[0]);
-    FILE *gp = pid > 0 ? fdopen(fd[1], "w") : NULL;
-    if (!gp) {
-        if (pid > 0) waitpid(pid, NULL, 0);
-        else close(fd[1]);
-        fclose(log);
-        snprintf(msg, len, "cannot run gnuplot: %s", strerror(errno));
-        return -1;
-    }
+    FILE *gp = g.in;
     int ax = jf_study_noise_axis(s);
     fprintf(gp, "set terminal pngcairo size 960,600 font ',10' noenhanced\n"
                 "set grid\nset key outside right top\nset xlabel ");
@@ -243,7 +220,7 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
     int nset = s->nstrategy * s->ndegree * s->nflags;
 
     /* normal.png */
-    set_output(gp, dir, names[0]);
+    set_output(gp, &tf[0]);
     fprintf(gp, "set title 'normal error against noise (mean over repeats, bars: spread)'\n"
                 "set ylabel 'median normal angle (degrees)'\n");
     made[0] = noise_lines(gp, s, JF_M_NORMAL_MEDIAN, 0) > 0;
@@ -251,7 +228,7 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
 
     /* curvature.png: two panels */
     fprintf(gp, "set terminal pngcairo size 960,900 font ',10' noenhanced\n");
-    set_output(gp, dir, names[1]);
+    set_output(gp, &tf[1]);
     fprintf(gp, "set multiplot layout 2,1\nset title 'k1 error against noise'\n"
                 "set ylabel 'median |k1 - k1_true| / max(|k1_true|, 1)'\n");
     int c1 = noise_lines(gp, s, JF_M_K1_MEDIAN, nset);
@@ -264,7 +241,7 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
     /* k.png */
     if (k_lines(gp, s, 0) > 0) {
         fprintf(gp, "set terminal pngcairo size 960,600 font ',10' noenhanced\n");
-        set_output(gp, dir, names[2]);
+        set_output(gp, &tf[2]);
         fprintf(gp, "set title 'normal error against neighbourhood size'\n"
                     "set xlabel 'K (knn) or N (natural)'\n"
                     "set ylabel 'median normal angle (degrees)'\n");
@@ -273,30 +250,10 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
         fprintf(gp, "unset output\n");
         made[2] = 1;
     }
-    fclose(gp);
-    int rc = 0;
-    if (waitpid(pid, &rc, 0) != pid) rc = -1;
-    int n = 0, bad = rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0;
+    int bad = jf_gp_close(&g, msg, len) != 0, n = 0;
     for (int p = 0; p < 3; p++) {
-        jf_study_path(dir, names[p], 1, tmp, sizeof tmp);
-        jf_study_path(dir, names[p], 0, path, sizeof path);
-        if (!bad && made[p] && rename(tmp, path) == 0) n++;
-        else remove(tmp);
+        if (!bad && made[p] && jf_tmpfile_commit(&tf[p], path[p], &e) == JF_OK) n++;
+        else jf_tmpfile_discard(&tf[p]);
     }
-    if (bad) {
-        /* the first line of gnuplot's that says what went wrong */
-        char line[512], why[512] = "";
-        rewind(log);
-        while (fgets(line, sizeof line, log))
-            if (strstr(line, "rror") || strstr(line, "annot")) {
-                line[strcspn(line, "\n")] = '\0';
-                snprintf(why, sizeof why, "%s", line);
-                break;
-            }
-        fclose(log);
-        snprintf(msg, len, "gnuplot failed%s%s", why[0] ? ": " : "", why);
-        return -1;
-    }
-    fclose(log);
-    return n;
+    return bad ? -1 : n;
 }

@@ -37,7 +37,7 @@ static int embed_png(FILE *f, const char *dir, const char *name, const char *alt
 {
     static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     char path[4096];
-    jf_study_path(dir, name, 0, path, sizeof path);
+    jf_study_path(dir, name, path, sizeof path);
     FILE *in = fopen(path, "rb");
     if (!in) return 0;
     fprintf(f, "<figure><img alt=\"%s\" src=\"data:image/png;base64,", alt);
@@ -208,13 +208,9 @@ static void cells_table(FILE *f, const jf_study *s)
 
 int jf_study_report(const jf_study *s, const char *dir, char *msg, size_t len)
 {
-    char tmp[4096];
-    jf_study_path(dir, "report.html", 1, tmp, sizeof tmp);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        snprintf(msg, len, "%s: %s", tmp, strerror(errno));
-        return -1;
-    }
+    jf_study_out o;
+    if (jf_study_out_open(&o, dir, "report.html", msg, len)) return -1;
+    FILE *f = o.f;
     size_t ndone = 0, nfail = 0;
     for (size_t i = 0; i < s->ncells; i++) {
         ndone += s->cell[i].done != 0;
@@ -254,5 +250,5 @@ int jf_study_report(const jf_study *s, const char *dir, char *msg, size_t len)
     fputs("<h2>Every cell (study.csv)</h2>\n", f);
     cells_table(f, s);
     fputs("</body></html>\n", f);
-    return jf_study_commit(f, dir, "report.html", msg, len);
+    return jf_study_out_commit(&o, msg, len);
 }

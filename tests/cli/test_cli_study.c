@@ -406,9 +406,13 @@ START_TEST(resume_after_kill_gives_the_same_files)
     ck_assert_msg(kept >= 2 && kept < 8, "%d cells before the kill", kept);
     snprintf(pa, sizeof pa, "%s/report.html", b);
     ck_assert(!cli_exists(pa)); /* the interrupted study had not finished */
+    /* what a kill during a write leaves: resuming removes it */
+    snprintf(pa, sizeof pa, "%s/.study.csv.Ab3dEf9hJk.tmp", b);
+    cli_write_text(pa, "half a table");
     argv_b[15] = "--resume";
     ck_assert_msg(run_to(NULL, argv_b) == 0, "resume: %s", cli_err);
     ck_assert_msg(strstr(cli_err, "resuming") != NULL, "%s", cli_err);
+    ck_assert(!cli_exists(pa));
     snprintf(pa, sizeof pa, "%s/study.csv", a);
     same_but_timing(pa, pb, ",");
     snprintf(pa, sizeof pa, "%s/best.csv", a);
