@@ -606,6 +606,14 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
                          size_t ncols, size_t nrows, int ascii,
                          jf_writer **w, jf_error *err);
 
+/* LAS output (.las: LAS 1.4, point format 0 holding x y z, every other
+ * column an Extra Byte named as the column; x y z must be the first three
+ * columns): the coordinates are stored as int32 counts of a scale chosen
+ * from the cloud's bounding box (0.1 um where the extent allows, 1e-7 m
+ * up to ~200 m), so the cloud must be given before the first row.  A
+ * no-op for other formats.  JF_ERR_INVALID after the first row. */
+jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
+
 /* PLY only (ignored by text formats): also write a `face` element
  * (list uchar int vertex_indices) from nfaces polygons
  * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the

@@ -300,6 +300,7 @@ int jf_cmd_estimate(int argc, char **argv)
     /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
+    (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
     jf_result *r = malloc(c.n * sizeof *r);
     if (!r) {
         fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);

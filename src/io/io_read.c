@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -88,6 +89,8 @@ jf_format jf_format_from_path(const char *path)
         return JF_FMT_CSV;
     if (!strcmp(ext, "off"))
         return JF_FMT_OFF;
+    if (!strcmp(ext, "las") || !strcmp(ext, "laz"))
+        return JF_FMT_LAS;
     return JF_FMT_UNKNOWN;
 }
 
@@ -305,10 +308,13 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     case JF_FMT_OFF:
         st = jf_read_off(buf, len, name, c, err);
         break;
+    case JF_FMT_LAS:
+        st = jf_read_las(buf, len, name, c, err);
+        break;
     default:
         st = jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                         "unknown file extension (expected .ply, .xyz, .pts, "
-                        ".txt, .csv or .off)");
+                        ".txt, .csv, .off or .las)");
     }
     /* a header announcing 0 vertices is as useless as an empty file */
     if (st == JF_OK && c->n == 0)
@@ -329,11 +335,16 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     memset(c, 0, sizeof *c);
     if (!path)
         return jf_io_fail(err, JF_ERR_INVALID, "(null)", 0, "no file name");
+    size_t plen = strlen(path);
+    if (plen >= 4 && !strcasecmp(path + plen - 4, ".e57"))
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
+                          "E57 is not read: convert it first, e.g. `pdal translate in.e57 "
+                          "out.las` or CloudCompare (File > Save as LAS or PLY)");
     jf_format fmt = jf_format_from_path(path);
     if (fmt == JF_FMT_UNKNOWN)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "unknown file extension (expected .ply, .xyz, "
-                          ".pts, .txt, .csv or .off)");
+                          ".pts, .txt, .csv, .off or .las)");
     /* O_NONBLOCK: a FIFO or device must not block the open; only regular
      * files are read.  The file is read (not mapped): a file that shrinks
      * while it is read is an I/O error, never a SIGBUS. */
