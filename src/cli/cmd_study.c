@@ -368,8 +368,11 @@ int jf_cmd_study(int argc, char **argv)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
+    /* an ignored signal (nohup, a background job) stays ignored, as in main.c */
+    sigaction(SIGINT, NULL, &old_int);
+    sigaction(SIGTERM, NULL, &old_term);
+    if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
+    if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, NULL);
     for (size_t g = 0; g < s->ncells && !werr && !stop_asked; g += (size_t)c.nsetting) {
         int todo = 0;
         for (int j = 0; j < c.nsetting; j++) todo |= !s->cell[g + (size_t)j].done;
