@@ -8,7 +8,8 @@ if(JF_FUZZ)
   endif()
   set(JF_FUZZ_READER_SOURCES
       ${PROJECT_SOURCE_DIR}/src/io/io_read.c ${PROJECT_SOURCE_DIR}/src/io/io_ply.c
-      ${PROJECT_SOURCE_DIR}/src/io/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io/io_off.c)
+      ${PROJECT_SOURCE_DIR}/src/io/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io/io_off.c
+      ${PROJECT_SOURCE_DIR}/src/io/io_las.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
   foreach(reader ply xyz off)
