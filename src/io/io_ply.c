@@ -385,6 +385,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     jf_status st = parse_header(h, buf, len, &body);
     jf_uvec fi = {0};
     int seen_vertex = 0, seen_face = 0;
+    uint64_t vertex_row = 0; /* bytes of a binary vertex row */
     h->p = (const unsigned char *)buf + body;
     h->end = (const unsigned char *)buf + len;
     for (int e = 0; st == JF_OK && e < h->nelems; e++) {
@@ -416,6 +417,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
         }
         if (is_vertex) {
             seen_vertex = 1;
+            vertex_row = need;
             int ix = prop_index(el, "x", 0), iy = prop_index(el, "y", 0),
                 iz = prop_index(el, "z", 0);
             if (ix < 0 || iy < 0 || iz < 0) {
@@ -490,6 +492,13 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
             }
         }
     }
+    /* binary: room for another vertex row after the last element is the
+     * same lie; fewer bytes (a writer's trailing newline) are tolerated */
+    if (st == JF_OK && h->format && vertex_row && (uint64_t)(h->end - h->p) >= vertex_row)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                        "%zu bytes after the last element (a vertex row is %llu): an "
+                        "element count in the header is smaller than the rows in the file",
+                        (size_t)(h->end - h->p), (unsigned long long)vertex_row);
     /* faces listed before the vertices: check their indices now */
     for (size_t f = 0; st == JF_OK && f < c->nfaces; f++)
         for (size_t k = c->face_off[f]; k < c->face_off[f + 1]; k++)
