@@ -100,6 +100,14 @@ END_TEST
 START_TEST(nul_byte)
 {
     refused("z.xyz", "1 2 3\n4 5\0 6\n", 11, "NUL byte", 2);
+    /* ascii PLY: body (before: "'' is not a number") and header (before:
+     * "z\0" read as the name z, rc 0) */
+    static const char zp[] = "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
+                             "property double y\nproperty double z\nend_header\n0 0 0\n1 \0 0\n";
+    refused("z.ply", zp, sizeof zp - 1, "NUL byte", 9);
+    static const char zh[] = "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\n"
+                             "property double y\nproperty double z\0\nend_header\n0 0 0\n";
+    refused("zh.ply", zh, sizeof zh - 1, "NUL byte in the header", 6);
     refused("z.off", "OFF\n3 1 0\n0 0 0\n1\0 0 0\n0 1 0\n3 0 1 2\n", 36, "NUL byte", 4);
 }
 END_TEST
