@@ -895,9 +895,10 @@ typedef void (*jf_progress_fn)(void *user, size_t done, size_t total);
  * triangulation, fitting, orientation).  Once it says stop, every thread
  * leaves the fit after its current block and jf_estimate returns
  * JF_ERR_CANCELLED (out is then partly filled).  A stage that is not
- * split into blocks (the natural neighbours' Delaunay triangulation, the
- * mst orientation) runs to its end first.  The command's Ctrl-C and the
- * Python module's KeyboardInterrupt go through it. */
+ * split into blocks (the k-d tree, the natural neighbours' Delaunay
+ * triangulation and tangent-plane normals, the mst orientation) runs to
+ * its end first.  `jetfit study`'s Ctrl-C and the Python module's
+ * KeyboardInterrupt go through it. */
 typedef int (*jf_cancel_fn)(void *user);
 
 typedef struct {
