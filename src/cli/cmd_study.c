@@ -252,6 +252,13 @@ static int load_input(jf_study_args *c)
                 c->cloud.n);
         return 1;
     }
+    /* as eval: a truth with coordinates must be about this cloud */
+    char names[3][32] = {"x", "y", "z"};
+    jf_eval_table view = {.nrows = c->cloud.n, .ncols = 3, .names = names, .v = c->cloud.xyz};
+    if (jf_cli_truth_coords_check(s->truth, &view, msg, sizeof msg)) {
+        fprintf(stderr, "jetfit: %s\n", msg);
+        return 1;
+    }
     /* as estimate: input normals orient the result unless told otherwise */
     if (!c->base.orient_set && c->cloud.nrm)
         for (int i = 0; i < c->nsetting; i++) c->setting[i].orient = JF_ORIENT_INPUT;

@@ -66,6 +66,20 @@ static int bad_opt(const char *opt, const char *val, const char *why)
     return 2;
 }
 
+/* 1 if option `n` takes a value (the study's own or estimate's): an
+ * unknown option given last is then named as unknown, not as lacking a
+ * value (issue 11.10).  Keep in step with the parser below. */
+static int takes_value(const char *n)
+{
+    static const char *const own[] = {"-o", "--output", "--truth", "--subset", "--neighbors",
+                                      "--neighbours", "--degree", "--flags", "--noise",
+                                      "--noise-uniform", "--outliers", "--metrics", "--repeat",
+                                      "--seed", "--n"};
+    for (size_t k = 0; k < sizeof own / sizeof own[0]; k++)
+        if (!strcmp(n, own[k])) return 1;
+    return jf_cli_est_takes_value(n) == 1;
+}
+
 /* ---- lists ---- */
 
 /* Splits a copy of text at any of seps into *out (strings trimmed of
@@ -276,7 +290,9 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
             val = eq + 1;
         } else {
             snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc) return bad_opt(a, "", "needs a value");
+            if (i + 1 >= argc)
+                return takes_value(name) ? bad_opt(a, "", "needs a value")
+                                         : bad_opt("unknown option", a, "not an option of study");
             val = argv[++i];
         }
         int iv;

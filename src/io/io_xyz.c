@@ -163,15 +163,24 @@ static int default_normals(const tab *t, const char *ls, const char *le)
     return n2 >= 0.81 && n2 <= 1.21;
 }
 
-/* 1 if the row's blank-separated fields are numbers written with a
- * decimal comma ("-0,352 -0,698 0,736"): each holds exactly one ',' with
- * a digit on both sides.  Read as separators they would double the
- * columns and shift every value. */
+/* 1 if the row's fields, separated by blanks or ';', are numbers written
+ * with a decimal comma ("-0,352 -0,698 0,736", "1,5;2,5;3,5" from a
+ * European spreadsheet): each holds exactly one ',' with a digit on both
+ * sides.  Read as separators they would double the columns and shift
+ * every value. */
 static int decimal_commas(const char *ls, const char *le)
 {
     const char *p = ls, *fs, *fe;
     int n = 0;
-    while (jf_next_token(&p, le, 0, &fs, &fe)) {
+    for (;;) {
+        while (p < le && (jf_is_space(*p) || *p == ';'))
+            p++;
+        if (p == le)
+            break;
+        fs = p;
+        while (p < le && !jf_is_space(*p) && *p != ';')
+            p++;
+        fe = p;
         const char *c = memchr(fs, ',', (size_t)(fe - fs));
         if (!c || c == fs || c + 1 == fe || memchr(c + 1, ',', (size_t)(fe - c - 1)) ||
             c[-1] < '0' || c[-1] > '9' || c[1] < '0' || c[1] > '9')
@@ -306,8 +315,12 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                            t.maxcol + 1, nf);
         /* a row of another width is a broken or shifted line, not data */
         if (!bad && nf0 >= 0 && nf != nf0)
-            bad = snprintf(why, sizeof why, "row %zu: %d columns, the first data row has %d",
-                           n, nf, nf0);
+            bad = !t.csv && decimal_commas(ls, le)
+                      ? snprintf(why, sizeof why, "row %zu: '%.*s' has decimal commas; jetfit "
+                                 "reads '.' as the decimal point (sed 's/,/./g')", n,
+                                 (int)(le - ls > 40 ? 40 : le - ls), ls)
+                      : snprintf(why, sizeof why, "row %zu: %d columns, the first data row has %d",
+                                 n, nf, nf0);
         if (bad && !skip)
             return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line, "%s", why);
         if (bad) { /* --bad-rows skip: a NaN row keeps every later index */

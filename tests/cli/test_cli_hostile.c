@@ -303,6 +303,11 @@ START_TEST(messages)
     const char *in = sphere(300), *out = cli_path("m.xyz");
     ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--bogus", NULL), 2);
     ck_assert_ptr_nonnull(strstr(cli_err, "unknown option"));
+    /* study too (before: "--bogus '': needs a value") */
+    ck_assert_int_eq(cli_run("study", "exp", "-o", cli_path("st"), "--bogus", NULL), 2);
+    ck_assert_ptr_nonnull(strstr(cli_err, "unknown option '--bogus'"));
+    ck_assert_int_eq(cli_run("study", "exp", "-o", cli_path("st"), "--repeat", NULL), 2);
+    ck_assert_ptr_nonnull(strstr(cli_err, "needs a value"));
     ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--threads", "5000", NULL), 2);
     ck_assert_ptr_nonnull(strstr(cli_err, "4096"));
     ck_assert_int_eq(cli_run("estimate", in, "-o", out, "--neighbors", "knn:5000000000", NULL), 2);

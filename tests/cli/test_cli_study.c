@@ -203,7 +203,8 @@ static void check_cell(const csv_row *h, const csv_row *c, const char *input, co
 START_TEST(study_equals_generate_estimate_eval)
 {
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     const char *nb = "knn:16;knn:24,radius:0.3", *deg = "2;3";
     const char *flags = ";--robust-normals;--scales 8,16,32";
     int rc = cli_run("study", "exp", "-o", dir, "--n", "1500", "--neighbors", nb, "--degree",
@@ -244,6 +245,8 @@ START_TEST(study_equals_generate_estimate_eval)
         }
     ck_assert(with_out);
     free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
     cli_teardown();
 }
 END_TEST
@@ -258,7 +261,8 @@ START_TEST(study_of_an_input_equals_estimate_eval_subset)
     FILE *f = fopen(sub, "w");
     for (int i = 0; i < 1200; i += 3) fprintf(f, "%d\n", i);
     fclose(f);
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     int rc = cli_run("study", in, "--truth", truth, "--subset", sub, "-o", dir, "--neighbors",
                      "knn:12;natural:24", "--degree", "2;4", "--quiet", NULL);
     ck_assert_msg(rc == 0, "%s", cli_err);
@@ -283,7 +287,8 @@ END_TEST
 START_TEST(mesh_study_equals_generate_mesh)
 {
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     int rc = cli_run("study", "paraboloid", "--mesh", "--n", "900", "-o", dir, "--neighbors",
                      "rings;rings:20;knn:12", "--noise", "0;0.003", "--seed", "4", "--quiet", NULL);
     ck_assert_msg(rc == 0, "%s", cli_err);
@@ -530,7 +535,8 @@ START_TEST(report_opens_in_chromium)
         return;
     }
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     int rc = cli_run("study", "paraboloid", "-o", dir, "--n", "2000", "--neighbors",
                      "knn:12;knn:24;knn:48", "--degree", "2;3", "--noise", "0;0.002;0.005",
                      "--repeat", "2", "--threads", "2", NULL);
@@ -619,7 +625,8 @@ END_TEST
 START_TEST(bad_input_one_line_no_folder)
 {
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: many paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     struct {
         const char *args[8];
         int rc;
@@ -650,6 +657,14 @@ START_TEST(bad_input_one_line_no_folder)
     ck_assert_msg(strstr(cli_err, "399 rows") && strstr(cli_err, "400 points"), "%s", cli_err);
     ck_assert_int_eq(count_str(cli_err, "\n"), 1);
     ck_assert(!cli_exists(dir));
+    /* a truth of another cloud with as many rows (eval's check) */
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "400", "--seed", "2", "-o",
+                             cli_path("y.ply"), "--truth", cli_path("t2.csv"), NULL), 0);
+    rc = cli_run("study", cli_path("c.ply"), "--truth", cli_path("t2.csv"), "-o", dir, NULL);
+    ck_assert_int_eq(rc, 1);
+    ck_assert_msg(strstr(cli_err, "not the same cloud"), "%s", cli_err);
+    ck_assert_int_eq(count_str(cli_err, "\n"), 1);
+    ck_assert(!cli_exists(dir));
     /* neither a surface nor an input with truth */
     ck_assert_int_eq(cli_run("study", "torus", "-o", dir, NULL), 2);
     ck_assert(!cli_exists(dir));
@@ -660,7 +675,8 @@ END_TEST
 START_TEST(failing_cell_recorded_study_goes_on)
 {
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     /* rings needs a mesh: a cloud makes that cell fail, knn goes on */
     ck_assert_int_eq(cli_run("generate", "sphere", "--n", "800", "-o", cli_path("s.ply"),
                              "--truth", cli_path("t.ply"), NULL), 0);
@@ -696,7 +712,8 @@ END_TEST
 START_TEST(one_progress_line_with_eta)
 {
     cli_setup();
-    const char *dir = cli_path("st");
+    char dir[300]; /* not cli_path's rotating buffer: more paths follow */
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
     int rc = cli_run_tty("study", "exp", "-o", dir, "--n", "3000", "--neighbors",
                          "knn:16;knn:32", "--noise", "0;0.01", NULL);
     ck_assert_msg(rc == 0, "%s", cli_err);

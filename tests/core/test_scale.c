@@ -86,6 +86,20 @@ END_TEST
  * ulps, and the umbilic verdict must not change (it did at 1e10). */
 START_TEST(scale_decimal)
 {
+    /* the umbilic verdict too, at degree 4 (to 1e+-90: its coefficients
+     * overflow beyond): nearly umbilic points (k1 - k2 ~ 6e-7 and 2e-6
+     * here, from the fit) never become umbilic at any decimal scale, as
+     * they did from 1e10 with the absolute test */
+    for (int e = -90; e <= 90; e += 10) /* degree 4: c ~ 1/length^3 */
+        for (int ai = 0; ai < 2; ai++) {
+            const double an = ai ? 1e-6 : 0.0;
+            jf_result ref, r;
+            fit(an, 1.0, 4, &ref);
+            fit(an, pow(10.0, e), 4, &r);
+            ck_assert_msg(r.status == ref.status, "aniso %g 1e%d: status %u, want %u", an, e,
+                          r.status, ref.status);
+            ck_assert_msg(!(r.status & JF_PT_UMBILIC), "aniso %g 1e%d: umbilic", an, e);
+        }
     for (int e = -150; e <= 150; e += 10) {
         double s = pow(10.0, e);
         jf_result ref, r;

@@ -40,6 +40,10 @@ static void refused(const char *name, const char *s, size_t len, const char *wha
 START_TEST(decimal_commas)
 {
     refused("dc.xyz", "-0,352 -0,698 0,736\n0,5 0,25 0,125\n", 0, "decimal comma", 1);
+    /* a first row of integers, then commas: named too (before: "6 columns") */
+    /* ';'-separated with decimal commas (before: "1,5;2,5;3,5" was 1 5 2) */
+    refused("dc3.xyz", "1,5;2,5;3,5\n4,5;5,5;6,5\n", 0, "decimal comma", 1);
+    refused("dc2.xyz", "0 0 1\n0,5 0,25 0,125\n", 0, "decimal comma", 2);
     /* comma-separated values are still fine */
     jf_cloud c;
     const char *p = fixture("cs.xyz", "1.5,2.5,3.5\n4,5,6\n", strlen("1.5,2.5,3.5\n4,5,6\n"));
@@ -96,6 +100,14 @@ END_TEST
 START_TEST(nul_byte)
 {
     refused("z.xyz", "1 2 3\n4 5\0 6\n", 11, "NUL byte", 2);
+    /* ascii PLY: body (before: "'' is not a number") and header (before:
+     * "z\0" read as the name z, rc 0) */
+    static const char zp[] = "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
+                             "property double y\nproperty double z\nend_header\n0 0 0\n1 \0 0\n";
+    refused("z.ply", zp, sizeof zp - 1, "NUL byte", 9);
+    static const char zh[] = "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\n"
+                             "property double y\nproperty double z\0\nend_header\n0 0 0\n";
+    refused("zh.ply", zh, sizeof zh - 1, "NUL byte in the header", 6);
     refused("z.off", "OFF\n3 1 0\n0 0 0\n1\0 0 0\n0 1 0\n3 0 1 2\n", 36, "NUL byte", 4);
 }
 END_TEST
@@ -119,9 +131,26 @@ START_TEST(counts_and_duplicates)
             "property double z\nproperty double x\nend_header\n0 0 0 1\n",
             0, "property 'x' appears twice", 7);
     refused("dup.csv", "x,y,z,x\n1,2,3,4\n", 0, "column 'x' appears twice", 1);
+    /* binary: a third float row after a count of 2 (before: silent) */
+    static const char hb[] = "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
+                             "property float x\nproperty float y\nproperty float z\nend_header\n";
+    char bin[sizeof hb + 3 * 12 + 1];
+    memcpy(bin, hb, sizeof hb - 1);
+    for (int i = 0; i < 9; i++) {
+        float f = (float)i;
+        memcpy(bin + sizeof hb - 1 + 4 * i, &f, 4);
+    }
+    bin[sizeof hb - 1 + 36] = '\n';
+    refused("short_bin.ply", bin, sizeof hb - 1 + 36, "12 bytes after the last element", 0);
     refused("c.pts", "5\n1 2 3\n4 5 6\n7 8 9\n", 0, "count line says 5 points, 3 rows", 1);
     /* a right count, and two scans each with theirs, still read */
     jf_cloud c;
+    /* two rows and a writer's trailing newline still read */
+    memcpy(bin + sizeof hb - 1 + 24, "\n", 1);
+    const char *b2 = fixture("nl_bin.ply", bin, sizeof hb - 1 + 25);
+    ck_assert_int_eq(jf_cloud_read(b2, NULL, &c, NULL), JF_OK);
+    ck_assert(c.n == 2 && c.xyz[5] == 5);
+    jf_cloud_free(&c);
     const char *p = fixture("ok.pts", "2\n1 2 3\n4 5 6\n1\n7 8 9\n", strlen("2\n1 2 3\n4 5 6\n1\n7 8 9\n"));
     ck_assert_int_eq(jf_cloud_read(p, NULL, &c, NULL), JF_OK);
     ck_assert_uint_eq(c.n, 3);
