@@ -5,7 +5,7 @@
  * so rename(2) is atomic) under an unpredictable name, exclusively
  * (O_CREAT|O_EXCL|O_NOFOLLOW: a planted file or link at that name makes the
  * open fail and another name is drawn, never followed).  Its name is
- * ".BASE.XXXXXXXX.tmp" with BASE cut to 200 bytes, so a final name near the
+ * ".BASE.XXXXXXXXXX.tmp" with BASE cut to 200 bytes, so a final name near the
  * 255-byte limit still gets a temporary.  An output path that is a symbolic
  * link is written through to its target, as cp(1) does: the link stays and
  * the target is replaced.  The new file keeps the mode of the file it

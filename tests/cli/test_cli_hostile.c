@@ -32,6 +32,7 @@ static char *slurp(const char *path, size_t *n)
     rewind(f);
     char *b = malloc((size_t)len + 1);
     *n = fread(b, 1, (size_t)len, f);
+    b[*n] = '\0';
     fclose(f);
     return b;
 }
