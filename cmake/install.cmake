@@ -8,6 +8,18 @@ install(TARGETS jetfit_shared EXPORT jetfitTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/src/jetfit.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+# libjetfit.a (JF_STATIC_LIB): the library and the CGAL bridge in one
+# archive; a program links it with `pkg-config --static --libs jetfit` (GSL,
+# OpenMP, the C++ runtime, and CGAL's GMP/MPFR) or jetfit::jetfit_static.
+if(JF_STATIC_LIB)
+  add_library(jetfit_static STATIC $<TARGET_OBJECTS:jetfit_obj> $<TARGET_OBJECTS:jetfit_cgal_obj>)
+  set_target_properties(jetfit_static PROPERTIES OUTPUT_NAME jetfit EXPORT_NAME jetfit_static)
+  target_include_directories(jetfit_static PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+  install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
 install(FILES ${PROJECT_SOURCE_DIR}/docs/jetfit.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 
 install(EXPORT jetfitTargets NAMESPACE jetfit:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jetfit)

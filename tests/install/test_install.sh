@@ -39,14 +39,26 @@ cmake -S "$ex" -B "$tmp/b" -DCMAKE_PREFIX_PATH="$p" -DCMAKE_BUILD_RPATH="$libdir
   || { cat "$tmp/cm.log"; fail "find_package(jetfit) configure failed"; }
 cmake --build "$tmp/b" >"$tmp/cb.log" 2>&1 || { cat "$tmp/cb.log"; fail "find_package build failed"; }
 
+# 3. the static library (JF_STATIC_LIB): no libjetfit.so needed at run time
+if [ -f "$libdir/libjetfit.a" ]; then
+  cc "$ex/normals.c" -I"$p/include" "$libdir/libjetfit.a" \
+     $(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --static --libs-only-l jetfit | sed 's/-ljetfit//') \
+     -o "$tmp/normals-static" || fail "build against libjetfit.a failed"
+  ldd "$tmp/normals-static" | grep -q libjetfit && fail "the static build needs libjetfit.so"
+fi
+
 scan=$src/data/bun090.ply
 "$tmp/normals-pc" "$scan" >"$tmp/pc.out" || fail "normals (pkg-config) failed"
 "$tmp/b/normals" "$scan" >"$tmp/cm.out" || fail "normals (find_package) failed"
 cmp -s "$tmp/pc.out" "$tmp/cm.out" || fail "the two builds disagree"
+if [ -x "$tmp/normals-static" ]; then
+  "$tmp/normals-static" "$scan" >"$tmp/st.out" || fail "normals (static) failed"
+  cmp -s "$tmp/pc.out" "$tmp/st.out" || fail "the static build disagrees"
+fi
 grep -q ': 30379 points, 30379 fitted$' "$tmp/pc.out" || { cat "$tmp/pc.out"; fail "wrong summary"; }
 # the installed command's first row, formatted as the example prints it
 "$p/bin/jetfit" estimate "$scan" -o "$tmp/r.csv" --quiet || fail "installed jetfit failed"
 want=$(awk -F, 'NR == 2 { printf "point 0: normal %.6f %.6f %.6f  k1 %.6g  k2 %.6g\n", $4, $5, $6, $7, $8 }' "$tmp/r.csv")
 got=$(sed -n 2p "$tmp/pc.out")
 [ "$got" = "$want" ] || fail "library '$got' != command '$want'"
-echo "test_install: installed, built twice (pkg-config, find_package), same numbers as the command"
+echo "test_install: installed, built with pkg-config, find_package and the static library, same numbers as the command"
