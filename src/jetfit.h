@@ -52,7 +52,8 @@ typedef enum {
                                the file can hold                          */
     JF_ERR_NUMERIC = 6,     /* a numerical routine failed                */
     JF_ERR_UNSUPPORTED = 7, /* feature not built in (e.g. no CGAL)       */
-    JF_ERR_INTERNAL = 8     /* a bug: please report                      */
+    JF_ERR_INTERNAL = 8,    /* a bug: please report                      */
+    JF_ERR_CANCELLED = 9    /* the caller's cancel hook asked to stop    */
 } jf_status;
 
 /* Static English name of a status; never NULL. */
@@ -104,6 +105,7 @@ char *jf_point_status_str(unsigned status, char *buf, size_t len);
 /* ------------------------------------------------------------------ */
 #define JF_MAX_DEGREE 9         /* largest jet degree (N_9 = 55)       */
 #define JF_MAX_MONGE_DEGREE 4
+#define JF_MAX_NEIGHBORS ((size_t)1 << 20) /* largest neighbourhood a fit takes */
 
 typedef enum { JF_FIT_APPROX = 0, JF_FIT_INTERP = 1 } jf_fit_mode;
 typedef enum { JF_FRAME_PCA = 0, JF_FRAME_AXIS = 1 } jf_frame_mode;
@@ -515,6 +517,9 @@ typedef struct {
     size_t nfaces;       /* mesh faces (0 for a cloud)                 */
     size_t *face_off;    /* nfaces+1 offsets into face_idx, or NULL    */
     uint32_t *face_idx;  /* polygon vertex indices, or NULL            */
+    size_t nbad;         /* text rows that did not parse, kept as NaN
+                            points (jf_read_opts.bad_rows = skip)      */
+    size_t bad_line[10]; /* the first min(nbad, 10) of their lines     */
 } jf_cloud;
 
 typedef struct {
@@ -528,6 +533,11 @@ typedef struct {
                             header names x,y,z[,nx,ny,nz] (any case).
                             x,y,z must be all set or all -1; normals
                             likewise.                                  */
+    int bad_rows;        /* text formats: 0 (default) an unparsable row
+                            is an error; 1 it is kept as a row of NaN
+                            (so every later row keeps its index; the
+                            pipeline marks it nonfinite) and counted in
+                            jf_cloud.nbad / bad_line                   */
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */
@@ -595,6 +605,14 @@ typedef struct jf_writer jf_writer;
 jf_status jf_writer_open(const char *path, const jf_column *cols,
                          size_t ncols, size_t nrows, int ascii,
                          jf_writer **w, jf_error *err);
+
+/* LAS output (.las: LAS 1.4, point format 0 holding x y z, every other
+ * column an Extra Byte named as the column; x y z must be the first three
+ * columns): the coordinates are stored as int32 counts of a scale chosen
+ * from the cloud's bounding box (0.1 um where the extent allows, 1e-7 m
+ * up to ~200 m), so the cloud must be given before the first row.  A
+ * no-op for other formats.  JF_ERR_INVALID after the first row. */
+jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
 
 /* PLY only (ignored by text formats): also write a `face` element
  * (list uchar int vertex_indices) from nfaces polygons
@@ -828,6 +846,40 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
                            size_t *ring_end);
 
 /* ------------------------------------------------------------------ */
+/* Output files that appear whole or not at all (src/io/io_tmpfile.c)  */
+/* ------------------------------------------------------------------ */
+/* Every writer of the library goes through this; it is public so that a
+ * program writing its own files (a picture, a report) gets the same
+ * guarantees.  The temporary is created beside the final file, under an
+ * unpredictable name, exclusively (a planted file or link is never
+ * followed), even for a final name near the 255-byte limit.  A final path
+ * that is a symbolic link is written through to its target (as cp does).
+ * The new file keeps the mode of the file it replaces, else 0666 less the
+ * umask. */
+typedef struct {
+    int fd;          /* write here (open, O_WRONLY)                    */
+    char *tmp;       /* the temporary's path                           */
+    char *target;    /* the file that commit replaces                  */
+    int slot;        /* internal: its place in the signal-safe list    */
+} jf_tmpfile;
+
+/* Creates the temporary for `final`.  JF_OK, or JF_ERR_IO / _INVALID /
+ * _NOMEM with err "FINAL: reason" and *t holding nothing.  Thread-safe. */
+jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err);
+/* Closes the temporary and renames it onto its target; on failure removes
+ * it.  Either way *t holds nothing afterwards. */
+jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err);
+/* Closes and removes the temporary (t may be NULL or empty). */
+void jf_tmpfile_discard(jf_tmpfile *t);
+/* Removes every temporary of this process that is not yet committed or
+ * discarded: unlink(2) only, async-signal-safe, for a SIGINT/SIGTERM
+ * handler. */
+void jf_tmpfiles_remove_all(void);
+/* 1 when a and b name the same existing file (device and inode, links
+ * followed), else 0. */
+int jf_same_file(const char *a, const char *b);
+
+/* ------------------------------------------------------------------ */
 /* Estimation pipeline (src/pipeline.c): a whole cloud, with OpenMP    */
 /* ------------------------------------------------------------------ */
 #define JF_ESTIMATE_DEFAULT_K 32   /* knn:32, the command's default    */
@@ -836,6 +888,18 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
  * thread that called jf_estimate only (never concurrently), a few
  * hundred points apart, and once with done == total. */
 typedef void (*jf_progress_fn)(void *user, size_t done, size_t total);
+
+/* Cancellation hook: returns nonzero to stop.  Polled on the thread that
+ * called jf_estimate only (never concurrently): after each block of a few
+ * hundred points that thread fits, and between the stages (index or
+ * triangulation, fitting, orientation).  Once it says stop, every thread
+ * leaves the fit after its current block and jf_estimate returns
+ * JF_ERR_CANCELLED (out is then partly filled).  A stage that is not
+ * split into blocks (the k-d tree, the natural neighbours' Delaunay
+ * triangulation and tangent-plane normals, the mst orientation) runs to
+ * its end first.  `jetfit study`'s Ctrl-C and the Python module's
+ * KeyboardInterrupt go through it. */
+typedef int (*jf_cancel_fn)(void *user);
 
 typedef struct {
     jf_params params;        /* the fit (params.max_neighbors must hold
@@ -852,6 +916,8 @@ typedef struct {
     int threads;             /* <= 0: all cores (OpenMP default)        */
     jf_progress_fn progress; /* may be NULL                             */
     void *progress_user;
+    jf_cancel_fn cancel;     /* may be NULL (jf_cancel_fn)              */
+    void *cancel_user;
 } jf_estimate_opts;
 
 /* Fills defaults.  Never fails. */
@@ -875,6 +941,7 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * with mst.
  * Returns JF_OK, JF_ERR_INVALID (bad options, rings without faces,
  * orient/normal input without normals; err says which), JF_ERR_NOMEM,
+ * JF_ERR_CANCELLED (o->cancel said stop),
  * JF_ERR_FORMAT (bad face indices), or the failing stage's status; err
  * (may be NULL) gets one line.  Thread-safe on distinct outputs. */
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,

@@ -1,6 +1,7 @@
 # cli.cmake -- the end-to-end tests of `jetfit estimate` run the built
 # binary (JF_BUILD_DIR/jetfit): build it before them, label them.
-foreach(t test_cli_errors test_cli_formats test_cli_orient test_cli_mesh test_cli_robust)
+foreach(t test_cli_version test_cli_hostile test_cli_errors test_cli_formats test_cli_orient test_cli_mesh test_cli_robust
+          test_cli_study)
   if(TARGET ${t})
     add_dependencies(${t} jetfit)
     set_tests_properties(${t} PROPERTIES LABELS "cli;e2e")
@@ -23,4 +24,9 @@ if(TARGET bench_estimate)
   if(TARGET CGAL::Eigen3_support)
     target_link_libraries(bench_estimate PRIVATE CGAL::Eigen3_support)
   endif()
+endif()
+# test_gnuplot_quote exercises the command's gnuplot quoting (src/cli/gnuplot.c)
+if(TARGET test_gnuplot_quote)
+  target_sources(test_gnuplot_quote PRIVATE ${PROJECT_SOURCE_DIR}/src/cli/gnuplot.c)
+  target_include_directories(test_gnuplot_quote PRIVATE ${PROJECT_SOURCE_DIR}/src/cli)
 endif()

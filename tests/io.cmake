@@ -4,3 +4,23 @@ foreach(t test_io_read test_io_write test_io_bad)
     set_tests_properties(${t} PROPERTIES LABELS io)
   endif()
 endforeach()
+foreach(t test_io_las test_io_hostile)
+  if(TEST ${t})
+    set_tests_properties(${t} PROPERTIES LABELS io)
+  endif()
+endforeach()
+# test_las_numpy: a second LAS reader (numpy, tests/io/las_numpy_check.py)
+# reads jetfit's LAS output; Debian's python3 (where python3-numpy is), else
+# any; skipped (77) without numpy.
+find_program(JF_NUMPY_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT JF_NUMPY_PYTHON)
+  find_program(JF_NUMPY_PYTHON NAMES python3)
+endif()
+if(JF_NUMPY_PYTHON AND TARGET jetfit)
+  add_test(NAME test_las_numpy
+           COMMAND ${CMAKE_COMMAND} -E env ${JF_NUMPY_PYTHON}
+                   ${CMAKE_CURRENT_SOURCE_DIR}/io/las_numpy_check.py $<TARGET_FILE:jetfit>
+                   ${PROJECT_SOURCE_DIR}/tests/data/las/vegetation_1_3.las
+                   ${CMAKE_CURRENT_BINARY_DIR})
+  set_tests_properties(test_las_numpy PROPERTIES LABELS io SKIP_RETURN_CODE 77)
+endif()

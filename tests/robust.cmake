@@ -4,10 +4,9 @@ if(TARGET test_eval AND TARGET jetfit)
   add_dependencies(test_eval jetfit)
 endif()
 
-# bench_pcpnet: the PCPNet study reads ../shared/data/pcpnet and runs CGAL's
+# bench_pcpnet: the PCPNet study (data folder as its argument or $JF_DATA/pcpnet) runs CGAL's
 # jet_estimate_normals, whose default SVD is Eigen's (CGAL::Eigen3_support).
 if(TARGET bench_pcpnet)
-  target_compile_definitions(bench_pcpnet PRIVATE JF_SHARED_DATA="${JF_SHARED_DATA}")
   find_package(Eigen3 3.1.0 QUIET)
   include(CGAL_Eigen3_support OPTIONAL)
   if(TARGET CGAL::Eigen3_support)

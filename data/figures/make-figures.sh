@@ -31,4 +31,9 @@ trap 'rm -rf "$T"' EXIT
 "$B" estimate data/bun090.ply -o "$T/bun-jets.ply" --orient viewpoint:0,0,1 --quiet
 "$B" render "$T/bun-jets.ply" -o "$F/bunny_mean.png" --color mean --view top \
     --size 600,560 --small --title "bun090 range scan: mean curvature (knn:32, degree 2)"
+# docs/study.md: which neighbourhood at which noise level (jetfit study)
+"$B" study ellipsoid -o "$T/study" --n 10000 --quiet \
+    --neighbors 'knn:16;knn:32;knn:64;natural:32' --degree '2;3' \
+    --noise '0;0.002;0.005;0.01' --repeat 2
+cp "$T/study/normal.png" "$F/study_normal.png"
 ls -l "$F"/*.png "$F"/convergence/*.png

@@ -8,4 +8,5 @@ int jf_cmd_generate(int argc, char **argv);    /* cmd_generate.c    */
 int jf_cmd_convergence(int argc, char **argv); /* cmd_convergence.c */
 int jf_cmd_render(int argc, char **argv);      /* cmd_render.c      */
 int jf_cmd_eval(int argc, char **argv);        /* cmd_eval.c        */
+int jf_cmd_study(int argc, char **argv);       /* cmd_study.c       */
 #endif

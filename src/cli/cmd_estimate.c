@@ -1,7 +1,6 @@
 /* cmd_estimate.c -- `jetfit estimate INPUT -o OUTPUT [options]`: read,
  * estimate (jf_estimate), write one row per input point, summarise.
  * Uses only the public header. */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,8 +12,9 @@
 
 #include "cmd.h"
 #include "jetfit.h"
+#include "opts.h"
 
-#define DEFAULT_NEIGHBORS "knn:32"
+#define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
 static void usage(FILE *f)
 {
@@ -57,6 +57,9 @@ static void usage(FILE *f)
         "  --columns X,Y,Z[,NX,NY,NZ]\n"
         "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
         "                        (default: x y z first, normals in 3..5 if 6 columns)\n"
+        "  --bad-rows MODE       text input: error (default) stops at the first\n"
+        "                        unparsable row; skip keeps it as a NaN row (status\n"
+        "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
         "  --quiet               no progress line, no summary\n"
@@ -73,49 +76,6 @@ static int bad_option(const char *opt, const char *val, const char *why)
     fprintf(stderr, "jetfit estimate: %s '%s': %s (jetfit estimate --help)\n", opt,
             val ? val : "", why);
     return 2;
-}
-
-/* Strict number parsing: the whole string must be consumed. */
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) return -1;
-    *out = (int)v;
-    return 0;
-}
-
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-/* "a,b,c" -> up to max doubles; returns the count or -1. */
-static int parse_list(const char *s, double *v, int max)
-{
-    int n = 0;
-    const char *p = s;
-    while (*p) {
-        char buf[64];
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
-        if (len == 0 || len >= sizeof buf || n == max) return -1;
-        memcpy(buf, p, len);
-        buf[len] = '\0';
-        if (parse_double(buf, &v[n++])) return -1;
-        p += len;
-        if (*p == ',') {
-            p++;
-            if (!*p) return -1;
-        }
-    }
-    return n;
 }
 
 /* ---- progress line and summary ---------------------------------------- */
@@ -154,7 +114,7 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void summary(const jf_result *r, size_t n, double secs, const char *out)
+static void summary(const jf_result *r, size_t n, size_t nbad, double secs, const char *out)
 {
     size_t flags[32] = {0}, ok = 0, deg[JF_MAX_DEGREE + 1] = {0};
     for (size_t i = 0; i < n; i++) {
@@ -188,6 +148,8 @@ static void summary(const jf_result *r, size_t n, double secs, const char *out)
                 c[(m - 1) / 2], c[(size_t)(0.9 * (double)(m - 1))],
                 c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
     free(c);
+    if (nbad)
+        fprintf(stderr, "  bad rows: %zu (kept as NaN rows, status nonfinite)\n", nbad);
     fprintf(stderr, "  output: %s\n", out);
 }
 
@@ -239,12 +201,11 @@ static size_t make_row(const double *p, const jf_result *r, int monge, double *v
 
 int jf_cmd_estimate(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *nbspec = DEFAULT_NEIGHBORS, *monge_s = "";
-    int quiet = 0, ascii = 0, monge = -1, orient_set = 0;
-    jf_estimate_opts o;
-    jf_read_opts ro;
-    jf_estimate_opts_init(&o);
-    jf_read_opts_init(&ro);
+    const char *in = NULL, *out = NULL;
+    int quiet = 0, ascii = 0;
+    jf_cli_est e;
+    jf_cli_bad bad;
+    jf_cli_est_init(&e);
 
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -260,11 +221,8 @@ int jf_cmd_estimate(int argc, char **argv)
             ascii = 1;
             continue;
         }
-        if (!strcmp(a, "--robust-normals")) {
-            /* the preset measured on PCPNet (README): degree selection
-             * down to the plane, headed by the weighted top-degree fit */
-            o.params.degree_select = 1;
-            o.params.dist_weight = 0.55;
+        if (jf_cli_est_takes_value(a) == 0) {
+            (void)jf_cli_est_option(&e, a, NULL, &bad);
             continue;
         }
         if (a[0] != '-' || !a[1]) {
@@ -281,127 +239,53 @@ int jf_cmd_estimate(int argc, char **argv)
             val = eq + 1;
         } else {
             snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc) return bad_option(a, "", "needs a value");
+            if (i + 1 >= argc)
+                return strcmp(name, "-o") && strcmp(name, "--output") &&
+                               jf_cli_est_takes_value(name) != 1
+                           ? bad_option("unknown option", a, "not an option of estimate")
+                           : bad_option(a, "", "needs a value");
             val = argv[++i];
         }
-        int iv;
-        double dv, list[8];
         if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
             out = val;
-        } else if (!strcmp(name, "--neighbors") || !strcmp(name, "--neighbours")) {
-            nbspec = val;
-        } else if (!strcmp(name, "--degree")) {
-            if (parse_int(val, 1, JF_MAX_DEGREE, &iv))
-                return bad_option(name, val, "expected an integer 1..9");
-            o.params.degree = iv;
-        } else if (!strcmp(name, "--monge-degree")) {
-            if (parse_int(val, 2, JF_MAX_MONGE_DEGREE, &iv))
-                return bad_option(name, val, "expected 2, 3 or 4");
-            monge = iv;
-            monge_s = val;
-        } else if (!strcmp(name, "--fit")) {
-            if (!strcmp(val, "approx")) o.params.fit = JF_FIT_APPROX;
-            else if (!strcmp(val, "interp")) o.params.fit = JF_FIT_INTERP;
-            else return bad_option(name, val, "expected approx or interp");
-        } else if (!strcmp(name, "--frame")) {
-            if (!strcmp(val, "pca")) o.params.frame = JF_FRAME_PCA;
-            else if (!strcmp(val, "axis")) o.params.frame = JF_FRAME_AXIS;
-            else return bad_option(name, val, "expected pca or axis");
-        } else if (!strcmp(name, "--max-cond")) {
-            if (parse_double(val, &dv) || !(dv >= 1))
-                return bad_option(name, val, "expected a number >= 1");
-            o.params.max_cond = dv;
-        } else if (!strcmp(name, "--orient")) {
-            orient_set = 1;
-            if (!strcmp(val, "none")) o.orient = JF_ORIENT_NONE;
-            else if (!strcmp(val, "input")) o.orient = JF_ORIENT_INPUT;
-            else if (!strncmp(val, "viewpoint:", 10)) {
-                if (parse_list(val + 10, o.viewpoint, 3) != 3)
-                    return bad_option(name, val, "expected viewpoint:X,Y,Z");
-                o.orient = JF_ORIENT_VIEWPOINT;
-            } else if (!strcmp(val, "mst")) o.orient = JF_ORIENT_MST;
-            else if (!strncmp(val, "mst:", 4)) {
-                if (parse_int(val + 4, 1, 256, &iv))
-                    return bad_option(name, val, "expected mst:K with K in 1..256");
-                o.orient = JF_ORIENT_MST;
-                o.orient_k = (size_t)iv;
-            } else
-                return bad_option(name, val, "expected none, input, viewpoint:X,Y,Z or mst[:K]");
-        } else if (!strcmp(name, "--normal")) {
-            if (!strcmp(val, "poles")) o.normal = JF_NORMAL_POLES;
-            else if (!strcmp(val, "mincirc")) o.normal = JF_NORMAL_MINCIRC;
-            else if (!strcmp(val, "pca")) o.normal = JF_NORMAL_PCA;
-            else if (!strcmp(val, "input")) o.normal = JF_NORMAL_INPUT;
-            else return bad_option(name, val, "expected poles, mincirc, pca or input");
-        } else if (!strcmp(name, "--robust")) {
-            if (!strcmp(val, "none")) o.params.robust = JF_ROBUST_NONE;
-            else if (!strcmp(val, "huber")) o.params.robust = JF_ROBUST_HUBER;
-            else if (!strcmp(val, "tukey")) o.params.robust = JF_ROBUST_TUKEY;
-            else return bad_option(name, val, "expected none, huber or tukey");
-        } else if (!strcmp(name, "--scales")) {
-            int m = parse_list(val, list, 8);
-            if (m < 1) return bad_option(name, val, "expected 1 to 8 sizes K1,K2,...");
-            for (int j = 0; j < m; j++) {
-                if (list[j] < 3 || list[j] > 100000 || list[j] != floor(list[j]) ||
-                    (j && list[j] <= list[j - 1]))
-                    return bad_option(name, val, "expected ascending integers >= 3");
-                o.params.scales[j] = (size_t)list[j];
-            }
-            o.params.nscales = m;
-        } else if (!strcmp(name, "--degree-select")) {
-            if (parse_int(val, 1, JF_MAX_DEGREE, &iv))
-                return bad_option(name, val, "expected a degree 1..9");
-            o.params.degree_select = iv;
-        } else if (!strcmp(name, "--dist-weight")) {
-            if (parse_double(val, &dv) || !(dv > 0) || !isfinite(dv))
-                return bad_option(name, val, "expected a positive number");
-            o.params.dist_weight = dv;
-        } else if (!strcmp(name, "--columns")) {
-            int m = parse_list(val, list, 6);
-            if (m != 3 && m != 6) return bad_option(name, val, "expected 3 or 6 column numbers");
-            for (int j = 0; j < m; j++) {
-                if (list[j] < 0 || list[j] > 1000 || list[j] != floor(list[j]))
-                    return bad_option(name, val, "expected 0-based column numbers");
-                ro.columns[j] = (int)list[j];
-            }
-        } else if (!strcmp(name, "--threads")) {
-            if (parse_int(val, 1, 4096, &iv))
-                return bad_option(name, val, "expected a positive integer");
-            o.threads = iv;
-        } else {
+        } else if (jf_cli_est_takes_value(name) != 1) {
             return bad_option("unknown option", a, "not an option of estimate");
+        } else if (jf_cli_est_option(&e, name, val, &bad)) {
+            return bad_option(bad.opt, bad.val, bad.why);
         }
     }
     if (!in) return bad_option("INPUT", "", "missing input file");
     if (!out) return bad_option("-o", "", "missing output file");
+    if (jf_cli_est_finish(&e, &bad)) return bad_option(bad.opt, bad.val, bad.why);
+    jf_estimate_opts o = e.o;
+    int monge = e.monge;
     jf_error err = {{0}};
-    const char *why = NULL;
-    if (jf_nb_parse(nbspec, &o.nb, &why) != JF_OK)
-        return bad_option("--neighbors", nbspec, why ? why : "bad neighbourhood");
-    /* degree 1 has no curvature: monge 2, its columns are NaN */
-    int top = o.params.degree < 2 ? 2 : o.params.degree;
-    if (monge < 0) monge = top < JF_MAX_MONGE_DEGREE ? top : JF_MAX_MONGE_DEGREE;
-    else if (monge > top) return bad_option("--monge-degree", monge_s, "must not exceed --degree");
-    o.params.monge_degree = monge;
-    /* the fitter must accept the largest neighbourhood we may hand it */
-    size_t need = o.nb.kind == JF_NB_KNN || o.nb.kind == JF_NB_KNN_RADIUS ? o.nb.k : o.nb.n;
-    for (int j = 0; j < o.params.nscales; j++)
-        if (o.params.scales[j] > need) need = o.params.scales[j];
-    if (need > o.params.max_neighbors) o.params.max_neighbors = need;
-    if (o.params.degree_select > o.params.degree)
-        return bad_option("--degree-select", "", "must not exceed --degree");
-    const char *bad = NULL;
-    if (jf_params_validate(&o.params, &bad) != JF_OK)
-        return bad_option("parameters", bad ? bad : "?", "invalid combination");
 
     double t0 = now_s();
     jf_cloud c = {0};
-    jf_status st = jf_cloud_read(in, &ro, &c, &err);
+    /* writing over the input would lose its other columns (and, renamed
+     * over it, the input itself) */
+    if (jf_same_file(in, out)) {
+        fprintf(stderr, "jetfit: %s: is the input file (%s); write the result to another file\n",
+                out, in);
+        return 1;
+    }
+    jf_status st = jf_cloud_read(in, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;
     }
-    if (!orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
+    if (c.nbad) {
+        /* --bad-rows skip: say which rows, so the user can look at them */
+        char lines[160] = "";
+        size_t shown = c.nbad < 10 ? c.nbad : 10, len = 0;
+        for (size_t k = 0; k < shown && len < sizeof lines; k++)
+            len += (size_t)snprintf(lines + len, sizeof lines - len, "%s%zu", k ? ", " : "",
+                                    c.bad_line[k]);
+        fprintf(stderr, "jetfit: %s: %zu unparsable rows kept as NaN rows (status nonfinite), "
+                        "lines %s%s\n", in, c.nbad, lines, c.nbad > shown ? ", ..." : "");
+    }
+    if (!e.orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[32];
@@ -416,6 +300,7 @@ int jf_cmd_estimate(int argc, char **argv)
     /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
+    (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
     jf_result *r = malloc(c.n * sizeof *r);
     if (!r) {
         fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);
@@ -462,7 +347,7 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    if (!quiet) summary(r, c.n, now_s() - t0, out);
+    if (!quiet) summary(r, c.n, c.nbad, now_s() - t0, out);
     free(r);
     jf_cloud_free(&c);
     return 0;

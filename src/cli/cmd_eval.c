@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cmd.h"
+#include "eval_errors.h"
 #include "jetfit.h"
 
 static void usage(FILE *out)
@@ -19,7 +20,11 @@ static void usage(FILE *out)
         "               k1 k2 and status are used when present)\n"
         "  TRUTH        a truth file with columns nx ny nz [k1 k2] (jetfit generate),\n"
         "               or PCPNet data: SHAPE.normals or SHAPE.xyz (reads\n"
-        "               SHAPE.normals and, when present, SHAPE.curv)\n"
+        "               SHAPE.normals and, when present, SHAPE.curv), or a reference\n"
+        "               result of the same cloud.  The points must be RESULT's:\n"
+        "               a reference result's x y z exactly (1e-9 of the diagonal),\n"
+        "               generate's noise-free x y z within 5%% (median); PCPNet's\n"
+        "               .normals have no coordinates, so rows are matched by order only\n"
         "  --subset IDX only the rows whose 0-based indices IDX lists (e.g. .pidx)\n"
         "  --by-status  the same table for each status value of RESULT\n"
         "\n"
@@ -30,7 +35,7 @@ static void usage(FILE *out)
         "the sign convention of jetfit (a sphere with outward normals has k < 0).\n");
 }
 
-/* Column indices of a table, -1 where missing. */
+/* Column indices of a result, -1 where missing. */
 typedef struct {
     int n[3], k[2], status;
 } cols;
@@ -50,120 +55,17 @@ static cols find_cols(const jf_eval_table *t)
 static int has_normal(const cols *c) { return c->n[0] >= 0 && c->n[1] >= 0 && c->n[2] >= 0; }
 static int has_curv(const cols *c) { return c->k[0] >= 0 && c->k[1] >= 0; }
 
-static int ends_with(const char *s, const char *suf)
-{
-    size_t a = strlen(s), b = strlen(suf);
-    return a >= b && !strcmp(s + a - b, suf);
-}
-
-/* "dir/SHAPE.ext" -> "dir/SHAPE" + newext into buf. */
-static void sibling(const char *path, const char *newext, char *buf, size_t len)
-{
-    snprintf(buf, len, "%s", path);
-    char *dot = strrchr(buf, '.'), *sl = strrchr(buf, '/');
-    if (dot && (!sl || dot > sl)) *dot = '\0';
-    size_t u = strlen(buf);
-    snprintf(buf + u, len - u, "%s", newext);
-}
-
-static int load(const char *path, jf_eval_table *t)
-{
-    jf_error e;
-    jf_status st = jf_eval_table_read(path, t, &e);
-    if (st != JF_OK) {
-        fprintf(stderr, "jetfit eval: %s\n", e.msg[0] ? e.msg : jf_strerror(st));
-        return -1;
-    }
-    return 0;
-}
-
-/* The truth as rows of nx ny nz k1 k2 (k NaN when unknown). */
-static double *load_truth(const char *path, size_t *nrows, int *has_k)
-{
-    jf_eval_table t, tc;
-    memset(&tc, 0, sizeof tc);
-    char buf[4096];
-    int pcpnet = ends_with(path, ".normals");
-    if (!pcpnet && ends_with(path, ".xyz")) {
-        sibling(path, ".normals", buf, sizeof buf);
-        FILE *fp = fopen(buf, "r");
-        if (fp) { /* a PCPNet shape: the .xyz itself has no normals */
-            fclose(fp);
-            pcpnet = 1;
-            path = buf;
-        }
-    }
-    char npath[4096];
-    snprintf(npath, sizeof npath, "%s", path);
-    if (load(npath, &t)) return NULL;
-    cols c = find_cols(&t);
-    if (!has_normal(&c)) {
-        fprintf(stderr, "jetfit eval: %s: no nx ny nz columns\n", npath);
-        jf_eval_table_free(&t);
-        return NULL;
-    }
-    *has_k = has_curv(&c);
-    if (pcpnet) {
-        sibling(npath, ".curv", buf, sizeof buf);
-        FILE *fp = fopen(buf, "r");
-        *has_k = 0;
-        if (fp) {
-            fclose(fp);
-            if (load(buf, &tc)) {
-                jf_eval_table_free(&t);
-                return NULL;
-            }
-            if (tc.nrows != t.nrows || tc.ncols < 2) {
-                fprintf(stderr, "jetfit eval: %s: %zu rows, %s has %zu\n", buf, tc.nrows, npath, t.nrows);
-                jf_eval_table_free(&t);
-                jf_eval_table_free(&tc);
-                return NULL;
-            }
-            *has_k = 1;
-        }
-    }
-    double *v = malloc((t.nrows ? t.nrows : 1) * 5 * sizeof *v);
-    if (!v) {
-        fprintf(stderr, "jetfit eval: out of memory\n");
-    } else {
-        for (size_t i = 0; i < t.nrows; i++) {
-            const double *r = t.v + i * t.ncols;
-            double *o = v + 5 * i;
-            for (int d = 0; d < 3; d++) o[d] = r[c.n[d]];
-            o[3] = o[4] = NAN;
-            if (pcpnet && *has_k) {
-                /* PCPNet's .curv: two curvatures per point, positive where
-                 * the surface bends toward its (outward) .normals side,
-                 * i.e. the opposite of jetfit's sign; order them as
-                 * k1 >= k2 in jetfit's convention (verified on
-                 * armadillo100k against jet fits, see README). */
-                double a = -tc.v[i * tc.ncols], b = -tc.v[i * tc.ncols + 1];
-                o[3] = a > b ? a : b;
-                o[4] = a > b ? b : a;
-            } else if (*has_k) {
-                o[3] = r[c.k[0]];
-                o[4] = r[c.k[1]];
-            }
-        }
-        *nrows = t.nrows;
-    }
-    jf_eval_table_free(&t);
-    jf_eval_table_free(&tc);
-    return v;
-}
-
-enum { Q_NORMAL, Q_K1REL, Q_K2REL, Q_K1ABS, Q_K2ABS, NQ };
-static const char *const qname[NQ] = {"normal_deg", "k1_rel", "k2_rel", "k1_abs", "k2_abs"};
+enum { NQ = JF_NQ };
 
 static void print_table(double *err[NQ], size_t n, int with_k)
 {
     printf("%-11s %8s %8s %10s %10s %10s %10s %10s\n", "quantity", "n", "nonfin",
            "rms", "mean", "median", "p95", "max");
     for (int q = 0; q < NQ; q++) {
-        if (q > Q_NORMAL && !with_k) break;
+        if (q > JF_Q_NORMAL && !with_k) break;
         jf_err_stats s;
         jf_err_stats_compute(err[q], n, &s);
-        printf("%-11s %8zu %8zu %10.4g %10.4g %10.4g %10.4g %10.4g\n", qname[q], s.n,
+        printf("%-11s %8zu %8zu %10.4g %10.4g %10.4g %10.4g %10.4g\n", jf_q_name[q], s.n,
                s.nonfinite, s.rms, s.mean, s.median, s.p95, s.max);
     }
 }
@@ -206,56 +108,54 @@ int jf_cmd_eval(int argc, char **argv)
     double *truth = NULL, *err[NQ] = {0};
     size_t *sel = NULL;
     unsigned *stat = NULL;
-    jf_eval_table res, sub;
-    memset(&sub, 0, sizeof sub);
-    if (load(res_path, &res)) return 1;
+    char msg[4200];
+    jf_eval_table res;
+    jf_error e;
+    jf_status st = jf_eval_table_read(res_path, &res, &e);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit eval: %s\n", e.msg[0] ? e.msg : jf_strerror(st));
+        return 1;
+    }
     cols c = find_cols(&res);
     if (!has_normal(&c)) {
         fprintf(stderr, "jetfit eval: %s: no nx ny nz columns\n", res_path);
         goto done;
     }
-    if (!(truth = load_truth(truth_path, &ntruth, &truth_k))) goto done;
+    if (!(truth = jf_cli_truth_load(truth_path, &ntruth, &truth_k, msg, sizeof msg))) {
+        fprintf(stderr, "jetfit eval: %s\n", msg);
+        goto done;
+    }
     if (ntruth != res.nrows) {
         fprintf(stderr, "jetfit eval: %s has %zu rows, %s has %zu\n", res_path, res.nrows,
                 truth_path, ntruth);
         goto done;
     }
+    if (jf_cli_truth_coords_check(truth_path, &res, msg, sizeof msg)) {
+        fprintf(stderr, "jetfit eval: %s\n", msg);
+        goto done;
+    }
     if (subset_path) {
-        if (load(subset_path, &sub)) goto done;
-        nsel = sub.nrows;
+        if (jf_cli_subset_load(subset_path, res.nrows, &sel, &nsel, msg, sizeof msg)) {
+            fprintf(stderr, "jetfit eval: %s\n", msg);
+            goto done;
+        }
     } else {
         nsel = res.nrows;
+        sel = malloc((nsel ? nsel : 1) * sizeof *sel);
+        for (size_t j = 0; sel && j < nsel; j++) sel[j] = j;
     }
-    sel = malloc((nsel ? nsel : 1) * sizeof *sel);
     stat = malloc((nsel ? nsel : 1) * sizeof *stat);
     for (int q = 0; q < NQ; q++) err[q] = malloc((nsel ? nsel : 1) * sizeof *err[q]);
     if (!sel || !stat || !err[NQ - 1] || !err[0] || !err[1] || !err[2] || !err[3]) {
         fprintf(stderr, "jetfit eval: out of memory\n");
         goto done;
     }
-    for (size_t j = 0; j < nsel; j++) {
-        if (subset_path) {
-            double x = sub.v[j * sub.ncols];
-            if (!(x >= 0.0 && x < (double)res.nrows) || x != floor(x)) {
-                fprintf(stderr, "jetfit eval: %s:%zu: index %g out of range 0..%zu\n",
-                        subset_path, j + 1, x, res.nrows - 1);
-                goto done;
-            }
-            sel[j] = (size_t)x;
-        } else {
-            sel[j] = j;
-        }
-    }
     int with_k = truth_k && has_curv(&c);
     for (size_t j = 0; j < nsel; j++) {
         const double *r = res.v + sel[j] * res.ncols, *t = truth + 5 * sel[j];
-        double n[3] = {r[c.n[0]], r[c.n[1]], r[c.n[2]]}, ea[2] = {NAN, NAN}, er[2] = {NAN, NAN};
-        err[Q_NORMAL][j] = jf_normal_angle_deg(n, t);
-        if (with_k) jf_curv_compare(n, r[c.k[0]], r[c.k[1]], t, t[3], t[4], ea, er);
-        err[Q_K1REL][j] = er[0];
-        err[Q_K2REL][j] = er[1];
-        err[Q_K1ABS][j] = ea[0];
-        err[Q_K2ABS][j] = ea[1];
+        double n[3] = {r[c.n[0]], r[c.n[1]], r[c.n[2]]}, ev[NQ];
+        jf_cli_point_errors(n, with_k ? r[c.k[0]] : NAN, with_k ? r[c.k[1]] : NAN, t, with_k, ev);
+        for (int q = 0; q < NQ; q++) err[q][j] = ev[q];
         stat[j] = c.status >= 0 ? (unsigned)r[c.status] : 0u;
     }
     printf("# %s vs %s: %zu points%s\n", res_path, truth_path, nsel,
@@ -295,7 +195,6 @@ int jf_cmd_eval(int argc, char **argv)
     rc = 0;
 done:
     jf_eval_table_free(&res);
-    jf_eval_table_free(&sub);
     free(truth);
     free(sel);
     free(stat);

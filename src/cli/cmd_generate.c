@@ -118,6 +118,15 @@ static jf_status write_truth(const char *path, const jf_sample *s, int dirs,
     jf_status st = jf_writer_open(path, cols, nc, s->n, ascii, &w, err);
     if (st)
         return st;
+    double *xyz = malloc((s->n ? s->n : 1) * 3 * sizeof *xyz); /* .las: its frame */
+    if (!xyz) {
+        jf_writer_abort(w);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < s->n; i++)
+        memcpy(xyz + 3 * i, s->truth[i].xyz, 3 * sizeof *xyz);
+    (void)jf_writer_las_frame(w, xyz, s->n);
+    free(xyz);
     for (size_t i = 0; i < s->n && !st; i++) {
         const jf_truth *t = &s->truth[i];
         double row[14] = {t->xyz[0], t->xyz[1], t->xyz[2], t->normal[0],

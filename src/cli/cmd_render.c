@@ -23,6 +23,7 @@
 #include <sys/wait.h>
 
 #include "cmd.h"
+#include "gnuplot.h"
 #include "jetfit.h"
 
 #ifndef M_PI
@@ -187,8 +188,13 @@ int jf_cmd_render(int argc, char **argv)
     size_t lo = strlen(out);
     if (lo < 4 || strcasecmp(out + lo - 4, ".png"))
         return bad("-o wants a .png file, not '%s'", out);
-    if (strchr(out, '"') || strchr(out, '\\'))
-        return bad("output name '%s' has a quote or backslash", out);
+    for (const char *q = out; *q; q++)
+        if ((unsigned char)*q < 0x20 || *q == 0x7f)
+            return bad("%s", "the output name has a control character");
+    if (jf_same_file(in, out)) {
+        fprintf(stderr, "jetfit render: %s: is the input file (%s)\n", out, in);
+        return 2;
+    }
 
     jf_eval_table t;
     jf_error err = {{0}};
@@ -211,6 +217,16 @@ int jf_cmd_render(int argc, char **argv)
                 missing ? "missing columns" : "no rows");
         if (missing)
             fprintf(stderr, "jetfit render: needs %s\n", missing);
+        jf_eval_table_free(&t);
+        return 1;
+    }
+    size_t finite = 0;
+    for (size_t i = 0; i < t.nrows; i++) {
+        const double *r = t.v + i * t.ncols;
+        finite += isfinite(r[c.x]) && isfinite(r[c.y]) && isfinite(r[c.z]);
+    }
+    if (!finite) {
+        fprintf(stderr, "jetfit render: %s: no row has finite x y z: nothing to draw\n", in);
         jf_eval_table_free(&t);
         return 1;
     }
@@ -287,33 +303,40 @@ int jf_cmd_render(int argc, char **argv)
     if (ps <= 0)
         ps = n > 100000 ? 0.15 : n > 20000 ? 0.3 : n > 4000 ? 0.5 : 0.8;
 
-    if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        fprintf(stderr, "jetfit render: gnuplot not found (Debian package gnuplot-nox)\n");
+    /* the picture goes to a temporary beside FILE.png, renamed on success:
+     * an old picture survives a failure, and a missing folder is found
+     * before gnuplot runs */
+    jf_tmpfile tf;
+    jf_gp gpr;
+    char why[600];
+    if (jf_tmpfile_open(out, &tf, &err) != JF_OK) {
+        fprintf(stderr, "jetfit render: %s\n", err.msg);
         free(val), free(tmp), free(take), free(ord);
         jf_eval_table_free(&t);
         return 1;
     }
-    FILE *gp = popen("gnuplot", "w");
-    if (!gp) {
-        fprintf(stderr, "jetfit render: cannot run gnuplot: %s\n", strerror(errno));
+    if (jf_gp_open(&gpr, why, sizeof why) != 0) {
+        fprintf(stderr, "jetfit render: %s\n", why);
+        jf_tmpfile_discard(&tf);
         free(val), free(tmp), free(take), free(ord);
         jf_eval_table_free(&t);
         return 1;
     }
+    FILE *gp = gpr.in;
     if (small)
         fprintf(gp, "set terminal png size %d,%d noenhanced\n", w, hgt);
     else
         fprintf(gp, "set terminal pngcairo size %d,%d font ',10' noenhanced\n", w, hgt);
-    fprintf(gp, "set output \"%s\"\n", out);
+    fprintf(gp, "set output ");
+    jf_gp_quote(gp, tf.tmp);
+    fputc('\n', gp);
     char def_title[600];
     const char *base = strrchr(in, '/') ? strrchr(in, '/') + 1 : in;
     snprintf(def_title, sizeof def_title, "%s: %s%s", base,
              need_k ? color : "points", dirs ? "; kmax red, kmin blue" : "");
-    fprintf(gp, "set title \"");
-    for (const char *p = title ? title : def_title; *p; p++)
-        if (*p != '"' && *p != '\\')
-            fputc(*p, gp);
-    fprintf(gp, "\"\nunset key\nset border 0\nunset xtics\nunset ytics\nunset ztics\n");
+    fprintf(gp, "set title ");
+    jf_gp_quote(gp, title ? title : def_title);
+    fprintf(gp, "\nunset key\nset border 0\nunset xtics\nunset ytics\nunset ztics\n");
     fprintf(gp, diverging ? "set palette defined (0 '#762a83', 0.5 '#f2f2f2', 1 '#1b7837')\n"
                           : "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n");
     if (need_k)
@@ -358,12 +381,17 @@ int jf_cmd_render(int argc, char **argv)
             fprintf(gp, ", $dir1 using 1:2:3:4:5:6 with vectors nohead lw 2 lc rgb '#e41a1c'"
                         ", $dir2 using 1:2:3:4:5:6 with vectors nohead lw 2 lc rgb '#1f4fd8'");
     }
-    fprintf(gp, "\n");
-    int rc = pclose(gp);
+    fprintf(gp, "\nset output\n"); /* closes the picture before gnuplot exits */
+    int rc = jf_gp_close(&gpr, why, sizeof why);
     free(val), free(tmp), free(take), free(ord);
     jf_eval_table_free(&t);
-    if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
-        fprintf(stderr, "jetfit render: gnuplot failed writing %s\n", out);
+    if (rc != 0) {
+        jf_tmpfile_discard(&tf);
+        fprintf(stderr, "jetfit render: %s: %s\n", out, why);
+        return 1;
+    }
+    if (jf_tmpfile_commit(&tf, out, &err) != JF_OK) {
+        fprintf(stderr, "jetfit render: %s\n", err.msg);
         return 1;
     }
     return 0;

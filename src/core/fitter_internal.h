@@ -63,7 +63,7 @@ int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
  * b, c (up to monge_degree), and JF_PT_UMBILIC.  Orders above deg are
  * NaN. */
 void jf__quantities(const double *a, int deg, int monge_degree,
-                    const double r[9], jf_result *out);
+                    const double r[9], double h, jf_result *out);
 
 /* Sets every quantity of out to NaN (FAILED / NONFINITE rows). */
 void jf__result_nan(jf_result *out);

@@ -249,12 +249,15 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
         return JF_OK;
     }
 
-    /* 4. unscale A_ij = Y_ij / h^(i+j); residuals; quantities */
+    /* 4. unscale A_ij = Y_ij / h^(i+j); residuals; quantities.  With
+     * h = m 2^q, h^k = m^k 2^(qk) exactly, so Y / m^k then a power of two
+     * gives the same bits as Y / h^k without h^k ever under- or
+     * overflowing (lengths near 1e+-150), and scales exactly with h. */
     {
-        int c = 0;
-        double hk = 1.0;
-        for (int k = 0; k <= deg; k++, hk *= h)
-            for (int j = 0; j <= k; j++, c++) f->coef[c] = f->sol[c] / hk;
+        int c = 0, q;
+        double m = frexp(h, &q), mk = 1.0;
+        for (int k = 0; k <= deg; k++, mk *= m)
+            for (int j = 0; j <= k; j++, c++) f->coef[c] = ldexp(f->sol[c] / mk, -q * k);
     }
     const size_t cols = jf_jet_size(deg);
     /* weighted residual norm for free: after the QR, the components
@@ -273,7 +276,7 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
             fail_result(out, JF_PT_FAILED);
             return JF_OK;
         }
-    jf__quantities(f->coef, deg, f->p.monge_degree, r, out);
+    jf__quantities(f->coef, deg, f->p.monge_degree, r, h, out);
     return JF_OK;
 }
 

@@ -73,8 +73,8 @@ void jf__result_nan(jf_result *out)
     for (int i = 0; i < 5; i++) out->c[i] = nan;
 }
 
-void jf__quantities(const double *a, int deg, int monge_degree,
-                    const double r[9], jf_result *out)
+static void quantities(const double *a, int deg, int monge_degree, const double r[9],
+                       double h, jf_result *out)
 {
     const double a1 = a[TPI(1, 0)], a2 = a[TPI(0, 1)];
     const double wn = sqrt(1.0 + a1 * a1 + a2 * a2);
@@ -117,7 +117,10 @@ void jf__quantities(const double *a, int deg, int monge_degree,
     const double mean = g20 + g02;
     const double rad = sqrt((g20 - g02) * (g20 - g02) + g11 * g11);
     double k1 = mean + rad, k2 = mean - rad, th = 0.5 * atan2(2.0 * g11, 2.0 * (g20 - g02));
-    double big = fmax(1.0, fmax(fabs(k1), fabs(k2)));
+    /* k1 - k2 against max(|k1|, |k2|, 1/h) (h the neighbourhood's size):
+     * scale-invariant, as k scales as 1/length, and a plane, whose
+     * curvatures are rounding noise of order eps/h, is umbilic */
+    double big = fmax(fmax(fabs(k1), fabs(k2)), 1.0 / h);
     if (deg >= 2 && k1 - k2 <= 1e-10 * big) {
         /* umbilic: directions undefined, keep the orthonormal {t1, t2} */
         th = 0.0;
@@ -161,6 +164,43 @@ void jf__quantities(const double *a, int deg, int monge_degree,
             out->c[3] = okc ? 6.0 * gm[TPI(1, 3)] : NAN;
             out->c[4] = okc ? 24.0 * gm[TPI(0, 4)] : NAN;
         }
+    }
+}
+
+/* The series above multiplies coefficients of several orders, so in world
+ * units it overflows or underflows when lengths are near 1e+-100 (order 4
+ * scales as 1/length^3).  It runs in a unit of length L = 2^e with the
+ * second-order coefficients O(1): a_k (order k) becomes a_k L^(k-1), and
+ * k, b, c come back as k/L, b/L^2, c/L^3.  L is a power of two, so this is
+ * exact: a cloud scaled by 2^j gives the same bits, k scaled by 2^-j. */
+void jf__quantities(const double *a_in, int deg, int monge_degree, const double r[9],
+                    double h, jf_result *out)
+{
+    double a[(JF_MAX_DEGREE + 1) * (JF_MAX_DEGREE + 2) / 2];
+    int nc = (deg + 1) * (deg + 2) / 2;
+    double big = 0.0;
+    for (int k = TPI(2, 0); deg >= 2 && k < TPI(0, 2) + 1; k++)
+        big = fmax(big, fabs(a_in[k]));
+    int e = 0;
+    if (big > 0.0 && isfinite(big))
+        frexp(big, &e); /* big = m 2^e, m in [0.5, 1): L = 2^-e */
+    for (int k = 0; k < nc; k++) {
+        int order = 0;
+        while ((order + 1) * (order + 2) / 2 <= k) order++;
+        a[k] = ldexp(a_in[k], -e * (order - 1));
+    }
+    quantities(a, deg, monge_degree, r, ldexp(h, e), out); /* h in units of L */
+    out->k1 = ldexp(out->k1, e);
+    out->k2 = ldexp(out->k2, e);
+    for (int i = 0; i < 4; i++) out->b[i] = ldexp(out->b[i], 2 * e);
+    for (int i = 0; i < 5; i++) out->c[i] = ldexp(out->c[i], 3 * e);
+    if ((deg >= 2 && !(isfinite(out->k1) && isfinite(out->k2))) ||
+        !isfinite(out->normal[0]) || !isfinite(out->normal[1]) || !isfinite(out->normal[2])) {
+        /* overflow: never a row that looks fitted */
+        out->status = (out->status & ~(unsigned)JF_PT_UMBILIC) | JF_PT_FAILED;
+        out->k1 = out->k2 = NAN;
+        for (int i = 0; i < 3; i++)
+            out->normal[i] = out->d1[i] = out->d2[i] = NAN;
     }
 }
 

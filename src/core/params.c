@@ -12,7 +12,6 @@
 #define JF_DEFAULT_MAX_COND 1e3
 
 /* Largest neighbourhood a fitter accepts (bounds the workspace). */
-#define JF_MAX_NEIGHBORS_LIMIT ((size_t)1 << 20)
 
 size_t jf_jet_size(int degree)
 {
@@ -55,7 +54,7 @@ jf_status jf_params_validate(const jf_params *p, const char **bad_field)
     if (p->frame != JF_FRAME_PCA && p->frame != JF_FRAME_AXIS) return bad(bad_field, "frame");
     /* NaN fails the comparison; +Inf disables the condition test. */
     if (!(p->max_cond >= 1.0)) return bad(bad_field, "max_cond");
-    if (p->max_neighbors < 1 || p->max_neighbors > JF_MAX_NEIGHBORS_LIMIT)
+    if (p->max_neighbors < 1 || p->max_neighbors > JF_MAX_NEIGHBORS)
         return bad(bad_field, "max_neighbors");
     if (p->robust != JF_ROBUST_NONE && p->robust != JF_ROBUST_HUBER &&
         p->robust != JF_ROBUST_TUKEY)

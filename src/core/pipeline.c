@@ -58,6 +58,18 @@ static void nan_result(jf_result *r, unsigned status)
     jf__result_nan(r);
 }
 
+/* The caller's cancel hook (jetfit.h): polled on the calling thread only. */
+static int cancelled(const jf_estimate_opts *o)
+{
+    return o->cancel && o->cancel(o->cancel_user);
+}
+
+static jf_status cancel_status(jf_error *err)
+{
+    set_err(err, "cancelled");
+    return JF_ERR_CANCELLED;
+}
+
 static int finite3(const double *p)
 {
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
@@ -338,6 +350,10 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         goto out;
     }
     x.ix = ix;
+    if (cancelled(o)) {
+        st = cancel_status(err);
+        goto out;
+    }
     if (o->nb.kind == JF_NB_RINGS &&
         (st = jf_mesh_build(n, c->nfaces, c->face_off, c->face_idx, &x.mesh, err)) != JF_OK)
         goto out;
@@ -386,6 +402,10 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     }
 
     /* step 2 */
+    if (cancelled(o)) {
+        st = cancel_status(err);
+        goto out;
+    }
     size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = n - nwalk;
     jf_status failed = JF_OK;
 #pragma omp parallel num_threads(nt)
@@ -415,10 +435,21 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
             size_t now;
 #pragma omp atomic capture
             now = done += end - beg;
-            /* the progress callback runs on the calling thread only */
-            if (o->progress && omp_get_thread_num() == 0) o->progress(o->progress_user, now, n);
+            /* the progress and cancel hooks run on the calling thread only;
+             * a stop is seen by every thread before its next block */
+            if (omp_get_thread_num() == 0) {
+                if (o->progress) o->progress(o->progress_user, now, n);
+                if (cancelled(o)) {
+#pragma omp atomic write
+                    failed = JF_ERR_CANCELLED;
+                }
+            }
         }
         worker_free(&w);
+    }
+    if (failed == JF_ERR_CANCELLED) {
+        st = cancel_status(err);
+        goto out;
     }
     if (failed != JF_OK) {
         st = failed;
@@ -431,6 +462,10 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     jf_index_free(ix); /* the orientation does not need it: lower peak */
     ix = NULL;
     if (o->progress) o->progress(o->progress_user, n, n);
+    if (o->orient != JF_ORIENT_NONE && cancelled(o)) {
+        st = cancel_status(err);
+        goto out;
+    }
 
     /* step 3 */
     switch (o->orient) {

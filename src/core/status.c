@@ -18,6 +18,7 @@ const char *jf_strerror(jf_status s)
     case JF_ERR_NUMERIC: return "numerical failure";
     case JF_ERR_UNSUPPORTED: return "not supported by this build";
     case JF_ERR_INTERNAL: return "internal error";
+    case JF_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }

@@ -20,7 +20,8 @@ typedef enum {
     JF_FMT_XYZ,   /* .xyz and .txt */
     JF_FMT_PTS,
     JF_FMT_CSV,
-    JF_FMT_OFF
+    JF_FMT_OFF,
+    JF_FMT_LAS    /* .las; .laz is recognised only to be refused */
 } jf_format;
 
 /* Format from the extension (any case); JF_FMT_UNKNOWN if none fits. */
@@ -41,6 +42,22 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                       jf_error *err);
 jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
+jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c,
+                      jf_error *err);
+
+/* LAS output (io_las_write.c), used by the table writer: the header and
+ * Extra Bytes VLR size, the record size, the frame (scale, offset and
+ * stored bounds) of a cloud, one record, and the header written at
+ * offset 0 of fd at commit (0, or -1 on a write error). */
+size_t jf__las_prefix_size(size_t ncols);
+size_t jf__las_record_size(const jf_col_type *types, size_t ncols);
+void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3],
+                   double lo[3], double hi[3]);
+size_t jf__las_format_row(const double *vals, const jf_col_type *types, size_t ncols,
+                          const double scale[3], const double offset[3], char *o);
+int jf__las_write_prefix(int fd, char *const *names, const jf_col_type *types, size_t ncols,
+                         size_t nrows, const double scale[3], const double offset[3],
+                         const double lo[3], const double hi[3]);
 
 /* Fills err (may be NULL) with "NAME:LINE: reason" (line > 0) or
  * "NAME: reason" (line == 0); returns st. */
@@ -84,7 +101,8 @@ typedef struct {
     size_t line;          /* number of the line last returned */
 } jf_text;
 
-/* Next line as [*ls, *le) without '\n' and a trailing '\r'.  0 at end. */
+/* Next line as [*ls, *le) without its end: '\n', "\r\n", or a lone '\r'
+ * (old Mac exports end lines with CR only).  0 at end. */
 static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
 {
     if (t->p >= t->end)
@@ -93,8 +111,13 @@ static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
     const char *nl = memchr(s, '\n', (size_t)(t->end - s));
     const char *e = nl ? nl : t->end;
     t->p = nl ? nl + 1 : t->end;
-    if (e > s && e[-1] == '\r')
-        e--;
+    const char *cr = memchr(s, '\r', (size_t)(e - s));
+    if (cr && cr + 1 < e) { /* a lone CR ends the line */
+        e = cr;
+        t->p = cr + 1;
+    } else if (cr) {
+        e--; /* CRLF, or a CR at the very end */
+    }
     t->line++;
     *ls = s;
     *le = e;
@@ -148,8 +171,9 @@ int jf_zvec_reserve(size_t **v, size_t *cap, size_t want);
  * final name; the first failure sticks in st/err and later calls do
  * nothing. */
 typedef struct {
-    int fd;
-    char *tmp, *final;
+    int fd;              /* t.fd                                     */
+    jf_tmpfile t;        /* the temporary (io_tmpfile.c)             */
+    char *final;
     char *buf;
     size_t len, cap;
     jf_status st;

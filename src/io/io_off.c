@@ -62,6 +62,10 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
     p = ls;
     jf_next_token(&p, le, 0, &ts, &te);
     int kw = keyword(ts, te, &normals);
+    const char *bs, *be, *bp = p;
+    if (kw > 0 && jf_next_token(&bp, le, 0, &bs, &be) && be - bs == 6 && !memcmp(bs, "BINARY", 6))
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, t.line,
+                          "binary OFF is not supported (convert it to ascii OFF or to PLY)");
     if (kw == 0)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, t.line,
                           "unsupported OFF variant '%.*s' (4D, nD and "

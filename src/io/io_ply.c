@@ -77,6 +77,10 @@ static jf_status parse_header(ply *h, const char *buf, size_t len,
                           "not a PLY file (first line is not \"ply\")");
     h->format = -1;
     while (jf_text_line(&t, &ls, &le)) {
+        /* the header is text: a NUL is named, not read as a name's end */
+        if (memchr(ls, '\0', (size_t)(le - ls)))
+            return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                              "a NUL byte in the header");
         q = ls;
         if (!jf_next_token(&q, le, 0, &ts, &te))
             continue; /* blank header line */
@@ -155,6 +159,11 @@ static jf_status parse_header(ply *h, const char *buf, size_t len,
                                   "INTTYPE TYPE NAME\")");
             memcpy(pr->name, ns, (size_t)(ne - ns));
             pr->name[ne - ns] = '\0';
+            for (int k = 0; k < el->nprops; k++)
+                if (!strcmp(el->props[k].name, pr->name))
+                    return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
+                                      "property '%s' appears twice in element %s", pr->name,
+                                      el->name);
             el->nprops++;
             continue;
         }
@@ -380,8 +389,19 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     jf_status st = parse_header(h, buf, len, &body);
     jf_uvec fi = {0};
     int seen_vertex = 0, seen_face = 0;
+    uint64_t vertex_row = 0; /* bytes of a binary vertex row */
     h->p = (const unsigned char *)buf + body;
     h->end = (const unsigned char *)buf + len;
+    /* ascii body: a NUL is named as such (binary data in a text file?),
+     * as in the other text readers, not reported as '' is not a number */
+    const char *z = st == JF_OK && h->format == 0 ? memchr(buf + body, '\0', len - body) : NULL;
+    if (z) {
+        size_t line = h->tx.line + 1;
+        for (const char *q = buf + body; (q = memchr(q, '\n', (size_t)(z - q))) != NULL; q++)
+            line++;
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, line,
+                        "a NUL byte (binary data in a text file?)");
+    }
     for (int e = 0; st == JF_OK && e < h->nelems; e++) {
         const ply_elem *el = &h->elems[e];
         ply_plan pl = {{0}, -1};
@@ -411,6 +431,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
         }
         if (is_vertex) {
             seen_vertex = 1;
+            vertex_row = need;
             int ix = prop_index(el, "x", 0), iy = prop_index(el, "y", 0),
                 iz = prop_index(el, "z", 0);
             if (ix < 0 || iy < 0 || iz < 0) {
@@ -471,6 +492,27 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     }
     if (st == JF_OK && !seen_vertex)
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no vertex element");
+    /* ascii: data after the last element means a count smaller than the
+     * rows -- points would be dropped or read as faces */
+    if (st == JF_OK && h->format == 0) {
+        const char *ls, *le;
+        while (jf_text_line(&h->tx, &ls, &le)) {
+            const char *q = ls, *ts, *te;
+            if (jf_next_token(&q, le, 0, &ts, &te)) {
+                st = jf_io_fail(err, JF_ERR_FORMAT, name, h->tx.line,
+                                "data after the last element: an element count in the "
+                                "header is smaller than the rows in the file");
+                break;
+            }
+        }
+    }
+    /* binary: room for another vertex row after the last element is the
+     * same lie; fewer bytes (a writer's trailing newline) are tolerated */
+    if (st == JF_OK && h->format && vertex_row && (uint64_t)(h->end - h->p) >= vertex_row)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                        "%zu bytes after the last element (a vertex row is %llu): an "
+                        "element count in the header is smaller than the rows in the file",
+                        (size_t)(h->end - h->p), (unsigned long long)vertex_row);
     /* faces listed before the vertices: check their indices now */
     for (size_t f = 0; st == JF_OK && f < c->nfaces; f++)
         for (size_t k = c->face_off[f]; k < c->face_off[f + 1]; k++)

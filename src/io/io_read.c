@@ -17,7 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -31,6 +31,7 @@ void jf_read_opts_init(jf_read_opts *o)
         return;
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
+    o->bad_rows = 0;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -88,6 +89,8 @@ jf_format jf_format_from_path(const char *path)
         return JF_FMT_CSV;
     if (!strcmp(ext, "off"))
         return JF_FMT_OFF;
+    if (!strcmp(ext, "las") || !strcmp(ext, "laz"))
+        return JF_FMT_LAS;
     return JF_FMT_UNKNOWN;
 }
 
@@ -281,6 +284,17 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         err->msg[0] = '\0';
     if (len == 0)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "empty file");
+    if (fmt == JF_FMT_XYZ || fmt == JF_FMT_PTS || fmt == JF_FMT_CSV || fmt == JF_FMT_OFF) {
+        /* a NUL is named as such, not reported as a strange number */
+        const char *z = memchr(buf, '\0', len);
+        if (z) {
+            size_t line = 1;
+            for (const char *q = buf; (q = memchr(q, '\n', (size_t)(z - q))) != NULL; q++)
+                line++;
+            return jf_io_fail(err, JF_ERR_FORMAT, name, line,
+                              "a NUL byte (binary data in a text file?)");
+        }
+    }
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
@@ -294,10 +308,13 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     case JF_FMT_OFF:
         st = jf_read_off(buf, len, name, c, err);
         break;
+    case JF_FMT_LAS:
+        st = jf_read_las(buf, len, name, c, err);
+        break;
     default:
         st = jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                         "unknown file extension (expected .ply, .xyz, .pts, "
-                        ".txt, .csv or .off)");
+                        ".txt, .csv, .off or .las)");
     }
     /* a header announcing 0 vertices is as useless as an empty file */
     if (st == JF_OK && c->n == 0)
@@ -318,57 +335,61 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     memset(c, 0, sizeof *c);
     if (!path)
         return jf_io_fail(err, JF_ERR_INVALID, "(null)", 0, "no file name");
+    size_t plen = strlen(path);
+    if (plen >= 4 && !strcasecmp(path + plen - 4, ".e57"))
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
+                          "E57 is not read: convert it first, e.g. `pdal translate in.e57 "
+                          "out.las` or CloudCompare (File > Save as LAS or PLY)");
     jf_format fmt = jf_format_from_path(path);
     if (fmt == JF_FMT_UNKNOWN)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "unknown file extension (expected .ply, .xyz, "
-                          ".pts, .txt, .csv or .off)");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+                          ".pts, .txt, .csv, .off or .las)");
+    /* O_NONBLOCK: a FIFO or device must not block the open; only regular
+     * files are read.  The file is read (not mapped): a file that shrinks
+     * while it is read is an I/O error, never a SIGBUS. */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0)
         return jf_io_fail(err, JF_ERR_IO, path, 0, "cannot open: %s",
                           strerror(errno));
     struct stat sb;
     if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
         close(fd);
-        return jf_io_fail(err, JF_ERR_IO, path, 0, "not a regular file");
+        return jf_io_fail(err, JF_ERR_IO, path, 0,
+                          "not a regular file (a folder, FIFO or device)");
     }
     size_t len = (size_t)sb.st_size;
     if (len == 0) {
         close(fd);
         return jf_io_fail(err, JF_ERR_FORMAT, path, 0, "empty file");
     }
-    char *buf = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
-    int mapped = buf != MAP_FAILED;
-    if (!mapped) {
-        /* e.g. a file system without mmap: read it whole */
-        buf = malloc(len);
-        if (!buf) {
-            close(fd);
-            return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
-                              "out of memory reading %zu bytes", len);
+    char *buf = malloc(len);
+    if (!buf) {
+        close(fd);
+        return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
+                          "out of memory reading %zu bytes", len);
+    }
+    size_t got = 0;
+    int e = 0;
+    while (got < len) {
+        ssize_t r = read(fd, buf + got, len - got > (1u << 30) ? (1u << 30) : len - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            e = r < 0 ? errno : 0;
+            break;
         }
-        size_t got = 0;
-        while (got < len) {
-            ssize_t r = read(fd, buf + got, len - got);
-            if (r < 0 && errno == EINTR)
-                continue;
-            if (r <= 0)
-                break;
-            got += (size_t)r;
-        }
-        if (got < len) {
-            free(buf);
-            close(fd);
-            return jf_io_fail(err, JF_ERR_IO, path, 0, "read failed");
-        }
-    } else {
-        posix_madvise(buf, len, POSIX_MADV_SEQUENTIAL);
+        got += (size_t)r;
     }
     close(fd);
-    jf_status st = jf_cloud_read_mem(buf, len, fmt, path, o, c, err);
-    if (mapped)
-        munmap(buf, len);
-    else
+    if (got < len) {
         free(buf);
+        if (e)
+            return jf_io_fail(err, JF_ERR_IO, path, 0, "read failed: %s", strerror(e));
+        return jf_io_fail(err, JF_ERR_IO, path, 0,
+                          "the file shrank while it was read (%zu of %zu bytes)", got, len);
+    }
+    jf_status st = jf_cloud_read_mem(buf, len, fmt, path, o, c, err);
+    free(buf);
     return st;
 }

@@ -1,8 +1,9 @@
 /*
  * io_wfile.c -- the buffered output file of every writer: a buffer (1 MiB,
- * one write(2) per flush) feeding a temporary ".NAME.tmp.PID" beside the
- * final file; jf_wf_close renames it onto NAME on success and unlinks it on
- * any failure, so no partial file ever carries the final name.
+ * one write(2) per flush) feeding a temporary beside the final file
+ * (jf_tmpfile_open: exclusive, unpredictable name); jf_wf_close renames it
+ * onto NAME on success and unlinks it on any failure, so no partial file
+ * ever carries the final name.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
@@ -34,25 +35,17 @@ jf_status jf_wf_open(jf_wfile *f, const char *path, size_t min_cap)
 {
     memset(f, 0, sizeof *f);
     f->fd = -1;
-    const char *slash = strrchr(path, '/');
-    size_t dirlen = slash ? (size_t)(slash - path + 1) : 0;
-    const char *base = path + dirlen;
-    size_t n = strlen(path) + 48;
+    f->t.fd = -1;
+    f->t.slot = -1;
     f->final = strdup(path);
-    f->tmp = malloc(n);
     f->cap = min_cap > BUF_CAP ? min_cap : BUF_CAP;
     f->buf = malloc(f->cap);
-    if (!f->final || !f->tmp || !f->buf) {
+    if (!f->final || !f->buf)
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
-    }
-    if (!*base)
-        return jf_wf_fail(f, JF_ERR_INVALID, "no file name");
-    snprintf(f->tmp, n, "%.*s.%s.tmp.%ld", (int)dirlen, path, base,
-             (long)getpid());
-    f->fd = open(f->tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (f->fd < 0)
-        return jf_wf_fail(f, JF_ERR_IO, "cannot create %s: %s", f->tmp,
-                       strerror(errno));
+    jf_status st = jf_tmpfile_open(path, &f->t, &f->err);
+    if (st != JF_OK)
+        return f->st = st;
+    f->fd = f->t.fd;
     return JF_OK;
 }
 
@@ -109,19 +102,17 @@ jf_status jf_wf_close(jf_wfile *f, jf_error *err)
     jf_status st = f->st;
     if (st == JF_OK)
         st = jf_wf_flush(f);
-    if (f->fd >= 0 && close(f->fd) != 0 && st == JF_OK)
-        st = jf_wf_fail(f, JF_ERR_IO, "close failed: %s", strerror(errno));
+    if (st == JF_OK) {
+        st = jf_tmpfile_commit(&f->t, f->final, &f->err);
+        f->st = st;
+    } else {
+        jf_tmpfile_discard(&f->t);
+    }
     f->fd = -1;
-    if (st == JF_OK && (!f->tmp || rename(f->tmp, f->final) != 0))
-        st = jf_wf_fail(f, JF_ERR_IO, "cannot rename %s onto it: %s", f->tmp,
-                     strerror(errno));
-    if (st != JF_OK && f->tmp)
-        unlink(f->tmp);
     if (err)
         *err = f->err;
     if (err && st == JF_ERR_NOMEM && !f->err.msg[0])
         snprintf(err->msg, sizeof err->msg, "out of memory");
-    free(f->tmp);
     free(f->final);
     free(f->buf);
     return st;

@@ -18,7 +18,7 @@
 
 /* ---- the table writer ------------------------------------------------- */
 
-enum { FMT_PLY, FMT_CSV, FMT_XYZ };
+enum { FMT_PLY, FMT_CSV, FMT_XYZ, FMT_LAS };
 
 struct jf_writer {
     jf_wfile f;
@@ -30,6 +30,8 @@ struct jf_writer {
     size_t nfaces;
     const size_t *foff;
     const uint32_t *fidx;
+    int las_framed;                  /* LAS: jf_writer_las_frame called  */
+    double las_scale[3], las_off[3], las_lo[3], las_hi[3];
 };
 
 static int host_little(void)
@@ -52,6 +54,24 @@ static jf_status write_header(jf_writer *w)
     static const char *const ply_t[] = {"double", "float", "int"};
     char line[128];
     w->header_done = 1;
+    if (w->fmt == FMT_LAS) {
+        /* a placeholder of the header's size: the real one, with the
+         * count and bounds, is written over it at commit */
+        if (!w->las_framed)
+            return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
+                                                 "(jf_writer_las_frame) before the rows");
+        size_t n = jf__las_prefix_size(w->ncols);
+        while (n && f->st == JF_OK) {
+            size_t k = n < 4096 ? n : 4096;
+            char *o = jf_wf_room(f, k);
+            if (!o)
+                break;
+            memset(o, 0, k);
+            f->len += k;
+            n -= k;
+        }
+        return f->st;
+    }
     if (w->fmt == FMT_PLY) {
         snprintf(line, sizeof line, "ply\nformat %s 1.0\n",
                  w->ascii ? "ascii" : "binary_little_endian");
@@ -95,10 +115,17 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
         return jf_io_fail(err, JF_ERR_INVALID, nm, 0,
                           "invalid writer arguments");
     jf_format fmt = jf_format_from_path(path);
-    if (fmt != JF_FMT_PLY && fmt != JF_FMT_CSV && fmt != JF_FMT_XYZ)
+    size_t pl = strlen(path);
+    int laz = pl >= 4 && (!strcmp(path + pl - 4, ".laz") || !strcmp(path + pl - 4, ".LAZ"));
+    if ((fmt != JF_FMT_PLY && fmt != JF_FMT_CSV && fmt != JF_FMT_XYZ && fmt != JF_FMT_LAS) || laz)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, nm, 0,
                           "cannot write a table in this format (use .ply, "
-                          ".csv, .xyz or .txt)");
+                          ".csv, .xyz, .txt or .las)");
+    if (fmt == JF_FMT_LAS &&
+        (ncols < 3 || strcmp(cols[0].name, "x") || strcmp(cols[1].name, "y") ||
+         strcmp(cols[2].name, "z") || ncols - 3 > 65535 / 192))
+        return jf_io_fail(err, JF_ERR_INVALID, nm, 0,
+                          "LAS output needs x y z as the first columns (and at most 341 more)");
     for (size_t j = 0; j < ncols; j++) {
         const char *c = cols[j].name;
         int bad = !c || !*c || (unsigned)cols[j].type > JF_COL_I32;
@@ -112,7 +139,7 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     if (!w)
         return jf_io_fail(err, JF_ERR_NOMEM, nm, 0, "out of memory");
     w->fmt = fmt == JF_FMT_PLY ? FMT_PLY : fmt == JF_FMT_CSV ? FMT_CSV
-                                                             : FMT_XYZ;
+                                         : fmt == JF_FMT_LAS ? FMT_LAS : FMT_XYZ;
     w->ascii = ascii != 0;
     w->ncols = ncols;
     w->nrows = nrows;
@@ -141,6 +168,17 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     return JF_OK;
 }
 
+jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n)
+{
+    if (!w || w->header_done || (n && !xyz))
+        return JF_ERR_INVALID;
+    if (w->fmt != FMT_LAS)
+        return JF_OK;
+    jf__las_frame(xyz, n, w->las_scale, w->las_off, w->las_lo, w->las_hi);
+    w->las_framed = 1;
+    return JF_OK;
+}
+
 jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
                           const uint32_t *idx)
 {
@@ -164,6 +202,8 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
 static size_t format_row(const jf_writer *w, const double *vals, char *o)
 {
     char *o0 = o;
+    if (w->fmt == FMT_LAS)
+        return jf__las_format_row(vals, w->types, w->ncols, w->las_scale, w->las_off, o);
     if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
         /* the usual case, kept tight (it runs once per point): fixed-size
          * copies, no per-value memcpy call */
@@ -356,6 +396,10 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
                 w->rows, w->nrows);
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
+    if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
+        jf__las_write_prefix(f->fd, w->names, w->types, w->ncols, w->nrows, w->las_scale,
+                             w->las_off, w->las_lo, w->las_hi) != 0)
+        jf_wf_fail(f, JF_ERR_IO, "cannot write the LAS header");
     jf_status st = jf_wf_close(f, err);
     free_writer(w);
     return st;

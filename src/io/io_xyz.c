@@ -13,6 +13,7 @@
 #include "io_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -98,9 +99,16 @@ static jf_status csv_header(tab *t, const char *ls, const char *le,
             fs++;
             fe--;
         }
-        for (int k = 0; k < 6; k++)
-            if (found[k] < 0 && lower_eq(fs, fe, names[k]))
-                found[k] = j;
+        for (int k = 0; k < 6; k++) {
+            if (!lower_eq(fs, fe, names[k]))
+                continue;
+            /* a duplicated name would make the choice of column a guess */
+            if (found[k] >= 0)
+                return jf_io_fail(t->err, JF_ERR_FORMAT, t->name, line,
+                                  "column '%s' appears twice (columns %d and %d)",
+                                  names[k], found[k] + 1, j + 1);
+            found[k] = j;
+        }
     }
     if (want_names & 1) {
         int named = found[0] >= 0 && found[1] >= 0 && found[2] >= 0;
@@ -155,6 +163,33 @@ static int default_normals(const tab *t, const char *ls, const char *le)
     return n2 >= 0.81 && n2 <= 1.21;
 }
 
+/* 1 if the row's fields, separated by blanks or ';', are numbers written
+ * with a decimal comma ("-0,352 -0,698 0,736", "1,5;2,5;3,5" from a
+ * European spreadsheet): each holds exactly one ',' with a digit on both
+ * sides.  Read as separators they would double the columns and shift
+ * every value. */
+static int decimal_commas(const char *ls, const char *le)
+{
+    const char *p = ls, *fs, *fe;
+    int n = 0;
+    for (;;) {
+        while (p < le && (jf_is_space(*p) || *p == ';'))
+            p++;
+        if (p == le)
+            break;
+        fs = p;
+        while (p < le && !jf_is_space(*p) && *p != ';')
+            p++;
+        fe = p;
+        const char *c = memchr(fs, ',', (size_t)(fe - fs));
+        if (!c || c == fs || c + 1 == fe || memchr(c + 1, ',', (size_t)(fe - c - 1)) ||
+            c[-1] < '0' || c[-1] > '9' || c[1] < '0' || c[1] > '9')
+            return 0;
+        n++;
+    }
+    return n >= 2;
+}
+
 static int set_maxcol(tab *t)
 {
     t->maxcol = -1;
@@ -184,16 +219,24 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                           "none");
     /* upper bound on data rows: the lines, and the bytes (a row of m
      * needed fields takes at least 2m, separators and newline included) */
+    /* a UTF-8 byte order mark (spreadsheet exports) is not data */
+    if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
+        buf += 3, len -= 3;
     size_t lines = 1;
     for (const char *q = buf, *e = buf + len;
          (q = memchr(q, '\n', (size_t)(e - q))) != NULL; q++)
+        lines++;
+    for (const char *q = buf, *e = buf + len; /* lone-CR line ends too */
+         (q = memchr(q, '\r', (size_t)(e - q))) != NULL; q++)
         lines++;
     size_t cap = 0;
     jf_text tx = {buf, buf + len, 0};
     const char *ls, *le;
     int started = 0, have_nrm = 0;
     size_t n = 0, since_count = 0, last_count = 0;
-    int counted = 0;
+    int counted = 0, nf0 = -1;
+    size_t count_line = 0;
+    const int skip = o->bad_rows == 1;
     while (jf_text_line(&tx, &ls, &le)) {
         if (!strip_comment(&t, ls, &le))
             continue;
@@ -206,6 +249,7 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                 jf_parse_size(fs, fe, UINT64_MAX, &cnt) &&
                 (!counted ? n == 0 : since_count == last_count)) {
                 counted = 1;
+                count_line = tx.line;
                 last_count = (size_t)cnt;
                 since_count = 0;
                 continue;
@@ -214,6 +258,11 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
         if (!started) {
             /* the first data line decides the columns */
             started = 1;
+            if (!t.csv && decimal_commas(ls, le))
+                return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line,
+                                  "'%.*s' has decimal commas; jetfit reads '.' as the decimal "
+                                  "point (convert with: sed 's/,/./g')",
+                                  (int)(le - ls > 40 ? 40 : le - ls), ls);
             /* csv: a header unless all numbers; xyz: a line of names
              * only ("X Y Z", "x y z nx ny nz") */
             int header = t.csv ? !all_numeric(&t, ls, le)
@@ -244,26 +293,45 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
         }
         const char *p = ls, *fs, *fe;
         double v[6];
-        int j = 0;
+        int j = 0, bad = 0;
+        char why[160] = "";
         for (; j <= t.maxcol && next_field(&t, &p, le, &fs, &fe); j++) {
-            for (int k = 0; k < 6; k++) {
+            for (int k = 0; k < 6 && !bad; k++) {
                 if (t.col[k] != j)
                     continue;
                 if (fs == fe)
-                    return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line,
-                                      "row %zu: empty field in column %d", n,
-                                      j + 1);
-                if (!jf_parse_double(fs, fe, &v[k]))
-                    return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line,
-                                      "row %zu: column %d: '%.*s' is not a "
-                                      "number", n, j + 1,
-                                      (int)(fe - fs > 40 ? 40 : fe - fs), fs);
+                    bad = snprintf(why, sizeof why, "row %zu: empty field in column %d", n,
+                                   j + 1);
+                else if (!jf_parse_double(fs, fe, &v[k]))
+                    bad = snprintf(why, sizeof why, "row %zu: column %d: '%.*s' is not a number",
+                                   n, j + 1, (int)(fe - fs > 40 ? 40 : fe - fs), fs);
             }
         }
-        if (j <= t.maxcol)
-            return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line,
-                              "row %zu: expected %d numbers, found %d", n,
-                              t.maxcol + 1, count_fields(&t, ls, le));
+        int nf = j;
+        while (next_field(&t, &p, le, &fs, &fe))
+            nf++;
+        if (!bad && j <= t.maxcol)
+            bad = snprintf(why, sizeof why, "row %zu: expected %d numbers, found %d", n,
+                           t.maxcol + 1, nf);
+        /* a row of another width is a broken or shifted line, not data */
+        if (!bad && nf0 >= 0 && nf != nf0)
+            bad = !t.csv && decimal_commas(ls, le)
+                      ? snprintf(why, sizeof why, "row %zu: '%.*s' has decimal commas; jetfit "
+                                 "reads '.' as the decimal point (sed 's/,/./g')", n,
+                                 (int)(le - ls > 40 ? 40 : le - ls), ls)
+                      : snprintf(why, sizeof why, "row %zu: %d columns, the first data row has %d",
+                                 n, nf, nf0);
+        if (bad && !skip)
+            return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line, "%s", why);
+        if (bad) { /* --bad-rows skip: a NaN row keeps every later index */
+            if (c->nbad < sizeof c->bad_line / sizeof c->bad_line[0])
+                c->bad_line[c->nbad] = tx.line;
+            c->nbad++;
+            for (int k = 0; k < 6; k++)
+                v[k] = NAN;
+        } else if (nf0 < 0) {
+            nf0 = nf;
+        }
         if (n == cap) /* cannot happen for rows that parse: the bound */
             return jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
                               "more rows than supported");
@@ -273,7 +341,11 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
         n++;
         since_count++;
     }
-    if (n == 0)
+    if (counted && since_count != last_count)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, count_line,
+                          "the count line says %zu points, %zu rows follow it", last_count,
+                          since_count);
+    if (n == 0 || n == c->nbad)
         return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line ? tx.line : 0,
                           "no points in the file");
     c->n = n;

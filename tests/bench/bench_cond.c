@@ -8,8 +8,8 @@
  *     A. the paper's perturbed grid (x = u + δh, y = v + δ'h, δ in [0,0.9]),
  *     B. uniform random samples, C. the same with Gaussian noise of
  *     sigma 1e-5 and 1e-4 on z (0.13% and 1.3% of the spacing ~1/128);
- *   - a raw range scan, /work/shared/data/scans/stanford_bunny/data/bun000.ply
- *     (path can be given as argv[1]).
+ *   - a raw range scan: argv[1], or $JF_DATA/scans/stanford_bunny/data/bun000.ply,
+ *     or the bundled data/bun090.ply.
  * Where the truth is known (§6.1) it also fits every neighbourhood at the
  * degree below, and tabulates, per decade of kappa, the curvature error at
  * degree d and at d-1: a threshold is worth having where, above it, the
@@ -274,8 +274,11 @@ static void run(const dataset *ds, const jf_index *ix, int d, size_t K,
 
 int main(int argc, char **argv)
 {
-    const char *bunny = argc > 1 ? argv[1]
-        : "/work/shared/data/scans/stanford_bunny/data/bun000.ply";
+    char envpath[4096];
+    const char *env = getenv("JF_DATA");
+    if (env)
+        snprintf(envpath, sizeof envpath, "%s/scans/stanford_bunny/data/bun000.ply", env);
+    const char *bunny = argc > 1 ? argv[1] : env ? envpath : JF_TEST_DATA "/bun090.ply";
     size_t Q = argc > 2 ? strtoul(argv[2], NULL, 10) : 4000;
     if (Q < 1) return 2;
 

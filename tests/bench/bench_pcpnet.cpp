@@ -188,7 +188,9 @@ static double run_cgal(const Study &s, bool jet, int degree, size_t k, double *s
 
 int main(int argc, char **argv)
 {
-    std::string dir = JF_SHARED_DATA "/pcpnet";
+    // the PCPNet folder: argv (any non-option argument), else $JF_DATA/pcpnet
+    const char *env = std::getenv("JF_DATA");
+    std::string dir = env ? std::string(env) + "/pcpnet" : std::string();
     bool quick = false, no_cgal = false, no_fixed = false;
     const char *sweep = nullptr; // "K,deg,robust[,dsel] ...": extra fixed configs
     const char *only_levels = nullptr; // "0,0.012": a subset of the noise levels
@@ -210,6 +212,12 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) only_levels = argv[++i];
         else if (!std::strcmp(argv[i], "--sweep") && i + 1 < argc) sweep = argv[++i];
         else dir = argv[i];
+    }
+    if (dir.empty()) {
+        std::fprintf(stderr, "bench_pcpnet: give the PCPNet folder (or set JF_DATA to a folder "
+                             "holding pcpnet/): it must contain armadillo100k.xyz, "
+                             "armadillo100k.normals and armadillo100k.pidx\n");
+        return 2;
     }
     if (same_points) g_extra = 1;
     jf_eval_table tx, tn, ti;

@@ -4,15 +4,19 @@
 # LAS-derived LiDAR .xyz clouds (georeferenced, coordinates ~1e5-1e6).
 # Checks: exit status 0, one row per input point, no NaN/Inf in a row whose
 # status is 0; prints per file: points, seconds, status counts.
-# Usage: sh tests/bench_scans.sh [BUILD_DIR] [-- extra estimate options]
-# (default build dir: build; data from ../shared/data/scans).
+# Usage: sh tests/bench/bench_scans.sh BUILD_DIR DATA [-- extra estimate options]
+# DATA holds scans/stanford_bunny/data/*.ply and scans/lidar_laspy/*.xyz
+# (default: $JF_DATA).
 set -u
 top=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$top/build}
 [ $# -gt 0 ] && shift
+root=${JF_DATA:-}
+if [ $# -gt 0 ] && [ "$1" != "--" ]; then root=$1; shift; fi
 [ "${1:-}" = "--" ] && shift
 jetfit=$build/jetfit
-data=$(cd "$top/../shared/data/scans" 2>/dev/null && pwd) || { echo "bench_scans: no ../shared/data/scans"; exit 2; }
+data=$(cd "$root/scans" 2>/dev/null && pwd) || {
+  echo "bench_scans: give the data folder (argument or JF_DATA): it must hold scans/stanford_bunny/data/*.ply and/or scans/lidar_laspy/*.xyz"; exit 2; }
 [ -x "$jetfit" ] || { echo "bench_scans: $jetfit not built"; exit 2; }
 tmp=$(mktemp -d /tmp/jf_scans.XXXXXX)
 trap 'rm -rf "$tmp"' EXIT

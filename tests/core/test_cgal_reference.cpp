@@ -39,10 +39,6 @@ using jf_cgalref::Monge_fitting;
 using jf_cgalref::Monge_form;
 using jf_cgalref::Point;
 
-#ifndef JF_SHARED_DATA
-#define JF_SHARED_DATA "/work/shared/data"
-#endif
-
 static const double REL = 1e-8;
 
 /* ---------------------------------------------------------------- */
@@ -442,7 +438,7 @@ static std::vector<double> read_xyz(const std::string &path)
 START_TEST(test_cgal_in_points_d4)
 {
     std::vector<double> xyz =
-        read_xyz(JF_SHARED_DATA "/cgal_jet/in_points_d4.txt");
+        read_xyz(JF_TESTS_DIR "/data/cgal_jet/in_points_d4.txt");
     ck_assert_int_eq((int)xyz.size(), 3 * 17);
     const double rad = 2.0 * std::sqrt(2.0);
     Cgal_fit c4 = cgal_fit(xyz, 4, 4);
@@ -476,7 +472,7 @@ END_TEST
 START_TEST(test_cgal_in_points_file)
 {
     std::vector<double> xyz =
-        read_xyz(JF_SHARED_DATA "/cgal_jet/in_points_file.txt");
+        read_xyz(JF_TESTS_DIR "/data/cgal_jet/in_points_file.txt");
     ck_assert_int_eq((int)xyz.size(), 3 * 6);
     Cgal_fit c = cgal_fit(xyz, 2, 2);
     jf_result r = jet_fit(xyz, 2, 2, JF_FIT_INTERP, JF_FRAME_PCA);

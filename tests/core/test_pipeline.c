@@ -186,6 +186,57 @@ START_TEST(progress_and_nonfinite)
 }
 END_TEST
 
+/* The cancel hook: polled on the calling thread; stopping at the k-th
+ * poll returns JF_ERR_CANCELLED with no poll after it, and a hook that
+ * never stops leaves the results bit-identical to no hook. */
+typedef struct {
+    int polls, stop_at, bad_thread;
+} cancel_state;
+
+static int cancel_at(void *user)
+{
+    cancel_state *s = user;
+    if (omp_get_thread_num() != 0) s->bad_thread = 1;
+    return ++s->polls == s->stop_at;
+}
+
+START_TEST(cancel_hook)
+{
+    size_t n = 20000;
+    double c[3] = {0, 0, 0}, *xyz = malloc(3 * n * sizeof *xyz);
+    jf_result *r0 = malloc(n * sizeof *r0), *r1 = malloc(n * sizeof *r1);
+    fib_sphere(n, 1, c, xyz);
+    jf_cloud cl = {.n = n, .xyz = xyz};
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    o.nb.k = 12;
+    o.threads = 2;
+    o.orient = JF_ORIENT_VIEWPOINT;
+    ck_assert_int_eq(jf_estimate(&cl, &o, r0, NULL), JF_OK);
+    cancel_state s = {0, -1, 0};
+    o.cancel = cancel_at;
+    o.cancel_user = &s;
+    ck_assert_int_eq(jf_estimate(&cl, &o, r1, NULL), JF_OK);
+    ck_assert(memcmp(r0, r1, n * sizeof *r0) == 0);
+    /* polls: after the tree, before the fit, >= 1 per block of thread 0,
+     * before the orientation */
+    ck_assert_int_ge(s.polls, 4);
+    ck_assert(!s.bad_thread);
+    for (int k = 1; k <= 4; k++) {
+        jf_error e;
+        s = (cancel_state){0, k, 0};
+        ck_assert_int_eq(jf_estimate(&cl, &o, r1, &e), JF_ERR_CANCELLED);
+        ck_assert_int_eq(s.polls, k);
+        ck_assert_str_eq(e.msg, "cancelled");
+        ck_assert(!s.bad_thread);
+    }
+    ck_assert_str_eq(jf_strerror(JF_ERR_CANCELLED), "cancelled");
+    free(xyz);
+    free(r0);
+    free(r1);
+}
+END_TEST
+
 START_TEST(degenerate_clouds)
 {
     double xyz[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.1, 0.5, 0.3, 0.02};
@@ -322,6 +373,7 @@ int main(void)
     tcase_add_test(tc, sphere_values_and_sign);
     tcase_add_test(tc, brute_force_and_threads);
     tcase_add_test(tc, progress_and_nonfinite);
+    tcase_add_test(tc, cancel_hook);
     tcase_add_test(tc, degenerate_clouds);
     tcase_add_test(tc, rings_on_mesh);
     tcase_add_test(tc, natural_on_sphere);

@@ -1,0 +1,37 @@
+# install.cmake -- what `cmake --install build --prefix P` puts under P:
+# bin/jetfit, lib/libjetfit.so.0 (+ the dev symlink), include/jetfit.h,
+# lib/pkgconfig/jetfit.pc, lib/cmake/jetfit/ (find_package(jetfit) with the
+# imported target jetfit::jetfit) and share/man/man1/jetfit.1.
+include(CMakePackageConfigHelpers)
+install(TARGETS jetfit RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS jetfit_shared EXPORT jetfitTargets
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/src/jetfit.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+# libjetfit.a (JF_STATIC_LIB): the library and the CGAL bridge in one
+# archive; a program links it with `pkg-config --static --libs jetfit` (GSL,
+# OpenMP, the C++ runtime, and CGAL's GMP/MPFR) or jetfit::jetfit_static.
+if(JF_STATIC_LIB)
+  add_library(jetfit_static STATIC $<TARGET_OBJECTS:jetfit_obj> $<TARGET_OBJECTS:jetfit_cgal_obj>)
+  set_target_properties(jetfit_static PROPERTIES OUTPUT_NAME jetfit EXPORT_NAME jetfit_static)
+  target_include_directories(jetfit_static PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+  install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
+install(FILES ${PROJECT_SOURCE_DIR}/docs/jetfit.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+
+install(EXPORT jetfitTargets NAMESPACE jetfit:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jetfit)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/jetfitConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/jetfitConfig.cmake INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jetfit)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/jetfitConfigVersion.cmake
+  COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/jetfitConfig.cmake ${PROJECT_BINARY_DIR}/jetfitConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jetfit)
+
+# pkg-config: paths relative to the .pc file, so `--prefix P` at install
+# time (not the configure-time prefix) is what the file describes
+file(RELATIVE_PATH JF_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit.pc.in ${PROJECT_BINARY_DIR}/jetfit.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/jetfit.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

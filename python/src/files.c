@@ -1,0 +1,231 @@
+/* files.c -- jetfit.read(path) and jetfit.write(path, result, ...): the
+ * library's readers (jf_cloud_read) and table writer (jf_writer_*), so a
+ * file means the same as to the command, errors read the same ("FILE:LINE:
+ * reason", raised as jetfit.FileError, an OSError) and write() produces the
+ * command's output file byte for byte (same columns, rows, temporary then
+ * rename: a failed write leaves an existing file untouched). */
+#include "jfpy.h"
+
+/* ---- read ---------------------------------------------------------------- */
+
+static void free_capsule(PyObject *cap) { free(PyCapsule_GetPointer(cap, NULL)); }
+
+/* An (n, 3) float64 array over malloc'd data, which it then owns (no copy;
+ * the library allocated it with malloc). */
+static PyObject *own_xyz(double *data, size_t n)
+{
+    npy_intp dims[2] = {(npy_intp)n, 3};
+    PyObject *a = PyArray_SimpleNewFromData(2, dims, NPY_DOUBLE, data);
+    if (!a) return NULL;
+    PyObject *cap = PyCapsule_New(data, NULL, free_capsule);
+    if (!cap) {
+        Py_DECREF(a);
+        return NULL;
+    }
+    if (PyArray_SetBaseObject((PyArrayObject *)a, cap) < 0) { /* steals cap */
+        Py_DECREF(a);
+        return NULL;
+    }
+    return a;
+}
+
+static PyObject *file_error(jf_status st, const jf_error *err, const char *path)
+{
+    if (st == JF_ERR_NOMEM) return PyErr_NoMemory();
+    PyErr_SetString(jf_py_FileError, err->msg[0] ? err->msg : path);
+    return NULL;
+}
+
+PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    static char *kwl[] = {"path", "columns", "bad_rows", NULL};
+    PyObject *pathobj, *columns = NULL, *bad_rows = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$OO:read", kwl, PyUnicode_FSConverter, &pathobj,
+                                     &columns, &bad_rows))
+        return NULL;
+    const char *path = PyBytes_AS_STRING(pathobj);
+    jf_py_opts po;
+    jf_cli_est_init(&po.e);
+    po.used = 0;
+    if (jf_py_opt(&po, "--columns", "columns", columns, JF_PY_LIST) ||
+        jf_py_opt(&po, "--bad-rows", "bad_rows", bad_rows, JF_PY_STR)) {
+        Py_DECREF(pathobj);
+        return NULL;
+    }
+    jf_cloud c = {0};
+    jf_error err = {{0}};
+    jf_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = jf_cloud_read(path, &po.e.ro, &c, &err);
+    Py_END_ALLOW_THREADS
+    if (st != JF_OK) {
+        file_error(st, &err, path);
+        Py_DECREF(pathobj);
+        return NULL;
+    }
+    if (c.nbad) {
+        /* bad_rows="skip": the command's line, as a warning */
+        char lines[160] = "";
+        size_t shown = c.nbad < 10 ? c.nbad : 10, len = 0;
+        for (size_t k = 0; k < shown && len < sizeof lines; k++)
+            len += (size_t)snprintf(lines + len, sizeof lines - len, "%s%zu", k ? ", " : "",
+                                    c.bad_line[k]);
+        if (PyErr_WarnFormat(PyExc_RuntimeWarning, 1,
+                             "%s: %zu unparsable rows kept as NaN rows (status nonfinite), "
+                             "lines %s%s", path, c.nbad, lines, c.nbad > shown ? ", ..." : "") < 0) {
+            jf_cloud_free(&c);
+            Py_DECREF(pathobj);
+            return NULL;
+        }
+    }
+    Py_DECREF(pathobj);
+    PyObject *pts = NULL, *nrm = NULL, *faces = NULL, *attrs = NULL, *out = NULL;
+    if (!(pts = own_xyz(c.xyz, c.n))) goto done;
+    c.xyz = NULL; /* the array owns it now */
+    if (c.nrm) {
+        if (!(nrm = own_xyz(c.nrm, c.n))) goto done;
+        c.nrm = NULL;
+    } else {
+        nrm = Py_NewRef(Py_None);
+    }
+    faces = c.nfaces ? jf_py_faces_out(&c) : Py_NewRef(Py_None);
+    if (!faces) goto done;
+    /* per-point attributes other than coordinates and normals: none are
+     * carried by the library's readers yet */
+    if (!(attrs = PyDict_New())) goto done;
+    out = PyTuple_Pack(4, pts, nrm, faces, attrs);
+done:
+    Py_XDECREF(pts);
+    Py_XDECREF(nrm);
+    Py_XDECREF(faces);
+    Py_XDECREF(attrs);
+    jf_cloud_free(&c);
+    return out;
+}
+
+/* ---- write --------------------------------------------------------------- */
+
+/* The arrays of a Result, looked up once (borrowed through `r`). */
+typedef struct {
+    const double *xyz, *nrm, *k1, *k2, *d1, *d2, *b, *c, *cond, *res;
+    const int32_t *deg, *nb, *st;
+} cols_src;
+
+static const void *data_of(PyObject *r, const char *name)
+{
+    PyObject *a = PyObject_GetAttrString(r, name);
+    if (!a) return NULL;
+    const void *d = a == Py_None ? NULL : PyArray_DATA((PyArrayObject *)a);
+    Py_DECREF(a); /* the Result keeps it alive */
+    return d;
+}
+
+/* One row as cmd_estimate.c's make_row builds it. */
+static size_t make_row(const cols_src *s, size_t i, int monge, double *v)
+{
+    size_t n = 0;
+    for (int j = 0; j < 3; j++) v[n++] = s->xyz[3 * i + (size_t)j];
+    for (int j = 0; j < 3; j++) v[n++] = s->nrm[3 * i + (size_t)j];
+    v[n++] = s->k1[i];
+    v[n++] = s->k2[i];
+    for (int j = 0; j < 3; j++) v[n++] = s->d1[3 * i + (size_t)j];
+    for (int j = 0; j < 3; j++) v[n++] = s->d2[3 * i + (size_t)j];
+    if (monge >= 3)
+        for (int j = 0; j < 4; j++) v[n++] = s->b[4 * i + (size_t)j];
+    if (monge >= 4)
+        for (int j = 0; j < 5; j++) v[n++] = s->c[5 * i + (size_t)j];
+    v[n++] = s->deg[i];
+    v[n++] = s->nb[i];
+    v[n++] = s->cond[i];
+    v[n++] = s->res[i];
+    v[n++] = (double)(uint32_t)s->st[i];
+    return n;
+}
+
+PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    static char *kwl[] = {"path", "result", "points", "faces", "ascii", "threads", NULL};
+    PyObject *pathobj, *result, *points = NULL, *faces = NULL, *threads = NULL;
+    int ascii = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&O!|$OOpO:write", kwl, PyUnicode_FSConverter,
+                                     &pathobj, &jf_py_ResultType, &result, &points, &faces, &ascii,
+                                     &threads))
+        return NULL;
+    PyObject *ret = NULL;
+    PyArrayObject *pa = NULL;
+    jf_cloud fc = {0};
+    jf_py_opts po;
+    jf_cli_est_init(&po.e);
+    po.used = 0;
+    if (jf_py_opt(&po, "--threads", "threads", threads, JF_PY_INT)) goto out;
+    int nthreads = po.e.o.threads;
+    if (!points || points == Py_None) points = PyObject_GetAttrString(result, "points");
+    else Py_INCREF(points);
+    if (!points) goto out;
+    if (points == Py_None) {
+        Py_DECREF(points);
+        PyErr_SetString(PyExc_ValueError, "write: this Result has no points; pass points=");
+        goto out;
+    }
+    pa = jf_py_points(points, "points");
+    Py_DECREF(points);
+    if (!pa) goto out;
+    size_t n = (size_t)PyObject_Length(result);
+    if ((size_t)PyArray_DIM(pa, 0) != n) {
+        PyErr_Format(PyExc_ValueError, "points: %zd rows for a Result of %zd",
+                     (Py_ssize_t)PyArray_DIM(pa, 0), (Py_ssize_t)n);
+        goto out;
+    }
+    PyObject *fobj = faces && faces != Py_None ? Py_NewRef(faces)
+                                               : PyObject_GetAttrString(result, "faces");
+    if (!fobj) goto out;
+    int fbad = fobj != Py_None && jf_py_faces(fobj, n, &fc) < 0;
+    Py_DECREF(fobj);
+    if (fbad) goto out;
+
+    int monge = jf_py_result_monge(result);
+    cols_src s = {PyArray_DATA(pa), data_of(result, "normal"), data_of(result, "k1"),
+                  data_of(result, "k2"), data_of(result, "d1"), data_of(result, "d2"),
+                  data_of(result, "b"), data_of(result, "c"), data_of(result, "cond"),
+                  data_of(result, "residual"), data_of(result, "degree"),
+                  data_of(result, "neighbors"), data_of(result, "status")};
+    if (PyErr_Occurred()) goto out;
+    jf_column cols[32];
+    size_t ncols = jf_py_result_columns(result, cols);
+    const char *path = PyBytes_AS_STRING(pathobj);
+    jf_error err = {{0}};
+    jf_writer *w = NULL;
+    jf_status st;
+    enum { BLOCK = 65536 };
+    double *rows = PyMem_RawMalloc((n < BLOCK ? (n ? n : 1) : BLOCK) * ncols * sizeof *rows);
+    if (!rows) {
+        PyErr_NoMemory();
+        goto out;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    st = jf_writer_open(path, cols, ncols, n, ascii, &w, &err);
+    if (st == JF_OK) {
+        /* a mesh keeps its faces in a PLY output, as the command does */
+        if (fc.nfaces) (void)jf_writer_faces(w, fc.nfaces, fc.face_off, fc.face_idx);
+        for (size_t b0 = 0; b0 < n; b0 += BLOCK) {
+            size_t nb = n - b0 < BLOCK ? n - b0 : BLOCK;
+            for (size_t k = 0; k < nb; k++) make_row(&s, b0 + k, monge, rows + k * ncols);
+            if (jf_writer_rows(w, rows, nb, nthreads) != JF_OK) break;
+        }
+        st = jf_writer_commit(w, &err); /* reports a failed row too */
+    }
+    Py_END_ALLOW_THREADS
+    PyMem_RawFree(rows);
+    if (st != JF_OK) {
+        file_error(st, &err, path);
+        goto out;
+    }
+    ret = Py_NewRef(Py_None);
+out:
+    jf_py_faces_free(&fc);
+    Py_XDECREF(pa);
+    Py_DECREF(pathobj);
+    return ret;
+}

@@ -1,0 +1,91 @@
+/* jfpy.h -- shared declarations of the Python module's C files (python/src):
+ *   module.c   the module: functions table, STATUS, FileError, __version__
+ *   arrays.c   numpy in (points, normals, faces) and out
+ *   options.c  keyword arguments -> jf_estimate_opts through the command's
+ *              own option parser (src/cli/opts.c), so values are accepted
+ *              and rejected with the command's words
+ *   estimate.c estimate(), estimate_mesh(): GIL released, Ctrl-C polled
+ *   result.c   the Result type and as_structured()
+ *   files.c    read(), write() over the library's readers and writers
+ *   fitjet.c   fit_jet(): one neighbourhood
+ * Only module.c defines PY_ARRAY_UNIQUE_SYMBOL's table; the others import
+ * it (NO_IMPORT_ARRAY). */
+#ifndef JF_PY_H
+#define JF_PY_H
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#define PY_ARRAY_UNIQUE_SYMBOL jf_py_ARRAY_API
+#ifndef JF_PY_MODULE_C
+#define NO_IMPORT_ARRAY
+#endif
+#include <numpy/arrayobject.h>
+
+#include "jetfit.h"
+#include "opts.h"
+
+/* module.c */
+extern PyObject *jf_py_FileError;
+/* Raises the exception matching a library status (NOMEM: MemoryError,
+ * CANCELLED: keeps the pending KeyboardInterrupt, INVALID/FORMAT/TOO_LARGE:
+ * ValueError, others RuntimeError) with msg (or jf_strerror). NULL. */
+PyObject *jf_py_status_error(jf_status st, const char *msg);
+
+/* arrays.c */
+/* An (N, 3) float64 C-contiguous view of obj: a new reference to obj
+ * itself when it already is one (no copy), else a converted copy; float
+ * and integer dtypes are accepted, others raise TypeError, other shapes
+ * ValueError naming `what`. */
+PyArrayObject *jf_py_points(PyObject *obj, const char *what);
+/* Faces: an (M, k) integer array (k >= 3) or a sequence of index
+ * sequences, into jf_cloud's face_off/face_idx (PyMem_Malloc'd; free with
+ * jf_py_faces_free).  0 or -1 with an exception. */
+int jf_py_faces(PyObject *obj, size_t nverts, jf_cloud *c);
+void jf_py_faces_free(jf_cloud *c);
+/* Faces back to Python: (M, k) int32 if every face has k vertices, else
+ * a list of int32 arrays. */
+PyObject *jf_py_faces_out(const jf_cloud *c);
+/* New uninitialised arrays. */
+PyArrayObject *jf_py_empty(int nd, npy_intp d0, npy_intp d1, int type);
+
+/* options.c */
+typedef struct {
+    jf_cli_est e;   /* the command's option set                        */
+    char buf[512];  /* the option values as text (e points into it)    */
+    size_t used;
+} jf_py_opts;
+/* The keywords of estimate()/estimate_mesh() (neighbors as given). */
+int jf_py_opts_parse(jf_py_opts *po, PyObject *neighbors, PyObject *degree,
+                     PyObject *monge_degree, PyObject *fit, PyObject *frame,
+                     PyObject *max_cond, PyObject *orient, PyObject *normal,
+                     PyObject *robust, PyObject *scales, PyObject *degree_select,
+                     PyObject *dist_weight, PyObject *robust_normals, PyObject *threads);
+/* One option from a Python value: None skips it; int, float, str or a
+ * sequence of numbers ("a,b,c") as the command would see it. */
+int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int kind);
+enum { JF_PY_INT, JF_PY_FLOAT, JF_PY_STR, JF_PY_LIST };
+int jf_py_opts_finish(jf_py_opts *po);
+
+/* result.c */
+extern PyTypeObject jf_py_ResultType;
+/* A Result of n rows for Monge degree `monge` with its arrays allocated
+ * (b, c None below 3, 4); keeps points and faces (may be NULL). */
+PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *faces);
+/* Copies res[0..n-1] into the Result's arrays on `threads` OpenMP threads
+ * (<= 0: all cores); no Python calls. */
+void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads);
+/* The output file's columns and rows, as the command writes them. */
+size_t jf_py_result_columns(PyObject *result, jf_column *cols);
+int jf_py_result_monge(PyObject *result);
+
+/* estimate.c, files.c, fitjet.c: module functions */
+PyObject *jf_py_estimate(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *jf_py_estimate_mesh(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *jf_py_fit_jet(PyObject *self, PyObject *args, PyObject *kw);
+extern PyTypeObject *jf_py_JetType;
+int jf_py_fitjet_init(PyObject *m);
+
+#endif

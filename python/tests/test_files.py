@@ -1,0 +1,115 @@
+"""jetfit.read / jetfit.write over the library's readers and writers:
+the command's formats, its error lines, and its rule that a failed write
+leaves the old file untouched."""
+import numpy as np
+import pytest
+
+import jetfit
+from conftest import fib_sphere, save_xyz
+
+
+def test_read_cloud_with_and_without_normals(tmp_path, cmd):
+    p = fib_sphere(100)
+    pts, nrm, faces, attrs = jetfit.read(str(save_xyz(tmp_path / "a.xyz", p)))
+    assert np.array_equal(pts, p) and nrm is None and faces is None and attrs == {}
+    assert pts.dtype == np.float64 and pts.flags.c_contiguous and pts.flags.owndata is False
+    pts, nrm, _, _ = jetfit.read(save_xyz(tmp_path / "b.xyz", p, p))
+    assert np.array_equal(nrm, p)
+    cmd("generate", "sphere", "-o", tmp_path / "s.ply", "--n", "50")
+    pts, _, _, _ = jetfit.read(tmp_path / "s.ply")  # os.PathLike
+    assert pts.shape == (50, 3)
+
+
+def test_read_columns(tmp_path):
+    data = np.arange(30, dtype=float).reshape(6, 5)
+    np.savetxt(tmp_path / "c.txt", data, fmt="%.17g")
+    pts, _, _, _ = jetfit.read(str(tmp_path / "c.txt"), columns=[4, 2, 0])
+    assert np.array_equal(pts, data[:, [4, 2, 0]])
+    with pytest.raises(ValueError, match="^--columns '1,2': expected 3 or 6 column numbers$"):
+        jetfit.read(str(tmp_path / "c.txt"), columns=[1, 2])
+
+
+def test_read_polygons(tmp_path):
+    (tmp_path / "q.off").write_text("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 2 0\n"
+                                    "4 0 1 2 3\n3 1 4 2\n")
+    v, _, faces, _ = jetfit.read(str(tmp_path / "q.off"))
+    assert isinstance(faces, list) and [f.tolist() for f in faces] == [[0, 1, 2, 3], [1, 4, 2]]
+
+
+@pytest.mark.parametrize("content,ext", [("1 2 3\n4 5 x\n", "xyz"), ("", "xyz"),
+                                         ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "off"),
+                                         ("ply\nformat nonsense 1.0\n", "ply")])
+def test_read_errors_are_the_commands(tmp_path, cmd, content, ext):
+    f = tmp_path / f"bad.{ext}"
+    f.write_text(content)
+    rc, err = cmd("estimate", f, "-o", tmp_path / "o.ply", check=False)
+    assert rc == 1
+    with pytest.raises(jetfit.FileError) as e:
+        jetfit.read(str(f))
+    assert isinstance(e.value, OSError)
+    assert "jetfit: " + str(e.value) == err.strip()
+
+
+def test_missing_file(tmp_path, cmd):
+    rc, err = cmd("estimate", tmp_path / "nope.xyz", "-o", tmp_path / "o.ply", check=False)
+    with pytest.raises(OSError) as e:
+        jetfit.read(str(tmp_path / "nope.xyz"))
+    assert "jetfit: " + str(e.value) == err.strip()
+
+
+@pytest.mark.parametrize("ext", ["ply", "csv", "xyz", "txt"])
+def test_write_formats_equal_the_command(tmp_path, cmd, ext):
+    f = save_xyz(tmp_path / "in.xyz", fib_sphere(400))
+    cmd("estimate", f, "-o", tmp_path / f"c.{ext}", "--quiet", "--degree", "4", "--ascii")
+    pts, _, _, _ = jetfit.read(str(f))
+    r = jetfit.estimate(pts, degree=4)
+    jetfit.write(str(tmp_path / f"p.{ext}"), r, ascii=True, threads=2)
+    assert (tmp_path / f"p.{ext}").read_bytes() == (tmp_path / f"c.{ext}").read_bytes()
+
+
+def test_mesh_ply_keeps_faces(tmp_path, cmd):
+    cmd("generate", "sphere", "-o", tmp_path / "m.off", "--n", "300", "--mesh")
+    cmd("estimate", tmp_path / "m.off", "-o", tmp_path / "c.ply", "--quiet", "--neighbors", "rings")
+    v, _, faces, _ = jetfit.read(str(tmp_path / "m.off"))
+    r = jetfit.estimate_mesh(v, faces)
+    jetfit.write(str(tmp_path / "p.ply"), r)
+    assert (tmp_path / "p.ply").read_bytes() == (tmp_path / "c.ply").read_bytes()
+    _, _, f2, _ = jetfit.read(str(tmp_path / "p.ply"))
+    assert np.array_equal(f2, faces)
+
+
+def test_failed_write_leaves_old_file(tmp_path):
+    r = jetfit.estimate(fib_sphere(100))
+    old = tmp_path / "out.ply"
+    old.write_bytes(b"old content")
+    with pytest.raises(ValueError, match="points: 3 rows for a Result of 100"):
+        jetfit.write(str(old), r, points=np.zeros((3, 3)))
+    with pytest.raises(jetfit.FileError):
+        jetfit.write(str(tmp_path / "no" / "such" / "dir.ply"), r)
+    with pytest.raises(jetfit.FileError):
+        jetfit.write(str(tmp_path / "out.unknown"), r)
+    assert old.read_bytes() == b"old content"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
+    jetfit.write(str(old), r)
+    assert old.read_bytes().startswith(b"ply\n")
+
+
+def test_write_needs_points():
+    with pytest.raises(TypeError):
+        jetfit.write("x.ply", "not a result")
+
+
+def test_read_bad_rows(tmp_path, cmd):
+    f = tmp_path / "b.xyz"
+    f.write_text("0 0 0\n1 0 0\n1 x 0\n0 1 0\n")
+    rc, err = cmd("estimate", f, "-o", tmp_path / "o.ply", check=False)
+    with pytest.raises(jetfit.FileError) as e:
+        jetfit.read(str(f))
+    assert "jetfit: " + str(e.value) == err.strip()
+    rc, err = cmd("estimate", f, "-o", tmp_path / "o.ply", "--bad-rows", "skip", "--quiet")
+    with pytest.warns(RuntimeWarning) as w:
+        pts, _, _, _ = jetfit.read(str(f), bad_rows="skip")
+    assert "jetfit: " + str(w[0].message) in err
+    assert pts.shape == (4, 3) and np.isnan(pts[2]).all() and (pts[3] == [0, 1, 0]).all()
+    with pytest.raises(ValueError, match="^--bad-rows 'keep': "):
+        jetfit.read(str(f), bad_rows="keep")

@@ -1,0 +1,49 @@
+/* opts.h -- the estimation options shared by `jetfit estimate` and
+ * `jetfit study` (src/cli/opts.c): strict number parsing, one option at a
+ * time into a jf_estimate_opts, and the checks that need them all.  Study
+ * parses each of its --flags sets with the same code, so an option means
+ * the same in both commands. */
+#ifndef JF_CLI_OPTS_H
+#define JF_CLI_OPTS_H
+
+#include <stddef.h>
+
+#include "jetfit.h"
+
+/* Strict parsing: the whole string must be consumed; 0 or -1. */
+int jf_cli_parse_int(const char *s, int lo, int hi, int *out);
+int jf_cli_parse_double(const char *s, double *out);
+/* "a,b,c" -> up to max doubles; returns the count or -1. */
+int jf_cli_parse_list(const char *s, double *v, int max);
+
+/* One set of estimation options as the command line gives them. */
+typedef struct {
+    jf_estimate_opts o;
+    jf_read_opts ro;       /* --columns                                  */
+    const char *nbspec;    /* --neighbors text (parsed by _finish)       */
+    int monge;             /* --monge-degree, -1 = from the degree       */
+    const char *monge_s;
+    int orient_set;        /* --orient given (else: input if normals)    */
+} jf_cli_est;
+
+/* What was wrong: option, its value, why (static or argv strings). */
+typedef struct {
+    const char *opt, *val, *why;
+} jf_cli_bad;
+
+#define JF_CLI_DEFAULT_NEIGHBORS "knn:32"
+
+void jf_cli_est_init(jf_cli_est *e);
+
+/* 1 if NAME is an estimation option taking a value, 0 if it is one
+ * without (--robust-normals), -1 if it is not an estimation option. */
+int jf_cli_est_takes_value(const char *name);
+
+/* Applies option NAME (with VAL, NULL for a flag).  0, or -1 with *bad. */
+int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_bad *bad);
+
+/* After all options: parses the neighbourhood, settles the Monge degree
+ * and max_neighbors, validates.  0, or -1 with *bad. */
+int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad);
+
+#endif

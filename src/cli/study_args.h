@@ -1,0 +1,40 @@
+/* study_args.h -- `jetfit study`'s command line (src/cli/study_args.c):
+ * the lists, the base estimate options, every setting parsed and
+ * validated before any work, and what cmd_study.c loads for INPUT mode. */
+#ifndef JF_STUDY_ARGS_H
+#define JF_STUDY_ARGS_H
+
+#include "jetfit.h"
+#include "opts.h"
+#include "study.h"
+#include "surfaces.h"
+
+#define JF_STUDY_DEFAULT_N 10000
+
+typedef struct {
+    jf_study s;
+    const char *dir, *nb_text, *deg_text, *flags_text, *metrics_text;
+    char **strat_block, **flags_block;
+    jf_surface surf;
+    int is_surface, mesh, quiet, resume;
+    size_t npoints;              /* --n                                */
+    size_t ndraw;                /* points of each draw (cmd_study.c)  */
+    jf_cli_est base;             /* options outside --flags           */
+    jf_estimate_opts *setting;   /* strategy x degree x flags, in the
+                                    order of jf_study_setting         */
+    int nsetting;
+    /* INPUT mode (cmd_study.c loads them) */
+    jf_cloud cloud;
+    double *truth; /* 5 per row: nx ny nz k1 k2 */
+    int truth_k;
+    size_t *sel, nsel;
+} jf_study_args;
+
+/* Parses argv into *c (zeroed by the caller).  0; -1 after --help
+ * (printed); or the exit status of a bad option (2), its line printed. */
+int jf_study_args_parse(jf_study_args *c, int argc, char **argv);
+
+/* Frees what parse and cmd_study.c allocated. */
+void jf_study_args_free(jf_study_args *c);
+
+#endif

@@ -1,0 +1,225 @@
+/* test_io_las.c -- the LAS reader (issue 13): every point data record
+ * format 0-10 in files written here (versions 1.2 and 1.4, legacy and
+ * 64-bit counts, records longer than their format), georeferenced values
+ * exact; the two real laspy samples against their x y z listings; every
+ * header lie, LAZ and E57 a one-line error. */
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "jetfit.h"
+
+#include "test_io_util.h"
+
+static void setup(void) { tmpdir_setup("/tmp/jf_io_las_XXXXXX"); }
+
+static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+
+static void put16(unsigned char *p, unsigned v) { p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8); }
+static void put32(unsigned char *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+static void put64(unsigned char *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+static void putd(unsigned char *p, double d)
+{
+    uint64_t b;
+    memcpy(&b, &d, 8);
+    put64(p, b);
+}
+
+/* A LAS file of n points in record format fmt, record length base + pad:
+ * X = 1000 i - 7, Y = -3 i, Z = i * i, scale (0.001, 0.002, 0.01), offset
+ * (1e6, -2e6, 350).  Version 1.4 (64-bit count only) for formats >= 6,
+ * else 1.2.  Returns its size; *out malloc'd. */
+static size_t make_las(unsigned fmt, unsigned pad, size_t n, unsigned char **out)
+{
+    int v14 = fmt >= 6;
+    unsigned hsize = v14 ? 375 : 227, rl = base_len[fmt] + pad;
+    size_t len = hsize + n * rl;
+    unsigned char *b = calloc(1, len);
+    memcpy(b, "LASF", 4);
+    b[24] = 1;
+    b[25] = v14 ? 4 : 2;
+    memcpy(b + 26, "jetfit test", 11);
+    put16(b + 94, hsize);
+    put32(b + 96, hsize);
+    b[104] = (unsigned char)fmt;
+    put16(b + 105, rl);
+    put32(b + 107, v14 ? 0 : (uint32_t)n);
+    putd(b + 131, 0.001), putd(b + 139, 0.002), putd(b + 147, 0.01);
+    putd(b + 155, 1e6), putd(b + 163, -2e6), putd(b + 171, 350);
+    if (v14) put64(b + 247, n);
+    for (size_t i = 0; i < n; i++) {
+        unsigned char *r = b + hsize + i * rl;
+        put32(r, (uint32_t)(int32_t)(1000 * (int)i - 7));
+        put32(r + 4, (uint32_t)(int32_t)(-3 * (int)i));
+        put32(r + 8, (uint32_t)(int32_t)(i * i));
+        memset(r + 12, 0xA5, rl - 12); /* the rest of the record: ignored */
+    }
+    *out = b;
+    return len;
+}
+
+START_TEST(every_format)
+{
+    for (unsigned fmt = 0; fmt <= 10; fmt++)
+        for (unsigned pad = 0; pad <= 5; pad += 5) {
+            unsigned char *b;
+            size_t len = make_las(fmt, pad, 50, &b);
+            const char *p = fixture("f.las", b, len);
+            jf_cloud c;
+            jf_error e;
+            ck_assert_msg(jf_cloud_read(p, NULL, &c, &e) == JF_OK, "format %u: %s", fmt, e.msg);
+            ck_assert_uint_eq(c.n, 50);
+            for (size_t i = 0; i < 50; i++) {
+                ck_assert(c.xyz[3 * i] == (1000.0 * (double)i - 7) * 0.001 + 1e6);
+                ck_assert(c.xyz[3 * i + 1] == (-3.0 * (double)i) * 0.002 - 2e6);
+                ck_assert(c.xyz[3 * i + 2] == (double)(i * i) * 0.01 + 350);
+            }
+            jf_cloud_free(&c);
+            free(b);
+        }
+}
+END_TEST
+
+/* laspy's samples against the x y z listings made from them (3 decimals,
+ * so to half a millimetre; the scale is 0.01 or 0.001). */
+static void sample(const char *las, const char *xyz, size_t n)
+{
+    jf_cloud a, t;
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(las, NULL, &a, &e) == JF_OK, "%s", e.msg);
+    ck_assert_msg(jf_cloud_read(xyz, NULL, &t, &e) == JF_OK, "%s", e.msg);
+    ck_assert_uint_eq(a.n, n);
+    ck_assert_uint_eq(t.n, n);
+    for (size_t i = 0; i < 3 * n; i++)
+        ck_assert_msg(fabs(a.xyz[i] - t.xyz[i]) <= 5e-4, "%s: value %zu: %.17g vs %.17g", las, i,
+                      a.xyz[i], t.xyz[i]);
+    jf_cloud_free(&a);
+    jf_cloud_free(&t);
+}
+
+START_TEST(real_samples)
+{
+    sample(JF_TESTS_DIR "/data/las/simple.las", JF_TESTS_DIR "/data/las/simple.xyz", 1065);
+    sample(JF_TESTS_DIR "/data/las/vegetation_1_3.las", JF_TESTS_DIR "/data/las/vegetation_1_3.xyz",
+           10683);
+}
+END_TEST
+
+static void refused(const char *name, const unsigned char *b, size_t len, const char *what)
+{
+    const char *p = fixture(name, b, len);
+    jf_cloud c;
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(p, NULL, &c, &e) != JF_OK, "%s was read", what);
+    ck_assert_msg(strstr(e.msg, p) == e.msg, "'%s'", e.msg);
+    ck_assert_msg(strstr(e.msg, what), "'%s' lacks '%s'", e.msg, what);
+    ck_assert_ptr_null(strchr(e.msg, '\n'));
+    ck_assert_ptr_null(c.xyz);
+}
+
+START_TEST(header_lies)
+{
+    unsigned char *b;
+    size_t len = make_las(1, 0, 20, &b);
+    unsigned char *m = malloc(len);
+    memcpy(m, b, len);
+    put32(m + 107, 21); /* one point more than the file holds */
+    refused("count.las", m, len, "cannot fit");
+    refused("trunc.las", b, len - 5, "cannot fit");
+    memcpy(m, b, len);
+    put32(m + 96, (uint32_t)len + 10); /* point data past the end */
+    refused("off.las", m, len, "offset to point data");
+    memcpy(m, b, len);
+    put16(m + 105, 27); /* shorter than format 1's 28 bytes */
+    refused("rl.las", m, len, "shorter than format 1");
+    memcpy(m, b, len);
+    m[104] = 11;
+    refused("fmt.las", m, len, "record format 11");
+    memcpy(m, b, len);
+    m[104] = 0x80 | 1; /* laszip's compression bit */
+    refused("c.las", m, len, "pdal translate");
+    refused("c.laz", m, len, "LAZ");
+    memcpy(m, b, len);
+    m[24] = 2;
+    refused("v.las", m, len, "version 2");
+    memcpy(m, b, len);
+    putd(m + 139, 0.0);
+    refused("s.las", m, len, "scale");
+    memcpy(m, b, len);
+    put32(m + 107, 0);
+    refused("empty.las", m, len, "no points");
+    refused("short.las", b, 100, "at least 227");
+    refused("sig.las", (const unsigned char *)"PLY not LAS", 11, "LASF");
+    refused("x.e57", b, len, "E57 is not read");
+    free(m);
+    free(b);
+}
+END_TEST
+
+/* The writer: x y z at 1e6 (georeferenced) within half a scale step of
+ * 1e-7 m, read back by our reader; the rows without a frame are refused. */
+START_TEST(writer_round_trip)
+{
+    const size_t n = 200;
+    double *xyz = malloc(n * 3 * sizeof *xyz);
+    for (size_t i = 0; i < n; i++) {
+        xyz[3 * i] = 1e6 + 0.37 * (double)i;
+        xyz[3 * i + 1] = -4e6 + sin((double)i) * 50;
+        xyz[3 * i + 2] = 123.456789 + 1e-3 * (double)(i % 7);
+    }
+    jf_column cols[5] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
+                         {"k1", JF_COL_F64}, {"status", JF_COL_I32}};
+    char path[128];
+    snprintf(path, sizeof path, "%s/w.las", tmpdir);
+    jf_writer *w;
+    jf_error e;
+    ck_assert_int_eq(jf_writer_open(path, cols, 5, n, 0, &w, &e), JF_OK);
+    double row[5] = {1, 2, 3, 4, 5};
+    ck_assert_int_ne(jf_writer_row(w, row), JF_OK); /* no frame yet */
+    jf_writer_abort(w);
+    ck_assert(access(path, F_OK) != 0);
+    ck_assert_int_eq(jf_writer_open(path, cols, 5, n, 0, &w, &e), JF_OK);
+    ck_assert_int_eq(jf_writer_las_frame(w, xyz, n), JF_OK);
+    for (size_t i = 0; i < n; i++) {
+        double r[5] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2], 0.5 * (double)i, (double)i};
+        ck_assert_int_eq(jf_writer_row(w, r), JF_OK);
+    }
+    ck_assert_int_eq(jf_writer_commit(w, &e), JF_OK);
+    jf_cloud c;
+    ck_assert_msg(jf_cloud_read(path, NULL, &c, &e) == JF_OK, "%s", e.msg);
+    ck_assert_uint_eq(c.n, n);
+    for (size_t i = 0; i < 3 * n; i++)
+        ck_assert_msg(fabs(c.xyz[i] - xyz[i]) <= 0.5e-7 * (1 + 1e-6) + 1e-15 * fabs(xyz[i]),
+                      "value %zu: %.17g vs %.17g", i, c.xyz[i], xyz[i]);
+    jf_cloud_free(&c);
+    free(xyz);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("io_las");
+    TCase *tc = tcase_create("las");
+    tcase_add_checked_fixture(tc, setup, teardown);
+    tcase_add_test(tc, every_format);
+    tcase_add_test(tc, real_samples);
+    tcase_add_test(tc, header_lies);
+    tcase_add_test(tc, writer_round_trip);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failures = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failures ? 1 : 0;
+}
