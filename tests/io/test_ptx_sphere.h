@@ -38,7 +38,7 @@ static inline void ptx_rot(int s, double R[3][3])
 }
 
 /* Registered point of scan s, cell (row, col): the cap of the sphere
- * facing the scanner (up to 75 degrees from its direction). */
+ * facing the scanner (up to 60 degrees, all seen by it from its direction). */
 static inline void ptx_point(int s, int row, int col, double p[3])
 {
     double d[3], l = 0, e1[3], e2[3];
@@ -50,7 +50,7 @@ static inline void ptx_point(int s, int row, int col, double p[3])
     m = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
     for (int k = 0; k < 3; k++) e1[k] /= m;
     e2[0] = d[1] * e1[2] - d[2] * e1[1], e2[1] = d[2] * e1[0] - d[0] * e1[2], e2[2] = d[0] * e1[1] - d[1] * e1[0];
-    double th = (row + 1) * (75.0 / PTX_ROWS) * M_PI / 180, ph = col * 2 * M_PI / PTX_COLS;
+    double th = (row + 1) * (60.0 / PTX_ROWS) * M_PI / 180, ph = col * 2 * M_PI / PTX_COLS;
     for (int k = 0; k < 3; k++)
         p[k] = ptx_C[k] + ptx_R * (cos(th) * d[k] + sin(th) * (cos(ph) * e1[k] + sin(ph) * e2[k]));
 }
