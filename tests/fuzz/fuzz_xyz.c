@@ -2,6 +2,10 @@
  * fuzz_xyz.c -- libFuzzer harness for the text table reader (.xyz/.txt,
  * .pts, .csv).  The first byte picks the format and the column selection
  * (default, or x y z [nx ny nz] at small positions); the rest is the file.
+ * Each input is read twice, with bad_rows = error and = skip (--bad-rows):
+ * a file the strict read accepts reads the same, bit for bit, under skip
+ * with nothing skipped; a skip read keeps a parsable row, lists its bad
+ * lines in increasing order, and every bad row is NaN.
  */
 #include "fuzz_common.h"
 
@@ -20,5 +24,37 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (int k = 0; k < 3; k++)
             o.columns[3 + k] = (int)((sel >> 6) & 3) + k;
     jf_fuzz_check(data + 1, size - 1, fmts[sel % 3], &o);
+
+    jf_cloud a, b;
+    jf_error e;
+    jf_status sa = jf_cloud_read_mem((const char *)data + 1, size - 1, fmts[sel % 3], "fuzz", &o,
+                                     &a, &e);
+    o.bad_rows = 1;
+    jf_status sb = jf_cloud_read_mem((const char *)data + 1, size - 1, fmts[sel % 3], "fuzz", &o,
+                                     &b, &e);
+    if (sb != JF_OK && (b.xyz || b.n || strncmp(e.msg, "fuzz", 4) || strchr(e.msg, '\n')))
+        abort();
+    if (sa == JF_OK &&
+        (sb != JF_OK || b.nbad || b.n != a.n || !!a.nrm != !!b.nrm ||
+         memcmp(a.xyz, b.xyz, 3 * a.n * sizeof(double)) ||
+         (a.nrm && memcmp(a.nrm, b.nrm, 3 * a.n * sizeof(double)))))
+        abort();
+    if (sb == JF_OK) {
+        if (b.nbad >= b.n)
+            abort();
+        size_t shown = b.nbad < 10 ? b.nbad : 10;
+        for (size_t k = 0; k < shown; k++)
+            if (b.bad_line[k] < 1 || (k && b.bad_line[k] <= b.bad_line[k - 1]))
+                abort();
+        size_t nan_rows = 0;
+        for (size_t i = 0; i < b.n; i++)
+            nan_rows += b.xyz[3 * i] != b.xyz[3 * i]; /* NaN */
+        if (nan_rows < b.nbad)
+            abort();
+    }
+    if (sa == JF_OK)
+        jf_cloud_free(&a);
+    if (sb == JF_OK)
+        jf_cloud_free(&b);
     return 0;
 }
