@@ -520,6 +520,10 @@ typedef struct {
     size_t nbad;         /* text rows that did not parse, kept as NaN
                             points (jf_read_opts.bad_rows = skip)      */
     size_t bad_line[10]; /* the first min(nbad, 10) of their lines     */
+    uint32_t *scan;      /* PTX: scan of each point (n), else NULL     */
+    double *scanner;     /* PTX: 3 nscans scanner positions in the
+                            registered frame, else NULL                */
+    size_t nscans;       /* PTX: number of scans, else 0               */
 } jf_cloud;
 
 typedef struct {
@@ -557,6 +561,9 @@ void jf_read_opts_init(jf_read_opts *o);
  *    (all-numeric first line: x y z first).
  *  - OFF (also COFF/NOFF/STOFF variants; NOFF normals are read): polygons
  *    of any size >= 3; indices are checked against the vertex count.
+ *  - PTX: one or more scans (header: cols, rows, scanner position, axes,
+ *    4x4 row-vector transform); points moved to the registered frame;
+ *    "0 0 0" (no return) kept as a NaN row; fills scan/scanner/nscans.
  * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
  * A file without points (empty, comments only, 0 vertices) is an error.
  * o may be NULL (defaults).  c is overwritten (not freed first).
@@ -722,8 +729,10 @@ typedef enum {
     JF_ORIENT_NONE = 0,      /* as fitted                                */
     JF_ORIENT_INPUT = 1,     /* agree with the normals read from the file */
     JF_ORIENT_VIEWPOINT = 2, /* point towards a scanner position          */
-    JF_ORIENT_MST = 3        /* propagate along a k-NN minimum spanning
+    JF_ORIENT_MST = 3,       /* propagate along a k-NN minimum spanning
                                 tree (Hoppe et al. 1992)                 */
+    JF_ORIENT_SCANNER = 4    /* towards the scanner that measured each
+                                point (jf_cloud.scan / scanner: PTX)     */
 } jf_orient_mode;
 
 /* res[i] agrees with nrm[3i..3i+2] (n_i . nrm_i >= 0).  nrm is caller-owned. */
@@ -732,6 +741,11 @@ jf_status jf_orient_input(jf_result *res, size_t n, const double *nrm);
 /* res[i] points towards vp: n_i . (vp - p_i) >= 0. */
 jf_status jf_orient_viewpoint(jf_result *res, const double *xyz, size_t n,
                               const double vp[3]);
+
+/* res[i] points towards the scanner of its scan: n_i . (scanner[3 scan[i]]
+ * - p_i) >= 0.  JF_ERR_INVALID if a scan index is >= nscans. */
+jf_status jf_orient_scanner(jf_result *res, const double *xyz, size_t n,
+                            const uint32_t *scan, const double *scanner, size_t nscans);
 
 /* Consistent orientation by Prim's algorithm on the graph of the k nearest
  * neighbours (ix built over xyz), weights 1 - |ni.nj|: each newly reached

@@ -37,7 +37,7 @@ static void usage(FILE *f)
         "  --fit MODE            approx | interp (default approx)\n"
         "  --frame MODE          pca | axis (default pca)\n"
         "  --max-cond X          lower the degree while cond > X (default %g)\n"
-        "  --orient MODE         none | input | viewpoint:X,Y,Z | mst[:K]\n"
+        "  --orient MODE         none | input | viewpoint:X,Y,Z | scanner | mst[:K]\n"
         "                        (default: input if INPUT has normals, else none;\n"
         "                        mst uses K nearest neighbours, default 8)\n"
         "  --normal MODE         natural only: tangent plane from poles | mincirc |\n"
@@ -286,6 +286,13 @@ int jf_cmd_estimate(int argc, char **argv)
                         "lines %s%s\n", in, c.nbad, lines, c.nbad > shown ? ", ..." : "");
     }
     if (!e.orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
+    if (!e.orient_set && c.scanner) o.orient = JF_ORIENT_SCANNER; /* PTX */
+    if (o.orient == JF_ORIENT_SCANNER && !c.scanner) {
+        fprintf(stderr, "jetfit: %s: --orient scanner needs the scanner positions of a PTX "
+                        "file; this input has none\n", in);
+        jf_cloud_free(&c);
+        return 1;
+    }
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[32];

@@ -127,14 +127,15 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
             if (jf_cli_parse_list(val + 10, o->viewpoint, 3) != 3)
                 return bad_(bad, name, val, "expected viewpoint:X,Y,Z");
             o->orient = JF_ORIENT_VIEWPOINT;
-        } else if (!strcmp(val, "mst")) o->orient = JF_ORIENT_MST;
+        } else if (!strcmp(val, "scanner")) o->orient = JF_ORIENT_SCANNER;
+        else if (!strcmp(val, "mst")) o->orient = JF_ORIENT_MST;
         else if (!strncmp(val, "mst:", 4)) {
             if (jf_cli_parse_int(val + 4, 1, 256, &iv))
                 return bad_(bad, name, val, "expected mst:K with K in 1..256");
             o->orient = JF_ORIENT_MST;
             o->orient_k = (size_t)iv;
         } else
-            return bad_(bad, name, val, "expected none, input, viewpoint:X,Y,Z or mst[:K]");
+            return bad_(bad, name, val, "expected none, input, viewpoint:X,Y,Z, scanner or mst[:K]");
     } else if (!strcmp(name, "--normal")) {
         if (!strcmp(val, "poles")) o->normal = JF_NORMAL_POLES;
         else if (!strcmp(val, "mincirc")) o->normal = JF_NORMAL_MINCIRC;

@@ -306,6 +306,10 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         set_err(err, "--orient input: the input file has no normals");
         return JF_ERR_INVALID;
     }
+    if (o->orient == JF_ORIENT_SCANNER && (!c->scan || !c->scanner || !c->nscans)) {
+        set_err(err, "--orient scanner: the input has no scanner positions (PTX input has)");
+        return JF_ERR_INVALID;
+    }
     if (o->nb.kind == JF_NB_RINGS && !c->nfaces) {
         set_err(err, "--neighbors rings needs a mesh (faces in the input file)");
         return JF_ERR_INVALID;
@@ -472,6 +476,9 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     case JF_ORIENT_NONE: break;
     case JF_ORIENT_INPUT: st = jf_orient_input(out, n, c->nrm); break;
     case JF_ORIENT_VIEWPOINT: st = jf_orient_viewpoint(out, c->xyz, n, o->viewpoint); break;
+    case JF_ORIENT_SCANNER:
+        st = jf_orient_scanner(out, c->xyz, n, c->scan, c->scanner, c->nscans);
+        break;
     case JF_ORIENT_MST: st = jf_orient_mst_graph(out, c->xyz, n, x.graph, x.gk); break;
     default: st = JF_ERR_INVALID;
     }

@@ -21,7 +21,8 @@ typedef enum {
     JF_FMT_PTS,
     JF_FMT_CSV,
     JF_FMT_OFF,
-    JF_FMT_LAS    /* .las; .laz is recognised only to be refused */
+    JF_FMT_LAS,   /* .las; .laz is recognised only to be refused */
+    JF_FMT_PTX    /* .ptx (Leica/Faro scans with their scanner poses) */
 } jf_format;
 
 /* Format from the extension (any case); JF_FMT_UNKNOWN if none fits. */
@@ -43,6 +44,8 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
 jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c,
+                      jf_error *err);
+jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
                       jf_error *err);
 
 /* LAS output (io_las_write.c), used by the table writer: the header and

@@ -42,6 +42,8 @@ void jf_cloud_free(jf_cloud *c)
     free(c->nrm);
     free(c->face_off);
     free(c->face_idx);
+    free(c->scan);
+    free(c->scanner);
     memset(c, 0, sizeof *c);
 }
 
@@ -91,6 +93,8 @@ jf_format jf_format_from_path(const char *path)
         return JF_FMT_OFF;
     if (!strcmp(ext, "las") || !strcmp(ext, "laz"))
         return JF_FMT_LAS;
+    if (!strcmp(ext, "ptx"))
+        return JF_FMT_PTX;
     return JF_FMT_UNKNOWN;
 }
 
@@ -284,7 +288,8 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         err->msg[0] = '\0';
     if (len == 0)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "empty file");
-    if (fmt == JF_FMT_XYZ || fmt == JF_FMT_PTS || fmt == JF_FMT_CSV || fmt == JF_FMT_OFF) {
+    if (fmt == JF_FMT_XYZ || fmt == JF_FMT_PTS || fmt == JF_FMT_CSV || fmt == JF_FMT_OFF ||
+        fmt == JF_FMT_PTX) {
         /* a NUL is named as such, not reported as a strange number */
         const char *z = memchr(buf, '\0', len);
         if (z) {
@@ -311,10 +316,13 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     case JF_FMT_LAS:
         st = jf_read_las(buf, len, name, c, err);
         break;
+    case JF_FMT_PTX:
+        st = jf_read_ptx(buf, len, name, c, err);
+        break;
     default:
         st = jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                         "unknown file extension (expected .ply, .xyz, .pts, "
-                        ".txt, .csv, .off or .las)");
+                        ".txt, .csv, .off, .las or .ptx)");
     }
     /* a header announcing 0 vertices is as useless as an empty file */
     if (st == JF_OK && c->n == 0)
@@ -344,7 +352,7 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     if (fmt == JF_FMT_UNKNOWN)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "unknown file extension (expected .ply, .xyz, "
-                          ".pts, .txt, .csv, .off or .las)");
+                          ".pts, .txt, .csv, .off, .las or .ptx)");
     /* O_NONBLOCK: a FIFO or device must not block the open; only regular
      * files are read.  The file is read (not mapped): a file that shrinks
      * while it is read is an I/O error, never a SIGBUS. */

@@ -58,6 +58,21 @@ jf_status jf_orient_viewpoint(jf_result *res, const double *xyz, size_t n,
     return JF_OK;
 }
 
+jf_status jf_orient_scanner(jf_result *res, const double *xyz, size_t n,
+                            const uint32_t *scan, const double *scanner, size_t nscans)
+{
+    if (n && (!res || !xyz || !scan || !scanner)) return JF_ERR_INVALID;
+    for (size_t i = 0; i < n; i++)
+        if (scan[i] >= nscans) return JF_ERR_INVALID; /* before any flip */
+    for (size_t i = 0; i < n; i++) {
+        if (!orientable(&res[i])) continue;
+        const double *p = xyz + 3 * i, *s = scanner + 3 * (size_t)scan[i];
+        double dir[3] = {s[0] - p[0], s[1] - p[1], s[2] - p[2]};
+        orient_along(&res[i], dir);
+    }
+    return JF_OK;
+}
+
 /* ---- mst: Prim's algorithm with an indexed binary min-heap -------------- */
 
 #define NOT_SEEN UINT32_MAX        /* never reached                  */
