@@ -92,8 +92,12 @@ enum {
                                       normal read from the file         */
     JF_PT_SCALE_SELECTED = 1u << 13,/* scale selection chose a K other
                                       than the largest candidate        */
-    JF_PT_MESH_NONMANIFOLD = 1u << 14 /* rings: the vertex is on a mesh
+    JF_PT_MESH_NONMANIFOLD = 1u << 14,/* rings: the vertex is on a mesh
                                       edge shared by more than 2 faces  */
+    JF_PT_NORMAL_JET = 1u << 15    /* natural: tangent plane from the jet
+                                      of the N nearest points, ring on
+                                      the jet-projected cloud (noisy
+                                      cloud, docs/natural.md)           */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf
@@ -771,7 +775,12 @@ typedef enum {
     JF_NORMAL_POLES = 0,   /* Amenta-Bern pole, mincirc where unreliable */
     JF_NORMAL_MINCIRC = 1, /* minimum-circumradius triangle (§5.1)       */
     JF_NORMAL_PCA = 2,     /* the caller's (not computed here)           */
-    JF_NORMAL_INPUT = 3    /* the caller's (not computed here)           */
+    JF_NORMAL_INPUT = 3,   /* the caller's (not computed here)           */
+    JF_NORMAL_JET = 4,     /* jf_estimate: jet normal of knn:N, natural
+                              rings on the points projected on their jet
+                              (not computed here)                        */
+    JF_NORMAL_AUTO = 5     /* jf_estimate's default: JET when the cloud is
+                              noisy (JF_NATURAL_NOISY_*), else POLES     */
 } jf_normal_source;
 
 /* A pole whose reliability (pole distance / nearest-neighbour distance)
@@ -782,6 +791,16 @@ typedef enum {
  * [1,2): 21 vs 35 deg); below 1 mincirc wins on the clean rim of the
  * open patch (0.1 vs 26 deg) and on the noisy sphere (61 vs 68 deg). */
 #define JF_NATURAL_MIN_RELIABILITY 1.0
+
+/* JF_NORMAL_AUTO calls a cloud noisy when more than JF_NATURAL_NOISY_FRACTION
+ * of its points have a pole reliability below JF_NATURAL_NOISY_RELIABILITY:
+ * noise flattens the Voronoi cells, so the pole comes near the sample.
+ * Measured on 20,000-point `jetfit generate` clouds (ellipsoid, sphere,
+ * §6.1 surface, uniform and gradient density): the 10th percentile of the
+ * reliability is >= 22 when clean, <= 6 at Gaussian noise of 0.1% of the
+ * diagonal (median 17-20), <= 2.7 at 0.3% (docs/natural.md). */
+#define JF_NATURAL_NOISY_RELIABILITY 10.0
+#define JF_NATURAL_NOISY_FRACTION 0.1
 
 /* The 3D Delaunay triangulation of a cloud, kept as plain arrays (vertex
  * map, adjacency, poles, a copy of the coordinates): xyz may be freed
@@ -921,9 +940,12 @@ typedef struct {
     jf_nb_spec nb;           /* neighbourhood (default knn:32; K and N
                                 count the point itself).  natural with
                                 n = 0: max(2 N_n, 12) points            */
-    jf_normal_source normal; /* natural only: tangent planes from poles
-                                (default), mincirc, pca (PCA of the 16
-                                nearest points) or input (c->nrm)       */
+    jf_normal_source normal; /* natural only: tangent planes from auto
+                                (default: jet on a noisy cloud, else
+                                poles), poles, mincirc, pca (PCA of the
+                                16 nearest points), jet (jet normal of
+                                the N nearest, rings on the cloud
+                                projected on those jets) or input       */
     jf_orient_mode orient;   /* default none                            */
     double viewpoint[3];     /* JF_ORIENT_VIEWPOINT                     */
     size_t orient_k;         /* JF_ORIENT_MST: k of the k-NN graph (8)  */

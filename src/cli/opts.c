@@ -141,7 +141,9 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
         else if (!strcmp(val, "mincirc")) o->normal = JF_NORMAL_MINCIRC;
         else if (!strcmp(val, "pca")) o->normal = JF_NORMAL_PCA;
         else if (!strcmp(val, "input")) o->normal = JF_NORMAL_INPUT;
-        else return bad_(bad, name, val, "expected poles, mincirc, pca or input");
+        else if (!strcmp(val, "jet")) o->normal = JF_NORMAL_JET;
+        else if (!strcmp(val, "auto")) o->normal = JF_NORMAL_AUTO;
+        else return bad_(bad, name, val, "expected auto, poles, mincirc, pca, jet or input");
     } else if (!strcmp(name, "--robust")) {
         if (!strcmp(val, "none")) o->params.robust = JF_ROBUST_NONE;
         else if (!strcmp(val, "huber")) o->params.robust = JF_ROBUST_HUBER;

@@ -27,6 +27,7 @@
 #include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
+#include "planes_internal.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
 #define PCA_K 16       /* --normal pca: PCA of the 16 nearest points     */
@@ -38,7 +39,7 @@ void jf_estimate_opts_init(jf_estimate_opts *o)
     jf_params_init(&o->params);
     o->nb.kind = JF_NB_KNN;
     o->nb.k = JF_ESTIMATE_DEFAULT_K;
-    o->normal = JF_NORMAL_POLES;
+    o->normal = JF_NORMAL_AUTO;
     o->orient = JF_ORIENT_NONE;
     o->orient_k = 8;
 }
@@ -139,34 +140,107 @@ static jf_status pca_normals(const jf_index *ix, const double *xyz, size_t n, in
     return st;
 }
 
-/* Step 1 for natural[:N]: triangulation and tangent-plane normals. */
+/* JF_NORMAL_AUTO's test (jetfit.h): more than JF_NATURAL_NOISY_FRACTION of
+ * the kept points have a pole reliability below JF_NATURAL_NOISY_RELIABILITY. */
+static int noisy_cloud(const jf_natural *nt, const double *rel, size_t n)
+{
+    size_t kept = 0, low = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (jf_natural_kept(nt, i) != i) continue; /* non-finite or duplicate */
+        kept++;
+        low += rel[i] < JF_NATURAL_NOISY_RELIABILITY;
+    }
+    return (double)low > JF_NATURAL_NOISY_FRACTION * (double)kept;
+}
+
+/* JF_NORMAL_JET (planes.c): the plane of point i is the jet normal of its
+ * N nearest points, and the triangulation is built on the points moved to
+ * their jets; the fit later uses the original points (x->xyz).  A point
+ * whose jet failed (too few points) gets the pole or mincirc normal of
+ * that triangulation, with its flags. */
+static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params *prm,
+                           jf_error *err)
+{
+    size_t n = c->n;
+    jf_index *own = NULL;
+    double *proj = malloc(3 * n * sizeof *proj);
+    jf_status st = proj ? JF_OK : JF_ERR_NOMEM;
+    if (st == JF_OK && !x->ix && (st = jf__index_build_threads(c->xyz, n, nt, &own)) != JF_OK)
+        set_err(err, "building the k-d tree failed");
+    /* x->nflags holds "jet ok" until turned into flags below */
+    if (st == JF_OK)
+        st = jf__planes_knn_jet(x->ix ? x->ix : own, c->xyz, n, x->want, prm, nt, x->nrm_own,
+                                proj, x->nflags);
+    jf_index_free(own); /* before the triangulation: a lower peak */
+    if (st == JF_OK && (st = jf_natural_create(proj, n, &x->nt)) != JF_OK)
+        set_err(err, "natural neighbours: building the Delaunay triangulation failed");
+    free(proj);
+    if (st != JF_OK) return st;
+    size_t nfail = 0;
+    for (size_t i = 0; i < n; i++) {
+        nfail += !x->nflags[i] && finite3(c->xyz + 3 * i);
+        x->nflags[i] = x->nflags[i] ? JF_PT_NORMAL_JET : 0;
+    }
+    if (!nfail) return JF_OK;
+    double *pn = malloc(3 * n * sizeof *pn);
+    unsigned *pf = calloc(n, sizeof *pf);
+    if (!pn || !pf) st = JF_ERR_NOMEM;
+    if (st == JF_OK) st = jf_natural_normals(x->nt, JF_NORMAL_POLES, nt, pn, pf, NULL);
+    for (size_t i = 0; st == JF_OK && i < n; i++)
+        if (!x->nflags[i] && finite3(c->xyz + 3 * i)) {
+            memcpy(x->nrm_own + 3 * i, pn + 3 * i, sizeof(double[3]));
+            x->nflags[i] = pf[i];
+        }
+    free(pn);
+    free(pf);
+    if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
+    return st;
+}
+
+/* Step 1 for natural[:N]: triangulation and tangent-plane normals.  AUTO
+ * is POLES on a clean cloud and JET on a noisy one (docs/natural.md). */
 static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src, int nt,
-                               jf_error *err)
+                               const jf_params *prm, jf_error *err)
 {
     size_t n = c->n;
     x->nflags = calloc(n, sizeof *x->nflags);
     if (!x->nflags) return JF_ERR_NOMEM;
+    if (src == JF_NORMAL_INPUT && !c->nrm) {
+        set_err(err, "--normal input: the input file has no normals");
+        return JF_ERR_INVALID;
+    }
+    if (src != JF_NORMAL_INPUT) {
+        x->nrm_own = malloc(3 * n * sizeof *x->nrm_own);
+        if (!x->nrm_own) return JF_ERR_NOMEM;
+        x->nrm = x->nrm_own;
+    }
+    if (src == JF_NORMAL_JET) return jet_setup(x, c, nt, prm, err);
     jf_status st = jf_natural_create(c->xyz, n, &x->nt);
     if (st != JF_OK) {
         set_err(err, "natural neighbours: building the Delaunay triangulation failed");
         return st;
     }
     if (src == JF_NORMAL_INPUT) {
-        if (!c->nrm) {
-            set_err(err, "--normal input: the input file has no normals");
-            return JF_ERR_INVALID;
-        }
         x->nrm = c->nrm;
         for (size_t i = 0; i < n; i++) x->nflags[i] = JF_PT_NORMAL_INPUT;
         return JF_OK;
     }
-    x->nrm_own = malloc(3 * n * sizeof *x->nrm_own);
-    if (!x->nrm_own) return JF_ERR_NOMEM;
-    x->nrm = x->nrm_own;
     if (src == JF_NORMAL_PCA) return pca_normals(x->ix, c->xyz, n, nt, x->nrm_own, x->nflags);
-    st = jf_natural_normals(x->nt, src, nt, x->nrm_own, x->nflags, NULL);
-    if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
-    return st;
+    double *rel = NULL;
+    if (src == JF_NORMAL_AUTO && !(rel = malloc(n * sizeof *rel))) return JF_ERR_NOMEM;
+    st = jf_natural_normals(x->nt, src == JF_NORMAL_AUTO ? JF_NORMAL_POLES : src, nt,
+                            x->nrm_own, x->nflags, rel);
+    int noisy = st == JF_OK && rel && noisy_cloud(x->nt, rel, n);
+    free(rel);
+    if (st != JF_OK) {
+        set_err(err, "natural neighbours: tangent-plane normals failed");
+        return st;
+    }
+    if (!noisy) return JF_OK;
+    jf_natural_free(x->nt); /* rebuilt on the projected points */
+    x->nt = NULL;
+    memset(x->nflags, 0, n * sizeof *x->nflags);
+    return jet_setup(x, c, nt, prm, err);
 }
 
 /* Neighbourhood of point i (at p) into idx[0..cap-1] and, for the k-d
@@ -361,7 +435,7 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     if (o->nb.kind == JF_NB_RINGS &&
         (st = jf_mesh_build(n, c->nfaces, c->face_off, c->face_idx, &x.mesh, err)) != JF_OK)
         goto out;
-    if (o->nb.kind == JF_NB_NATURAL && (st = natural_setup(&x, c, o->normal, nt, err)) != JF_OK) {
+    if (o->nb.kind == JF_NB_NATURAL && (st = natural_setup(&x, c, o->normal, nt, p, err)) != JF_OK) {
         if (err && !err->msg[0]) set_err(err, jf_strerror(st));
         goto out;
     }

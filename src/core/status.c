@@ -27,7 +27,7 @@ static const char *const flag_names[] = {
     "lowered_cond", "lowered_rank", "lowered_few", "umbilic",
     "failed", "nonfinite", "few_neighbors", "normal_poles",
     "normal_mincirc", "normal_fallback", "robust_noconv", "orient_unknown",
-    "normal_input", "scale_selected", "mesh_nonmanifold",
+    "normal_input", "scale_selected", "mesh_nonmanifold", "normal_jet",
 };
 
 char *jf_point_status_str(unsigned status, char *buf, size_t len)
