@@ -136,7 +136,10 @@ START_TEST(header_lies)
     memcpy(m, b, len);
     put32(m + 107, 21); /* one point more than the file holds */
     refused("count.las", m, len, "cannot fit");
+    refused("count.las", m, len, "point count 21");
+    refused("count.las", m, len, "point record 21 is missing");
     refused("trunc.las", b, len - 5, "cannot fit");
+    refused("trunc.las", b, len - 5, "point record 20 is missing or cut short");
     memcpy(m, b, len);
     put32(m + 96, (uint32_t)len + 10); /* point data past the end */
     refused("off.las", m, len, "offset to point data");
