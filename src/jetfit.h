@@ -794,15 +794,11 @@ typedef enum {
  * open patch (0.1 vs 26 deg) and on the noisy sphere (61 vs 68 deg). */
 #define JF_NATURAL_MIN_RELIABILITY 1.0
 
-/* JF_NORMAL_AUTO calls a cloud noisy when more than JF_NATURAL_NOISY_FRACTION
- * of its points have a pole reliability below JF_NATURAL_NOISY_RELIABILITY:
- * noise flattens the Voronoi cells, so the pole comes near the sample.
- * Measured on 20,000-point `jetfit generate` clouds (ellipsoid, sphere,
- * §6.1 surface, uniform and gradient density): the 10th percentile of the
- * reliability is >= 22 when clean, <= 6 at Gaussian noise of 0.1% of the
- * diagonal (median 17-20), <= 2.7 at 0.3% (docs/natural.md). */
-#define JF_NATURAL_NOISY_RELIABILITY 10.0
-#define JF_NATURAL_NOISY_FRACTION 0.1
+/* JF_NORMAL_AUTO calls a cloud noisy when the median, over up to 2000
+ * points, of the RMS residual of a degree-2 jet fitted to 20 natural
+ * neighbours, relative to their RMS distance to the point, is above this
+ * (a clean surface leaves a residual of higher order; docs/natural.md). */
+#define JF_NATURAL_NOISY_RESIDUAL 0.02
 
 /* The 3D Delaunay triangulation of a cloud, kept as plain arrays (vertex
  * map, adjacency, poles, a copy of the coordinates): xyz may be freed

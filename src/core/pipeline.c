@@ -148,17 +148,57 @@ static jf_status pca_normals(const jf_index *ix, const double *xyz, size_t n, in
     return st;
 }
 
-/* JF_NORMAL_AUTO's test (jetfit.h): more than JF_NATURAL_NOISY_FRACTION of
- * the kept points have a pole reliability below JF_NATURAL_NOISY_RELIABILITY. */
-static int noisy_cloud(const jf_natural *nt, const double *rel, size_t n)
+static int cmp_double(const void *a, const void *b)
 {
-    size_t kept = 0, low = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (jf_natural_kept(nt, i) != i) continue; /* non-finite or duplicate */
-        kept++;
-        low += rel[i] < JF_NATURAL_NOISY_RELIABILITY;
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* JF_NORMAL_AUTO's test (jetfit.h): at up to NOISE_SAMPLES points spread
+ * over the input order, the RMS residual of a plain degree-2 jet fitted to
+ * the NOISE_N natural neighbours in the pole plane, relative to their RMS
+ * distance to the point.  A clean surface leaves a residual of higher
+ * order (~ r^3 / R^2); noise leaves ~ sigma.  Noisy: the median ratio is
+ * above JF_NATURAL_NOISY_RESIDUAL. */
+#define NOISE_SAMPLES 2000
+#define NOISE_N 20
+static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const double *nrm,
+                             size_t n, int *noisy)
+{
+    *noisy = 0;
+    jf_params p;
+    jf_params_init(&p);
+    p.degree = 2;
+    jf_fitter *f = NULL;
+    jf_natural_ws *ws = NULL;
+    double *ratio = malloc(NOISE_SAMPLES * sizeof *ratio);
+    jf_status st = ratio ? jf_fitter_create(&p, &f) : JF_ERR_NOMEM;
+    if (st == JF_OK) st = jf_natural_ws_create(nt, &ws);
+    size_t m = 0, step = n > NOISE_SAMPLES ? n / NOISE_SAMPLES : 1;
+    for (size_t i = 0; st == JF_OK && i < n && m < NOISE_SAMPLES; i += step) {
+        uint32_t idx[NOISE_N];
+        double pts[3 * NOISE_N], d2 = 0;
+        size_t found = 0;
+        jf_result r;
+        if (jf_natural_kept(nt, i) != i || !finite3(nrm + 3 * i)) continue;
+        if ((st = jf_natural_neighbors(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
+            break;
+        for (size_t j = 0; j < found; j++)
+            for (int c = 0; c < 3; c++) {
+                pts[3 * j + c] = xyz[3 * (size_t)idx[j] + c];
+                d2 += (pts[3 * j + c] - xyz[3 * i + c]) * (pts[3 * j + c] - xyz[3 * i + c]);
+            }
+        if (found < NOISE_N || (st = jf_fit_point(f, xyz + 3 * i, pts, found, &r)) != JF_OK) continue;
+        if (r.degree == 2 && d2 > 0) ratio[m++] = r.residual / sqrt(d2 / (double)found);
     }
-    return (double)low > JF_NATURAL_NOISY_FRACTION * (double)kept;
+    if (st == JF_OK && m > 0) {
+        qsort(ratio, m, sizeof *ratio, cmp_double);
+        *noisy = ratio[m / 2] > JF_NATURAL_NOISY_RESIDUAL;
+    }
+    jf_natural_ws_free(ws);
+    jf_fitter_free(f);
+    free(ratio);
+    return st;
 }
 
 /* JF_NORMAL_JET (planes.c): the plane of point i is the jet normal of its
@@ -234,12 +274,10 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         return JF_OK;
     }
     if (src == JF_NORMAL_PCA) return pca_normals(x->ix, c->xyz, n, nt, x->nrm_own, x->nflags);
-    double *rel = NULL;
-    if (src == JF_NORMAL_AUTO && !(rel = malloc(n * sizeof *rel))) return JF_ERR_NOMEM;
     st = jf_natural_normals(x->nt, src == JF_NORMAL_AUTO ? JF_NORMAL_POLES : src, nt,
-                            x->nrm_own, x->nflags, rel);
-    int noisy = st == JF_OK && rel && noisy_cloud(x->nt, rel, n);
-    free(rel);
+                            x->nrm_own, x->nflags, NULL);
+    int noisy = 0;
+    if (st == JF_OK && src == JF_NORMAL_AUTO) st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy);
     if (st != JF_OK) {
         set_err(err, "natural neighbours: tangent-plane normals failed");
         return st;
