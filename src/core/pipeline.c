@@ -27,6 +27,7 @@
 #include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
+#include "parts.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
 #define PCA_K 16       /* --normal pca: PCA of the 16 nearest points     */
@@ -285,6 +286,13 @@ static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
                       jf_error *err)
 {
+    return jf__estimate_masked(c, o, NULL, out, err);
+}
+
+/* parts.h: the points of a part's halo are neighbours, not fitted */
+jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                              jf_result *out, jf_error *err)
+{
     const char *bad = NULL;
     if (err) err->msg[0] = '\0';
     if (!c || !o || (c->n && (!c->xyz || !out))) {
@@ -430,7 +438,8 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
             for (size_t k = beg; k < end && wst == JF_OK; k++) {
                 const size_t i = walk[k];
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : c->xyz + 3 * i;
-                wst = fit_one(&w, &x, i, pt, &out[i]);
+                if (fit && !fit[i]) nan_result(&out[i], JF_PT_NONFINITE);
+                else wst = fit_one(&w, &x, i, pt, &out[i]);
             }
             if (wst != JF_OK) {
 #pragma omp atomic write
