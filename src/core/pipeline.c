@@ -35,6 +35,7 @@
 #include "index_internal.h"
 #include "jetfit.h"
 #include "orient_internal.h"
+#include "parts.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
 #define PCA_K 16       /* --normal pca: PCA of the 16 nearest points     */
@@ -374,6 +375,7 @@ typedef struct {
     const jf_cloud *c;
     const jf_estimate_opts *o;
     nbctx *x;
+    const uint8_t *fit;   /* fit only where fit[i] (NULL: all; parts.h) */
     jf_result *out;
     jf_block_fn sink;
     void *user;
@@ -445,17 +447,24 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
             seen = failed;
             if (seen != JF_OK || wst != JF_OK) continue;
             size_t beg = ch * CHUNK, end = beg + CHUNK < nwalk ? beg + CHUNK : nwalk;
+            const uint8_t *fit = R->fit;
+            size_t m = 0; /* block modes: results in w.blk */
             for (size_t k = beg; k < end && wst == JF_OK;) {
                 const size_t i = walk[k];
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : R->c->xyz + 3 * i;
-                if (blocks) w.bidx[k - beg] = (uint32_t)i;
-                jf_result *d0 = blocks ? &w.blk[k - beg] : &R->out[i];
-                if (x->plain && k + 1 < end) {
+                if (fit && !fit[i]) { /* a halo point: a neighbour only */
+                    if (!blocks) nan_result(&R->out[i], JF_PT_NONFINITE);
+                    k++;
+                    continue;
+                }
+                if (blocks) w.bidx[m] = (uint32_t)i;
+                jf_result *d0 = blocks ? &w.blk[m++] : &R->out[i];
+                if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
                     const size_t i1 = walk[k + 1];
                     const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : R->c->xyz + 3 * i1;
-                    if (blocks) w.bidx[k + 1 - beg] = (uint32_t)i1;
+                    if (blocks) w.bidx[m] = (uint32_t)i1;
                     wst = fit_two(&w, x, i, pt, i1, pt1, d0,
-                                  blocks ? &w.blk[k + 1 - beg] : &R->out[i1]);
+                                  blocks ? &w.blk[m++] : &R->out[i1]);
                     k += 2;
                 } else {
                     wst = fit_one(&w, x, i, pt, d0);
@@ -463,7 +472,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                 }
             }
             _mm_sfence(); /* the streamed rows (store_row), before anyone reads them */
-            if (wst == JF_OK && blocks) wst = deliver(R, w.bidx, w.blk, end - beg);
+            if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.blk, m);
             if (wst != JF_OK) {
 #pragma omp atomic write
                 failed = wst;
@@ -520,9 +529,10 @@ static jf_status pass_status(jf_status failed, jf_error *err)
     return failed;
 }
 
-/* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL). */
-static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
-                          jf_block_fn sink, void *user, jf_error *err)
+/* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
+ * parts.h's mask (NULL: every point). */
+static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                          jf_result *out, jf_block_fn sink, void *user, jf_error *err)
 {
     const char *bad = NULL;
     if (err) err->msg[0] = '\0';
@@ -592,7 +602,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_resul
     }
 
     const int mst_blocks = !out && o->orient == JF_ORIENT_MST;
-    runctx R = {c, o, &x, out, sink, user, mst_blocks, NULL, NULL, NULL, 0, mst_blocks ? 2 * n : n};
+    runctx R = {c, o, &x, fit, out, sink, user, mst_blocks, NULL, NULL, NULL, 0, mst_blocks ? 2 * n : n};
     jf_status st = JF_OK;
     jf_index *ix = NULL;
     uint32_t *order = NULL;
@@ -730,11 +740,18 @@ out:
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
                       jf_error *err)
 {
-    return estimate(c, o, out, NULL, NULL, err);
+    return estimate(c, o, NULL, out, NULL, NULL, err);
+}
+
+/* parts.h: the points of a part's halo are neighbours, not fitted */
+jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                              jf_result *out, jf_error *err)
+{
+    return estimate(c, o, fit, out, NULL, NULL, err);
 }
 
 jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o, jf_block_fn sink,
                              void *user, jf_error *err)
 {
-    return estimate(c, o, NULL, sink, user, err);
+    return estimate(c, o, NULL, NULL, sink, user, err);
 }
