@@ -154,7 +154,7 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     size_t n = c->n;
     x->nflags = calloc(n, sizeof *x->nflags);
     if (!x->nflags) return JF_ERR_NOMEM;
-    jf_status st = jf_natural_create(c->xyz, n, &x->nt);
+    jf_status st = jf_natural_create_threads(c->xyz, n, nt, &x->nt);
     if (st != JF_OK) {
         set_err(err, "natural neighbours: building the Delaunay triangulation failed");
         return st;
