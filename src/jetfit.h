@@ -649,22 +649,23 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
  * jf_writer_las_frame / jf_writer_faces and instead of any
  * jf_writer_row(s); then jf_writer_put from any number of threads at
  * once; then jf_writer_commit.  The file's bytes are exactly those that
- * jf_writer_rows would write with the rows in row order.  Binary PLY and
- * LAS have fixed-size records: each row is written in place (pwrite at
- * header + row x record size).  Text (.csv, .xyz, .txt, ascii PLY): each
- * row goes as ncols raw doubles to a second temporary in the output's
- * folder (a jf_tmpfile: removed on failure, abort or a signal), which
- * commit converts to text in row order in one sequential pass and
- * removes.  Begin: JF_ERR_INVALID after a row was written, else the
- * header's write status. */
-jf_status jf_writer_begin_put(jf_writer *w);
+ * jf_writer_rows would write with the rows in row order, for every
+ * format.  The rows go as raw doubles to a second temporary in the
+ * output's folder (a jf_tmpfile: removed on failure, abort or a signal;
+ * about nrows x (8 ncols + 8) bytes), bucketed by row number so that its
+ * writes are large whatever the order; commit reads it back in row order
+ * (one bucket of up to 32 MiB at a time), formats the rows with
+ * jf_writer_rows on `threads` threads (<= 0: the OpenMP default) and
+ * removes it.  Memory: 64 KiB of staging per 32 MiB of rows.  Begin:
+ * JF_ERR_INVALID after a row was written, else the header's write or
+ * the spool's creation status. */
+jf_status jf_writer_begin_put(jf_writer *w, int threads);
 
 /* Writes m rows: vals[j * ncols ..] is row rows[j] (< nrows), in any
  * order; over the writer's life each row must be put exactly once
- * (commit checks the count).  Thread-safe against other jf_writer_put
- * calls on w; allocates one buffer of m records per call.  After a
- * failure (a write error, a row out of range) every call returns it and
- * commit reports it. */
+ * (commit checks).  Thread-safe against other jf_writer_put calls on w;
+ * no allocation.  After a failure (a write error, a row out of range)
+ * every call returns it and commit reports it. */
 jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, size_t m);
 
 /* Flushes, closes, checks the row count and renames the temporary onto

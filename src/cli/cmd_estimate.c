@@ -360,7 +360,7 @@ int jf_cmd_estimate(int argc, char **argv)
     const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
     sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
-    if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w) != JF_OK) {
+    if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
         /* a failed begin is reported by commit's message below */
         if (!sk.rows || !sk.tl || (!quiet && !sk.cond))
             fprintf(stderr, "jetfit: out of memory (%zu points)\n", c.n);

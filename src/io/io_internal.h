@@ -56,6 +56,22 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
 jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, jf_cloud *c,
                                jf_error *err);
 
+/* io_spool.c: rows put in any order from any thread, drained in row
+ * order (the table writer's positioned rows).  open: a temporary beside
+ * `final` for nrows rows of ncols doubles, buckets of bucket_bytes of
+ * values (0: 32 MiB; small values are for tests).  put: thread-safe; JF_ERR_IO /
+ * _INVALID (a row >= nrows, or more rows than a bucket holds) stick.
+ * drain (once, one thread): every row must have been put exactly once;
+ * emit gets the rows in order, a bucket (up to 32 MiB of values) at a
+ * time; err "NAME: reason".  free: removes the temporary (NULL ok). */
+typedef struct jf_spool jf_spool;
+jf_status jf__spool_open(const char *final, size_t nrows, size_t ncols, size_t bucket_bytes,
+                         jf_spool **s, jf_error *err);
+jf_status jf__spool_put(jf_spool *s, const uint32_t *rows, const double *vals, size_t m);
+jf_status jf__spool_drain(jf_spool *s, jf_status (*emit)(void *, const double *, size_t),
+                          void *user, const char *name, jf_error *err);
+void jf__spool_free(jf_spool *s);
+
 /* LAS output (io_las_write.c), used by the table writer: the header and
  * Extra Bytes VLR size, the record size, the frame (scale, offset and
  * stored bounds) of a cloud, one record, and the header written at

@@ -12,8 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "test_cli_util.h"
+#include <omp.h>
+
+#include "io_internal.h"
 #include "jetfit.h"
+#include "test_cli_util.h"
 
 /* ---- fixtures ------------------------------------------------------- */
 
@@ -181,7 +184,7 @@ static jf_status write_blocks(const char *path, const jf_cloud *c, const jf_esti
     ck_assert_int_eq(jf_writer_open(path, cols, nc, c->n, ascii, &w, &err), JF_OK);
     ck_assert_int_eq(jf_writer_faces(w, c->nfaces, c->face_off, c->face_idx), JF_OK);
     ck_assert_int_eq(jf_writer_las_frame(w, c->xyz, c->n), JF_OK);
-    ck_assert_int_eq(jf_writer_begin_put(w), JF_OK);
+    ck_assert_int_eq(jf_writer_begin_put(w, 2), JF_OK);
     sinkctx s = {w, c->xyz, monge, nc, 0, fail_after};
     jf_status st = jf_estimate_blocks(c, o, sink, &s, &err);
     if (st != JF_OK) {
@@ -343,7 +346,7 @@ START_TEST(put_checks_rows)
         jf_writer *w;
         jf_error err;
         ck_assert_int_eq(jf_writer_open(p, cols, 3, 2, 0, &w, &err), JF_OK);
-        ck_assert_int_eq(jf_writer_begin_put(w), JF_OK);
+        ck_assert_int_eq(jf_writer_begin_put(w, 2), JF_OK);
         ck_assert_int_eq(jf_writer_row(w, v), JF_ERR_INVALID); /* no appending */
         uint32_t r[2] = {1, k == 2 ? 2 : 1};
         jf_status st = jf_writer_put(w, r, v, 2);
@@ -359,12 +362,71 @@ START_TEST(put_checks_rows)
     ck_assert_int_eq(jf_writer_rows(w, v, 2, 1), JF_OK);
     ck_assert_int_eq(jf_writer_commit(w, &err), JF_OK);
     ck_assert_int_eq(jf_writer_open(cli_path("b.csv"), cols, 3, 2, 0, &w, &err), JF_OK);
-    ck_assert_int_eq(jf_writer_begin_put(w), JF_OK);
+    ck_assert_int_eq(jf_writer_begin_put(w, 2), JF_OK);
     const uint32_t r[2] = {1, 0};
     const double sw[6] = {4, 5, 6, 1, 2, 3};
     ck_assert_int_eq(jf_writer_put(w, r, sw, 2), JF_OK);
     ck_assert_int_eq(jf_writer_commit(w, &err), JF_OK);
     assert_same_file(cli_path("a.csv"), cli_path("b.csv"), "csv rows put out of order");
+    cli_teardown();
+}
+END_TEST
+
+/* The row spool with buckets of 100 rows (the default is 32 MiB of
+ * values): 10007 rows put in a random order from 2 threads come back in
+ * row order, each once; a row given twice or missing is an error. */
+static size_t drained;
+static jf_status check_rows(void *user, const double *v, size_t m)
+{
+    (void)user;
+    for (size_t r = 0; r < m; r++, drained++)
+        for (int j = 0; j < 3; j++)
+            if (v[3 * r + (size_t)j] != (double)drained * 3 + j) return JF_ERR_FORMAT;
+    return JF_OK;
+}
+
+START_TEST(spool_buckets)
+{
+    cli_setup();
+    enum { N = 10007 };
+    uint32_t *perm = malloc(N * sizeof *perm);
+    double *v = malloc(3 * N * sizeof *v);
+    for (size_t i = 0; i < N; i++) perm[i] = (uint32_t)i;
+    for (size_t i = N; i > 1; i--) {
+        size_t j = (size_t)(urand() * (double)i);
+        uint32_t t = perm[i - 1];
+        perm[i - 1] = perm[j];
+        perm[j] = t;
+    }
+    for (size_t i = 0; i < N; i++)
+        for (int j = 0; j < 3; j++) v[3 * i + (size_t)j] = (double)perm[i] * 3 + j;
+    for (int mode = 0; mode < 3; mode++) {
+        jf_spool *s;
+        jf_error err;
+        ck_assert_int_eq(jf__spool_open(cli_path("out.ply"), N, 3, 2400, &s, &err), JF_OK);
+        size_t n = mode == 2 ? N - 1 : N; /* mode 2: the last row missing */
+#pragma omp parallel for num_threads(2) schedule(dynamic, 1)
+        for (size_t b = 0; b < n; b += 37) {
+            size_t m = n - b < 37 ? n - b : 37;
+            ck_assert_int_eq(jf__spool_put(s, perm + b, v + 3 * b, m), JF_OK);
+        }
+        if (mode == 1) /* a row twice (and so one missing in its bucket) */
+            ck_assert_int_eq(jf__spool_put(s, perm, v, 1), JF_OK);
+        drained = 0;
+        jf_status st = jf__spool_drain(s, check_rows, NULL, "out.ply", &err);
+        if (mode == 0) {
+            ck_assert_int_eq(st, JF_OK);
+            ck_assert_uint_eq(drained, N);
+        } else {
+            ck_assert_int_ne(st, JF_OK);
+            ck_assert_msg(strstr(err.msg, "missing or given twice"), "%s", err.msg);
+        }
+        ck_assert_int_eq(cli_count_files(), 1); /* the spool, until freed */
+        jf__spool_free(s);
+        ck_assert_int_eq(cli_count_files(), 0);
+    }
+    free(perm);
+    free(v);
     cli_teardown();
 }
 END_TEST
@@ -423,6 +485,7 @@ static Suite *suite(void)
     tcase_add_loop_test(t, blocks_equal_whole_array, 0, (int)(sizeof configs / sizeof *configs));
     tcase_add_test(t, failing_sink_leaves_nothing);
     tcase_add_test(t, put_checks_rows);
+    tcase_add_test(t, spool_buckets);
     tcase_add_test(t, command_equals_whole_array);
     suite_add_tcase(s, t);
     return s;
