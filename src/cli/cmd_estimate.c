@@ -62,6 +62,11 @@ static void usage(FILE *f)
         "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
+        "  --memory SIZE         memory for the points and their k-d tree, e.g. 8G,\n"
+        "                        256M (K, M, G, T: powers of 1024; default: the\n"
+        "                        available memory, MemAvailable); when ~64 bytes per\n"
+        "                        point would not fit, the cloud is fitted in parts\n"
+        "                        with exact halos, one at a time (same output)\n"
         "  --quiet               no progress line, no summary\n"
         "  -h, --help            this text\n"
         "\n"
@@ -69,6 +74,39 @@ static void usage(FILE *f)
         "         degree neighbors cond residual status\n"
         "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
         JF_MAX_DEGREE, p.degree, p.max_cond, omp_get_max_threads());
+}
+
+/* SIZE: a number of bytes with an optional K, M, G or T (powers of 1024,
+ * an optional trailing B).  0 if it is not one. */
+static unsigned long long parse_size(const char *s)
+{
+    char *end = NULL;
+    if (!s || !*s || *s == '-') return 0;
+    double v = strtod(s, &end);
+    if (end == s || !(v > 0)) return 0;
+    double mul = 1;
+    switch (*end) {
+    case 'k': case 'K': mul = 1024.0, end++; break;
+    case 'm': case 'M': mul = 1048576.0, end++; break;
+    case 'g': case 'G': mul = 1073741824.0, end++; break;
+    case 't': case 'T': mul = 1099511627776.0, end++; break;
+    default: break;
+    }
+    if (*end == 'b' || *end == 'B') end++;
+    if (*end || !(v * mul < 1.8e19) || v * mul < 1) return 0;
+    return (unsigned long long)(v * mul);
+}
+
+/* MemAvailable of /proc/meminfo in bytes, or 0 when unknown. */
+static unsigned long long mem_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    char line[256];
+    unsigned long long kb = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+    if (f) fclose(f);
+    return kb * 1024ULL;
 }
 
 static int bad_option(const char *opt, const char *val, const char *why)
@@ -252,6 +290,7 @@ int jf_cmd_estimate(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL;
     int quiet = 0, ascii = 0;
+    unsigned long long memory = 0; /* --memory; 0: MemAvailable */
     jf_cli_est e;
     jf_cli_bad bad;
     jf_cli_est_init(&e);
@@ -289,7 +328,7 @@ int jf_cmd_estimate(int argc, char **argv)
         } else {
             snprintf(name, sizeof name, "%s", a);
             if (i + 1 >= argc)
-                return strcmp(name, "-o") && strcmp(name, "--output") &&
+                return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--memory") &&
                                jf_cli_est_takes_value(name) != 1
                            ? bad_option("unknown option", a, "not an option of estimate")
                            : bad_option(a, "", "needs a value");
@@ -297,6 +336,9 @@ int jf_cmd_estimate(int argc, char **argv)
         }
         if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
             out = val;
+        } else if (!strcmp(name, "--memory")) {
+            if (!(memory = parse_size(val)))
+                return bad_option("--memory", val, "expected a size such as 8G, 256M or 1500000000");
         } else if (jf_cli_est_takes_value(name) != 1) {
             return bad_option("unknown option", a, "not an option of estimate");
         } else if (jf_cli_est_option(&e, name, val, &bad)) {
@@ -378,7 +420,24 @@ int jf_cmd_estimate(int argc, char **argv)
         o.progress = progress;
         o.progress_user = &ps;
     }
-    st = jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
+    /* --memory: parts when the points and their tree (about 64 bytes per
+     * point) would not fit; then each part's tree and halo take about
+     * half of it (docs/scale.md) */
+    if (!memory) memory = mem_available();
+    int nparts = 1;
+    if (memory && 64.0 * (double)c.n > (double)memory) {
+        double p = ceil(128.0 * (double)c.n / (double)memory);
+        nparts = p > 65536 ? 65536 : (int)p;
+        if (o.nb.kind == JF_NB_RINGS || o.nb.kind == JF_NB_NATURAL || o.orient == JF_ORIENT_MST) {
+            if (!quiet)
+                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
+                                "natural and mst need the whole cloud: fitting it whole\n",
+                        c.n, memory >> 20);
+            nparts = 1;
+        }
+    }
+    st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
+                    : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
     free(sk.rows);
     if (st != JF_OK) {
         /* a failed write: the writer's own message says which file and

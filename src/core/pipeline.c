@@ -755,3 +755,10 @@ jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o, jf_bl
 {
     return estimate(c, o, NULL, NULL, sink, user, err);
 }
+
+jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
+                                     const uint8_t *fit, jf_block_fn sink, void *user,
+                                     jf_error *err)
+{
+    return estimate(c, o, fit, NULL, sink, user, err);
+}

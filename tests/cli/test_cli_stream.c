@@ -316,6 +316,65 @@ START_TEST(blocks_equal_whole_array)
 }
 END_TEST
 
+/* Parts with exact halos (jf_estimate_parts, `--memory`): the same file
+ * as the whole cloud's blocks for 2, 3, 7 and 60 parts (60: parts of ~10
+ * points, fewer than K; the duplicates and the NaN point are in the
+ * fixture) for every k-d tree neighbourhood and per-point orientation. */
+static jf_status write_parts(const char *path, const jf_cloud *c, const jf_estimate_opts *o,
+                             int nparts)
+{
+    jf_column cols[32];
+    int monge = o->params.monge_degree;
+    size_t nc = columns(monge, cols);
+    jf_error err;
+    jf_writer *w;
+    ck_assert_int_eq(jf_writer_open(path, cols, nc, c->n, 0, &w, &err), JF_OK);
+    ck_assert_int_eq(jf_writer_faces(w, c->nfaces, c->face_off, c->face_idx), JF_OK);
+    ck_assert_int_eq(jf_writer_las_frame(w, c->xyz, c->n), JF_OK);
+    ck_assert_int_eq(jf_writer_begin_put(w, 2), JF_OK);
+    sinkctx s = {w, c->xyz, monge, nc, 0, 0};
+    jf_status st = jf_estimate_parts(c, o, nparts, sink, &s, &err);
+    if (st != JF_OK) {
+        jf_writer_abort(w);
+        return st;
+    }
+    return jf_writer_commit(w, &err);
+}
+
+START_TEST(parts_equal_whole_cloud)
+{
+    const config *cf = &configs[_i];
+    jf_cloud c;
+    make_cloud(&c, 24);
+    cli_setup();
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    o.params.monge_degree = 2;
+    o.threads = 2;
+    cf->set(&o);
+    const int kd = o.nb.kind <= JF_NB_KNN_RADIUS && o.orient != JF_ORIENT_MST;
+    char pa[512];
+    snprintf(pa, sizeof pa, "%s", cli_path("whole.ply"));
+    ck_assert_int_eq(write_blocks(pa, &c, &o, 0, 0), JF_OK);
+    static const int P[] = {2, 3, 7, 60};
+    for (size_t k = 0; k < 4; k++) {
+        char nb[32];
+        snprintf(nb, sizeof nb, "parts%d.ply", P[k]);
+        jf_status st = write_parts(cli_path(nb), &c, &o, P[k]);
+        if (!kd) {
+            ck_assert_int_eq(st, JF_ERR_UNSUPPORTED); /* rings, natural, mst */
+            continue;
+        }
+        ck_assert_int_eq(st, JF_OK);
+        char what[128];
+        snprintf(what, sizeof what, "%s, %d parts", cf->name, P[k]);
+        assert_same_file(pa, cli_path(nb), what);
+    }
+    cli_teardown();
+    jf_cloud_free(&c);
+}
+END_TEST
+
 /* A sink that fails stops the fit with its status; the writer aborted
  * leaves nothing (the text spool included). */
 START_TEST(failing_sink_leaves_nothing)
@@ -470,7 +529,20 @@ START_TEST(command_equals_whole_array)
                                  runs[k].orient, "--threads", "2", "--quiet", NULL),
                          0);
         assert_same_file(ref, cli_path(runs[k].out), runs[k].out);
+        /* --memory 4K: 64 bytes per point do not fit, parts (or, for
+         * rings and mst, the whole cloud with a note): the same bytes */
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(runs[k].out),
+                                 "--neighbors", runs[k].nb, "--degree", "2", "--orient",
+                                 runs[k].orient, "--threads", "2", "--memory", "4K", NULL),
+                         0);
+        assert_same_file(ref, cli_path(runs[k].out), runs[k].out);
+        ck_assert_msg((strstr(cli_err, "note:") != NULL) == (runs[k].kind == 1 || runs[k].kind == 2),
+                      "%s", cli_err);
     }
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("x.ply"), "--memory",
+                             "lots", NULL),
+                     2);
+    ck_assert_msg(strstr(cli_err, "--memory 'lots'"), "%s", cli_err);
     jf_cloud_free(&r);
     cli_teardown();
     jf_cloud_free(&c);
@@ -483,6 +555,7 @@ static Suite *suite(void)
     TCase *t = tcase_create("blocks");
     tcase_set_timeout(t, 300);
     tcase_add_loop_test(t, blocks_equal_whole_array, 0, (int)(sizeof configs / sizeof *configs));
+    tcase_add_loop_test(t, parts_equal_whole_cloud, 0, (int)(sizeof configs / sizeof *configs));
     tcase_add_test(t, failing_sink_leaves_nothing);
     tcase_add_test(t, put_checks_rows);
     tcase_add_test(t, spool_buckets);
