@@ -104,6 +104,44 @@ static int has_ext(const char *path, const char *ext)
     return !strcasecmp(dot, ext);
 }
 
+/* A random cloud without truth, noise or outliers, written a chunk of
+ * 2^20 points at a time (issue 12.1: 10^8 points without holding their
+ * parameters and truth).  jf_sample_random draws point after point from
+ * rng, so chunks give the points of one call, and the writer the bytes
+ * of jf_cloud_write. */
+static int stream_random(jf_surface surf, const char *surf_name, uint64_t n, jf_density d,
+                         jf_rng *rng, const char *out, int ascii)
+{
+    enum { CHUNK = 1 << 20 };
+    static const jf_column cols[3] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64}};
+    jf_error err = {{0}};
+    jf_writer *w = NULL;
+    if (n > (uint64_t)UINT32_MAX - 2) {
+        fprintf(stderr, "jetfit generate: --n %llu: at most 2^32 - 2 points\n",
+                (unsigned long long)n);
+        return 1;
+    }
+    jf_status st = jf_writer_open(out, cols, 3, (size_t)n, ascii, &w, &err);
+    for (uint64_t k = 0; st == JF_OK && k < n; k += CHUNK) {
+        jf_sample s;
+        size_t m = n - k < CHUNK ? (size_t)(n - k) : CHUNK;
+        if ((st = jf_sample_random(surf, m, d, rng, &s)) != JF_OK) {
+            fprintf(stderr, "jetfit generate: cannot sample %s: %s\n", surf_name,
+                    jf_strerror(st));
+            jf_writer_abort(w);
+            return 1;
+        }
+        st = jf_writer_rows(w, s.xyz, m, 1); /* binary rows: copying, not worth threads */
+        jf_sample_free(&s);
+    }
+    if (w) st = jf_writer_commit(w, &err);
+    if (st) {
+        fprintf(stderr, "jetfit generate: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        return 1;
+    }
+    return 0;
+}
+
 static jf_status write_truth(const char *path, const jf_sample *s, int dirs,
                              int ascii, jf_error *err)
 {
@@ -250,6 +288,9 @@ int jf_cmd_generate(int argc, char **argv)
     jf_rng_seed(&rng, (uint64_t)seed);
     jf_sample s;
     jf_status st;
+    if (!grid && !truth && !(noise > 0) && !(noise_u > 0) && !(outliers > 0) &&
+        !has_ext(out, ".off"))
+        return stream_random(surf, surf_name, n ? n : DEFAULT_N, density, &rng, out, ascii);
     if (grid) {
         double h = grid_h > 0 ? grid_h : jf_sample_grid_h_for(surf, n ? n : DEFAULT_N);
         st = jf_sample_grid(surf, h, perturb, mesh, &rng, &s);

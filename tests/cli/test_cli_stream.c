@@ -549,6 +549,23 @@ START_TEST(command_equals_whole_array)
 }
 END_TEST
 
+/* `jetfit generate` writes a random cloud without truth or noise a chunk
+ * of 2^20 points at a time: the same file as the whole-sample path (taken
+ * when --truth is asked), over two chunks. */
+START_TEST(generate_streamed)
+{
+    cli_setup();
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "1100000", "--seed", "5", "-o",
+                             cli_path("a.ply"), NULL),
+                     0);
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "1100000", "--seed", "5", "-o",
+                             cli_path("b.ply"), "--truth", cli_path("t.ply"), NULL),
+                     0);
+    assert_same_file(cli_path("a.ply"), cli_path("b.ply"), "generate, streamed and whole");
+    cli_teardown();
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("stream");
@@ -560,6 +577,7 @@ static Suite *suite(void)
     tcase_add_test(t, put_checks_rows);
     tcase_add_test(t, spool_buckets);
     tcase_add_test(t, command_equals_whole_array);
+    tcase_add_test(t, generate_streamed);
     suite_add_tcase(s, t);
     return s;
 }
