@@ -202,7 +202,38 @@ static double load(const unsigned char *p, int type, int swap)
 typedef struct {
     double *dst[MAX_PROPS]; /* scalar destination row pointer or NULL */
     int face_list;          /* index of the face list property, or -1 */
+    unsigned char *adst[MAX_PROPS]; /* attribute: its place in record 0 */
+    size_t astride;         /* attribute record size                  */
 } ply_plan;
+
+/* The jf_attr_type of each PLY type. */
+static const jf_attr_type attr_type[] = {JF_ATTR_U8, JF_ATTR_I8, JF_ATTR_U8, JF_ATTR_I16,
+                                         JF_ATTR_U16, JF_ATTR_I32, JF_ATTR_U32, JF_ATTR_F32,
+                                         JF_ATTR_F64};
+
+/* Stores v (a value of PLY type t, so exact in a double) into an attribute
+ * record, little endian; an ascii value outside the type's range is
+ * clamped (NaN: 0). */
+static void store_attr(unsigned char *p, int t, double v)
+{
+    static const double lo[] = {0, -128, 0, -32768, 0, -2147483648.0, 0};
+    static const double hi[] = {0, 127, 255, 32767, 65535, 2147483647.0, 4294967295.0};
+    uint64_t b;
+    if (t == T_F32) {
+        float f = (float)v;
+        uint32_t u;
+        memcpy(&u, &f, 4);
+        b = u;
+    } else if (t == T_F64) {
+        memcpy(&b, &v, 8);
+    } else {
+        double c = v == v ? v : 0;
+        c = c < lo[t] ? lo[t] : c > hi[t] ? hi[t] : c;
+        b = (uint64_t)(int64_t)c;
+    }
+    for (unsigned k = 0; k < type_size[t]; k++)
+        p[k] = (unsigned char)(b >> (8 * k));
+}
 
 /* Stores a face index (checked: integral, in range when known). */
 static jf_status face_index(ply *h, jf_uvec *fi, double v, size_t line,
@@ -258,8 +289,13 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
         }
         if (scalar && row && (uint64_t)(h->end - h->p) / row >= el->count) {
             for (uint64_t r = 0; r < el->count; r++, h->p += row)
-                for (int k = 0; k < el->nprops; k++)
-                    if (pl->dst[k]) pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
+                for (int k = 0; k < el->nprops; k++) {
+                    if (pl->dst[k])
+                        pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
+                    else if (pl->adst[k])
+                        store_attr(pl->adst[k] + r * pl->astride, el->props[k].type,
+                                   load(h->p + off[k], el->props[k].type, swap));
+                }
             return JF_OK;
         }
     }
@@ -328,6 +364,8 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                         return st;
                 } else if (!list && pl->dst[k]) {
                     pl->dst[k][3 * r] = v;
+                } else if (!list && pl->adst[k]) {
+                    store_attr(pl->adst[k] + r * pl->astride, pr->type, v);
                 }
             }
         }
@@ -378,7 +416,7 @@ static int prop_index(const ply_elem *el, const char *name, int list)
 }
 
 jf_status jf_read_ply(const char *buf, size_t len, const char *name,
-                      jf_cloud *c, jf_error *err)
+                      const jf_read_opts *o, jf_cloud *c, jf_error *err)
 {
     ply *h = calloc(1, sizeof *h);
     if (!h)
@@ -404,7 +442,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     }
     for (int e = 0; st == JF_OK && e < h->nelems; e++) {
         const ply_elem *el = &h->elems[e];
-        ply_plan pl = {{0}, -1};
+        ply_plan pl = {{0}, -1, {0}, 0};
         int is_vertex = !seen_vertex && !strcmp(el->name, "vertex");
         int is_face = !seen_face && !strcmp(el->name, "face");
         /* room check: bytes a row needs at least */
@@ -466,6 +504,37 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
             pl.dst[ix] = c->xyz;
             pl.dst[iy] = c->xyz + 1;
             pl.dst[iz] = c->xyz + 2;
+            /* every other scalar property is carried (normals too: an
+             * output names them in_nx ...), in its own type */
+            jf_attrs *a = &c->attrs;
+            for (int k = 0; k < el->nprops && !o->no_attrs; k++) {
+                const ply_prop *pr = &el->props[k];
+                if (k == ix || k == iy || k == iz || pr->count_type != T_NONE)
+                    continue;
+                if (!jf__attrs_add(a, pr->name, strlen(pr->name), attr_type[pr->type],
+                                   (uint32_t)a->stride, 0, 0)) {
+                    st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+                    break;
+                }
+                a->stride += type_size[pr->type];
+            }
+            if (st == JF_OK && a->nattrs) {
+                a->rec = malloc((n ? n : 1) * a->stride);
+                if (!a->rec) {
+                    st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
+                                    "out of memory for the attributes of %zu vertices", n);
+                    break;
+                }
+                for (int k = 0, j = 0; k < el->nprops; k++) {
+                    const ply_prop *pr = &el->props[k];
+                    if (k == ix || k == iy || k == iz || pr->count_type != T_NONE)
+                        continue;
+                    pl.adst[k] = a->rec + a->attr[j++].offset;
+                }
+                pl.astride = a->stride;
+            }
+            if (st != JF_OK)
+                break;
         } else if (is_face) {
             seen_face = 1;
             pl.face_list = prop_index(el, "vertex_indices", 1);

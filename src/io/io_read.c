@@ -44,6 +44,7 @@ void jf_cloud_free(jf_cloud *c)
     free(c->face_idx);
     free(c->scan);
     free(c->scanner);
+    jf_attrs_free(&c->attrs);
     memset(c, 0, sizeof *c);
 }
 
@@ -303,7 +304,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
-        st = jf_read_ply(buf, len, name, c, err);
+        st = jf_read_ply(buf, len, name, o, c, err);
         break;
     case JF_FMT_XYZ:
     case JF_FMT_PTS:
@@ -314,7 +315,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_read_off(buf, len, name, c, err);
         break;
     case JF_FMT_LAS:
-        st = jf_read_las(buf, len, name, c, err);
+        st = jf_read_las(buf, len, name, o, c, err);
         break;
     case JF_FMT_PTX:
         st = jf_read_ptx(buf, len, name, c, err);
