@@ -620,6 +620,15 @@ void jf_read_opts_init(jf_read_opts *o);
  *  - PTX: one or more scans (header: cols, rows, scanner position, axes,
  *    4x4 row-vector transform); points moved to the registered frame;
  *    "0 0 0" (no return) kept as a NaN row; fills scan/scanner/nscans.
+ *  - LAS 1.0-1.4, point formats 0-10: x = X * scale + offset.
+ * Attributes (jf_cloud.attrs, unless o->no_attrs): PLY every scalar
+ * vertex property but x y z, in its type; CSV/XYZ with a header line
+ * every named column but x y z whose fields are all numbers (empty: NaN),
+ * packed as uchar, ushort or int when every value is such an integer,
+ * else double; LAS the record whole, described as laspy names its
+ * dimensions (intensity, return_number, ..., gps_time, red, ...) and the
+ * Extra Bytes by their descriptions (scalar types), plus the header,
+ * VLRs and EVLRs verbatim.
  * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
  * A file without points (empty, comments only, 0 vertices) is an error.
  * o may be NULL (defaults).  c is overwritten (not freed first).
@@ -782,7 +791,8 @@ typedef struct {
  * .txt, .pts the last "# name name ..." comment before the data (jetfit's
  * and generate's outputs); .ply the vertex element's properties (ascii or
  * binary_little_endian; other elements must come after it and are
- * ignored); headerless files by extension: .normals nx ny nz, .curv k1 k2
+ * ignored); .las x y z then every dimension and Extra Byte as
+ * jf_cloud_read's attributes name them (a LAS jetfit wrote: its columns); headerless files by extension: .normals nx ny nz, .curv k1 k2
  * (PCPNet's column order, not re-sorted), .pidx index, otherwise
  * x y z nx ny nz k1 k2.  On failure fills err ("FILE:LINE: reason") and
  * leaves *t empty.  The table is owned by the caller: jf_eval_table_free. */
