@@ -743,7 +743,9 @@ void jf_writer_abort(jf_writer *w);
  * extension: .off (NOFF when normals are present), .ply (binary little
  * endian, or ascii if ascii != 0; x y z [nx ny nz] as double, face
  * element list uchar int vertex_indices), .xyz/.txt/.csv (vertices and
- * normals only; faces are not written).  Thread-safe. */
+ * normals only; faces are not written), .las (LAS 1.4 format 0, the frame
+ * of jf_writer_las_frame; normals as Extra Bytes nx ny nz; faces are not
+ * written).  Thread-safe. */
 jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
                          jf_error *err);
 

@@ -9,10 +9,10 @@ if(JF_FUZZ)
   set(JF_FUZZ_READER_SOURCES
       ${PROJECT_SOURCE_DIR}/src/io/io_read.c ${PROJECT_SOURCE_DIR}/src/io/io_ply.c
       ${PROJECT_SOURCE_DIR}/src/io/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io/io_off.c
-      ${PROJECT_SOURCE_DIR}/src/io/io_las.c)
+      ${PROJECT_SOURCE_DIR}/src/io/io_las.c ${PROJECT_SOURCE_DIR}/src/io/io_ptx.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
-  foreach(reader ply xyz off las)
+  foreach(reader ply xyz off las ptx)
     add_executable(fuzz_${reader} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_${reader}.c
                    ${JF_FUZZ_READER_SOURCES})
     target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/src/io)

@@ -58,7 +58,8 @@ def estimate(points: _Points, *, neighbors: Optional[str] = "knn:32",
              degree_select: Optional[int] = None,
              dist_weight: Optional[float] = None,
              robust_normals: bool = False,
-             threads: Optional[int] = None) -> Result: ...
+             threads: Optional[int] = None,
+             scanners: Optional[_Points] = None) -> Result: ...
 
 def estimate_mesh(vertices: _Points, faces: _Faces, rings: Optional[int] = None, *,
                   neighbors: Optional[str] = None,
@@ -71,7 +72,8 @@ def estimate_mesh(vertices: _Points, faces: _Faces, rings: Optional[int] = None,
                   degree_select: Optional[int] = None,
                   dist_weight: Optional[float] = None,
                   robust_normals: bool = False,
-                  threads: Optional[int] = None) -> Result: ...
+                  threads: Optional[int] = None,
+                  scanners: Optional[_Points] = None) -> Result: ...
 
 def fit_jet(neighbors: _Points, degree: Optional[int] = 2, *,
             monge_degree: Optional[int] = None, fit: Optional[str] = "approx",

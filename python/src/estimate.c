@@ -51,6 +51,14 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
 {
     jf_estimate_opts *o = &po->e.o;
     if (!po->e.orient_set && c->nrm) o->orient = JF_ORIENT_INPUT; /* as the command */
+    if (!po->e.orient_set && c->scanner) o->orient = JF_ORIENT_SCANNER; /* as for PTX */
+    if (o->orient == JF_ORIENT_SCANNER && !c->scanner) {
+        PyErr_SetString(PyExc_ValueError,
+                        "orient='scanner' needs scanners=: the (N, 3) position of the scanner "
+                        "that measured each point (jetfit.read gives them for a PTX file as "
+                        "attributes['scanner'])");
+        return NULL;
+    }
     PyObject *result = jf_py_result_new(c->n, po->e.monge, points, faces);
     if (!result) return NULL;
     jf_result *res = PyMem_RawMalloc((c->n ? c->n : 1) * sizeof *res);
@@ -77,12 +85,12 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
 
 #define EST_KW "neighbors", "degree", "monge_degree", "fit", "frame", "max_cond", "orient", \
                "normals", "normal", "robust", "scales", "degree_select", "dist_weight",      \
-               "robust_normals", "threads"
+               "robust_normals", "threads", "scanners"
 
 /* The shared keywords, parsed into po; normals into *nrm (or NULL). */
 typedef struct {
     PyObject *neighbors, *degree, *monge, *fit, *frame, *max_cond, *orient, *normals, *normal,
-        *robust, *scales, *dsel, *dw, *rn, *threads;
+        *robust, *scales, *dsel, *dw, *rn, *threads, *scanners;
 } est_kw;
 
 static int parse_kw(jf_py_opts *po, est_kw *k)
@@ -113,25 +121,59 @@ static int cloud_from(PyObject *points, PyObject *normals, const char *what, jf_
     return 0;
 }
 
+/* scanners= (N, 3): the scanner of each point, as scan i of N scans (the
+ * library's PTX form: scan index per point, one position per scan).
+ * *sa owns the positions, *scan (PyMem) the indices. */
+static int scanners_from(PyObject *scanners, jf_cloud *c, PyArrayObject **sa, uint32_t **scan)
+{
+    if (!scanners || scanners == Py_None) return 0;
+    *sa = jf_py_points(scanners, "scanners");
+    if (!*sa) return -1;
+    if ((size_t)PyArray_DIM(*sa, 0) != c->n) {
+        PyErr_Format(PyExc_ValueError, "scanners: %zd rows for %zd points",
+                     (Py_ssize_t)PyArray_DIM(*sa, 0), (Py_ssize_t)c->n);
+        return -1;
+    }
+    if (c->n >= UINT32_MAX) { /* jf_estimate refuses it anyway */
+        PyErr_SetString(PyExc_ValueError, "scanners: too many points");
+        return -1;
+    }
+    *scan = PyMem_Malloc((c->n ? c->n : 1) * sizeof **scan);
+    if (!*scan) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    for (size_t i = 0; i < c->n; i++) (*scan)[i] = (uint32_t)i;
+    c->scan = *scan;
+    c->scanner = PyArray_DATA(*sa);
+    c->nscans = c->n;
+    return 0;
+}
+
 PyObject *jf_py_estimate(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
     static char *kwl[] = {"points", EST_KW, NULL};
     PyObject *points;
     est_kw k = {0};
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|$OOOOOOOOOOOOOOO:estimate", kwl, &points,
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|$OOOOOOOOOOOOOOOO:estimate", kwl, &points,
                                      &k.neighbors, &k.degree, &k.monge, &k.fit, &k.frame,
                                      &k.max_cond, &k.orient, &k.normals, &k.normal, &k.robust,
-                                     &k.scales, &k.dsel, &k.dw, &k.rn, &k.threads))
+                                     &k.scales, &k.dsel, &k.dw, &k.rn, &k.threads, &k.scanners))
         return NULL;
     jf_py_opts po;
     if (parse_kw(&po, &k) || jf_py_opts_finish(&po)) return NULL;
     jf_cloud c = {0};
-    PyArrayObject *pa = NULL, *na = NULL;
+    PyArrayObject *pa = NULL, *na = NULL, *sa = NULL;
+    uint32_t *scan = NULL;
     PyObject *r = NULL;
-    if (cloud_from(points, k.normals, "points", &c, &pa, &na) == 0) r = run(&c, &po, points, NULL);
+    if (cloud_from(points, k.normals, "points", &c, &pa, &na) == 0 &&
+        scanners_from(k.scanners, &c, &sa, &scan) == 0)
+        r = run(&c, &po, points, NULL);
+    PyMem_Free(scan);
     Py_XDECREF(pa);
     Py_XDECREF(na);
+    Py_XDECREF(sa);
     return r;
 }
 
@@ -141,10 +183,11 @@ PyObject *jf_py_estimate_mesh(PyObject *self, PyObject *args, PyObject *kw)
     static char *kwl[] = {"vertices", "faces", "rings", EST_KW, NULL};
     PyObject *verts, *faces, *rings = NULL;
     est_kw k = {0};
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|O$OOOOOOOOOOOOOOO:estimate_mesh", kwl, &verts,
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|O$OOOOOOOOOOOOOOOO:estimate_mesh", kwl, &verts,
                                      &faces, &rings, &k.neighbors, &k.degree, &k.monge, &k.fit,
                                      &k.frame, &k.max_cond, &k.orient, &k.normals, &k.normal,
-                                     &k.robust, &k.scales, &k.dsel, &k.dw, &k.rn, &k.threads))
+                                     &k.robust, &k.scales, &k.dsel, &k.dw, &k.rn, &k.threads,
+                                     &k.scanners))
         return NULL;
     jf_py_opts po;
     if (parse_kw(&po, &k)) return NULL;
@@ -168,14 +211,17 @@ PyObject *jf_py_estimate_mesh(PyObject *self, PyObject *args, PyObject *kw)
     }
     if (jf_py_opts_finish(&po)) return NULL;
     jf_cloud c = {0};
-    PyArrayObject *pa = NULL, *na = NULL;
+    PyArrayObject *pa = NULL, *na = NULL, *sa = NULL;
+    uint32_t *scan = NULL;
     PyObject *r = NULL;
     if (cloud_from(verts, k.normals, "vertices", &c, &pa, &na) == 0 &&
-        jf_py_faces(faces, c.n, &c) == 0) {
+        scanners_from(k.scanners, &c, &sa, &scan) == 0 && jf_py_faces(faces, c.n, &c) == 0) {
         r = run(&c, &po, verts, faces);
         jf_py_faces_free(&c);
     }
+    PyMem_Free(scan);
     Py_XDECREF(pa);
     Py_XDECREF(na);
+    Py_XDECREF(sa);
     return r;
 }

@@ -74,6 +74,29 @@ static PyObject *attrs_dict(const jf_attrs *a, size_t n)
     return d;
 }
 
+/* attrs["scan"] (N,) int32 and attrs["scanner"] (N, 3) float64: the scan
+ * of each row and the position of its scanner (c->scanner[c->scan[i]]). */
+static int scanner_attrs(const jf_cloud *c, PyObject *attrs)
+{
+    PyArrayObject *scan = jf_py_empty(1, (npy_intp)c->n, 0, NPY_INT32);
+    PyArrayObject *pos = scan ? jf_py_empty(2, (npy_intp)c->n, 3, NPY_DOUBLE) : NULL;
+    int rc = -1;
+    if (pos) {
+        int32_t *s = PyArray_DATA(scan);
+        double *p = PyArray_DATA(pos);
+        for (size_t i = 0; i < c->n; i++) {
+            s[i] = (int32_t)c->scan[i];
+            memcpy(p + 3 * i, c->scanner + 3 * (size_t)c->scan[i], 3 * sizeof(double));
+        }
+        if (PyDict_SetItemString(attrs, "scan", (PyObject *)scan) == 0 &&
+            PyDict_SetItemString(attrs, "scanner", (PyObject *)pos) == 0)
+            rc = 0;
+    }
+    Py_XDECREF(scan);
+    Py_XDECREF(pos);
+    return rc;
+}
+
 PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
@@ -130,8 +153,10 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
     faces = c.nfaces ? jf_py_faces_out(&c) : Py_NewRef(Py_None);
     if (!faces) goto done;
     /* the input's other per-point values (jf_cloud.attrs): name -> an (N,)
-     * array of the input's type */
+     * array of the input's type; a PTX file's scans (scan index and scanner
+     * position of every row, what estimate(..., scanners=) takes) */
     if (!(attrs = attrs_dict(&c.attrs, c.n))) goto done;
+    if (c.scanner && scanner_attrs(&c, attrs) < 0) goto done;
     out = PyTuple_Pack(4, pts, nrm, faces, attrs);
 done:
     Py_XDECREF(pts);

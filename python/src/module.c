@@ -51,7 +51,8 @@ static PyObject *status_dict(void)
 PyDoc_STRVAR(estimate_doc,
 "estimate(points, *, neighbors='knn:32', degree=2, monge_degree=None, fit='approx', "
 "frame='pca', max_cond=1000, orient=None, normals=None, normal=None, robust=None, "
-"scales=None, degree_select=None, dist_weight=None, robust_normals=False, threads=None)\n"
+"scales=None, degree_select=None, dist_weight=None, robust_normals=False, threads=None, "
+"scanners=None)\n"
 "--\n\n"
 "Normals, principal curvatures and directions and Monge coefficients of every\n"
 "point of an (N, 3) array, as `jetfit estimate` computes them (same options,\n"
@@ -63,7 +64,7 @@ PyDoc_STRVAR(estimate_mesh_doc,
 "estimate_mesh(vertices, faces, rings=None, *, neighbors=None, degree=2, "
 "monge_degree=None, fit='approx', frame='pca', max_cond=1000, orient=None, "
 "normals=None, normal=None, robust=None, scales=None, degree_select=None, "
-"dist_weight=None, robust_normals=False, threads=None)\n"
+"dist_weight=None, robust_normals=False, threads=None, scanners=None)\n"
 "--\n\n"
 "estimate() on a mesh: faces is an (M, k) integer array or a sequence of\n"
 "polygons; rings=None is the command's `rings`, rings=N is `rings:N`.");
@@ -73,8 +74,8 @@ PyDoc_STRVAR(read_doc,
 "Reads a cloud or mesh with the command's readers: (points (N, 3) float64,\n"
 "normals or None, faces or None, attributes: a dict name -> (N,) array in\n"
 "the input's type of every other per-point value (PLY properties, named CSV\n"
-"columns, LAS dimensions and extra bytes)).  Errors raise\n"
-"jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");
+"columns, LAS dimensions and extra bytes; PTX: scan and scanner)).  Errors\n"
+"raise jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");
 
 PyDoc_STRVAR(write_doc,
 "write(path, result, *, points=None, faces=None, ascii=False, threads=None)\n--\n\n"

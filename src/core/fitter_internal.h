@@ -57,6 +57,15 @@ void jf__eig3(const double a[9], double eval[3], double evec[9]);
 int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
               double r[9], double eval[3]);
 
+/* jf__frame in steps: the covariance (0, or -1 as jf__frame), then the
+ * axes r from the eigenvectors of jf__eig3 (or jf__eig3_x2). */
+int jf__frame_cov(const double *q, const double *w, size_t n, double cov[9]);
+void jf__frame_axes(const double evec[9], jf_frame_mode mode, double r[9]);
+
+/* jf__eig3 of a0 and of a1 at once (SIMD lanes), bit for bit the same. */
+void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
+                 double eval1[3], double evec1[9]);
+
 /* monge.c */
 /* Differential quantities of the jet A (fitting frame, degree deg, rows of
  * r = frame axes in world coordinates) into out: normal, k1, k2, d1, d2,
@@ -68,6 +77,14 @@ void jf__quantities(const double *a, int deg, int monge_degree,
 /* Sets every quantity of out to NaN (FAILED / NONFINITE rows). */
 void jf__result_nan(jf_result *out);
 
+/* jet.c */
+/* jf_fit_point on two neighbourhoods with two distinct fitters at once:
+ * the same results (and fitter state), bit for bit, as the two calls;
+ * their eigen-solvers share SIMD lanes (frame.c, solve.c). */
+jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0, size_t n0,
+                           jf_result *out0, jf_fitter *f1, const double p1[3],
+                           const double *nbr1, size_t n1, jf_result *out1);
+
 /* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
  * by pivoted QR, then (kappa <= 1e3) the eigenvalues of R^T R and a
@@ -78,6 +95,19 @@ void jf__result_nan(jf_result *out);
  * DBL_EPSILON), -1 when no SVD was had (GSL failure, or a singular value
  * not finite). */
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
+
+/* jf__svd_solve in steps, for two fits side by side (jet.c):
+ * jf__qr_gram: the QR, then G = R^T R into f->x; returns 1, or 0 when
+ * the fast path does not apply (no eigenvalues wanted).
+ * jf__eigvals: G's eigenvalues into f->s; 1 ok, 0 failed.
+ * jf__eigvals_x2: the same for f0 and f1 (same cols) at once, bit for
+ * bit; ok[i] as jf__eigvals' return.
+ * jf__solve_after_eig: the rest (have_eig: the eigenvalues are in f->s);
+ * returns as jf__svd_solve. */
+int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
+int jf__eigvals(jf_fitter *f, size_t cols);
+void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
+int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond);
 
 /* jet.c */
 /* Makes GSL return error codes instead of aborting (once per process). */

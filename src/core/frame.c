@@ -7,6 +7,7 @@
  * loses all precision at large offsets, see CGAL_NOTES.md); a cyclic Jacobi
  * eigen-solver gives orthonormal eigenvectors whose signs are pinned so the
  * frame, hence every result, is reproducible. */
+#include <emmintrin.h>
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -23,6 +24,24 @@ static void pin_sign(double *v)
         v[0] = -v[0];
         v[1] = -v[1];
         v[2] = -v[2];
+    }
+}
+
+/* Eigenvalues (diagonal of a) ascending, stable on ties (deterministic),
+ * and their eigenvectors (columns of v) with pinned signs. */
+static void eig3_sorted(double a[3][3], double v[3][3], double eval[3], double evec[9])
+{
+    int idx[3] = {0, 1, 2};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && a[idx[j]][idx[j]] < a[idx[j - 1]][idx[j - 1]]; j--) {
+            int t = idx[j];
+            idx[j] = idx[j - 1];
+            idx[j - 1] = t;
+        }
+    for (int k = 0; k < 3; k++) {
+        eval[k] = a[idx[k]][idx[k]];
+        for (int i = 0; i < 3; i++) evec[3 * k + i] = v[i][idx[k]];
+        pin_sign(evec + 3 * k);
     }
 }
 
@@ -68,19 +87,7 @@ void jf__eig3(const double a_in[9], double eval[3], double evec[9])
             }
         }
     }
-    /* sort ascending (stable on ties, deterministic) */
-    int idx[3] = {0, 1, 2};
-    for (int i = 1; i < 3; i++)
-        for (int j = i; j > 0 && a[idx[j]][idx[j]] < a[idx[j - 1]][idx[j - 1]]; j--) {
-            int t = idx[j];
-            idx[j] = idx[j - 1];
-            idx[j - 1] = t;
-        }
-    for (int k = 0; k < 3; k++) {
-        eval[k] = a[idx[k]][idx[k]];
-        for (int i = 0; i < 3; i++) evec[3 * k + i] = v[i][idx[k]];
-        pin_sign(evec + 3 * k);
-    }
+    eig3_sorted(a, v, eval, evec);
 }
 
 static void cross(const double a[3], const double b[3], double c[3])
@@ -90,8 +97,7 @@ static void cross(const double a[3], const double b[3], double c[3])
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
-              double r[9], double eval[3])
+int jf__frame_cov(const double *q, const double *w, size_t n, double cov[9])
 {
     /* pass 1: weighted centroid */
     double sw = 0, c[3] = {0, 0, 0};
@@ -103,7 +109,7 @@ int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
     if (!(sw > 0) || !isfinite(sw)) return -1;
     for (int k = 0; k < 3; k++) c[k] /= sw;
     /* pass 2: covariance about the centroid */
-    double cov[9] = {0};
+    for (int k = 0; k < 9; k++) cov[k] = 0.0;
     for (size_t i = 0; i < n; i++) {
         if (!(w[i] > 0)) continue;
         double d[3] = {q[3 * i] - c[0], q[3 * i + 1] - c[1], q[3 * i + 2] - c[2]};
@@ -117,9 +123,11 @@ int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
         }
     for (int k = 0; k < 9; k++)
         if (!isfinite(cov[k])) return -1;
+    return 0;
+}
 
-    double evec[9];
-    jf__eig3(cov, eval, evec);
+void jf__frame_axes(const double evec[9], jf_frame_mode mode, double r[9])
+{
     if (mode == JF_FRAME_AXIS) {
         /* §5.2: z is the world axis closest to the rough (PCA) normal; its
          * positive direction, since the pinned normal's largest component
@@ -138,5 +146,85 @@ int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
         memcpy(r + 6, evec + 0, 3 * sizeof r[0]);
         cross(r + 6, r + 0, r + 3);
     }
+}
+
+int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
+              double r[9], double eval[3])
+{
+    double cov[9], evec[9];
+    if (jf__frame_cov(q, w, n, cov) != 0) return -1;
+    jf__eig3(cov, eval, evec);
+    jf__frame_axes(evec, mode, r);
     return 0;
+}
+
+/* ---- two at once ------------------------------------------------------
+ * jf__eig3 of two matrices in the two lanes of SSE2 vectors: the same
+ * rotations in the same order, each lane's own skips and stop kept by
+ * masks (a lane that would skip a rotation keeps its values), so each
+ * lane gets the bits jf__eig3 gives.  The Jacobi rotations are a chain of
+ * dependent divisions and square roots: two chains side by side cost
+ * little more than one. */
+typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
+
+static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
+static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
+static inline v2d sqrt2(v2d x) { return (v2d)_mm_sqrt_pd((__m128d)x); }
+
+void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
+                 double eval1[3], double evec1[9])
+{
+    v2d a[3][3], v[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            a[i][j] = (v2d){0.5 * (a0[3 * i + j] + a0[3 * j + i]),
+                            0.5 * (a1[3 * i + j] + a1[3 * j + i])};
+            v[i][j] = (v2d){i == j ? 1.0 : 0.0, i == j ? 1.0 : 0.0};
+        }
+    const v2d one = {1.0, 1.0}, zero = {0.0, 0.0};
+    v2l live = {-1, -1}; /* lanes still sweeping */
+    for (int sweep = 0; sweep < 50; sweep++) {
+        v2d off = abs2(a[0][1]) + abs2(a[0][2]) + abs2(a[1][2]);
+        v2d diag = abs2(a[0][0]) + abs2(a[1][1]) + abs2(a[2][2]);
+        live &= ~((v2l)(off == zero) | (v2l)(off <= DBL_EPSILON * DBL_EPSILON * diag));
+        if (!live[0] && !live[1]) break;
+        for (int p = 0; p < 2; p++) {
+            for (int q = p + 1; q < 3; q++) {
+                const v2l on = live & ~(v2l)(a[p][q] == zero);
+                if (!on[0] && !on[1]) continue;
+                /* a lane that skips may divide by 0 here: masked below */
+                v2d theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                v2d sg = sel2((v2l)(theta >= zero), one, -one);
+                v2d t = sel2((v2l)(abs2(theta) > (v2d){1e150, 1e150}), one / (2.0 * theta),
+                             sg / (abs2(theta) + sqrt2(theta * theta + one)));
+                v2d c = one / sqrt2(t * t + one), s = t * c;
+                for (int k = 0; k < 3; k++) { /* A <- A J */
+                    v2d akp = a[k][p], akq = a[k][q];
+                    a[k][p] = sel2(on, c * akp - s * akq, akp);
+                    a[k][q] = sel2(on, s * akp + c * akq, akq);
+                }
+                for (int k = 0; k < 3; k++) { /* A <- J^T A */
+                    v2d apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = sel2(on, c * apk - s * aqk, apk);
+                    a[q][k] = sel2(on, s * apk + c * aqk, aqk);
+                }
+                a[p][q] = a[q][p] = sel2(on, zero, a[p][q]);
+                for (int k = 0; k < 3; k++) { /* V <- V J */
+                    v2d vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = sel2(on, c * vkp - s * vkq, vkp);
+                    v[k][q] = sel2(on, s * vkp + c * vkq, vkq);
+                }
+            }
+        }
+    }
+    double al[3][3], vl[3][3];
+    for (int lane = 0; lane < 2; lane++) {
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                al[i][j] = a[i][j][lane];
+                vl[i][j] = v[i][j][lane];
+            }
+        eig3_sorted(al, vl, lane ? eval1 : eval0, lane ? evec1 : evec0);
+    }
 }

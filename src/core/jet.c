@@ -120,15 +120,38 @@ static void fail_result(jf_result *out, unsigned flags)
     jf__result_nan(out);
 }
 
-jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *nbr,
-                                const double *w, size_t n, jf_result *out)
+/* A fit in progress, in the steps the design above lists; the steps are
+ * functions so that two fits can run side by side (jf__fit_point_x2) and
+ * share the SIMD lanes of their eigen-solvers. */
+typedef struct {
+    jf_fitter *f;
+    jf_result *out;
+    size_t n, usable, rows;
+    int interp, d;
+    double h;
+    double r[9];
+    double cov[9];
+} fit_job;
+
+static jf_status check_args(jf_fitter *f, const double p[3], const double *nbr, const double *w,
+                            size_t n, jf_result *out)
 {
     if (!f || !p || !out || (n > 0 && !nbr)) return JF_ERR_INVALID;
     if (n > f->maxn) return JF_ERR_TOO_LARGE;
     if (w)
         for (size_t i = 0; i < n; i++)
             if (!(w[i] >= 0) || !isfinite(w[i])) return JF_ERR_INVALID;
+    return JF_OK;
+}
 
+/* Step 1 and the covariance of step 2.  Returns 1 to go on with the
+ * eigen-decomposition of j->cov, 0 when out is final. */
+static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *nbr,
+                     const double *w, size_t n, jf_result *out)
+{
+    j->f = f;
+    j->out = out;
+    j->n = n;
     memset(out, 0, sizeof *out);
     out->cond = NAN;
     f->last_n = n;
@@ -137,7 +160,7 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
     for (int k = 0; k < 3; k++) out->pca_eval[k] = NAN;
     if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
         fail_result(out, JF_PT_NONFINITE);
-        return JF_OK;
+        return 0;
     }
 
     /* 1. translate to p; unusable points get weight 0 */
@@ -152,18 +175,31 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
         f->w[i] = ok ? wi : 0.0;
         if (f->w[i] > 0) f->order[usable++] = (uint32_t)i;
     }
+    j->usable = usable;
     out->n_used = (int)usable;
     if (usable < 3) {
         fail_result(out, JF_PT_LOWERED_FEW | JF_PT_FAILED);
-        return JF_OK;
+        return 0;
     }
-
-    /* 2. fitting frame; local coordinates */
-    double r[9];
-    if (jf__frame(f->loc, f->w, n, f->p.frame, r, out->pca_eval) != 0) {
+    /* 2. fitting frame: its covariance */
+    if (jf__frame_cov(f->loc, f->w, n, j->cov) != 0) {
         fail_result(out, JF_PT_FAILED);
-        return JF_OK;
+        return 0;
     }
+    return 1;
+}
+
+static int job_system(fit_job *j);
+
+/* The rest of step 2 (the frame from the eigenvectors evec of j->cov;
+ * out->pca_eval holds the eigenvalues), then the first system of step 3.
+ * Returns as job_system. */
+static int job_frame(fit_job *j, const double evec[9])
+{
+    jf_fitter *f = j->f;
+    const size_t n = j->n;
+    double *r = j->r;
+    jf__frame_axes(evec, f->p.frame, r);
     for (size_t i = 0; i < n; i++) {
         double *q = f->loc + 3 * i;
         double x = r[0] * q[0] + r[1] * q[1] + r[2] * q[2];
@@ -173,8 +209,9 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
         q[1] = y;
         q[2] = z;
     }
-    const int interp = f->p.fit == JF_FIT_INTERP;
-    if (interp) {
+    j->interp = f->p.fit == JF_FIT_INTERP;
+    if (j->interp) {
+        size_t usable = j->usable;
         for (size_t t = 0; t < usable; t++) {
             const double *q = f->loc + 3 * f->order[t];
             f->dist[f->order[t]] = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
@@ -197,21 +234,30 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
             }
             if (!dup) f->order[kept++] = i;
         }
-        usable = kept;
+        j->usable = kept;
     }
+    j->d = f->p.degree;
+    return job_system(j);
+}
 
-    /* 3. adaptive degree */
-    int deg = 0;
-    size_t rows = 0;
-    double h = 0, mon[55];
-    for (int d = f->p.degree; d >= 1; d--) {
+/* 3. adaptive degree: from degree j->d down, the first whose system can
+ * be set up; its scaled M' and B, then the QR (jf__qr_gram).  Returns 1
+ * (G = R^T R is in f->x for the eigenvalues), 2 (QR done, no eigenvalues
+ * wanted), or 0 when no degree is left (out is final). */
+static int job_system(fit_job *j)
+{
+    jf_fitter *f = j->f;
+    jf_result *out = j->out;
+    double mon[55];
+    for (; j->d >= 1; j->d--) {
+        const int d = j->d;
         size_t cols = jf_jet_size(d);
-        if (usable < cols) {
+        if (j->usable < cols) {
             out->status |= JF_PT_LOWERED_FEW;
             continue;
         }
-        rows = interp ? cols : usable;
-        h = 0;
+        size_t rows = j->interp ? cols : j->usable;
+        double h = 0;
         for (size_t t = 0; t < rows; t++) {
             const double *q = f->loc + 3 * f->order[t];
             h += sqrt(q[0] * q[0] + q[1] * q[1]);
@@ -231,33 +277,59 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
             for (size_t c = 0; c < cols; c++) f->m[c * rows + t] = wi * mon[c];
             f->rhs[t] = wi * q[2];
         }
-        int rc = jf__svd_solve(f, rows, cols, &out->cond);
-        if (rc != 0) {
-            out->status |= JF_PT_LOWERED_RANK;
-            continue;
-        }
-        if (out->cond > f->p.max_cond) {
-            out->status |= JF_PT_LOWERED_COND;
-            continue;
-        }
-        deg = d;
-        break;
+        j->rows = rows;
+        j->h = h;
+        return jf__qr_gram(f, rows, cols) ? 1 : 2;
     }
-    if (deg == 0) {
-        fail_result(out, JF_PT_FAILED);
-        out->n_used = (int)usable;
-        return JF_OK;
-    }
+    fail_result(out, JF_PT_FAILED);
+    out->n_used = (int)j->usable;
+    return 0;
+}
 
-    /* 4. unscale A_ij = Y_ij / h^(i+j); residuals; quantities.  With
-     * h = m 2^q, h^k = m^k 2^(qk) exactly, so Y / m^k then a power of two
-     * gives the same bits as Y / h^k without h^k ever under- or
+static void job_finish(fit_job *j);
+
+/* After the solve of degree j->d (rc as jf__svd_solve's): keep it and
+ * finish (returns 0), or lower the degree (returns as job_system). */
+static int job_solved(fit_job *j, int rc)
+{
+    jf_result *out = j->out;
+    if (rc != 0) {
+        out->status |= JF_PT_LOWERED_RANK;
+        j->d--;
+        return job_system(j);
+    }
+    if (out->cond > j->f->p.max_cond) {
+        out->status |= JF_PT_LOWERED_COND;
+        j->d--;
+        return job_system(j);
+    }
+    job_finish(j);
+    return 0;
+}
+
+/* The solve of the current system, after job_system returned st. */
+static int job_solve(fit_job *j, int st, int have_eig)
+{
+    const size_t cols = jf_jet_size(j->d);
+    return jf__solve_after_eig(j->f, j->rows, cols, st == 1 && have_eig, &j->out->cond);
+}
+
+/* 4. unscale A_ij = Y_ij / h^(i+j); residuals; quantities. */
+static void job_finish(fit_job *j)
+{
+    jf_fitter *f = j->f;
+    jf_result *out = j->out;
+    const int deg = j->d;
+    const size_t rows = j->rows;
+    const double h = j->h;
+    /* With h = m 2^q, h^k = m^k 2^(qk) exactly, so Y / m^k then a power
+     * of two gives the same bits as Y / h^k without h^k ever under- or
      * overflowing (lengths near 1e+-150), and scales exactly with h. */
     {
         int c = 0, q;
         double m = frexp(h, &q), mk = 1.0;
         for (int k = 0; k <= deg; k++, mk *= m)
-            for (int j = 0; j <= k; j++, c++) f->coef[c] = ldexp(f->sol[c] / mk, -q * k);
+            for (int i = 0; i <= k; i++, c++) f->coef[c] = ldexp(f->sol[c] / mk, -q * k);
     }
     const size_t cols = jf_jet_size(deg);
     /* weighted residual norm for free: after the QR, the components
@@ -266,7 +338,7 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
     for (size_t t = 0; t < rows; t++) sw2 += f->w[f->order[t]] * f->w[f->order[t]];
     for (size_t t = cols; t < rows; t++) sr2 += f->rhs[t] * f->rhs[t];
     f->last_h = h;
-    memcpy(f->frame, r, sizeof r);
+    memcpy(f->frame, j->r, sizeof j->r);
     f->last_deg = deg;
     out->degree = deg;
     out->n_used = (int)rows;
@@ -274,9 +346,59 @@ jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *n
     for (size_t c = 0; c < cols; c++)
         if (!isfinite(f->coef[c])) {
             fail_result(out, JF_PT_FAILED);
-            return JF_OK;
+            return;
         }
-    jf__quantities(f->coef, deg, f->p.monge_degree, r, h, out);
+    jf__quantities(f->coef, deg, f->p.monge_degree, j->r, h, out);
+}
+
+jf_status jf_fit_point_weighted(jf_fitter *f, const double p[3], const double *nbr,
+                                const double *w, size_t n, jf_result *out)
+{
+    jf_status st0 = check_args(f, p, nbr, w, n, out);
+    if (st0 != JF_OK) return st0;
+    fit_job j;
+    if (!job_begin(&j, f, p, nbr, w, n, out)) return JF_OK;
+    double evec[9];
+    jf__eig3(j.cov, out->pca_eval, evec);
+    for (int st = job_frame(&j, evec); st;)
+        st = job_solved(&j, job_solve(&j, st, st == 1 && jf__eigvals(f, jf_jet_size(j.d))));
+    return JF_OK;
+}
+
+jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0, size_t n0,
+                           jf_result *out0, jf_fitter *f1, const double p1[3],
+                           const double *nbr1, size_t n1, jf_result *out1)
+{
+    if (f0 == f1 || check_args(f0, p0, nbr0, NULL, n0, out0) != JF_OK ||
+        check_args(f1, p1, nbr1, NULL, n1, out1) != JF_OK) {
+        jf_status st = jf_fit_point(f0, p0, nbr0, n0, out0);
+        return st != JF_OK ? st : jf_fit_point(f1, p1, nbr1, n1, out1);
+    }
+    fit_job j[2];
+    int st[2];
+    double evec[2][9];
+    st[0] = job_begin(&j[0], f0, p0, nbr0, NULL, n0, out0);
+    st[1] = job_begin(&j[1], f1, p1, nbr1, NULL, n1, out1);
+    if (st[0] && st[1])
+        jf__eig3_x2(j[0].cov, j[1].cov, out0->pca_eval, evec[0], out1->pca_eval, evec[1]);
+    for (int k = 0; k < 2; k++) {
+        if (!st[k]) continue;
+        if (!st[1 - k]) jf__eig3(j[k].cov, j[k].out->pca_eval, evec[k]);
+        st[k] = job_frame(&j[k], evec[k]);
+    }
+    /* the first system of each, side by side when both want the
+     * eigenvalues of same-sized G (the usual case: one degree, k-NN) */
+    if (st[0] == 1 && st[1] == 1 && j[0].d == j[1].d) {
+        int ok[2];
+        jf__eigvals_x2(f0, f1, jf_jet_size(j[0].d), ok);
+        for (int k = 0; k < 2; k++) st[k] = job_solved(&j[k], job_solve(&j[k], st[k], ok[k]));
+    }
+    for (int k = 0; k < 2; k++)
+        while (st[k]) {
+            jf_fitter *f = j[k].f;
+            st[k] = job_solved(&j[k], job_solve(&j[k], st[k],
+                                                st[k] == 1 && jf__eigvals(f, jf_jet_size(j[k].d))));
+        }
     return JF_OK;
 }
 

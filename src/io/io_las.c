@@ -217,11 +217,13 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
                           "file %zu bytes)", (unsigned)data_off, hsize, len);
     if (n == 0)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
-    if (n > (len - data_off) / rec_len)
+    if (n > (len - data_off) / rec_len) /* name the first record that is not whole */
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0,
-                          "header: %llu points of %u bytes cannot fit in the %zu bytes after "
-                          "the header (count too large or file truncated)",
-                          (unsigned long long)n, rec_len, len - data_off);
+                          "header: point count %llu: records of %u bytes cannot fit in the %zu "
+                          "bytes after the offset to point data (point record %llu is missing "
+                          "or cut short: count too large or file truncated)",
+                          (unsigned long long)n, rec_len, len - data_off,
+                          (unsigned long long)((len - data_off) / rec_len + 1));
     if (n > JF_MAX_POINTS)
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: more than supported",
                           (unsigned long long)n);

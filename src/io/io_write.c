@@ -560,6 +560,7 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
     jf_status st = jf_writer_open(path, cols, nc, c->n, ascii, &w, err);
     if (st != JF_OK)
         return st;
+    (void)jf_writer_las_frame(w, c->xyz, c->n); /* .las: scale and offset from the cloud */
     if (c->nfaces && (st = jf_writer_faces(w, c->nfaces, c->face_off,
                                            c->face_idx)) != JF_OK) {
         jf_writer_abort(w);

@@ -1,16 +1,19 @@
 // bench_estimate.cpp -- end-to-end speed and peak memory of
 // `jetfit estimate` (read, index, fit, write) beside CGAL's peers, in the
 // same run, on N points (default 1,000,000) of the paper's §6.1 surface
-// z = 0.1 exp(2x + y - y^2) in random order, stored as binary PLY.
+// z = 0.1 exp(2x + y - y^2) in random order, stored twice: as binary PLY
+// and as .xyz text (%.17g, as scanners' exports and our own writer).
 //
-//   bench_estimate [N]            (needs the built jetfit next to it:
-//                                  JF_BUILD_DIR/jetfit)
+//   bench_estimate [N] [--normals] [--keep DIR]
+//       (needs the built jetfit next to it: JF_BUILD_DIR/jetfit)
+//   --normals   also run CGAL's jet_estimate_normals (binary PLY only)
+//   --keep DIR  write the inputs into DIR and keep them (for profiling)
 //
 // Every contender runs in its own child process (fork), so its peak
 // memory (wait4's ru_maxrss) is its own, and starts with no output file
 // from an earlier contender (deleting one costs ~0.1 s in the kernel):
 //  - jetfit estimate --threads 1 / 2 (exec of the built binary);
-//  - CGAL end to end: read_PLY, k-d tree (Orthogonal_k_neighbor_search),
+//  - CGAL end to end: read_PLY (or read_XYZ), k-d tree (Orthogonal_k_neighbor_search),
 //    Monge_via_jet_fitting per point (query point first), binary PLY out
 //    of the same quantities (x y z n k1 k2 d1 d2);
 //  - CGAL jet_estimate_normals<Sequential_tag> (normals only), read and
@@ -21,6 +24,7 @@
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/IO/read_ply_points.h>
+#include <CGAL/IO/read_xyz_points.h>
 #include <CGAL/IO/write_ply_points.h>
 #include <CGAL/jet_estimate_normals.h>
 #include <CGAL/property_map.h>
@@ -54,7 +58,7 @@ static std::string g_dir;
 
 // ---- the input ----------------------------------------------------------
 
-static void make_input(size_t n, const std::string &path)
+static void make_input(size_t n, const std::string &path, const std::string &text)
 {
     std::vector<double> xyz(3 * n);
     unsigned long long s = 2003;
@@ -72,10 +76,11 @@ static void make_input(size_t n, const std::string &path)
     c.n = n;
     c.xyz = xyz.data();
     jf_error e;
-    if (jf_cloud_write(path.c_str(), &c, 0, &e) != JF_OK) {
-        std::fprintf(stderr, "cannot write %s: %s\n", path.c_str(), e.msg);
-        std::exit(1);
-    }
+    for (const std::string *p : {&path, &text})
+        if (jf_cloud_write(p->c_str(), &c, 0, &e) != JF_OK) {
+            std::fprintf(stderr, "cannot write %s: %s\n", p->c_str(), e.msg);
+            std::exit(1);
+        }
 }
 
 // ---- running a contender in a child -----------------------------------------
@@ -123,7 +128,10 @@ static int run_cgal_monge(const std::string &in, int k, int degree)
     typedef jf_cgalref::Monge_fitting Monge;
     std::vector<Point> pts;
     std::ifstream is(in, std::ios::binary);
-    if (!CGAL::IO::read_PLY(is, std::back_inserter(pts))) return 1;
+    const bool text = in.size() > 4 && in.compare(in.size() - 4, 4, ".xyz") == 0;
+    if (text ? !CGAL::IO::read_XYZ(is, std::back_inserter(pts))
+             : !CGAL::IO::read_PLY(is, std::back_inserter(pts)))
+        return 1;
     Search::Tree tree(pts.begin(), pts.end());
     std::string out = g_dir + "/cgal_out.ply";
     FILE *f = std::fopen(out.c_str(), "wb");
@@ -201,35 +209,57 @@ static void loadavg(const char *when)
 
 int main(int argc, char **argv)
 {
-    size_t n = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 1000000;
+    size_t n = 1000000;
+    bool normals = false;
+    const char *keep = nullptr;
+    for (int a = 1; a < argc; a++) {
+        if (!std::strcmp(argv[a], "--normals")) normals = true;
+        else if (!std::strcmp(argv[a], "--keep") && a + 1 < argc) keep = argv[++a];
+        else n = std::strtoul(argv[a], nullptr, 10);
+    }
     char tmpl[] = "/tmp/jf_bench_XXXXXX";
     if (!mkdtemp(tmpl)) return 1;
     g_dir = tmpl;
-    std::string in = g_dir + "/surface61.ply";
-    make_input(n, in);
-    std::printf("bench_estimate: %zu points of the §6.1 surface, random order, binary PLY;\n"
-                "end to end (read, index, fit, write), each in a child process;\n"
-                "CGAL's SVD: %s\n\n",
+    std::string in_dir = keep ? std::string(keep) : g_dir;
+    std::string ply = in_dir + "/surface61.ply", xyz = in_dir + "/surface61.xyz";
+    make_input(n, ply, xyz);
+    std::printf("bench_estimate: %zu points of the §6.1 surface, random order, binary PLY\n"
+                "and .xyz text (%%.17g); end to end (read, index, fit, write binary PLY),\n"
+                "each in a child process, one run; CGAL's SVD: %s\n\n",
                 n, jf_cgalref::cgal_svd_name);
     loadavg("before");
     const int cfg[2][2] = {{16, 2}, {32, 3}};
-    for (auto &c : cfg) {
-        int k = c[0], d = c[1];
-        std::printf("knn:%d degree %d\n", k, d);
-        Run cg = in_child([&] { return run_cgal_monge(in, k, d); });
-        report("  CGAL kd-tree + Monge_via_jet_fitting", n, cg, nullptr);
-        Run jn = in_child([&] { return run_cgal_jet_normals(in, k, d); });
-        report("  CGAL jet_estimate_normals (seq)", n, jn, &cg);
-        Run j1 = in_child([&] { return run_jetfit(in, k, d, 1); });
-        report("  jetfit estimate --threads 1", n, j1, &cg);
-        Run j2 = in_child([&] { return run_jetfit(in, k, d, 2); });
-        report("  jetfit estimate --threads 2", n, j2, &cg);
-        if (j1.ok && j2.ok) std::printf("  jetfit speed-up 1 -> 2 threads: x%.2f\n", j1.secs / j2.secs);
-        std::printf("\n");
-    }
+    double ratio[2][2] = {{0, 0}, {0, 0}};
+    for (int ci = 0; ci < 2; ci++)
+        for (int fi = 0; fi < 2; fi++) {
+            int k = cfg[ci][0], d = cfg[ci][1];
+            const std::string &in = fi ? xyz : ply;
+            std::printf("knn:%d degree %d, %s input\n", k, d, fi ? ".xyz text" : "binary PLY");
+            Run cg = in_child([&] { return run_cgal_monge(in, k, d); });
+            report("  CGAL kd-tree + Monge_via_jet_fitting", n, cg, nullptr);
+            if (normals && !fi) {
+                Run jn = in_child([&] { return run_cgal_jet_normals(in, k, d); });
+                report("  CGAL jet_estimate_normals (seq)", n, jn, &cg);
+            }
+            Run j1 = in_child([&] { return run_jetfit(in, k, d, 1); });
+            report("  jetfit estimate --threads 1", n, j1, &cg);
+            Run j2 = in_child([&] { return run_jetfit(in, k, d, 2); });
+            report("  jetfit estimate --threads 2", n, j2, &cg);
+            if (j1.ok && j2.ok)
+                std::printf("  jetfit speed-up 1 -> 2 threads: x%.2f\n", j1.secs / j2.secs);
+            if (cg.ok && j1.ok) ratio[ci][fi] = cg.secs / j1.secs;
+            std::printf("\n");
+        }
     loadavg("after");
-    for (const char *f : {"surface61.ply", "jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
+    std::printf("one thread, wall, jetfit vs CGAL: knn:16 d2 PLY x%.2f, xyz x%.2f; "
+                "knn:32 d3 PLY x%.2f, xyz x%.2f\n",
+                ratio[0][0], ratio[0][1], ratio[1][0], ratio[1][1]);
+    for (const char *f : {"jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
         std::remove((g_dir + "/" + f).c_str());
+    if (!keep) {
+        std::remove(ply.c_str());
+        std::remove(xyz.c_str());
+    }
     rmdir(g_dir.c_str());
     return 0;
 }
