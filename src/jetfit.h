@@ -691,7 +691,8 @@ jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
  * as in the input with `in_` put before the name while it clashes with a
  * column of the table or an earlier attribute (an input `nx` is written
  * `in_nx`).  PLY: each property in its input type (64-bit integers as
- * double); text: integers exact, floats %.9g, doubles %.17g; LAS: from a
+ * double); text: integers exact, floats and doubles %.17g (the exact
+ * value, so a reader gets the same number back); LAS: from a
  * LAS input (a->las_head) the input's point records are written unchanged
  * -- same point format, scale, offset, header fields, VLRs and EVLRs --
  * with the table's columns 3.. appended as Extra Bytes after the input's

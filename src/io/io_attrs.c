@@ -191,12 +191,9 @@ char *jf__attrs_put(const jf_attrs *a, size_t row, int mode, char sep, char *o)
                 o = jf_fmt_uint(o, v.i < 0 ? (uint64_t)0 - (uint64_t)v.i : (uint64_t)v.i);
             } else if (v.kind == 1) {
                 o = jf_fmt_uint(o, v.u);
-            } else if (t == JF_ATTR_F32) {
-                if (isnan(v.d))
-                    memcpy(o, "nan", 3), o += 3;
-                else
-                    o += snprintf(o, 32, "%.9g", v.d);
             } else {
+                /* a float too: its exact value as a double, so a reader
+                 * gets the same number back, not a near one */
                 o = jf_fmt_g17(o, v.d);
             }
             continue;

@@ -68,6 +68,9 @@ void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3
                    double lo[3], double hi[3]);
 size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, char *o);
 int jf__las_write_prefix(int fd, const jf_las_out *L);
+/* The dimension names of point format 0 (as the LAS reader names them). */
+#define JF__LAS_FMT0_NDIMS 12
+extern const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS];
 /* 1 if the record (<= 65535 bytes) and the Extra Bytes VLR (<= 341
  * descriptions) fit the format. */
 int jf__las_fits(const jf_las_out *L);
@@ -93,7 +96,7 @@ const char *jf__attr_ply_type(const jf_attr *at);
 /* Formats the attributes of point `row` at o and returns the end: binary
  * PLY little or big endian (64-bit integers as doubles), LAS Extra Bytes
  * (little endian, every type as it is), or text (each value preceded by
- * sep; integers exact, F32 %.9g, F64 %.17g).  At most 32 bytes a value. */
+ * sep; integers exact, floats and doubles %.17g: exact).  At most 32 bytes a value. */
 enum { JF__ATTR_PLY_LE, JF__ATTR_PLY_BE, JF__ATTR_LAS, JF__ATTR_TEXT };
 char *jf__attrs_put(const jf_attrs *a, size_t row, int mode, char sep, char *o);
 /* Bytes of a row of attributes in a binary mode. */

@@ -75,6 +75,11 @@ void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3
     }
 }
 
+const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS] = {
+    "intensity", "return_number", "number_of_returns", "scan_direction_flag",
+    "edge_of_flight_line", "classification", "synthetic", "key_point", "withheld",
+    "scan_angle_rank", "user_data", "point_source_id"};
+
 /* Extra Bytes data_type of each jf_attr_type (LAS 1.4 R15 table 24). */
 static const unsigned char eb_code[10] = {2, 1, 4, 3, 6, 5, 8, 7, 9, 10};
 static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};

@@ -32,6 +32,7 @@ void jf_read_opts_init(jf_read_opts *o)
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
     o->bad_rows = 0;
+    o->no_attrs = 0;
 }
 
 void jf_cloud_free(jf_cloud *c)

@@ -212,7 +212,21 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
     char (*nm)[64] = calloc(a->nattrs ? a->nattrs : 1, sizeof *nm);
     if (!nm)
         return JF_ERR_NOMEM;
-    if (jf__attrs_names(a, w->names, w->ncols, nm) != 0) {
+    /* a format 0 LAS output also has its own dimensions: an Extra Byte
+     * named as one (intensity, classification, ...) would be a second
+     * dimension of that name to LAS readers */
+    int fmt0 = w->fmt == FMT_LAS && !a->las_head;
+    size_t nn = w->ncols + (fmt0 ? JF__LAS_FMT0_NDIMS : 0);
+    char **taken = malloc(nn * sizeof *taken);
+    if (!taken) {
+        free(nm);
+        return JF_ERR_NOMEM;
+    }
+    memcpy(taken, w->names, w->ncols * sizeof *taken);
+    for (size_t k = w->ncols; k < nn; k++) taken[k] = (char *)jf__las_fmt0_dims[k - w->ncols];
+    int bad = jf__attrs_names(a, taken, nn, nm) != 0;
+    free(taken);
+    if (bad) {
         free(nm);
         return JF_ERR_INVALID;
     }
@@ -277,8 +291,6 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
         /* the usual case, kept tight (it runs once per point): fixed-size
          * copies, no per-value memcpy call */
         for (size_t j = 0; j < w->ncols; j++) {
-            if (j == ATTRS_AFTER + 1 && at)
-                o = jf__attrs_put(at, row, JF__ATTR_PLY_LE, 0, o);
             const double v = vals[j];
             if (w->types[j] == JF_COL_F64) {
                 memcpy(o, &v, 8);
@@ -292,14 +304,14 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
                 memcpy(o, &x, 4);
                 o += 4;
             }
+            if (j == ATTRS_AFTER && at) /* the attributes after x y z */
+                o = jf__attrs_put(at, row, JF__ATTR_PLY_LE, 0, o);
         }
     } else if (w->fmt == FMT_PLY && !w->ascii) {
         int little = host_little();
         for (size_t j = 0; j < w->ncols; j++) {
             unsigned char b[8];
             size_t n;
-            if (j == ATTRS_AFTER + 1 && at)
-                o = jf__attrs_put(at, row, little ? JF__ATTR_PLY_LE : JF__ATTR_PLY_BE, 0, o);
             if (w->types[j] == JF_COL_F64) {
                 memcpy(b, &vals[j], 8), n = 8;
             } else if (w->types[j] == JF_COL_F32) {
@@ -316,12 +328,12 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
                     o[i] = (char)b[n - 1 - i];
             }
             o += n;
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, little ? JF__ATTR_PLY_LE : JF__ATTR_PLY_BE, 0, o);
         }
     } else {
         char sep = w->fmt == FMT_CSV ? ',' : ' ';
         for (size_t j = 0; j < w->ncols; j++) {
-            if (j == ATTRS_AFTER + 1 && at)
-                o = jf__attrs_put(at, row, JF__ATTR_TEXT, sep, o);
             if (j)
                 *o++ = sep;
             double v = vals[j];
@@ -339,6 +351,8 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
                     *o++ = '-';
                 o = jf_fmt_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
             }
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, JF__ATTR_TEXT, sep, o);
         }
         *o++ = '\n';
     }
