@@ -886,8 +886,12 @@ typedef struct jf_natural jf_natural;
  * one vertex (jf_natural_kept).  Coplanar, collinear or fewer than 4
  * points are accepted (jf_natural_stats says the dimension).  Returns
  * JF_OK, JF_ERR_INVALID (NULL args), JF_ERR_TOO_LARGE (n >= 2^32 - 1),
- * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Not parallel. */
+ * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Uses every core; the
+ * _threads form takes the count (<= 0: every core).  The result is the
+ * same bit for bit for any count (docs/natural.md, "Speed"). */
 jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
+jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
+                                    jf_natural **out);
 void jf_natural_free(jf_natural *nt);
 
 typedef struct {
@@ -896,6 +900,9 @@ typedef struct {
     size_t nvertices;    /* distinct finite points                      */
     size_t nduplicates;  /* finite points identical to a kept one       */
     size_t nnonfinite;   /* points with a NaN/Inf coordinate            */
+    double seconds[3];   /* wall time of create's spatial sort, CGAL's
+                            (sequential) insertion and the (parallel)
+                            extraction of adjacency and poles          */
 } jf_natural_stats;
 
 /* Fills *st.  Thread-safe. */

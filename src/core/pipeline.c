@@ -34,6 +34,7 @@
 #include <stdint.h>
 #include "index_internal.h"
 #include "jetfit.h"
+#include "parts.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
 #define PCA_K 16       /* --normal pca: PCA of the 16 nearest points     */
@@ -154,7 +155,7 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     size_t n = c->n;
     x->nflags = calloc(n, sizeof *x->nflags);
     if (!x->nflags) return JF_ERR_NOMEM;
-    jf_status st = jf_natural_create(c->xyz, n, &x->nt);
+    jf_status st = jf_natural_create_threads(c->xyz, n, nt, &x->nt);
     if (st != JF_OK) {
         set_err(err, "natural neighbours: building the Delaunay triangulation failed");
         return st;
@@ -358,6 +359,13 @@ static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
                       jf_error *err)
 {
+    return jf__estimate_masked(c, o, NULL, out, err);
+}
+
+/* parts.h: the points of a part's halo are neighbours, not fitted */
+jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                              jf_result *out, jf_error *err)
+{
     const char *bad = NULL;
     if (err) err->msg[0] = '\0';
     if (!c || !o || (c->n && (!c->xyz || !out))) {
@@ -505,7 +513,10 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
             for (size_t k = beg; k < end && wst == JF_OK;) {
                 const size_t i = walk[k];
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : c->xyz + 3 * i;
-                if (x.plain && k + 1 < end) {
+                if (fit && !fit[i]) { /* a halo point: a neighbour only */
+                    nan_result(&out[i], JF_PT_NONFINITE);
+                    k++;
+                } else if (x.plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
                     const size_t i1 = walk[k + 1];
                     const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : c->xyz + 3 * i1;
                     wst = fit_two(&w, &x, i, pt, i1, pt1, out);
