@@ -114,9 +114,15 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
 /* Parses the whole token [s, e) as a double (decimal, exponent, "nan",
  * "inf", hex floats): 1 on success, 0 if the token is not one number.
  * Exact: <= 19 digits with mantissa <= 2^53 and |exp| <= 22 is Clinger's
- * one-rounding case; <= 19 digits with |exp| <= 27 use exact 128-bit
- * integers; everything else goes to strtod. */
+ * one-rounding case; other <= 19 digit numbers with |exp| <= 64 are
+ * Eisel-Lemire's (jf__lemire), and where it cannot tell, |exp| <= 27 use
+ * exact 128-bit integers; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
+
+/* m 10^q (m != 0) correctly rounded, by Eisel-Lemire (io_lemire.c): 1 and
+ * *out, or 0 when it cannot tell (subnormal or overflowing results, |q| >
+ * 64, the rare ambiguous products): the caller's exact path decides. */
+int jf__lemire(uint64_t m, int q, double *out);
 
 /* 5^k for 0 <= k <= 27 (5^27 < 2^63): the exact decimal paths of
  * jf_parse_double and jf_fmt_g17. */

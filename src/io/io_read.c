@@ -207,7 +207,8 @@ int jf_parse_double(const char *s, const char *e, double *out)
         return slow_double(s, e, out); /* hex float, or not a number */
     if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22) {
         double v;
-        if (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v))
+        if (!jf__lemire(m, exp10, &v) &&
+            (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v)))
             return slow_double(s, e, out);
         *out = neg ? -v : v;
         return 1;
