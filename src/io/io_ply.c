@@ -295,7 +295,7 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                 for (int k = 0; k < el->nprops; k++) {
                     if (pl->dst[k])
                         pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
-                    else if (pl->adst[k])
+                    if (pl->adst[k]) /* normals too: also an attribute */
                         store_attr(pl->adst[k] + r * pl->astride, el->props[k].type,
                                    load(h->p + off[k], el->props[k].type, swap));
                 }
@@ -367,7 +367,8 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                         return st;
                 } else if (!list && pl->dst[k]) {
                     pl->dst[k][3 * r] = v;
-                } else if (!list && pl->adst[k]) {
+                }
+                if (!list && pl->adst[k]) {
                     store_attr(pl->adst[k] + r * pl->astride, pr->type, v);
                 }
             }
@@ -699,29 +700,29 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
     if (has_n)
         dst[inx] = nrm, dst[iny] = nrm + 1, dst[inz] = nrm + 2;
     /* the attributes, as the whole-file path describes them */
-    jf_attrs at = {0};
+    jf_attrs ta = {0};
     unsigned char *adst[MAX_PROPS] = {0};
     for (int j = 0; j < el->nprops && !(ro && ro->no_attrs); j++) {
         if (j == ix || j == iy || j == iz)
             continue;
-        if (!jf__attrs_add(&at, el->props[j].name, strlen(el->props[j].name),
-                           attr_type[el->props[j].type], (uint32_t)at.stride, 0, 0)) {
-            at.stride = SIZE_MAX;
+        if (!jf__attrs_add(&ta, el->props[j].name, strlen(el->props[j].name),
+                           attr_type[el->props[j].type], (uint32_t)ta.stride, 0, 0)) {
+            ta.stride = SIZE_MAX;
             break;
         }
-        at.stride += type_size[el->props[j].type];
+        ta.stride += type_size[el->props[j].type];
     }
-    if (at.stride == SIZE_MAX || (at.nattrs && !(at.rec = malloc(n * at.stride)))) {
+    if (ta.stride == SIZE_MAX || (ta.nattrs && !(ta.rec = malloc(n * ta.stride)))) {
         free(xyz);
         free(nrm);
-        jf_attrs_free(&at);
+        jf_attrs_free(&ta);
         st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
                         "out of memory for the attributes of %zu vertices", n);
         goto out;
     }
-    for (int j = 0, k = 0; at.nattrs && j < el->nprops; j++)
+    for (int j = 0, k = 0; ta.nattrs && j < el->nprops; j++)
         if (j != ix && j != iy && j != iz)
-            adst[j] = at.rec + at.attr[k++].offset;
+            adst[j] = ta.rec + ta.attr[k++].offset;
     size_t off[MAX_PROPS], o = 0;
     for (int j = 0; j < el->nprops; j++) {
         off[j] = o;
@@ -736,7 +737,7 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
     if (per * vrow > (got > CHUNK_BYTES ? got : CHUNK_BYTES)) {
         free(xyz);
         free(nrm);
-        jf_attrs_free(&at);
+        jf_attrs_free(&ta);
         goto out; /* a row over the chunk: the whole-file path */
     }
     for (size_t r0 = 0; r0 < n; r0 += per) {
@@ -744,7 +745,7 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
         if (!pread_all(fd, buf, m * vrow, at + r0 * vrow, &e)) {
             free(xyz);
             free(nrm);
-            jf_attrs_free(&at);
+            jf_attrs_free(&ta);
             st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
                             e ? strerror(e) : "the file shrank while it was read");
             goto out;
@@ -754,15 +755,15 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
             for (int j = 0; j < el->nprops; j++) {
                 if (dst[j])
                     dst[j][3 * r] = load(p + off[j], el->props[j].type, swap);
-                else if (adst[j])
-                    store_attr(adst[j] + r * at.stride, el->props[j].type,
+                if (adst[j])
+                    store_attr(adst[j] + r * ta.stride, el->props[j].type,
                                load(p + off[j], el->props[j].type, swap));
             }
     }
     c->n = n;
     c->xyz = xyz;
     c->nrm = nrm;
-    c->attrs = at;
+    c->attrs = ta;
     st = JF_OK;
 out:
     free(buf);
