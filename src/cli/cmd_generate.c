@@ -289,7 +289,7 @@ int jf_cmd_generate(int argc, char **argv)
     jf_sample s;
     jf_status st;
     if (!grid && !truth && !(noise > 0) && !(noise_u > 0) && !(outliers > 0) &&
-        !has_ext(out, ".off"))
+        !has_ext(out, ".off") && !has_ext(out, ".las")) /* LAS: needs the bbox first */
         return stream_random(surf, surf_name, n ? n : DEFAULT_N, density, &rng, out, ascii);
     if (grid) {
         double h = grid_h > 0 ? grid_h : jf_sample_grid_h_for(surf, n ? n : DEFAULT_N);
