@@ -30,7 +30,9 @@ typedef struct {
                            index among identical points)                 */
     size_t *adj_off;    /* [nv+1] CSR offsets into adj                     */
     uint32_t *adj;      /* Delaunay neighbours (vertex ids) of each vertex,
-                           in lexicographic (x, y, z) order of the points */
+                           nearest first (ties: lexicographic (x, y, z)
+                           order of the points); dimension < 3: lexico-
+                           graphic                                         */
     double *pole;       /* [3nv] vector from the sample to its pole (the
                            farthest Voronoi vertex of its cell; for a hull
                            sample the farthest one opposite `hull`); NaN

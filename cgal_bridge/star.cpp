@@ -12,8 +12,8 @@
 //     walks cells nor in id order, so it is a function of the point set
 //     alone: the same bit for bit for any thread count, any insertion
 //     order, any memory layout.
-//  2. neighbours: the finite vertices of the incident cells, in
-//     lexicographic order of their points.
+//  2. neighbours: the finite vertices of the incident cells, nearest
+//     first (ties: lexicographic order of their points).
 //  3. hull: each incident infinite cell has one finite facet, a convex-hull
 //     facet; the mean of their outer unit normals (summed in the facets'
 //     lexicographic order) is the direction of the vertex's unbounded
@@ -78,6 +78,7 @@ struct Ws {
     std::vector<std::uint32_t> stamp;         // [nv] == mark: neighbour already listed
     std::uint32_t mark = 0;
     std::vector<Vertex> nb;
+    std::vector<std::pair<double, Vertex>> nbd;  // (squared distance, vertex)
     struct Facet {  // a hull facet through the vertex
         const Point *p[3];  // corners in lexicographic order
         Vertex mirror;      // the finite vertex across it
@@ -156,7 +157,16 @@ void star(const DT3 &t, Ws &w, Vertex v, jfb_delaunay *d) {
             w.facets.push_back(f);
         }
     }
-    std::sort(w.nb.begin(), w.nb.end(), vlex_less);
+    // nearest first (ties lexicographic): the C core clips v's planar cell
+    // by these half-planes in this order, and the near ones make the cell,
+    // so the far ones then mostly cut nothing (clip's early exit)
+    const Point &pv0 = v->point();
+    w.nbd.clear();
+    for (Vertex u : w.nb) w.nbd.push_back({CGAL::squared_distance(pv0, u->point()), u});
+    std::sort(w.nbd.begin(), w.nbd.end(), [](const std::pair<double, Vertex> &a, const std::pair<double, Vertex> &b) {
+        return a.first != b.first ? a.first < b.first : vlex_less(a.second, b.second);
+    });
+    for (size_t k = 0; k < w.nb.size(); k++) w.nb[k] = w.nbd[k].second;
 
     // hull direction: facets in lexicographic order, normal from the smallest corner
     double *hd = d->hull + 3 * (size_t)id;
@@ -215,6 +225,7 @@ void flat_adjacency(DT3 &t, std::vector<Vertex> &vh, jfb_delaunay *d) {
     size_t nv = d->nv, len = 0, cap = 8 * nv + 16;
     d->adj = alloc<std::uint32_t>(cap);
     std::vector<Vertex> nb;
+    std::vector<std::pair<double, Vertex>> nbd;  // (squared distance, vertex)
     for (size_t id = 0; id < nv; id++) {
         nb.clear();
         if (t.dimension() >= 1) t.finite_adjacent_vertices(vh[id], std::back_inserter(nb));

@@ -33,6 +33,8 @@ static void usage(FILE *out)
         "  sphere      radius 1; area-uniform samples\n"
         "  ellipsoid   x^2 + (y/0.75)^2 + (z/0.5)^2 = 1; area-uniform samples\n"
         "  cylinder    radius 0.5, z in [-1,1], open; area-uniform samples\n"
+        "  torus       (sqrt(x^2+y^2) - 1)^2 + z^2 = 0.4^2 (closed, with a hole;\n"
+        "              hyperbolic inside); area-uniform samples\n"
         "              closed surfaces: outward normal (so convex k < 0)\n"
         "\n"
         "  -o FILE          output: .ply (binary; --ascii for ascii), .off, .xyz,\n"
@@ -40,11 +42,11 @@ static void usage(FILE *out)
         "  --n N            N random samples (default %d); with --mesh, a grid\n"
         "                   of about N vertices\n"
         "  --grid-h H       a grid of side H in parameter space instead (graphs:\n"
-        "                   x,y; sphere/ellipsoid: theta,phi in radians; cylinder:\n"
-        "                   arc length); vertices only unless --mesh\n"
+        "                   x,y; sphere/ellipsoid: theta,phi in radians; cylinder,\n"
+        "                   torus: arc length); vertices only unless --mesh\n"
         "  --mesh           triangulated grid (graphs: squares split along one\n"
         "                   diagonal; sphere/ellipsoid: closed UV mesh with one\n"
-        "                   vertex per pole; cylinder: open tube)\n"
+        "                   vertex per pole; cylinder: open tube; torus: closed)\n"
         "  --perturb D      grids: move each vertex by (d h, d' h), d, d' uniform\n"
         "                   in [0, D] (default 0.9, the paper's 6.1; 0 = regular)\n"
         "  --noise S        Gaussian noise, sigma = S x bounding-box diagonal,\n"
@@ -229,9 +231,9 @@ int jf_cmd_generate(int argc, char **argv)
     }
     jf_surface surf;
     if (!surf_name)
-        return fail("%s", "which SURFACE? (exp, paraboloid, revolution, sphere, ellipsoid, cylinder)");
+        return fail("%s", "which SURFACE? (exp, paraboloid, revolution, sphere, ellipsoid, cylinder, torus)");
     if (jf_surface_parse(surf_name, &surf))
-        return fail("unknown surface '%s' (exp, paraboloid, revolution, sphere, ellipsoid, cylinder)", surf_name);
+        return fail("unknown surface '%s' (exp, paraboloid, revolution, sphere, ellipsoid, cylinder, torus)", surf_name);
     if (!out)
         return fail("%s", "-o FILE is required");
     if (n && grid_h > 0)
