@@ -644,6 +644,29 @@ jf_status jf_writer_row(jf_writer *w, const double *vals);
 jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                          int threads);
 
+/* Positioned rows, for results that arrive out of order
+ * (jf_estimate_blocks): jf_writer_begin_put once, on one thread, after
+ * jf_writer_las_frame / jf_writer_faces and instead of any
+ * jf_writer_row(s); then jf_writer_put from any number of threads at
+ * once; then jf_writer_commit.  The file's bytes are exactly those that
+ * jf_writer_rows would write with the rows in row order.  Binary PLY and
+ * LAS have fixed-size records: each row is written in place (pwrite at
+ * header + row x record size).  Text (.csv, .xyz, .txt, ascii PLY): each
+ * row goes as ncols raw doubles to a second temporary in the output's
+ * folder (a jf_tmpfile: removed on failure, abort or a signal), which
+ * commit converts to text in row order in one sequential pass and
+ * removes.  Begin: JF_ERR_INVALID after a row was written, else the
+ * header's write status. */
+jf_status jf_writer_begin_put(jf_writer *w);
+
+/* Writes m rows: vals[j * ncols ..] is row rows[j] (< nrows), in any
+ * order; over the writer's life each row must be put exactly once
+ * (commit checks the count).  Thread-safe against other jf_writer_put
+ * calls on w; allocates one buffer of m records per call.  After a
+ * failure (a write error, a row out of range) every call returns it and
+ * commit reports it. */
+jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, size_t m);
+
 /* Flushes, closes, checks the row count and renames the temporary onto
  * the final name.  Frees w whatever happens (w may be NULL: invalid).
  * On failure the temporary is removed and err says why. */
@@ -882,7 +905,7 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
  * The new file keeps the mode of the file it replaces, else 0666 less the
  * umask. */
 typedef struct {
-    int fd;          /* write here (open, O_WRONLY)                    */
+    int fd;          /* write here (open, O_RDWR: a spool reads back)  */
     char *tmp;       /* the temporary's path                           */
     char *target;    /* the file that commit replaces                  */
     int slot;        /* internal: its place in the signal-safe list    */
@@ -971,6 +994,31 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * (may be NULL) gets one line.  Thread-safe on distinct outputs. */
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
                       jf_result *out, jf_error *err);
+
+/* A block of results from jf_estimate_blocks: res[j] belongs to input
+ * point idx[j], j < m (m <= 256); the results are final (oriented).
+ * Return JF_OK to go on; any other status stops the estimate, which
+ * returns it.  Called concurrently from the OpenMP threads of the fit
+ * (blocks are disjoint): it must be thread-safe.  res and idx are the
+ * library's, valid during the call only (res may be changed). */
+typedef jf_status (*jf_block_fn)(void *user, const uint32_t *idx, jf_result *res, size_t m);
+
+/* jf_estimate without the n results in memory: the same results, bit for
+ * bit, handed to `sink` a block at a time as they are fitted (in the
+ * walk's order: the k-d tree's leaf order for knn/radius, else Z-order;
+ * non-finite points first), each point exactly once.  Orientation none,
+ * input, viewpoint and scanner are applied per block.  mst needs every
+ * normal before any row is final: it runs the fit twice -- the first pass
+ * keeps the normals, statuses and orient_k graph edges (28 + 4 orient_k
+ * bytes per point), Prim decides a flip per point, the second pass fits
+ * again and hands over the flipped rows (twice the time; the progress
+ * hook then counts 2n).  Peak memory besides c: the index (about 40
+ * bytes per point for knn/radius) and, per thread, one block of results.
+ * Same statuses and errors as jf_estimate; a sink's status stops it
+ * (blocks already handed over stay handed over).  Thread-safe on distinct
+ * sinks. */
+jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o,
+                             jf_block_fn sink, void *user, jf_error *err);
 
 #ifdef __cplusplus
 }

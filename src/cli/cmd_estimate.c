@@ -114,40 +114,54 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void summary(const jf_result *r, size_t n, size_t nbad, double secs, const char *out)
+/* What the summary counts, per thread (the sink runs on the fit's
+ * threads), padded so that threads do not share a cache line. */
+typedef struct {
+    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1];
+    char pad[64];
+} tally;
+
+static void tally_add(tally *t, const jf_result *r)
 {
-    size_t flags[32] = {0}, ok = 0, deg[JF_MAX_DEGREE + 1] = {0};
-    for (size_t i = 0; i < n; i++) {
-        if (!r[i].status) ok++;
-        for (int b = 0; b < 32; b++)
-            if (r[i].status & (1u << b)) flags[b]++;
-        if (r[i].degree >= 0 && r[i].degree <= JF_MAX_DEGREE) deg[r[i].degree]++;
+    if (!r->status) t->ok++;
+    for (int b = 0; b < 32; b++)
+        if (r->status & (1u << b)) t->flags[b]++;
+    if (r->degree >= 0 && r->degree <= JF_MAX_DEGREE) t->deg[r->degree]++;
+}
+
+/* cond[i] of every point (NaN skipped); nt tallies summed. */
+static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
+                    const char *out)
+{
+    tally t = {{0}, 0, {0}, {0}};
+    for (int k = 0; k < nt; k++) {
+        t.ok += tl[k].ok;
+        for (int b = 0; b < 32; b++) t.flags[b] += tl[k].flags[b];
+        for (int d = 0; d <= JF_MAX_DEGREE; d++) t.deg[d] += tl[k].deg[d];
     }
     fprintf(stderr, "jetfit: %zu points in %.2f s (%.0f points/s)\n", n, secs,
             secs > 0 ? (double)n / secs : 0.0);
-    fprintf(stderr, "  status: ok %zu", ok);
+    fprintf(stderr, "  status: ok %zu", t.ok);
     for (int b = 0; b < 32; b++) {
         char name[64];
-        if (flags[b])
+        if (t.flags[b])
             fprintf(stderr, ", %s %zu", jf_point_status_str(1u << b, name, sizeof name),
-                    flags[b]);
+                    t.flags[b]);
     }
     fprintf(stderr, "\n  degree:");
     for (int d = 0; d <= JF_MAX_DEGREE; d++)
-        if (deg[d]) fprintf(stderr, " %d: %zu", d, deg[d]);
+        if (t.deg[d]) fprintf(stderr, " %d: %zu", d, t.deg[d]);
     fputc('\n', stderr);
-    double *c = malloc((n ? n : 1) * sizeof *c);
     size_t m = 0;
-    if (c) {
+    if (cond) {
         for (size_t i = 0; i < n; i++)
-            if (isfinite(r[i].cond)) c[m++] = r[i].cond;
-        qsort(c, m, sizeof *c, cmp_double);
+            if (isfinite(cond[i])) cond[m++] = cond[i];
+        qsort(cond, m, sizeof *cond, cmp_double);
     }
     if (m)
         fprintf(stderr, "  cond: p50 %.3g, p90 %.3g, p99 %.3g, max %.3g\n",
-                c[(m - 1) / 2], c[(size_t)(0.9 * (double)(m - 1))],
-                c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
-    free(c);
+                cond[(m - 1) / 2], cond[(size_t)(0.9 * (double)(m - 1))],
+                cond[(size_t)(0.99 * (double)(m - 1))], cond[m - 1]);
     if (nbad)
         fprintf(stderr, "  bad rows: %zu (kept as NaN rows, status nonfinite)\n", nbad);
     fprintf(stderr, "  output: %s\n", out);
@@ -195,6 +209,41 @@ static size_t make_row(const double *p, const jf_result *r, int monge, double *v
     v[n++] = r->residual;
     v[n++] = (double)r->status;
     return n;
+}
+
+/* ---- rows straight to the output ------------------------------------- */
+
+/* design (docs/scale.md): results are never held for the whole cloud.
+ * jf_estimate_blocks hands over blocks of <= 256 results from the fit's
+ * threads; each block becomes rows written at their input index
+ * (jf_writer_put: in place for binary PLY and LAS, through a binary spool
+ * for text).  What stays per point: the coordinates, the index, and the
+ * condition numbers for the summary's quantiles. */
+typedef struct {
+    jf_writer *w;
+    const double *xyz;
+    int monge, nt;
+    size_t ncols;
+    double *rows;    /* nt x 256 x ncols: one block per thread          */
+    tally *tl;       /* nt                                              */
+    double *cond;    /* n, or NULL (--quiet)                            */
+    int wfail;       /* a jf_writer_put failed (atomic)                 */
+} sinkctx;
+
+static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
+{
+    sinkctx *s = user;
+    int t = omp_get_thread_num();
+    if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
+    double *v = s->rows + (size_t)t * 256 * s->ncols;
+    for (size_t j = 0; j < m; j++) {
+        make_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        tally_add(&s->tl[t], &res[j]);
+        if (s->cond) s->cond[idx[j]] = res[j].cond;
+    }
+    jf_status st = jf_writer_put(s->w, idx, v, m);
+    if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
+    return st;
 }
 
 /* ---- the command ---------------------------------------------------------- */
@@ -308,10 +357,19 @@ int jf_cmd_estimate(int argc, char **argv)
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
     (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
-    jf_result *r = malloc(c.n * sizeof *r);
-    if (!r) {
-        fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);
-        jf_writer_abort(w);
+    const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
+    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
+                  calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
+    if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w) != JF_OK) {
+        /* a failed begin is reported by commit's message below */
+        if (!sk.rows || !sk.tl || (!quiet && !sk.cond))
+            fprintf(stderr, "jetfit: out of memory (%zu points)\n", c.n);
+        st = jf_writer_commit(w, &err);
+        if (st != JF_OK && sk.rows && sk.tl && (quiet || sk.cond))
+            fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        free(sk.rows);
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
@@ -320,42 +378,35 @@ int jf_cmd_estimate(int argc, char **argv)
         o.progress = progress;
         o.progress_user = &ps;
     }
-    st = jf_estimate(&c, &o, r, &err);
+    st = jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
+    free(sk.rows);
     if (st != JF_OK) {
-        fprintf(stderr, "jetfit: %s: %s\n", in, err.msg[0] ? err.msg : jf_strerror(st));
-        jf_writer_abort(w);
-        free(r);
+        /* a failed write: the writer's own message says which file and
+         * why (commit fails on it, and removes the temporary) */
+        jf_error werr = {{0}};
+        if (sk.wfail && jf_writer_commit(w, &werr) != JF_OK && werr.msg[0]) {
+            fprintf(stderr, "jetfit: %s\n", werr.msg);
+        } else {
+            if (!sk.wfail) jf_writer_abort(w);
+            fprintf(stderr, "jetfit: %s: %s\n", in, err.msg[0] ? err.msg : jf_strerror(st));
+        }
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
-    /* rows built and formatted in parallel, a block at a time (16 MB) */
-    enum { BLOCK = 65536 };
-    double *rows = malloc((c.n < BLOCK ? c.n : BLOCK) * ncols * sizeof *rows);
-    if (!rows) {
-        fprintf(stderr, "jetfit: out of memory (output rows)\n");
-        jf_writer_abort(w);
-        free(r);
-        jf_cloud_free(&c);
-        return 1;
-    }
-    for (size_t b0 = 0; b0 < c.n; b0 += BLOCK) {
-        const long nb = (long)(c.n - b0 < BLOCK ? c.n - b0 : BLOCK);
-#pragma omp parallel for num_threads(o.threads > 0 ? o.threads : omp_get_max_threads())
-        for (long k = 0; k < nb; k++)
-            make_row(c.xyz + 3 * (b0 + (size_t)k), &r[b0 + (size_t)k], monge, rows + (size_t)k * ncols);
-        if (jf_writer_rows(w, rows, (size_t)nb, o.threads) != JF_OK) break;
-    }
-    free(rows);
     /* commit reports a failed row too, and removes the temporary */
     st = jf_writer_commit(w, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
-        free(r);
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
-    if (!quiet) summary(r, c.n, c.nbad, now_s() - t0, out);
-    free(r);
+    if (!quiet) summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+    free(sk.tl);
+    free(sk.cond);
     jf_cloud_free(&c);
     return 0;
 }

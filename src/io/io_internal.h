@@ -48,6 +48,14 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
                       jf_error *err);
 
+/* io_ply.c: a binary PLY whose elements all have fixed-size rows and
+ * whose length matches its header, read from fd (len bytes) a chunk at a
+ * time straight into c (no file image in memory).  JF_ERR_UNSUPPORTED
+ * (c untouched, err not set) when the file does not qualify: read it
+ * whole.  Otherwise JF_OK, or JF_ERR_IO / _NOMEM with err set. */
+jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, jf_cloud *c,
+                               jf_error *err);
+
 /* LAS output (io_las_write.c), used by the table writer: the header and
  * Extra Bytes VLR size, the record size, the frame (scale, offset and
  * stored bounds) of a cloud, one record, and the header written at

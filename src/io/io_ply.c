@@ -9,10 +9,13 @@
  * left are checked: a binary row needs at least its fixed size, an ascii
  * row a byte per value.  Ascii rows are one line each.
  */
+#define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
 static const char *const type_names[][2] = {
@@ -525,6 +528,143 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     c->face_idx = fi.v;
     if (st == JF_OK && c->nfaces && !c->face_idx) /* all faces empty */
         c->face_idx = malloc(sizeof(uint32_t));
+    free(h);
+    return st;
+}
+
+/* ---- binary PLY read in chunks (jf_cloud_read) ------------------------ */
+
+/* design (issue 12.1): a 10^8-point binary PLY must not be held twice (the
+ * file image and the coordinates).  When every element has fixed-size
+ * rows (scalar properties only: a point cloud, no face lists) and the
+ * file's length is exactly what the header announces (up to the
+ * tolerated trailing bytes), the rows are read with pread(2) a chunk at a
+ * time straight into the coordinate arrays, by the same decoding as the
+ * whole-file path.  Anything else (ascii, lists, a size that does not
+ * match: whatever the whole-file path would refuse or treat specially)
+ * returns JF_ERR_UNSUPPORTED with *c untouched, and the caller reads the
+ * whole file as before, so results and messages stay the same. */
+#define HEAD_MAX (1u << 20)
+#define CHUNK_BYTES (4u << 20)
+
+static int pread_all(int fd, unsigned char *p, size_t n, uint64_t at, int *e)
+{
+    while (n) {
+        ssize_t k = pread(fd, p, n, (off_t)at);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            *e = k < 0 ? errno : 0;
+            return 0;
+        }
+        p += k, n -= (size_t)k, at += (uint64_t)k;
+    }
+    return 1;
+}
+
+jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, jf_cloud *c, jf_error *err)
+{
+    size_t got = len < HEAD_MAX ? len : HEAD_MAX;
+    unsigned char *buf = malloc(got > CHUNK_BYTES ? got : CHUNK_BYTES);
+    ply *h = calloc(1, sizeof *h);
+    jf_status st = JF_ERR_UNSUPPORTED;
+    int e = 0;
+    size_t body = 0;
+    if (!buf || !h) {
+        st = JF_ERR_UNSUPPORTED; /* the whole-file path says out of memory */
+        goto out;
+    }
+    h->name = name;
+    if (!pread_all(fd, buf, got, 0, &e)) {
+        st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
+                        e ? strerror(e) : "the file shrank while it was read");
+        goto out;
+    }
+    /* a header line cut by the prefix's end would parse differently */
+    if (parse_header(h, (const char *)buf, got, &body) != JF_OK || h->format == 0 ||
+        (body >= got && got < len))
+        goto out;
+    uint64_t total = body, vrow = 0;
+    int iv = -1;
+    size_t rowsz[MAX_ELEMS];
+    for (int k = 0; k < h->nelems; k++) {
+        const ply_elem *el = &h->elems[k];
+        uint64_t row = 0;
+        for (int j = 0; j < el->nprops; j++) {
+            if (el->props[j].count_type != T_NONE)
+                goto out;
+            row += type_size[el->props[j].type];
+        }
+        if (row && el->count > (UINT64_MAX - total) / row)
+            goto out;
+        total += row * el->count;
+        rowsz[k] = (size_t)row;
+        if (iv < 0 && !strcmp(el->name, "vertex")) {
+            iv = k;
+            vrow = row;
+        }
+    }
+    if (iv < 0 || !vrow || total > len || len - total >= vrow || h->elems[iv].count == 0 ||
+        h->elems[iv].count > JF_MAX_POINTS)
+        goto out;
+    const ply_elem *el = &h->elems[iv];
+    int ix = prop_index(el, "x", 0), iy = prop_index(el, "y", 0), iz = prop_index(el, "z", 0);
+    int inx = prop_index(el, "nx", 0), iny = prop_index(el, "ny", 0),
+        inz = prop_index(el, "nz", 0);
+    if (ix < 0 || iy < 0 || iz < 0)
+        goto out;
+    size_t n = (size_t)el->count;
+    double *xyz = malloc((n ? n : 1) * 3 * sizeof(double)), *nrm = NULL;
+    int has_n = inx >= 0 && iny >= 0 && inz >= 0;
+    if (has_n)
+        nrm = malloc((n ? n : 1) * 3 * sizeof(double));
+    if (!xyz || (has_n && !nrm)) {
+        free(xyz);
+        free(nrm);
+        st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu vertices", n);
+        goto out;
+    }
+    double *dst[MAX_PROPS] = {0};
+    dst[ix] = xyz, dst[iy] = xyz + 1, dst[iz] = xyz + 2;
+    if (has_n)
+        dst[inx] = nrm, dst[iny] = nrm + 1, dst[inz] = nrm + 2;
+    size_t off[MAX_PROPS], o = 0;
+    for (int j = 0; j < el->nprops; j++) {
+        off[j] = o;
+        o += type_size[el->props[j].type];
+    }
+    const uint16_t one = 1;
+    int swap = (h->format == 1) != (*(const unsigned char *)&one == 1);
+    uint64_t at = body;
+    for (int k = 0; k < iv; k++)
+        at += (uint64_t)rowsz[k] * h->elems[k].count;
+    size_t per = CHUNK_BYTES / vrow ? CHUNK_BYTES / vrow : 1;
+    if (per * vrow > (got > CHUNK_BYTES ? got : CHUNK_BYTES)) {
+        free(xyz);
+        free(nrm);
+        goto out; /* a row over the chunk: the whole-file path */
+    }
+    for (size_t r0 = 0; r0 < n; r0 += per) {
+        size_t m = n - r0 < per ? n - r0 : per;
+        if (!pread_all(fd, buf, m * vrow, at + r0 * vrow, &e)) {
+            free(xyz);
+            free(nrm);
+            st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
+                            e ? strerror(e) : "the file shrank while it was read");
+            goto out;
+        }
+        const unsigned char *p = buf;
+        for (size_t r = r0; r < r0 + m; r++, p += vrow)
+            for (int j = 0; j < el->nprops; j++)
+                if (dst[j])
+                    dst[j][3 * r] = load(p + off[j], el->props[j].type, swap);
+    }
+    c->n = n;
+    c->xyz = xyz;
+    c->nrm = nrm;
+    st = JF_OK;
+out:
+    free(buf);
     free(h);
     return st;
 }

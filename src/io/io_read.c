@@ -3,9 +3,11 @@
  * file, and holds the pieces every reader shares (messages, exact number
  * parsing, growable arrays).
  *
- * design: the file is mapped (or read whole when it cannot be mapped) and
- * the reader parses the byte range in place: no copy, no allocation per
- * token, no reading past the end.  Counts read from headers are checked
+ * design: the file is read whole (never mapped: issue 11) and the reader
+ * parses the byte range in place: no copy, no allocation per token, no
+ * reading past the end.  A binary PLY point cloud is read in chunks
+ * straight into the coordinates instead (io_ply.c, jf__read_ply_chunked),
+ * so that a 10^8-point file is not held twice.  Counts read from headers are checked
  * against the bytes left before anything is allocated from them.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -375,6 +377,14 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     if (len == 0) {
         close(fd);
         return jf_io_fail(err, JF_ERR_FORMAT, path, 0, "empty file");
+    }
+    if (fmt == JF_FMT_PLY) {
+        /* binary point clouds without a second copy (io_ply.c) */
+        jf_status cs = jf__read_ply_chunked(fd, len, path, c, err);
+        if (cs != JF_ERR_UNSUPPORTED) {
+            close(fd);
+            return cs;
+        }
     }
     char *buf = malloc(len);
     if (!buf) {

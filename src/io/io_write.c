@@ -9,10 +9,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <omp.h>
 
@@ -32,6 +34,14 @@ struct jf_writer {
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
     double las_scale[3], las_off[3], las_lo[3], las_hi[3];
+    /* positioned rows (jf_writer_begin_put / _put) */
+    int put;                         /* begun                            */
+    int spool_on;                    /* text: rows go to `spool`         */
+    jf_tmpfile spool;                /* text: ncols raw doubles per row  */
+    size_t base, rec;                /* first record's offset, its size  */
+    size_t put_rows;                 /* rows put (atomic)                */
+    int put_err;                     /* first failure: errno, or -1 a bad
+                                        row (atomic; 0 none)             */
 };
 
 static int host_little(void)
@@ -279,6 +289,8 @@ static jf_status ready_for(jf_writer *w, size_t nrows)
         return f->st;
     if (!w->header_done && write_header(w) != JF_OK)
         return f->st;
+    if (w->put)
+        return jf_wf_fail(f, JF_ERR_INVALID, "rows appended to a table of positioned rows");
     if (nrows > w->nrows - w->rows)
         return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced", w->nrows);
     return JF_OK;
@@ -341,6 +353,168 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     return f->st;
 }
 
+/* ---- positioned rows --------------------------------------------------- */
+
+/* design: binary PLY and LAS records have one size, so row r lives at
+ * base + r * rec of the output itself.  Text rows have no fixed size:
+ * they are spooled as raw doubles (rec = 8 ncols) to a temporary beside
+ * the output, and turned into text in row order at commit
+ * (spool_to_text), with the same formatting code as jf_writer_rows. */
+jf_status jf_writer_begin_put(jf_writer *w)
+{
+    if (!w || w->put || w->rows)
+        return JF_ERR_INVALID;
+    jf_wfile *f = &w->f;
+    if (ready_for(w, 0) != JF_OK || jf_wf_flush(f) != JF_OK)
+        return f->st;
+    off_t at = lseek(f->fd, 0, SEEK_CUR);
+    if (at < 0)
+        return jf_wf_fail(f, JF_ERR_IO, "seek failed: %s", strerror(errno));
+    w->spool.fd = -1;
+    w->spool.slot = -1;
+    w->base = (size_t)at;
+    if (w->fmt == FMT_CSV || w->fmt == FMT_XYZ || w->ascii) {
+        jf_error e;
+        if (jf_tmpfile_open(w->f.final, &w->spool, &e) != JF_OK)
+            return jf_wf_fail(f, JF_ERR_IO, "cannot create the row spool beside it");
+        w->spool_on = 1;
+        w->base = 0;
+        w->rec = 8 * w->ncols;
+    } else {
+        w->rec = w->fmt == FMT_LAS ? jf__las_record_size(w->types, w->ncols) : 0;
+        for (size_t j = 0; w->fmt == FMT_PLY && j < w->ncols; j++)
+            w->rec += w->types[j] == JF_COL_F64 ? 8 : 4;
+        /* what follows the rows (PLY faces) is appended after them */
+        if (lseek(f->fd, (off_t)(w->base + w->nrows * w->rec), SEEK_SET) < 0)
+            return jf_wf_fail(f, JF_ERR_IO, "seek failed: %s", strerror(errno));
+    }
+    w->put = 1;
+    return JF_OK;
+}
+
+static void put_fail(jf_writer *w, int e)
+{
+    int zero = 0;
+    __atomic_compare_exchange_n(&w->put_err, &zero, e ? e : EIO, 0, __ATOMIC_ACQ_REL,
+                                __ATOMIC_RELAXED);
+}
+
+static int pwrite_all(int fd, const char *p, size_t n, size_t at)
+{
+    while (n) {
+        ssize_t k = pwrite(fd, p, n, (off_t)at);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            return k < 0 ? errno : EIO;
+        p += k, n -= (size_t)k, at += (size_t)k;
+    }
+    return 0;
+}
+
+typedef struct {
+    uint32_t row, j;
+} rowref;
+
+static int rowref_cmp(const void *a, const void *b)
+{
+    uint32_t x = ((const rowref *)a)->row, y = ((const rowref *)b)->row;
+    return (x > y) - (x < y);
+}
+
+jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, size_t m)
+{
+    if (!w || !w->put || (m && (!rows || !vals)))
+        return JF_ERR_INVALID;
+    if (__atomic_load_n(&w->put_err, __ATOMIC_ACQUIRE))
+        return JF_ERR_IO;
+    if (!m)
+        return JF_OK;
+    /* rows in order, so that runs of consecutive rows go out in one write */
+    rowref *ord = malloc(m * sizeof *ord);
+    char *buf = malloc(m * (w->spool_on ? w->rec : w->ncols * 32 + 2));
+    int e = 0;
+    if (!ord || !buf)
+        e = ENOMEM;
+    for (size_t j = 0; !e && j < m; j++) {
+        if (rows[j] >= w->nrows)
+            e = -1;
+        ord[j] = (rowref){rows[j], (uint32_t)j};
+    }
+    if (!e)
+        qsort(ord, m, sizeof *ord, rowref_cmp);
+    const int fd = w->spool_on ? w->spool.fd : w->f.fd;
+    for (size_t a = 0; !e && a < m;) {
+        size_t b = a + 1;
+        while (b < m && ord[b].row == ord[b - 1].row + 1)
+            b++;
+        size_t len = 0;
+        for (size_t k = a; k < b; k++) {
+            const double *v = vals + (size_t)ord[k].j * w->ncols;
+            if (w->spool_on) {
+                memcpy(buf + len, v, w->rec);
+                len += w->rec;
+            } else {
+                len += format_row(w, v, buf + len);
+            }
+        }
+        e = pwrite_all(fd, buf, len, w->base + (size_t)ord[a].row * w->rec);
+        a = b;
+    }
+    free(ord);
+    free(buf);
+    if (e) {
+        put_fail(w, e);
+        return e == ENOMEM ? JF_ERR_NOMEM : e < 0 ? JF_ERR_INVALID : JF_ERR_IO;
+    }
+    __atomic_fetch_add(&w->put_rows, m, __ATOMIC_RELAXED);
+    return JF_OK;
+}
+
+/* Commit of a put table: the failure if any, the count, then (text) the
+ * spool read back in row order through jf_writer_rows.  Leaves w->rows
+ * at nrows when all went well. */
+static jf_status put_finish(jf_writer *w)
+{
+    jf_wfile *f = &w->f;
+    int e = w->put_err;
+    if (f->st == JF_OK && e)
+        jf_wf_fail(f, e == -1 ? JF_ERR_INVALID : e == ENOMEM ? JF_ERR_NOMEM : JF_ERR_IO, "%s",
+                   e == -1 ? "a row number beyond the announced count"
+                           : e == ENOMEM ? "out of memory" : strerror(e));
+    if (f->st == JF_OK && w->put_rows != w->nrows)
+        jf_wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced", w->put_rows, w->nrows);
+    if (f->st == JF_OK && !w->spool_on)
+        w->rows = w->nrows;
+    if (f->st != JF_OK || !w->spool_on)
+        return f->st;
+    enum { CH = 65536 };
+    size_t chunk = w->nrows < CH ? (w->nrows ? w->nrows : 1) : CH;
+    double *v = malloc(chunk * w->rec);
+    if (!v)
+        return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
+    w->put = 0; /* jf_writer_rows appends again */
+    for (size_t r0 = 0; r0 < w->nrows && f->st == JF_OK; r0 += chunk) {
+        size_t k = w->nrows - r0 < chunk ? w->nrows - r0 : chunk, got = 0;
+        while (got < k * w->rec) {
+            ssize_t g = pread(w->spool.fd, (char *)v + got, k * w->rec - got,
+                              (off_t)(r0 * w->rec + got));
+            if (g < 0 && errno == EINTR)
+                continue;
+            if (g <= 0) {
+                jf_wf_fail(f, JF_ERR_IO, "reading the row spool back failed: %s",
+                           g < 0 ? strerror(errno) : "short file");
+                break;
+            }
+            got += (size_t)g;
+        }
+        if (f->st == JF_OK)
+            jf_writer_rows(w, v, k, 0);
+    }
+    free(v);
+    return f->st;
+}
+
 static jf_status write_faces(jf_writer *w)
 {
     jf_wfile *f = &w->f;
@@ -377,6 +551,8 @@ static jf_status write_faces(jf_writer *w)
 /* Frees the writer itself (its file is closed by jf_wf_close). */
 static void free_writer(jf_writer *w)
 {
+    if (w->spool_on)
+        jf_tmpfile_discard(&w->spool);
     for (size_t j = 0; w->names && j < w->ncols; j++)
         free(w->names[j]);
     free(w->names);
@@ -391,6 +567,8 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
     jf_wfile *f = &w->f;
     if (f->st == JF_OK && !w->header_done)
         write_header(w);
+    if (w->put)
+        put_finish(w);
     if (f->st == JF_OK && w->rows != w->nrows)
         jf_wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced",
                 w->rows, w->nrows);
