@@ -510,6 +510,57 @@ jf_status jf_nb_query_mesh(const jf_mesh *m, const double *xyz,
 /* ------------------------------------------------------------------ */
 /* Clouds, meshes and files                                            */
 /* ------------------------------------------------------------------ */
+/* Per-point attributes carried from the input to the output (issue 13.4;
+ * src/io/io_attrs.c): every PLY vertex property other than x y z (lists
+ * excepted), every header-named CSV/XYZ column other than x y z, every LAS
+ * dimension and Extra Byte.  Kept compact: one packed record of `stride`
+ * bytes per point, each value in its input type, little endian (a PLY
+ * `uchar red` costs one byte a point, not a double).  For a LAS input the
+ * record IS the LAS point record, unchanged (X Y Z and the bit fields
+ * included), so a LAS output can copy it byte for byte. */
+typedef enum {
+    JF_ATTR_I8 = 0, JF_ATTR_U8, JF_ATTR_I16, JF_ATTR_U16, JF_ATTR_I32,
+    JF_ATTR_U32, JF_ATTR_I64, JF_ATTR_U64, JF_ATTR_F32, JF_ATTR_F64
+} jf_attr_type;
+
+typedef struct {
+    char name[64];       /* as the input names it (characters a PLY or
+                            CSV header cannot hold -- blanks, ',', '#'
+                            -- replaced by '_')                         */
+    jf_attr_type type;   /* the input's type                            */
+    uint32_t offset;     /* byte offset of the value in a record        */
+    uint8_t shift, bits; /* bits > 0: an unsigned bit field of the byte
+                            at offset, (b >> shift) & (2^bits - 1)
+                            (LAS return numbers, flags); type U8        */
+} jf_attr;
+
+typedef struct {
+    size_t nattrs;       /* 0: no attributes (and the rest NULL/0)      */
+    jf_attr *attr;       /* nattrs descriptions                         */
+    size_t stride;       /* bytes per point record                      */
+    unsigned char *rec;  /* n * stride bytes, point i at rec + i*stride */
+    unsigned char *las_head; /* LAS input only: the header block and
+                            VLRs verbatim (las_head_len bytes, up to the
+                            offset to point data); rec holds the point
+                            records; else NULL                          */
+    size_t las_head_len;
+    unsigned char *las_evlr; /* LAS 1.3/1.4 input: its EVLRs verbatim,
+                            or NULL                                     */
+    size_t las_evlr_len;
+} jf_attrs;
+
+/* Attribute j of point i as a double (bit fields decoded; 64-bit integers
+ * beyond 2^53 rounded).  NaN if j or i is out of range (n is not known
+ * here: the caller keeps i < the cloud's n).  Thread-safe. */
+double jf_attr_get(const jf_attrs *a, size_t j, size_t i);
+
+/* Index of the attribute named `name`, or -1. */
+int jf_attr_find(const jf_attrs *a, const char *name);
+
+/* Frees the arrays and zeroes *a (NULL or zeroed: no-op); jf_cloud_free
+ * calls it. */
+void jf_attrs_free(jf_attrs *a);
+
 typedef struct {
     size_t n;            /* number of points                           */
     double *xyz;         /* 3n coordinates                             */
@@ -524,6 +575,8 @@ typedef struct {
     double *scanner;     /* PTX: 3 nscans scanner positions in the
                             registered frame, else NULL                */
     size_t nscans;       /* PTX: number of scans, else 0               */
+    jf_attrs attrs;      /* the input's other per-point values (above);
+                            empty when jf_read_opts.no_attrs           */
 } jf_cloud;
 
 typedef struct {
@@ -542,6 +595,9 @@ typedef struct {
                             (so every later row keeps its index; the
                             pipeline marks it nonfinite) and counted in
                             jf_cloud.nbad / bad_line                   */
+    int no_attrs;        /* 0 (default) read the attributes into
+                            jf_cloud.attrs; 1 skip them (--keep none:
+                            no memory spent on them)                   */
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */
@@ -564,6 +620,15 @@ void jf_read_opts_init(jf_read_opts *o);
  *  - PTX: one or more scans (header: cols, rows, scanner position, axes,
  *    4x4 row-vector transform); points moved to the registered frame;
  *    "0 0 0" (no return) kept as a NaN row; fills scan/scanner/nscans.
+ *  - LAS 1.0-1.4, point formats 0-10: x = X * scale + offset.
+ * Attributes (jf_cloud.attrs, unless o->no_attrs): PLY every scalar
+ * vertex property but x y z, in its type; CSV/XYZ with a header line
+ * every named column but x y z whose fields are all numbers (empty: NaN),
+ * packed as uchar, ushort or int when every value is such an integer,
+ * else double; LAS the record whole, described as laspy names its
+ * dimensions (intensity, return_number, ..., gps_time, red, ...) and the
+ * Extra Bytes by their descriptions (scalar types), plus the header,
+ * VLRs and EVLRs verbatim.
  * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
  * A file without points (empty, comments only, 0 vertices) is an error.
  * o may be NULL (defaults).  c is overwritten (not freed first).
@@ -620,6 +685,28 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
  * up to ~200 m), so the cloud must be given before the first row.  A
  * no-op for other formats.  JF_ERR_INVALID after the first row. */
 jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
+
+/* Carries a cloud's attributes (jf_cloud.attrs) into the table: their
+ * columns go after x y z (columns 0-2) and before the others, each named
+ * as in the input with `in_` put before the name while it clashes with a
+ * column of the table or an earlier attribute (an input `nx` is written
+ * `in_nx`).  PLY: each property in its input type (64-bit integers as
+ * double); text: integers exact, floats and doubles %.17g (the exact
+ * value, so a reader gets the same number back); LAS: from a
+ * LAS input (a->las_head) the input's point records are written unchanged
+ * -- same point format, scale, offset, header fields, VLRs and EVLRs --
+ * with the table's columns 3.. appended as Extra Bytes after the input's
+ * own (x y z of the rows are then not used, and jf_writer_las_frame is
+ * not needed); from another input, format 0 with the attributes as Extra
+ * Bytes of their type ahead of the table's.  Row r of the table carries
+ * the attributes of point r (rows are in input order): `a` is read while
+ * rows are written and must stay valid until commit.  Call before the
+ * first row.  A table with no attribute (nattrs 0, not LAS) is a no-op.
+ * Returns JF_OK, JF_ERR_INVALID (rows already written, called twice,
+ * fewer than 3 columns, a name that cannot be made unique),
+ * JF_ERR_TOO_LARGE (LAS: a record over 65535 bytes or more than 341
+ * Extra Bytes), JF_ERR_NOMEM. */
+jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a);
 
 /* PLY only (ignored by text formats): also write a `face` element
  * (list uchar int vertex_indices) from nfaces polygons
@@ -730,7 +817,8 @@ typedef struct {
  * .txt, .pts the last "# name name ..." comment before the data (jetfit's
  * and generate's outputs); .ply the vertex element's properties (ascii or
  * binary_little_endian; other elements must come after it and are
- * ignored); headerless files by extension: .normals nx ny nz, .curv k1 k2
+ * ignored); .las x y z then every dimension and Extra Byte as
+ * jf_cloud_read's attributes name them (a LAS jetfit wrote: its columns); headerless files by extension: .normals nx ny nz, .curv k1 k2
  * (PCPNet's column order, not re-sorted), .pidx index, otherwise
  * x y z nx ny nz k1 k2.  On failure fills err ("FILE:LINE: reason") and
  * leaves *t empty.  The table is owned by the caller: jf_eval_table_free. */
@@ -838,6 +926,8 @@ typedef struct {
     double seconds[3];   /* wall time of create's spatial sort, CGAL's
                             (sequential) insertion and the (parallel)
                             extraction of adjacency and poles          */
+    double cpu_seconds[3]; /* the same in CPU time (the process's, all
+                            threads; bench_natural's profile)          */
 } jf_natural_stats;
 
 /* Fills *st.  Thread-safe. */

@@ -25,7 +25,7 @@ static void usage(FILE *f)
         "\n"
         "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
         "and writes one row per input point, in input order.\n"
-        "INPUT: .ply .xyz .pts .txt .csv .off    OUTPUT: .ply .csv .xyz .txt\n"
+        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx   OUTPUT: .ply .csv .xyz .txt .las\n"
         "\n"
         "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
         "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
@@ -62,6 +62,11 @@ static void usage(FILE *f)
         "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
+        "  --keep MODE           all (default): the input's other per-point values\n"
+        "                        (PLY properties, named CSV columns, LAS dimensions;\n"
+        "                        a LAS output keeps the LAS records) go to the output\n"
+        "                        after x y z, a name that clashes renamed in_NAME;\n"
+        "                        none: jetfit's columns only\n"
         "  --quiet               no progress line, no summary\n"
         "  -h, --help            this text\n"
         "\n"
@@ -251,7 +256,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
 int jf_cmd_estimate(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL;
-    int quiet = 0, ascii = 0;
+    int quiet = 0, ascii = 0, keep = 1;
     jf_cli_est e;
     jf_cli_bad bad;
     jf_cli_est_init(&e);
@@ -289,7 +294,7 @@ int jf_cmd_estimate(int argc, char **argv)
         } else {
             snprintf(name, sizeof name, "%s", a);
             if (i + 1 >= argc)
-                return strcmp(name, "-o") && strcmp(name, "--output") &&
+                return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--keep") &&
                                jf_cli_est_takes_value(name) != 1
                            ? bad_option("unknown option", a, "not an option of estimate")
                            : bad_option(a, "", "needs a value");
@@ -297,6 +302,10 @@ int jf_cmd_estimate(int argc, char **argv)
         }
         if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
             out = val;
+        } else if (!strcmp(name, "--keep")) {
+            if (!strcmp(val, "all")) keep = 1;
+            else if (!strcmp(val, "none")) keep = 0;
+            else return bad_option(name, val, "expected all or none");
         } else if (jf_cli_est_takes_value(name) != 1) {
             return bad_option("unknown option", a, "not an option of estimate");
         } else if (jf_cli_est_option(&e, name, val, &bad)) {
@@ -319,6 +328,7 @@ int jf_cmd_estimate(int argc, char **argv)
                 out, in);
         return 1;
     }
+    e.ro.no_attrs = !keep; /* --keep none: not even read */
     jf_status st = jf_cloud_read(in, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
@@ -357,6 +367,19 @@ int jf_cmd_estimate(int argc, char **argv)
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
     (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
+    /* the input's attributes after x y z (a LAS output from a LAS input
+     * keeps its records) */
+    st = jf_writer_attrs(w, &c.attrs);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s: cannot carry the input's attributes to %s: %s (use "
+                        "--keep none)\n", in, out,
+                st == JF_ERR_TOO_LARGE ? "a LAS record would exceed 65535 bytes or 341 "
+                                         "Extra Bytes"
+                                       : jf_strerror(st));
+        jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
     const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
     sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};

@@ -34,6 +34,7 @@ void jf_read_opts_init(jf_read_opts *o)
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
     o->bad_rows = 0;
+    o->no_attrs = 0;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -46,6 +47,7 @@ void jf_cloud_free(jf_cloud *c)
     free(c->face_idx);
     free(c->scan);
     free(c->scanner);
+    jf_attrs_free(&c->attrs);
     memset(c, 0, sizeof *c);
 }
 
@@ -306,7 +308,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
-        st = jf_read_ply(buf, len, name, c, err);
+        st = jf_read_ply(buf, len, name, o, c, err);
         break;
     case JF_FMT_XYZ:
     case JF_FMT_PTS:
@@ -317,7 +319,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_read_off(buf, len, name, c, err);
         break;
     case JF_FMT_LAS:
-        st = jf_read_las(buf, len, name, c, err);
+        st = jf_read_las(buf, len, name, o, c, err);
         break;
     case JF_FMT_PTX:
         st = jf_read_ptx(buf, len, name, c, err);
@@ -380,7 +382,7 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     }
     if (fmt == JF_FMT_PLY) {
         /* binary point clouds without a second copy (io_ply.c) */
-        jf_status cs = jf__read_ply_chunked(fd, len, path, c, err);
+        jf_status cs = jf__read_ply_chunked(fd, len, path, o, c, err);
         if (cs != JF_ERR_UNSUPPORTED) {
             close(fd);
             return cs;

@@ -33,7 +33,10 @@ struct jf_writer {
     const size_t *foff;
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
-    double las_scale[3], las_off[3], las_lo[3], las_hi[3];
+    jf_las_out las;                  /* LAS: what the output holds       */
+    const jf_attrs *attrs;           /* carried attributes, or NULL      */
+    char (*anames)[64];              /* their output names               */
+    size_t row_max;                  /* bytes a formatted row may take   */
     /* positioned rows (jf_writer_begin_put / _put) */
     int put;                         /* begun                            */
     int spool_on;                    /* text: rows go to `spool`         */
@@ -43,6 +46,9 @@ struct jf_writer {
     int put_err;                     /* first failure: errno, or -1 a bad
                                         row (atomic; 0 none)             */
 };
+
+/* The attribute columns go after column 2 (x y z). */
+#define ATTRS_AFTER 2
 
 static int host_little(void)
 {
@@ -67,10 +73,10 @@ static jf_status write_header(jf_writer *w)
     if (w->fmt == FMT_LAS) {
         /* a placeholder of the header's size: the real one, with the
          * count and bounds, is written over it at commit */
-        if (!w->las_framed)
+        if (!w->las_framed && !(w->attrs && w->attrs->las_head))
             return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
                                                  "(jf_writer_las_frame) before the rows");
-        size_t n = jf__las_prefix_size(w->ncols);
+        size_t n = jf__las_prefix_size(&w->las);
         while (n && f->st == JF_OK) {
             size_t k = n < 4096 ? n : 4096;
             char *o = jf_wf_room(f, k);
@@ -95,6 +101,13 @@ static jf_status write_header(jf_writer *w)
             jf_wf_puts(f, " ");
             jf_wf_puts(f, w->names[j]);
             jf_wf_puts(f, "\n");
+            for (size_t k = 0; j == ATTRS_AFTER && w->attrs && k < w->attrs->nattrs; k++) {
+                jf_wf_puts(f, "property ");
+                jf_wf_puts(f, jf__attr_ply_type(&w->attrs->attr[k]));
+                jf_wf_puts(f, " ");
+                jf_wf_puts(f, w->anames[k]);
+                jf_wf_puts(f, "\n");
+            }
         }
         if (w->foff) {
             snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
@@ -108,6 +121,10 @@ static jf_status write_header(jf_writer *w)
         if (j)
             jf_wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
         jf_wf_puts(f, w->names[j]);
+        for (size_t k = 0; j == ATTRS_AFTER && w->attrs && k < w->attrs->nattrs; k++) {
+            jf_wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
+            jf_wf_puts(f, w->anames[k]);
+        }
     }
     return jf_wf_puts(f, "\n");
 }
@@ -155,6 +172,7 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     w->nrows = nrows;
     w->types = malloc(ncols * sizeof *w->types);
     w->names = calloc(ncols, sizeof *w->names);
+    w->row_max = ncols * 32 + 2;
     jf_status st = JF_OK;
     /* a row takes at most 32 bytes per value */
     if (jf_wf_open(&w->f, path, ncols * 32 + 64) != JF_OK)
@@ -165,6 +183,10 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
         else
             w->types[j] = cols[j].type;
     }
+    w->las.names = w->names;
+    w->las.types = w->types;
+    w->las.ncols = ncols;
+    w->las.nrows = nrows;
     if (st != JF_OK) {
         if (err) {
             *err = w->f.err;
@@ -184,8 +206,67 @@ jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n)
         return JF_ERR_INVALID;
     if (w->fmt != FMT_LAS)
         return JF_OK;
-    jf__las_frame(xyz, n, w->las_scale, w->las_off, w->las_lo, w->las_hi);
+    jf__las_frame(xyz, n, w->las.scale, w->las.offset, w->las.lo, w->las.hi);
     w->las_framed = 1;
+    return JF_OK;
+}
+
+jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
+{
+    if (!w || w->header_done || w->attrs || w->f.st != JF_OK)
+        return JF_ERR_INVALID;
+    if (!a || (!a->nattrs && !(a->las_head && w->fmt == FMT_LAS)))
+        return JF_OK; /* nothing to carry */
+    if (w->ncols < 3 || (a->nattrs && !a->rec) || (a->las_head && !a->rec))
+        return JF_ERR_INVALID;
+    char (*nm)[64] = calloc(a->nattrs ? a->nattrs : 1, sizeof *nm);
+    if (!nm)
+        return JF_ERR_NOMEM;
+    /* a format 0 LAS output also has its own dimensions: an Extra Byte
+     * named as one (intensity, classification, ...) would be a second
+     * dimension of that name to LAS readers */
+    int fmt0 = w->fmt == FMT_LAS && !a->las_head;
+    size_t nn = w->ncols + (fmt0 ? JF__LAS_FMT0_NDIMS : 0);
+    char **taken = malloc(nn * sizeof *taken);
+    if (!taken) {
+        free(nm);
+        return JF_ERR_NOMEM;
+    }
+    memcpy(taken, w->names, w->ncols * sizeof *taken);
+    for (size_t k = w->ncols; k < nn; k++) taken[k] = (char *)jf__las_fmt0_dims[k - w->ncols];
+    int bad = jf__attrs_names(a, taken, nn, nm) != 0;
+    free(taken);
+    if (bad) {
+        free(nm);
+        return JF_ERR_INVALID;
+    }
+    size_t need = w->row_max + a->nattrs * 32;
+    w->las.a = a;
+    w->las.anames = nm;
+    if (w->fmt == FMT_LAS) {
+        size_t rec = jf__las_record_size(&w->las);
+        if (!jf__las_fits(&w->las)) {
+            w->las.a = NULL;
+            w->las.anames = NULL;
+            free(nm);
+            return JF_ERR_TOO_LARGE;
+        }
+        need = rec > need ? rec : need;
+    }
+    if (need > w->f.cap) { /* nothing is buffered yet: the header is not written */
+        char *b = realloc(w->f.buf, need);
+        if (!b) {
+            w->las.a = NULL;
+            w->las.anames = NULL;
+            free(nm);
+            return JF_ERR_NOMEM;
+        }
+        w->f.buf = b;
+        w->f.cap = need;
+    }
+    w->row_max = need;
+    w->attrs = a;
+    w->anames = nm;
     return JF_OK;
 }
 
@@ -207,13 +288,15 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
     return JF_OK;
 }
 
-/* One row, formatted into o (room for ncols * 32 + 2 bytes); returns the
- * number of bytes.  Reads w only: safe from several threads at once. */
-static size_t format_row(const jf_writer *w, const double *vals, char *o)
+/* One row, formatted into o (room for w->row_max bytes); `row` is the
+ * input index of the point, whose attributes the row carries.  Returns
+ * the number of bytes.  Reads w only: safe from several threads at once. */
+static size_t format_row(const jf_writer *w, const double *vals, size_t row, char *o)
 {
     char *o0 = o;
+    const jf_attrs *at = w->attrs;
     if (w->fmt == FMT_LAS)
-        return jf__las_format_row(vals, w->types, w->ncols, w->las_scale, w->las_off, o);
+        return jf__las_format_row(&w->las, row, vals, o);
     if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
         /* the usual case, kept tight (it runs once per point): fixed-size
          * copies, no per-value memcpy call */
@@ -231,6 +314,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                 memcpy(o, &x, 4);
                 o += 4;
             }
+            if (j == ATTRS_AFTER && at) /* the attributes after x y z */
+                o = jf__attrs_put(at, row, JF__ATTR_PLY_LE, 0, o);
         }
     } else if (w->fmt == FMT_PLY && !w->ascii) {
         int little = host_little();
@@ -253,6 +338,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                     o[i] = (char)b[n - 1 - i];
             }
             o += n;
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, little ? JF__ATTR_PLY_LE : JF__ATTR_PLY_BE, 0, o);
         }
     } else {
         char sep = w->fmt == FMT_CSV ? ',' : ' ';
@@ -274,6 +361,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                     *o++ = '-';
                 o = jf_fmt_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
             }
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, JF__ATTR_TEXT, sep, o);
         }
         *o++ = '\n';
     }
@@ -303,10 +392,10 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
     jf_wfile *f = &w->f;
     if (ready_for(w, 1) != JF_OK)
         return f->st;
-    char *o = jf_wf_room(f, w->ncols * 32 + 2);
+    char *o = jf_wf_room(f, w->row_max);
     if (!o)
         return f->st;
-    f->len += format_row(w, vals, o);
+    f->len += format_row(w, vals, w->rows, o);
     w->rows++;
     return JF_OK;
 }
@@ -323,7 +412,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
     const int nt = threads > 0 ? threads : omp_get_max_threads();
-    const size_t row_max = w->ncols * 32 + 2, slot = ROWS_BLOCK * row_max;
+    const size_t row_max = w->row_max, slot = ROWS_BLOCK * row_max;
     char *scratch = malloc((size_t)nt * slot);
     size_t *len = malloc((size_t)nt * sizeof *len);
     if (!scratch || !len) {
@@ -341,7 +430,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
             char *o = scratch + (size_t)t * slot;
             len[t] = 0;
             for (size_t r = a; r < b && r < nrows; r++)
-                len[t] += format_row(w, vals + r * w->ncols, o + len[t]);
+                len[t] += format_row(w, vals + r * w->ncols, w->rows + r, o + len[t]);
         }
         for (int t = 0; t < nt && f->st == JF_OK; t++)
             jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
@@ -381,9 +470,12 @@ jf_status jf_writer_begin_put(jf_writer *w)
         w->base = 0;
         w->rec = 8 * w->ncols;
     } else {
-        w->rec = w->fmt == FMT_LAS ? jf__las_record_size(w->types, w->ncols) : 0;
+        w->rec = w->fmt == FMT_LAS ? jf__las_record_size(&w->las) : 0;
         for (size_t j = 0; w->fmt == FMT_PLY && j < w->ncols; j++)
             w->rec += w->types[j] == JF_COL_F64 ? 8 : 4;
+        if (w->fmt == FMT_PLY && w->attrs) /* the attribute columns */
+            w->rec += jf__attrs_bin_size(w->attrs, host_little() ? JF__ATTR_PLY_LE
+                                                                 : JF__ATTR_PLY_BE);
         /* what follows the rows (PLY faces) is appended after them */
         if (lseek(f->fd, (off_t)(w->base + w->nrows * w->rec), SEEK_SET) < 0)
             return jf_wf_fail(f, JF_ERR_IO, "seek failed: %s", strerror(errno));
@@ -432,7 +524,7 @@ jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, 
         return JF_OK;
     /* rows in order, so that runs of consecutive rows go out in one write */
     rowref *ord = malloc(m * sizeof *ord);
-    char *buf = malloc(m * (w->spool_on ? w->rec : w->ncols * 32 + 2));
+    char *buf = malloc(m * (w->spool_on ? w->rec : w->row_max));
     int e = 0;
     if (!ord || !buf)
         e = ENOMEM;
@@ -455,7 +547,7 @@ jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, 
                 memcpy(buf + len, v, w->rec);
                 len += w->rec;
             } else {
-                len += format_row(w, v, buf + len);
+                len += format_row(w, v, ord[k].row, buf + len); /* row: its attributes */
             }
         }
         e = pwrite_all(fd, buf, len, w->base + (size_t)ord[a].row * w->rec);
@@ -557,6 +649,7 @@ static void free_writer(jf_writer *w)
         free(w->names[j]);
     free(w->names);
     free(w->types);
+    free(w->anames);
     free(w);
 }
 
@@ -574,9 +667,12 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
                 w->rows, w->nrows);
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
+    /* LAS: the input's EVLRs after the records, then the header */
+    if (f->st == JF_OK && w->fmt == FMT_LAS && w->attrs && w->attrs->las_head &&
+        w->attrs->las_evlr)
+        jf_wf_write(f, (const char *)w->attrs->las_evlr, w->attrs->las_evlr_len);
     if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
-        jf__las_write_prefix(f->fd, w->names, w->types, w->ncols, w->nrows, w->las_scale,
-                             w->las_off, w->las_lo, w->las_hi) != 0)
+        jf__las_write_prefix(f->fd, &w->las) != 0)
         jf_wf_fail(f, JF_ERR_IO, "cannot write the LAS header");
     jf_status st = jf_wf_close(f, err);
     free_writer(w);

@@ -140,6 +140,7 @@ static void write_whole(const char *path, const jf_cloud *c, const jf_estimate_o
     ck_assert_int_eq(jf_writer_open(path, cols, nc, c->n, ascii, &w, &err), JF_OK);
     ck_assert_int_eq(jf_writer_faces(w, c->nfaces, c->face_off, c->face_idx), JF_OK);
     ck_assert_int_eq(jf_writer_las_frame(w, c->xyz, c->n), JF_OK);
+    ck_assert_int_eq(jf_writer_attrs(w, &c->attrs), JF_OK); /* the input's, as the command */
     double *v = malloc(c->n * nc * sizeof *v);
     for (size_t i = 0; i < c->n; i++) row(c->xyz + 3 * i, &r[i], monge, v + i * nc);
     ck_assert_int_eq(jf_writer_rows(w, v, c->n, 2), JF_OK);
@@ -181,6 +182,7 @@ static jf_status write_blocks(const char *path, const jf_cloud *c, const jf_esti
     ck_assert_int_eq(jf_writer_open(path, cols, nc, c->n, ascii, &w, &err), JF_OK);
     ck_assert_int_eq(jf_writer_faces(w, c->nfaces, c->face_off, c->face_idx), JF_OK);
     ck_assert_int_eq(jf_writer_las_frame(w, c->xyz, c->n), JF_OK);
+    ck_assert_int_eq(jf_writer_attrs(w, &c->attrs), JF_OK); /* the input's, as the command */
     ck_assert_int_eq(jf_writer_begin_put(w), JF_OK);
     sinkctx s = {w, c->xyz, monge, nc, 0, fail_after};
     jf_status st = jf_estimate_blocks(c, o, sink, &s, &err);

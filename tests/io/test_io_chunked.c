@@ -80,7 +80,7 @@ static jf_status chunked(const unsigned char *bytes, size_t len)
     ck_assert_int_ge(fd, 0);
     jf_cloud c = {0};
     jf_error err;
-    jf_status st = jf__read_ply_chunked(fd, len, path, &c, &err);
+    jf_status st = jf__read_ply_chunked(fd, len, path, NULL, &c, &err);
     close(fd);
     jf_cloud_free(&c);
     return st;
@@ -93,6 +93,13 @@ static void same_cloud(const jf_cloud *a, const jf_cloud *b)
     ck_assert_int_eq(!a->nrm, !b->nrm);
     if (a->nrm) ck_assert_int_eq(memcmp(a->nrm, b->nrm, 3 * a->n * sizeof(double)), 0);
     ck_assert_uint_eq(a->nfaces, b->nfaces);
+    /* the attributes (flag [, nx ny nz]) too: same layout, same bytes */
+    ck_assert_uint_eq(a->attrs.nattrs, b->attrs.nattrs);
+    ck_assert_uint_eq(a->attrs.stride, b->attrs.stride);
+    for (size_t j = 0; j < a->attrs.nattrs; j++)
+        ck_assert_int_eq(memcmp(&a->attrs.attr[j], &b->attrs.attr[j], sizeof(jf_attr)), 0);
+    if (a->attrs.nattrs)
+        ck_assert_int_eq(memcmp(a->attrs.rec, b->attrs.rec, a->n * a->attrs.stride), 0);
 }
 
 /* The file read by jf_cloud_read (chunked when it qualifies) and its
@@ -126,7 +133,9 @@ START_TEST(chunked_equals_whole)
             jf_cloud c;
             jf_error err;
             ck_assert_int_eq(jf_cloud_read(fixture("c.ply", b, len), NULL, &c, &err), JF_OK);
-            /* the values themselves, not only agreement */
+            /* the values themselves, not only agreement; flag carried */
+            ck_assert_str_eq(c.attrs.attr[0].name, "flag");
+            ck_assert(jf_attr_get(&c.attrs, 0, 1000) == (double)(unsigned char)1000);
             ck_assert(c.xyz[3 * 1000] == 1000 * 0.25 - 3.0);
             ck_assert(c.xyz[3 * 1000 + 1] == sin(1000.0));
             ck_assert(isnan(c.xyz[3 * 17 + 2]));
