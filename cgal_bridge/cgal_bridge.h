@@ -42,6 +42,7 @@ typedef struct {
                            says how well they agree); 0 0 0 inside        */
     double seconds[3];  /* wall time of the spatial sort, the insertion and
                            the extraction (bench_natural's profile)      */
+    double cpu_seconds[3]; /* the same in CPU time (process, all threads) */
 } jfb_delaunay;
 
 /* Builds the triangulation of the finite points of xyz[3n] and fills *out

@@ -927,6 +927,8 @@ typedef struct {
     double seconds[3];   /* wall time of create's spatial sort, CGAL's
                             (sequential) insertion and the (parallel)
                             extraction of adjacency and poles          */
+    double cpu_seconds[3]; /* the same in CPU time (the process's, all
+                            threads; bench_natural's profile)          */
 } jf_natural_stats;
 
 /* Fills *st.  Thread-safe. */

@@ -275,8 +275,11 @@ static void keep_header(const jf_las_out *L, unsigned char *b, size_t prefix)
     }
     /* EVLRs move: they follow the records, which grew */
     size_t evlr_at = prefix + (size_t)n * jf__las_record_size(L);
-    uint64_t old_evlr = minor >= 4 ? g64(h + 235) : minor == 3 ? g64(h + 227) : 0;
-    uint64_t wave = minor >= 3 ? g64(h + 227) : 0;
+    /* the 1.3 field exists only in a header that long (a 1.3 file may
+     * declare a 227-byte header) */
+    int has_wave = minor >= 3 && in_hsize(L) >= 235;
+    uint64_t wave = has_wave ? g64(h + 227) : 0;
+    uint64_t old_evlr = minor >= 4 ? g64(h + 235) : wave;
     if (L->a->las_evlr) {
         put64(b + 235, evlr_at);
         put32(b + 243, minor >= 4 ? g32(h + 243) : 1);

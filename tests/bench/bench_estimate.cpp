@@ -234,7 +234,7 @@ int main(int argc, char **argv)
                 n, jf_cgalref::cgal_svd_name);
     loadavg("before");
     const int cfg[2][2] = {{16, 2}, {32, 3}};
-    double ratio[2][2] = {{0, 0}, {0, 0}};
+    double ratio[2][2] = {{0, 0}, {0, 0}}, cratio[2][2] = {{0, 0}, {0, 0}};
     for (int ci = 0; ci < 2; ci++)
         for (int fi = 0; fi < 2; fi++) {
             int k = cfg[ci][0], d = cfg[ci][1];
@@ -261,12 +261,16 @@ int main(int argc, char **argv)
             if (j1.ok && j2.ok)
                 std::printf("  jetfit speed-up 1 -> 2 threads: x%.2f\n", j1.secs / j2.secs);
             if (cg.ok && j1.ok) ratio[ci][fi] = cg.secs / j1.secs;
+            if (cg.ok && j1.ok) cratio[ci][fi] = cg.cpu / j1.cpu;
             std::printf("\n");
         }
     loadavg("after");
     std::printf("one thread, wall, jetfit vs CGAL: knn:16 d2 PLY x%.2f, xyz x%.2f; "
                 "knn:32 d3 PLY x%.2f, xyz x%.2f\n",
                 ratio[0][0], ratio[0][1], ratio[1][0], ratio[1][1]);
+    std::printf("one thread, cpu,  jetfit vs CGAL: knn:16 d2 PLY x%.2f, xyz x%.2f; "
+                "knn:32 d3 PLY x%.2f, xyz x%.2f\n",
+                cratio[0][0], cratio[0][1], cratio[1][0], cratio[1][1]);
     for (const char *f : {"jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
         std::remove((g_dir + "/" + f).c_str());
     if (!keep) {

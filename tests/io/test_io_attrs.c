@@ -507,6 +507,44 @@ START_TEST(las_dimensions)
 }
 END_TEST
 
+/* A LAS 1.3 file whose header is only 227 bytes (the 1.3 waveform field
+ * absent), internal-waveform bit set: kept without reading past it. */
+START_TEST(las_13_short_header)
+{
+    /* no VLR: the point data right after the 227 bytes */
+    unsigned rl0 = base_len[1];
+    size_t inlen = 227 + NL * rl0;
+    unsigned char *in = calloc(1, inlen);
+    memcpy(in, "LASF", 4);
+    in[6] = 2;
+    in[24] = 1, in[25] = 3;
+    put16(in + 94, 227);
+    put32(in + 96, 227);
+    in[104] = 1;
+    put16(in + 105, rl0);
+    put32(in + 107, NL);
+    putd(in + 131, 0.01), putd(in + 139, 0.01), putd(in + 147, 0.01);
+    for (size_t i = 0; i < NL * rl0; i++) in[227 + i] = (unsigned char)(i * 37 + 11);
+    const char *p = fixture("s.las", in, inlen);
+    jf_cloud c;
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(p, NULL, &c, &e) == JF_OK, "%s", e.msg);
+    ck_assert_ptr_null(c.attrs.las_evlr);
+    write_table(path_of("s.out.las"), &c, 0, 0, NULL);
+    size_t len;
+    unsigned char *b = slurp(path_of("s.out.las"), &len);
+    unsigned rl = g16(in + 105);
+    uint32_t doff = g32(b + 96), idoff = g32(in + 96);
+    ck_assert_uint_eq(g16(b + 105), rl);
+    ck_assert_uint_eq(g64(b + 227), 0);
+    ck_assert_uint_eq(len, doff + NL * rl);
+    ck_assert(!memcmp(b + doff, in + idoff, NL * rl));
+    free(b);
+    jf_cloud_free(&c);
+    free(in);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("io_attrs");
@@ -518,6 +556,7 @@ int main(void)
     tcase_add_test(tc, rename_clash);
     tcase_add_test(tc, las_records_kept);
     tcase_add_test(tc, las_dimensions);
+    tcase_add_test(tc, las_13_short_header);
     SRunner *r = srunner_create(s);
     suite_add_tcase(s, tc);
     srunner_run_all(r, CK_NORMAL);
