@@ -30,7 +30,9 @@ typedef struct {
                            index among identical points)                 */
     size_t *adj_off;    /* [nv+1] CSR offsets into adj                     */
     uint32_t *adj;      /* Delaunay neighbours (vertex ids) of each vertex,
-                           in lexicographic (x, y, z) order of the points */
+                           nearest first (ties: lexicographic (x, y, z)
+                           order of the points); dimension < 3: lexico-
+                           graphic                                         */
     double *pole;       /* [3nv] vector from the sample to its pole (the
                            farthest Voronoi vertex of its cell; for a hull
                            sample the farthest one opposite `hull`); NaN
@@ -40,6 +42,7 @@ typedef struct {
                            says how well they agree); 0 0 0 inside        */
     double seconds[3];  /* wall time of the spatial sort, the insertion and
                            the extraction (bench_natural's profile)      */
+    double cpu_seconds[3]; /* the same in CPU time (process, all threads) */
 } jfb_delaunay;
 
 /* Builds the triangulation of the finite points of xyz[3n] and fills *out

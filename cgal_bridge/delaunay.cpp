@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -37,6 +38,11 @@ constexpr std::uint32_t kNone = UINT32_MAX;
 
 double now() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+double cpu_now() {  // the process's CPU time, every thread
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
 template <class T> T *alloc(size_t n) {
@@ -74,18 +80,18 @@ void build(const double *xyz, size_t n, int threads, jfb_delaunay *d) {
         }
     }
     const size_t nf = order.size();
-    double t0 = now();
+    double t0 = now(), c0 = cpu_now();
     XyzMap pm{xyz};
     using Traits = CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>;
     CGAL::spatial_sort(order.begin(), order.end(), Traits(pm));
 
-    double t1 = now();
+    double t1 = now(), c1 = cpu_now();
     std::vector<DT3::Vertex_handle> of(n);
     DT3 t;
     DT3::Vertex_handle hint;
     for (std::uint32_t i : order) hint = of[i] = t.insert(get(pm, i), hint);
 
-    double t2 = now();
+    double t2 = now(), c2 = cpu_now();
     d->dimension = t.dimension();
     d->nv = t.number_of_vertices();
     d->nduplicates = nf - d->nv;
@@ -108,6 +114,7 @@ void build(const double *xyz, size_t n, int threads, jfb_delaunay *d) {
     std::vector<DT3::Vertex_handle>().swap(of);
     extract_stars(t, vh, threads, d);
     d->seconds[0] = t1 - t0, d->seconds[1] = t2 - t1, d->seconds[2] = now() - t2;
+    d->cpu_seconds[0] = c1 - c0, d->cpu_seconds[1] = c2 - c1, d->cpu_seconds[2] = cpu_now() - c2;
 }
 }  // namespace
 

@@ -12,8 +12,8 @@
 //     walks cells nor in id order, so it is a function of the point set
 //     alone: the same bit for bit for any thread count, any insertion
 //     order, any memory layout.
-//  2. neighbours: the finite vertices of the incident cells, in
-//     lexicographic order of their points.
+//  2. neighbours: the finite vertices of the incident cells, nearest
+//     first (ties: lexicographic order of their points).
 //  3. hull: each incident infinite cell has one finite facet, a convex-hull
 //     facet; the mean of their outer unit normals (summed in the facets'
 //     lexicographic order) is the direction of the vertex's unbounded
@@ -78,13 +78,14 @@ struct Ws {
     std::vector<std::uint32_t> stamp;         // [nv] == mark: neighbour already listed
     std::uint32_t mark = 0;
     std::vector<Vertex> nb;
+    std::vector<std::pair<double, Vertex>> nbd;  // (squared distance, vertex)
+    const std::uint32_t *rank = nullptr;      // [nv] lexicographic rank of each vertex
     struct Facet {  // a hull facet through the vertex
-        const Point *p[3];  // corners in lexicographic order
-        Vertex mirror;      // the finite vertex across it
+        std::uint32_t r[3];  // ranks of the corners, ascending
+        const Point *p[3];   // corners in that order
+        Vertex mirror;       // the finite vertex across it
         bool operator<(const Facet &o) const {
-            for (int k = 0; k < 3; k++)
-                if (*p[k] != *o.p[k]) return lex_less(*p[k], *o.p[k]);
-            return false;
+            return r[0] != o.r[0] ? r[0] < o.r[0] : r[1] != o.r[1] ? r[1] < o.r[1] : r[2] < o.r[2];
         }
     };
     std::vector<Facet> facets;
@@ -149,14 +150,25 @@ void star(const DT3 &t, Ws &w, Vertex v, jfb_delaunay *d) {
         int ii;
         if (c->has_vertex(inf, ii)) {
             Vertex u[3] = {c->vertex((ii + 1) & 3), c->vertex((ii + 2) & 3), c->vertex((ii + 3) & 3)};
-            std::sort(u, u + 3, vlex_less);
+            const std::uint32_t *rk = w.rank;
+            std::sort(u, u + 3, [rk](Vertex a, Vertex b) { return rk[a->info()] < rk[b->info()]; });
             Ws::Facet f;
-            for (int k = 0; k < 3; k++) f.p[k] = &u[k]->point();
+            for (int k = 0; k < 3; k++) f.p[k] = &u[k]->point(), f.r[k] = rk[u[k]->info()];
             f.mirror = t.mirror_vertex(c, ii);
             w.facets.push_back(f);
         }
     }
-    std::sort(w.nb.begin(), w.nb.end(), vlex_less);
+    // nearest first (ties lexicographic): the C core clips v's planar cell
+    // by these half-planes in this order, and the near ones make the cell,
+    // so the far ones then mostly cut nothing (clip's early exit)
+    const Point &pv0 = v->point();
+    w.nbd.clear();
+    for (Vertex u : w.nb) w.nbd.push_back({CGAL::squared_distance(pv0, u->point()), u});
+    const std::uint32_t *rk = w.rank;
+    std::sort(w.nbd.begin(), w.nbd.end(), [rk](const std::pair<double, Vertex> &a, const std::pair<double, Vertex> &b) {
+        return a.first != b.first ? a.first < b.first : rk[a.second->info()] < rk[b.second->info()];
+    });
+    for (size_t k = 0; k < w.nb.size(); k++) w.nb[k] = w.nbd[k].second;
 
     // hull direction: facets in lexicographic order, normal from the smallest corner
     double *hd = d->hull + 3 * (size_t)id;
@@ -186,7 +198,9 @@ void star(const DT3 &t, Ws &w, Vertex v, jfb_delaunay *d) {
     for (Cell c : w.cells) {
         if (t.is_infinite(c)) continue;
         Vertex q[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
-        std::sort(q, q + 4, vlex_less);
+        std::uint32_t r[4] = {rk[q[0]->info()], rk[q[1]->info()], rk[q[2]->info()], rk[q[3]->info()]};
+        for (int i = 1; i < 4; i++)  // insertion sort by rank (4 elements)
+            for (int j = i; j > 0 && r[j] < r[j - 1]; j--) std::swap(r[j], r[j - 1]), std::swap(q[j], q[j - 1]);
         const Point &p0 = q[0]->point();
         V3 a = sub(q[1]->point(), p0), b = sub(q[2]->point(), p0), e = sub(q[3]->point(), p0);
         V3 be = cross(b, e), ea = cross(e, a), ab = cross(a, b);
@@ -215,6 +229,7 @@ void flat_adjacency(DT3 &t, std::vector<Vertex> &vh, jfb_delaunay *d) {
     size_t nv = d->nv, len = 0, cap = 8 * nv + 16;
     d->adj = alloc<std::uint32_t>(cap);
     std::vector<Vertex> nb;
+    std::vector<std::pair<double, Vertex>> nbd;  // (squared distance, vertex)
     for (size_t id = 0; id < nv; id++) {
         nb.clear();
         if (t.dimension() >= 1) t.finite_adjacent_vertices(vh[id], std::back_inserter(nb));
@@ -243,6 +258,16 @@ void jfb::extract_stars(DT3 &t, std::vector<Vertex> &vh, int threads, jfb_delaun
         flat_adjacency(t, vh, d);
         return;
     }
+    // lexicographic rank of every vertex: every "in lexicographic order"
+    // above compares ranks (integers) instead of points
+    std::vector<std::uint32_t> rank(nv);
+    {
+        std::vector<std::uint32_t> ids(nv);
+        for (size_t id = 0; id < nv; id++) ids[id] = (std::uint32_t)id;
+        std::sort(ids.begin(), ids.end(),
+                  [&vh](std::uint32_t a, std::uint32_t b) { return lex_less(vh[a]->point(), vh[b]->point()); });
+        for (size_t k = 0; k < nv; k++) rank[ids[k]] = (std::uint32_t)k;
+    }
     // blocks of ids, each with its own adjacency buffer, joined in order
     const size_t nblocks = std::max<size_t>(1, std::min<size_t>(nv / 4096 + 1, 16 * (size_t)std::max(1, threads)));
     std::vector<std::uint32_t *> buf(nblocks, nullptr);
@@ -253,6 +278,7 @@ void jfb::extract_stars(DT3 &t, std::vector<Vertex> &vh, int threads, jfb_delaun
     {
         Ws w;
         try {
+            w.rank = rank.data();
             w.slot.assign(256, {nullptr, 0});
             w.stamp.assign(nv, 0);
             w.cells.reserve(256);

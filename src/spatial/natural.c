@@ -141,6 +141,7 @@ void jf_natural_get_stats(const jf_natural *nt, jf_natural_stats *st) {
     st->nduplicates = nt->d.nduplicates;
     st->nnonfinite = nt->d.nnonfinite;
     memcpy(st->seconds, nt->d.seconds, sizeof st->seconds);
+    memcpy(st->cpu_seconds, nt->d.cpu_seconds, sizeof st->cpu_seconds);
 }
 
 size_t jf_natural_kept(const jf_natural *nt, size_t i) {

@@ -224,6 +224,7 @@ static int cmp_u32(const void *a, const void *b)
 /* Sorts [start, a->n) and drops repeats. */
 static void sort_unique(ivec *a, size_t start)
 {
+    if (a->n <= start) return; /* an empty tail may have no array at all */
     qsort(a->v + start, a->n - start, sizeof *a->v, cmp_u32);
     size_t w = start;
     for (size_t j = start; j < a->n; j++)
@@ -361,7 +362,7 @@ jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int 
                     }
                     if (!ok) break;
                     size_t keep = w->mn < req[r].k ? w->mn : req[r].k;
-                    qsort(w->m, w->mn, sizeof *w->m, jf__halo_cmp);
+                    if (w->mn > 1) qsort(w->m, w->mn, sizeof *w->m, jf__halo_cmp);
                     for (size_t t = 0; t < keep && ok; t++)
                         if (w->m[t].remote) ok = ivec_push(&w->need, w->m[t].id);
                 }

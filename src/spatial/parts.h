@@ -120,4 +120,11 @@ jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int 
 jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o,
                               const uint8_t *fit, jf_result *out, jf_error *err);
 
+/* jf_estimate_blocks with the same mask: only the points with fit[i] != 0
+ * are fitted and handed to the sink (the halo points are neighbours
+ * only).  Defined in core/pipeline.c; used by core/parts_run.c. */
+jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
+                                     const uint8_t *fit, jf_block_fn sink, void *user,
+                                     jf_error *err);
+
 #endif /* JF_PARTS_H */
