@@ -13,6 +13,7 @@
 #include "cmd.h"
 #include "jetfit.h"
 #include "opts.h"
+#include "rows.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -79,27 +80,6 @@ static void usage(FILE *f)
         "         degree neighbors cond residual status\n"
         "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
         JF_MAX_DEGREE, p.degree, p.max_cond, omp_get_max_threads());
-}
-
-/* SIZE: a number of bytes with an optional K, M, G or T (powers of 1024,
- * an optional trailing B).  0 if it is not one. */
-static unsigned long long parse_size(const char *s)
-{
-    char *end = NULL;
-    if (!s || !*s || *s == '-') return 0;
-    double v = strtod(s, &end);
-    if (end == s || !(v > 0)) return 0;
-    double mul = 1;
-    switch (*end) {
-    case 'k': case 'K': mul = 1024.0, end++; break;
-    case 'm': case 'M': mul = 1048576.0, end++; break;
-    case 'g': case 'G': mul = 1073741824.0, end++; break;
-    case 't': case 'T': mul = 1099511627776.0, end++; break;
-    default: break;
-    }
-    if (*end == 'b' || *end == 'B') end++;
-    if (*end || !(v * mul < 1.8e19) || v * mul < 1) return 0;
-    return (unsigned long long)(v * mul);
 }
 
 /* MemAvailable of /proc/meminfo in bytes, or 0 when unknown. */
@@ -212,48 +192,6 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
 
 /* ---- output ------------------------------------------------------------ */
 
-static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",  "k1",
-                                        "k2",  "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
-static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
-static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
-
-static size_t make_columns(int monge, jf_column *cols)
-{
-    size_t n = 0;
-    for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
-    if (monge >= 3)
-        for (size_t j = 0; j < 4; j++) cols[n++] = (jf_column){b_cols[j], JF_COL_F64};
-    if (monge >= 4)
-        for (size_t j = 0; j < 5; j++) cols[n++] = (jf_column){c_cols[j], JF_COL_F64};
-    cols[n++] = (jf_column){"degree", JF_COL_I32};
-    cols[n++] = (jf_column){"neighbors", JF_COL_I32};
-    cols[n++] = (jf_column){"cond", JF_COL_F64};
-    cols[n++] = (jf_column){"residual", JF_COL_F64};
-    cols[n++] = (jf_column){"status", JF_COL_I32};
-    return n;
-}
-
-static size_t make_row(const double *p, const jf_result *r, int monge, double *v)
-{
-    size_t n = 0;
-    for (int j = 0; j < 3; j++) v[n++] = p[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->normal[j];
-    v[n++] = r->k1;
-    v[n++] = r->k2;
-    for (int j = 0; j < 3; j++) v[n++] = r->d1[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->d2[j];
-    if (monge >= 3)
-        for (int j = 0; j < 4; j++) v[n++] = r->b[j];
-    if (monge >= 4)
-        for (int j = 0; j < 5; j++) v[n++] = r->c[j];
-    v[n++] = r->degree;
-    v[n++] = r->n_used;
-    v[n++] = r->cond;
-    v[n++] = r->residual;
-    v[n++] = (double)r->status;
-    return n;
-}
-
 /* ---- rows straight to the output ------------------------------------- */
 
 /* design (docs/scale.md): results are never held for the whole cloud.
@@ -280,7 +218,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
     double *v = s->rows + (size_t)t * 256 * s->ncols;
     for (size_t j = 0; j < m; j++) {
-        make_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        jf_cli_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;
     }
@@ -293,71 +231,17 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
 
 int jf_cmd_estimate(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL;
-    int quiet = 0, ascii = 0, keep = 1;
-    unsigned long long memory = 0; /* --memory; 0: MemAvailable */
-    jf_cli_est e;
+    jf_cli_estimate_cmd cmd;
     jf_cli_bad bad;
-    jf_cli_est_init(&e);
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            usage(stdout);
-            return 0;
-        }
-        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            quiet = 1;
-            continue;
-        }
-        if (!strcmp(a, "--ascii")) {
-            ascii = 1;
-            continue;
-        }
-        if (jf_cli_est_takes_value(a) == 0) {
-            (void)jf_cli_est_option(&e, a, NULL, &bad);
-            continue;
-        }
-        if (a[0] != '-' || !a[1]) {
-            if (in) return bad_option("argument", a, "only one INPUT file is accepted");
-            in = a;
-            continue;
-        }
-        /* every other option takes a value: "--opt VALUE" or "--opt=VALUE" */
-        char name[32];
-        const char *val = NULL, *eq = strchr(a, '=');
-        if (eq && (size_t)(eq - a) < sizeof name) {
-            memcpy(name, a, (size_t)(eq - a));
-            name[eq - a] = '\0';
-            val = eq + 1;
-        } else {
-            snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc)
-                return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--keep") &&
-                               strcmp(name, "--memory") &&
-                               jf_cli_est_takes_value(name) != 1
-                           ? bad_option("unknown option", a, "not an option of estimate")
-                           : bad_option(a, "", "needs a value");
-            val = argv[++i];
-        }
-        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
-            out = val;
-        } else if (!strcmp(name, "--memory")) {
-            if (!(memory = parse_size(val)))
-                return bad_option("--memory", val, "expected a size such as 8G, 256M or 1500000000");
-        } else if (!strcmp(name, "--keep")) {
-            if (!strcmp(val, "all")) keep = 1;
-            else if (!strcmp(val, "none")) keep = 0;
-            else return bad_option(name, val, "expected all or none");
-        } else if (jf_cli_est_takes_value(name) != 1) {
-            return bad_option("unknown option", a, "not an option of estimate");
-        } else if (jf_cli_est_option(&e, name, val, &bad)) {
-            return bad_option(bad.opt, bad.val, bad.why);
-        }
+    if (jf_cli_estimate_parse(argc, argv, &cmd, &bad)) return bad_option(bad.opt, bad.val, bad.why);
+    if (cmd.help) {
+        usage(stdout);
+        return 0;
     }
-    if (!in) return bad_option("INPUT", "", "missing input file");
-    if (!out) return bad_option("-o", "", "missing output file");
-    if (jf_cli_est_finish(&e, &bad)) return bad_option(bad.opt, bad.val, bad.why);
+    jf_cli_est e = cmd.e;
+    const char *in = cmd.in, *out = cmd.out;
+    int quiet = cmd.quiet, ascii = cmd.ascii, keep = cmd.keep;
+    unsigned long long memory = cmd.memory; /* --memory; 0: MemAvailable */
     jf_estimate_opts o = e.o;
     int monge = e.monge;
     jf_error err = {{0}};
@@ -398,7 +282,7 @@ int jf_cmd_estimate(int argc, char **argv)
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[32];
-    size_t ncols = make_columns(monge, cols);
+    size_t ncols = jf_cli_columns(monge, cols);
     jf_writer *w = NULL;
     st = jf_writer_open(out, cols, ncols, c.n, ascii, &w, &err);
     if (st != JF_OK) {

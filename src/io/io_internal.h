@@ -57,6 +57,39 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
 jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *o,
                                jf_cloud *c, jf_error *err);
 
+/* io_ply.c: where the vertex rows of a binary PLY are (fixed-size rows,
+ * the file's length as its header says), for readers of a byte range of
+ * them (jetfit-mpi: each rank its own rows). */
+typedef struct {
+    uint64_t count;        /* vertices                                   */
+    uint64_t vertex_off;   /* file offset of vertex row 0                */
+    size_t row;            /* bytes per vertex row                       */
+    int has_normals;       /* nx ny nz are properties                    */
+    int swap;              /* byte order differs from the machine's      */
+    int type[6];           /* x y z nx ny nz: PLY scalar type            */
+    size_t off[6];         /* their offset in the row                    */
+} jf_ply_layout;
+
+/* The layout from the file's first len bytes (the whole header), the
+ * file being size bytes.  JF_ERR_FORMAT with err "NAME:LINE: reason" when
+ * it is not a binary PLY whose vertices have fixed-size rows that the
+ * file holds, or has no x y z. */
+jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_ply_layout *l, jf_error *err);
+/* Decodes k rows at raw into xyz (3k) and, if nrm and l->has_normals,
+ * nrm (3k), exactly as jf_read_ply would. */
+void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
+                  double *nrm);
+
+/* io_write.c, for rows written by other processes (jetfit-mpi): a binary
+ * little-endian PLY table without attributes or faces gets its header
+ * written and flushed; *header its size, *tmp the temporary's path (the
+ * rows go at header + row * row size).  placed: all nrows rows are in the
+ * file (commit then only renames).  row_le: one row in the file's bytes. */
+jf_status jf__writer_begin(jf_writer *w, uint64_t *header, const char **tmp);
+jf_status jf__writer_placed(jf_writer *w, size_t nrows);
+void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, char *o);
+
 /* io_spool.c: rows put in any order from any thread, drained in row
  * order (the table writer's positioned rows).  open: a temporary beside
  * `final` for nrows rows of ncols doubles, buckets of bucket_bytes of

@@ -602,6 +602,90 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     return st;
 }
 
+/* ---- the vertex layout of a binary PLY (io_internal.h) ----------------- */
+
+/* Offsets of the vertex element's rows and, per property, within a row;
+ * 0 when an element has a list property or the file does not hold what
+ * the header announces (lenient by less than one row, as the readers). */
+static int vertex_rows(const ply *h, size_t body, uint64_t len, int *iv, uint64_t *at,
+                       uint64_t *vrow)
+{
+    uint64_t total = body;
+    *iv = -1;
+    *vrow = 0;
+    for (int k = 0; k < h->nelems; k++) {
+        const ply_elem *el = &h->elems[k];
+        uint64_t row = 0;
+        for (int j = 0; j < el->nprops; j++) {
+            if (el->props[j].count_type != T_NONE) return 0;
+            row += type_size[el->props[j].type];
+        }
+        if (row && el->count > (UINT64_MAX - total) / row) return 0;
+        if (*iv < 0 && !strcmp(el->name, "vertex")) {
+            *iv = k;
+            *vrow = row;
+            *at = total;
+        }
+        total += row * el->count;
+    }
+    return *iv >= 0 && *vrow && total <= len && len - total < *vrow;
+}
+
+jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_ply_layout *l, jf_error *err)
+{
+    ply *h = calloc(1, sizeof *h);
+    size_t body = 0;
+    int iv;
+    uint64_t at, vrow;
+    memset(l, 0, sizeof *l);
+    if (!h) return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+    h->name = name;
+    h->err = err;
+    jf_status st = parse_header(h, buf, len, &body);
+    if (st == JF_OK && h->format == 0)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "an ascii PLY: distributed runs read "
+                        "binary PLY (jetfit estimate IN -o OUT.ply converts)");
+    else if (st == JF_OK && !vertex_rows(h, body, size, &iv, &at, &vrow))
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "needs vertex rows of fixed size (no "
+                        "lists) and a file as long as its header says");
+    if (st == JF_OK) {
+        const ply_elem *el = &h->elems[iv];
+        static const char *const nm[6] = {"x", "y", "z", "nx", "ny", "nz"};
+        int ip[6];
+        for (int j = 0; j < 6; j++) ip[j] = prop_index(el, nm[j], 0);
+        if (ip[0] < 0 || ip[1] < 0 || ip[2] < 0)
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "element vertex has no x y z");
+        else if (el->count > JF_MAX_POINTS)
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "too many vertices");
+        for (int j = 0; st == JF_OK && j < 6; j++) {
+            size_t o = 0;
+            for (int q = 0; q < ip[j]; q++) o += type_size[el->props[q].type];
+            l->off[j] = o;
+            l->type[j] = ip[j] >= 0 ? el->props[ip[j]].type : T_NONE;
+        }
+        const uint16_t one = 1;
+        l->count = el->count;
+        l->vertex_off = at;
+        l->row = (size_t)vrow;
+        l->has_normals = ip[3] >= 0 && ip[4] >= 0 && ip[5] >= 0;
+        l->swap = (h->format == 1) != (*(const unsigned char *)&one == 1);
+    }
+    free(h);
+    return st;
+}
+
+void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
+                  double *nrm)
+{
+    for (size_t r = 0; r < k; r++, raw += l->row) {
+        for (int j = 0; j < 3; j++) xyz[3 * r + j] = load(raw + l->off[j], l->type[j], l->swap);
+        if (nrm && l->has_normals)
+            for (int j = 0; j < 3; j++)
+                nrm[3 * r + j] = load(raw + l->off[3 + j], l->type[3 + j], l->swap);
+    }
+}
+
 /* ---- binary PLY read in chunks (jf_cloud_read) ------------------------ */
 
 /* design (issue 12.1): a 10^8-point binary PLY must not be held twice (the
@@ -655,27 +739,9 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
     if (parse_header(h, (const char *)buf, got, &body) != JF_OK || h->format == 0 ||
         (body >= got && got < len))
         goto out;
-    uint64_t total = body, vrow = 0;
+    uint64_t at = 0, vrow = 0;
     int iv = -1;
-    size_t rowsz[MAX_ELEMS];
-    for (int k = 0; k < h->nelems; k++) {
-        const ply_elem *el = &h->elems[k];
-        uint64_t row = 0;
-        for (int j = 0; j < el->nprops; j++) {
-            if (el->props[j].count_type != T_NONE)
-                goto out;
-            row += type_size[el->props[j].type];
-        }
-        if (row && el->count > (UINT64_MAX - total) / row)
-            goto out;
-        total += row * el->count;
-        rowsz[k] = (size_t)row;
-        if (iv < 0 && !strcmp(el->name, "vertex")) {
-            iv = k;
-            vrow = row;
-        }
-    }
-    if (iv < 0 || !vrow || total > len || len - total >= vrow || h->elems[iv].count == 0 ||
+    if (!vertex_rows(h, body, len, &iv, &at, &vrow) || h->elems[iv].count == 0 ||
         h->elems[iv].count > JF_MAX_POINTS)
         goto out;
     const ply_elem *el = &h->elems[iv];
@@ -730,9 +796,6 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
     }
     const uint16_t one = 1;
     int swap = (h->format == 1) != (*(const unsigned char *)&one == 1);
-    uint64_t at = body;
-    for (int k = 0; k < iv; k++)
-        at += (uint64_t)rowsz[k] * h->elems[k].count;
     size_t per = CHUNK_BYTES / vrow ? CHUNK_BYTES / vrow : 1;
     if (per * vrow > (got > CHUNK_BYTES ? got : CHUNK_BYTES)) {
         free(xyz);

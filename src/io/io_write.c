@@ -524,6 +524,51 @@ static jf_status write_faces(jf_writer *w)
 }
 
 /* Frees the writer itself (its file is closed by jf_wf_close). */
+/* ---- rows written by other processes (jetfit-mpi, io_internal.h) ------- */
+
+jf_status jf__writer_begin(jf_writer *w, uint64_t *header, const char **tmp)
+{
+    if (!w || w->fmt != FMT_PLY || w->ascii || w->attrs || w->foff || w->rows || w->put)
+        return JF_ERR_INVALID;
+    jf_wfile *f = &w->f;
+    if (ready_for(w, 0) != JF_OK || jf_wf_flush(f) != JF_OK)
+        return f->st;
+    off_t at = lseek(f->fd, 0, SEEK_CUR);
+    if (at < 0)
+        return jf_wf_fail(f, JF_ERR_IO, "%s", strerror(errno));
+    *header = (uint64_t)at;
+    *tmp = f->t.tmp;
+    return JF_OK;
+}
+
+jf_status jf__writer_placed(jf_writer *w, size_t nrows)
+{
+    if (!w || nrows != w->nrows || w->rows)
+        return JF_ERR_INVALID;
+    w->rows = nrows;
+    return JF_OK;
+}
+
+void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, char *o)
+{
+    for (size_t j = 0; j < ncols; j++) {
+        unsigned char b[8];
+        size_t n;
+        if (types[j] == JF_COL_F64) {
+            memcpy(b, &vals[j], 8), n = 8;
+        } else if (types[j] == JF_COL_F32) {
+            float x = (float)vals[j];
+            memcpy(b, &x, 4), n = 4;
+        } else {
+            int32_t x = to_i32(vals[j]);
+            memcpy(b, &x, 4), n = 4;
+        }
+        for (size_t i = 0; i < n; i++)
+            o[i] = (char)(host_little() ? b[i] : b[n - 1 - i]);
+        o += n;
+    }
+}
+
 static void free_writer(jf_writer *w)
 {
     jf__spool_free(w->spool);

@@ -40,7 +40,8 @@ static void usage(FILE *f)
         "holds the whole cloud.  Options: jetfit estimate --help.\n"
         "INPUT: binary PLY.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
         "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
-        "(they need the whole cloud at once), LAS input and output.\n"
+        "(they need the whole cloud at once), LAS input and output; the input's\n"
+        "other properties are not carried (the output is that of --keep none).\n"
         "docs/scale.md \"Distributed runs\" says how to run on a cluster.\n");
 }
 

@@ -593,10 +593,13 @@ void jf_mpi_load(jf_mpi *m, const char *path, const jf_ply_layout *l, const jf_p
     read_rows(m, path, l, normals, &pts, &npts, &bad, &nbad);
     if (jf_mpi_check(m)) goto out;
     double t0 = MPI_Wtime();
-    partition(m, &pts, &npts);
-    if (jf_mpi_check(m)) goto out;
-    fetch_halo(m, pts, npts, q, threads, &halo, &nhalo, &c->fetched);
-    if (jf_mpi_check(m)) goto out;
+    /* one rank: its rows are the whole cloud, read in input order */
+    if (m->size > 1) {
+        partition(m, &pts, &npts);
+        if (jf_mpi_check(m)) goto out;
+        fetch_halo(m, pts, npts, q, threads, &halo, &nhalo, &c->fetched);
+        if (jf_mpi_check(m)) goto out;
+    }
     m->t_exchange = MPI_Wtime() - t0;
 
     /* own, non-finite and halo points merged by input index */

@@ -20,8 +20,9 @@ mkdir -p "$work"
 cloud=$work/exp_$n.ply
 [ -f "$cloud" ] || "$jetfit" generate exp --n "$n" -o "$cloud" --seed 7 >/dev/null || exit 1
 opts="--neighbors knn:16 --degree 2"
+cores=$(nproc) # before OMP_NUM_THREADS, which nproc obeys
 export OMP_NUM_THREADS=1
-echo "# $n points (exp surface), $opts; $(nproc) cores, machine shared"
+echo "# $n points (exp surface), $opts; $cores cores, machine shared"
 printf '%-26s %8s %12s %10s  %s\n' run seconds points/s "RSS MiB" "exchange / fit / write s (slowest rank); halo"
 run() { # NAME OUT COMMAND...
   name=$1 out=$2; shift 2

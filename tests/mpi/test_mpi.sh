@@ -20,14 +20,14 @@ command -v python3 >/dev/null 2>&1 || { echo "SKIP: python3 not found"; exit 77;
 d="$work/mpi-$mode"
 rm -rf "$d" && mkdir -p "$d" && python3 "$here/make_clouds.py" "$d" || exit 1
 export OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
-mpi() { np=$1; shift; mpirun --allow-run-as-root --oversubscribe -np "$np" "$jmpi" "$@"; }
+mpi() { np=$1; shift; mpirun --allow-run-as-root --oversubscribe -q -np "$np" "$jmpi" "$@"; }
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
 # same NPS CLOUD OUT-EXT [options]: every np in NPS gives jetfit's bytes
 same() {
   nps=$1 cloud=$2 ext=$3; shift 3
-  "$jetfit" estimate "$d/$cloud" -o "$d/ref.$ext" --quiet --threads 1 "$@" ||
+  "$jetfit" estimate "$d/$cloud" -o "$d/ref.$ext" --quiet --threads 1 --keep none "$@" ||
     { bad "jetfit estimate $cloud $*"; return; }
   for np in $nps; do
     rm -f "$d/got.$ext"
@@ -83,7 +83,7 @@ errors)
   refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
   # a rank that fails mid-run: one line, exit 1, the old output intact
   echo old >"$d/keep.ply"
-  JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -x JETFIT_MPI_TEST_FAIL \
+  JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -q -x JETFIT_MPI_TEST_FAIL \
     -np 3 "$jmpi" estimate "$d/lattice.ply" -o "$d/keep.ply" --quiet 2>"$d/stderr"; rc=$?
   if [ $rc -ne 1 ] || [ "$(grep -c . "$d/stderr")" -ne 1 ] || ! grep -q "rank 2" "$d/stderr"; then
     bad "failing rank: exit $rc:"; cat "$d/stderr"
