@@ -514,6 +514,57 @@ jf_status jf_nb_query_mesh(const jf_mesh *m, const double *xyz,
 /* ------------------------------------------------------------------ */
 /* Clouds, meshes and files                                            */
 /* ------------------------------------------------------------------ */
+/* Per-point attributes carried from the input to the output (issue 13.4;
+ * src/io/io_attrs.c): every PLY vertex property other than x y z (lists
+ * excepted), every header-named CSV/XYZ column other than x y z, every LAS
+ * dimension and Extra Byte.  Kept compact: one packed record of `stride`
+ * bytes per point, each value in its input type, little endian (a PLY
+ * `uchar red` costs one byte a point, not a double).  For a LAS input the
+ * record IS the LAS point record, unchanged (X Y Z and the bit fields
+ * included), so a LAS output can copy it byte for byte. */
+typedef enum {
+    JF_ATTR_I8 = 0, JF_ATTR_U8, JF_ATTR_I16, JF_ATTR_U16, JF_ATTR_I32,
+    JF_ATTR_U32, JF_ATTR_I64, JF_ATTR_U64, JF_ATTR_F32, JF_ATTR_F64
+} jf_attr_type;
+
+typedef struct {
+    char name[64];       /* as the input names it (characters a PLY or
+                            CSV header cannot hold -- blanks, ',', '#'
+                            -- replaced by '_')                         */
+    jf_attr_type type;   /* the input's type                            */
+    uint32_t offset;     /* byte offset of the value in a record        */
+    uint8_t shift, bits; /* bits > 0: an unsigned bit field of the byte
+                            at offset, (b >> shift) & (2^bits - 1)
+                            (LAS return numbers, flags); type U8        */
+} jf_attr;
+
+typedef struct {
+    size_t nattrs;       /* 0: no attributes (and the rest NULL/0)      */
+    jf_attr *attr;       /* nattrs descriptions                         */
+    size_t stride;       /* bytes per point record                      */
+    unsigned char *rec;  /* n * stride bytes, point i at rec + i*stride */
+    unsigned char *las_head; /* LAS input only: the header block and
+                            VLRs verbatim (las_head_len bytes, up to the
+                            offset to point data); rec holds the point
+                            records; else NULL                          */
+    size_t las_head_len;
+    unsigned char *las_evlr; /* LAS 1.3/1.4 input: its EVLRs verbatim,
+                            or NULL                                     */
+    size_t las_evlr_len;
+} jf_attrs;
+
+/* Attribute j of point i as a double (bit fields decoded; 64-bit integers
+ * beyond 2^53 rounded).  NaN if j or i is out of range (n is not known
+ * here: the caller keeps i < the cloud's n).  Thread-safe. */
+double jf_attr_get(const jf_attrs *a, size_t j, size_t i);
+
+/* Index of the attribute named `name`, or -1. */
+int jf_attr_find(const jf_attrs *a, const char *name);
+
+/* Frees the arrays and zeroes *a (NULL or zeroed: no-op); jf_cloud_free
+ * calls it. */
+void jf_attrs_free(jf_attrs *a);
+
 typedef struct {
     size_t n;            /* number of points                           */
     double *xyz;         /* 3n coordinates                             */
@@ -528,6 +579,8 @@ typedef struct {
     double *scanner;     /* PTX: 3 nscans scanner positions in the
                             registered frame, else NULL                */
     size_t nscans;       /* PTX: number of scans, else 0               */
+    jf_attrs attrs;      /* the input's other per-point values (above);
+                            empty when jf_read_opts.no_attrs           */
 } jf_cloud;
 
 typedef struct {
@@ -546,6 +599,9 @@ typedef struct {
                             (so every later row keeps its index; the
                             pipeline marks it nonfinite) and counted in
                             jf_cloud.nbad / bad_line                   */
+    int no_attrs;        /* 0 (default) read the attributes into
+                            jf_cloud.attrs; 1 skip them (--keep none:
+                            no memory spent on them)                   */
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */
@@ -568,6 +624,15 @@ void jf_read_opts_init(jf_read_opts *o);
  *  - PTX: one or more scans (header: cols, rows, scanner position, axes,
  *    4x4 row-vector transform); points moved to the registered frame;
  *    "0 0 0" (no return) kept as a NaN row; fills scan/scanner/nscans.
+ *  - LAS 1.0-1.4, point formats 0-10: x = X * scale + offset.
+ * Attributes (jf_cloud.attrs, unless o->no_attrs): PLY every scalar
+ * vertex property but x y z, in its type; CSV/XYZ with a header line
+ * every named column but x y z whose fields are all numbers (empty: NaN),
+ * packed as uchar, ushort or int when every value is such an integer,
+ * else double; LAS the record whole, described as laspy names its
+ * dimensions (intensity, return_number, ..., gps_time, red, ...) and the
+ * Extra Bytes by their descriptions (scalar types), plus the header,
+ * VLRs and EVLRs verbatim.
  * "nan", "inf" are read as such (a NaN coordinate is kept, not an error).
  * A file without points (empty, comments only, 0 vertices) is an error.
  * o may be NULL (defaults).  c is overwritten (not freed first).
@@ -625,6 +690,28 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
  * no-op for other formats.  JF_ERR_INVALID after the first row. */
 jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
 
+/* Carries a cloud's attributes (jf_cloud.attrs) into the table: their
+ * columns go after x y z (columns 0-2) and before the others, each named
+ * as in the input with `in_` put before the name while it clashes with a
+ * column of the table or an earlier attribute (an input `nx` is written
+ * `in_nx`).  PLY: each property in its input type (64-bit integers as
+ * double); text: integers exact, floats and doubles %.17g (the exact
+ * value, so a reader gets the same number back); LAS: from a
+ * LAS input (a->las_head) the input's point records are written unchanged
+ * -- same point format, scale, offset, header fields, VLRs and EVLRs --
+ * with the table's columns 3.. appended as Extra Bytes after the input's
+ * own (x y z of the rows are then not used, and jf_writer_las_frame is
+ * not needed); from another input, format 0 with the attributes as Extra
+ * Bytes of their type ahead of the table's.  Row r of the table carries
+ * the attributes of point r (rows are in input order): `a` is read while
+ * rows are written and must stay valid until commit.  Call before the
+ * first row.  A table with no attribute (nattrs 0, not LAS) is a no-op.
+ * Returns JF_OK, JF_ERR_INVALID (rows already written, called twice,
+ * fewer than 3 columns, a name that cannot be made unique),
+ * JF_ERR_TOO_LARGE (LAS: a record over 65535 bytes or more than 341
+ * Extra Bytes), JF_ERR_NOMEM. */
+jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a);
+
 /* PLY only (ignored by text formats): also write a `face` element
  * (list uchar int vertex_indices) from nfaces polygons
  * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the
@@ -647,6 +734,30 @@ jf_status jf_writer_row(jf_writer *w, const double *vals);
  * x (32 ncols + 2) bytes for the call.  Same errors as jf_writer_row. */
 jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                          int threads);
+
+/* Positioned rows, for results that arrive out of order
+ * (jf_estimate_blocks): jf_writer_begin_put once, on one thread, after
+ * jf_writer_las_frame / jf_writer_faces and instead of any
+ * jf_writer_row(s); then jf_writer_put from any number of threads at
+ * once; then jf_writer_commit.  The file's bytes are exactly those that
+ * jf_writer_rows would write with the rows in row order, for every
+ * format.  The rows go as raw doubles to a second temporary in the
+ * output's folder (a jf_tmpfile: removed on failure, abort or a signal;
+ * about nrows x (8 ncols + 8) bytes), bucketed by row number so that its
+ * writes are large whatever the order; commit reads it back in row order
+ * (one bucket of up to 32 MiB at a time), formats the rows with
+ * jf_writer_rows on `threads` threads (<= 0: the OpenMP default) and
+ * removes it.  Memory: 64 KiB of staging per 32 MiB of rows.  Begin:
+ * JF_ERR_INVALID after a row was written, else the header's write or
+ * the spool's creation status. */
+jf_status jf_writer_begin_put(jf_writer *w, int threads);
+
+/* Writes m rows: vals[j * ncols ..] is row rows[j] (< nrows), in any
+ * order; over the writer's life each row must be put exactly once
+ * (commit checks).  Thread-safe against other jf_writer_put calls on w;
+ * no allocation.  After a failure (a write error, a row out of range)
+ * every call returns it and commit reports it. */
+jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, size_t m);
 
 /* Flushes, closes, checks the row count and renames the temporary onto
  * the final name.  Frees w whatever happens (w may be NULL: invalid).
@@ -711,7 +822,8 @@ typedef struct {
  * .txt, .pts the last "# name name ..." comment before the data (jetfit's
  * and generate's outputs); .ply the vertex element's properties (ascii or
  * binary_little_endian; other elements must come after it and are
- * ignored); headerless files by extension: .normals nx ny nz, .curv k1 k2
+ * ignored); .las x y z then every dimension and Extra Byte as
+ * jf_cloud_read's attributes name them (a LAS jetfit wrote: its columns); headerless files by extension: .normals nx ny nz, .curv k1 k2
  * (PCPNet's column order, not re-sorted), .pidx index, otherwise
  * x y z nx ny nz k1 k2.  On failure fills err ("FILE:LINE: reason") and
  * leaves *t empty.  The table is owned by the caller: jf_eval_table_free. */
@@ -813,8 +925,12 @@ typedef struct jf_natural jf_natural;
  * one vertex (jf_natural_kept).  Coplanar, collinear or fewer than 4
  * points are accepted (jf_natural_stats says the dimension).  Returns
  * JF_OK, JF_ERR_INVALID (NULL args), JF_ERR_TOO_LARGE (n >= 2^32 - 1),
- * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Not parallel. */
+ * JF_ERR_NOMEM, JF_ERR_INTERNAL (CGAL threw).  Uses every core; the
+ * _threads form takes the count (<= 0: every core).  The result is the
+ * same bit for bit for any count (docs/natural.md, "Speed"). */
 jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
+jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
+                                    jf_natural **out);
 void jf_natural_free(jf_natural *nt);
 
 typedef struct {
@@ -823,6 +939,11 @@ typedef struct {
     size_t nvertices;    /* distinct finite points                      */
     size_t nduplicates;  /* finite points identical to a kept one       */
     size_t nnonfinite;   /* points with a NaN/Inf coordinate            */
+    double seconds[3];   /* wall time of create's spatial sort, CGAL's
+                            (sequential) insertion and the (parallel)
+                            extraction of adjacency and poles          */
+    double cpu_seconds[3]; /* the same in CPU time (the process's, all
+                            threads; bench_natural's profile)          */
 } jf_natural_stats;
 
 /* Fills *st.  Thread-safe. */
@@ -888,7 +1009,7 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws,
  * The new file keeps the mode of the file it replaces, else 0666 less the
  * umask. */
 typedef struct {
-    int fd;          /* write here (open, O_WRONLY)                    */
+    int fd;          /* write here (open, O_RDWR: a spool reads back)  */
     char *tmp;       /* the temporary's path                           */
     char *target;    /* the file that commit replaces                  */
     int slot;        /* internal: its place in the signal-safe list    */
@@ -980,6 +1101,48 @@ void jf_estimate_opts_init(jf_estimate_opts *o);
  * (may be NULL) gets one line.  Thread-safe on distinct outputs. */
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
                       jf_result *out, jf_error *err);
+
+/* A block of results from jf_estimate_blocks: res[j] belongs to input
+ * point idx[j], j < m (m <= 256); the results are final (oriented).
+ * Return JF_OK to go on; any other status stops the estimate, which
+ * returns it.  Called concurrently from the OpenMP threads of the fit
+ * (blocks are disjoint): it must be thread-safe.  res and idx are the
+ * library's, valid during the call only (res may be changed). */
+typedef jf_status (*jf_block_fn)(void *user, const uint32_t *idx, jf_result *res, size_t m);
+
+/* jf_estimate without the n results in memory: the same results, bit for
+ * bit, handed to `sink` a block at a time as they are fitted (in the
+ * walk's order: the k-d tree's leaf order for knn/radius, else Z-order;
+ * non-finite points first), each point exactly once.  Orientation none,
+ * input, viewpoint and scanner are applied per block.  mst needs every
+ * normal before any row is final: it runs the fit twice -- the first pass
+ * keeps the normals, statuses and orient_k graph edges (28 + 4 orient_k
+ * bytes per point), Prim decides a flip per point, the second pass fits
+ * again and hands over the flipped rows (twice the time; the progress
+ * hook then counts 2n).  Peak memory besides c: the index (about 40
+ * bytes per point for knn/radius) and, per thread, one block of results.
+ * Same statuses and errors as jf_estimate; a sink's status stops it
+ * (blocks already handed over stay handed over).  Thread-safe on distinct
+ * sinks. */
+jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o,
+                             jf_block_fn sink, void *user, jf_error *err);
+
+/* jf_estimate_blocks in bounded memory: the finite points are cut into
+ * nparts parts of equal count along the Morton order, and the parts are
+ * processed one at a time, each with an exact halo (the points of other
+ * parts that can be among its points' neighbours, found by queries to one
+ * other part's index at a time), so that the index is never built over
+ * the whole cloud: about (n / nparts) x 64 bytes besides c at a time.
+ * The same results, bit for bit, as jf_estimate_blocks (neighbourhoods
+ * over own points + halo in input order break ties by input index as the
+ * whole cloud's do); the blocks come part after part, non-finite points
+ * first.  knn, radius, knn+radius only, and orientation none, input,
+ * viewpoint or scanner: JF_ERR_UNSUPPORTED otherwise (rings, natural and
+ * mst need the whole cloud).  nparts == 1 is jf_estimate_blocks.  The
+ * progress hook is called once, at the end.  Costs more index builds
+ * (up to nparts per part).  Errors as jf_estimate_blocks. */
+jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int nparts,
+                            jf_block_fn sink, void *user, jf_error *err);
 
 #ifdef __cplusplus
 }

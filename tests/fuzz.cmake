@@ -6,10 +6,9 @@ if(JF_FUZZ)
     message(FATAL_ERROR "JF_FUZZ=ON needs clang: configure with "
             "-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
   endif()
-  set(JF_FUZZ_READER_SOURCES
-      ${PROJECT_SOURCE_DIR}/src/io/io_read.c ${PROJECT_SOURCE_DIR}/src/io/io_ply.c
-      ${PROJECT_SOURCE_DIR}/src/io/io_xyz.c ${PROJECT_SOURCE_DIR}/src/io/io_off.c
-      ${PROJECT_SOURCE_DIR}/src/io/io_las.c ${PROJECT_SOURCE_DIR}/src/io/io_ptx.c)
+  # every file of src/io (the readers and what they call, e.g. the writers'
+  # helpers): a new reader file cannot break the fuzz build's link again
+  file(GLOB JF_FUZZ_READER_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/io/*.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
   foreach(reader ply xyz off las ptx)
@@ -18,5 +17,6 @@ if(JF_FUZZ)
     target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/src/io)
     target_compile_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
     target_link_options(fuzz_${reader} PRIVATE ${JF_FUZZ_FLAGS})
+    target_link_libraries(fuzz_${reader} PRIVATE OpenMP::OpenMP_C m)
   endforeach()
 endif()

@@ -36,6 +36,44 @@ static PyObject *file_error(jf_status st, const jf_error *err, const char *path)
     return NULL;
 }
 
+/* {name: (n,) array} of the attribute table, each in its input type
+ * (LAS bit fields as uint8), in the file's order. */
+static PyObject *attrs_dict(const jf_attrs *a, size_t n)
+{
+    static const int npy[10] = {NPY_INT8,  NPY_UINT8,  NPY_INT16, NPY_UINT16, NPY_INT32,
+                                NPY_UINT32, NPY_INT64, NPY_UINT64, NPY_FLOAT32, NPY_FLOAT64};
+    static const size_t size[10] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+    const uint16_t one = 1;
+    const int little = *(const unsigned char *)&one == 1;
+    PyObject *d = PyDict_New();
+    for (size_t j = 0; d && j < a->nattrs; j++) {
+        const jf_attr *at = &a->attr[j];
+        int t = at->bits ? JF_ATTR_U8 : (int)at->type;
+        npy_intp dims[1] = {(npy_intp)n};
+        PyObject *arr = PyArray_SimpleNew(1, dims, little ? npy[t] : NPY_FLOAT64);
+        if (!arr) {
+            Py_CLEAR(d);
+            break;
+        }
+        unsigned char *o = PyArray_DATA((PyArrayObject *)arr);
+        for (size_t i = 0; i < n; i++) {
+            const unsigned char *r = a->rec + i * a->stride + at->offset;
+            if (!little) { /* the records are little endian: values as doubles */
+                double v = jf_attr_get(a, j, i);
+                memcpy(o + 8 * i, &v, 8);
+            } else if (at->bits) {
+                o[i] = (unsigned char)((r[0] >> at->shift) & ((1u << at->bits) - 1u));
+            } else {
+                memcpy(o + size[t] * i, r, size[t]);
+            }
+        }
+        int bad = PyDict_SetItemString(d, at->name, arr) < 0;
+        Py_DECREF(arr);
+        if (bad) Py_CLEAR(d);
+    }
+    return d;
+}
+
 /* attrs["scan"] (N,) int32 and attrs["scanner"] (N, 3) float64: the scan
  * of each row and the position of its scanner (c->scanner[c->scan[i]]). */
 static int scanner_attrs(const jf_cloud *c, PyObject *attrs)
@@ -114,10 +152,10 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
     }
     faces = c.nfaces ? jf_py_faces_out(&c) : Py_NewRef(Py_None);
     if (!faces) goto done;
-    /* per-point attributes other than coordinates and normals: for now
-     * only a PTX file's scans (scan index and scanner position of every
-     * row, what estimate(..., scanners=) takes) */
-    if (!(attrs = PyDict_New())) goto done;
+    /* the input's other per-point values (jf_cloud.attrs): name -> an (N,)
+     * array of the input's type; a PTX file's scans (scan index and scanner
+     * position of every row, what estimate(..., scanners=) takes) */
+    if (!(attrs = attrs_dict(&c.attrs, c.n))) goto done;
     if (c.scanner && scanner_attrs(&c, attrs) < 0) goto done;
     out = PyTuple_Pack(4, pts, nrm, faces, attrs);
 done:

@@ -72,8 +72,10 @@ PyDoc_STRVAR(estimate_mesh_doc,
 PyDoc_STRVAR(read_doc,
 "read(path, *, columns=None, bad_rows=None)\n--\n\n"
 "Reads a cloud or mesh with the command's readers: (points (N, 3) float64,\n"
-"normals or None, faces or None, attributes dict).  Errors raise\n"
-"jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");
+"normals or None, faces or None, attributes: a dict name -> (N,) array in\n"
+"the input's type of every other per-point value (PLY properties, named CSV\n"
+"columns, LAS dimensions and extra bytes; PTX: scan and scanner)).  Errors\n"
+"raise jetfit.FileError (an OSError) with the command's 'FILE:LINE: reason'.");
 
 PyDoc_STRVAR(write_doc,
 "write(path, result, *, points=None, faces=None, ascii=False, threads=None)\n--\n\n"

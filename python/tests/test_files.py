@@ -1,11 +1,14 @@
 """jetfit.read / jetfit.write over the library's readers and writers:
 the command's formats, its error lines, and its rule that a failed write
 leaves the old file untouched."""
+import os
+import struct
+
 import numpy as np
 import pytest
 
 import jetfit
-from conftest import fib_sphere, save_xyz
+from conftest import TOP, fib_sphere, save_xyz
 
 
 def test_read_cloud_with_and_without_normals(tmp_path, cmd):
@@ -113,3 +116,75 @@ def test_read_bad_rows(tmp_path, cmd):
     assert pts.shape == (4, 3) and np.isnan(pts[2]).all() and (pts[3] == [0, 1, 0]).all()
     with pytest.raises(ValueError, match="^--bad-rows 'keep': "):
         jetfit.read(str(f), bad_rows="keep")
+
+
+def test_read_attributes_ply_csv(tmp_path):
+    """Every other per-point value comes back in its input type: PLY
+    properties (normals too), and the named columns of a CSV packed in
+    the smallest exact type."""
+    n = 7
+    p = fib_sphere(n)
+    rgb = np.arange(3 * n, dtype=np.uint8).reshape(n, 3) * 11
+    inten = np.linspace(-1.5, 2.25, n).astype(np.float32)
+    rec = np.zeros(n, dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("red", "u1"),
+                             ("green", "u1"), ("blue", "u1"), ("intensity", "<f4"),
+                             ("nx", "<f4")])
+    rec["x"], rec["y"], rec["z"] = p.T
+    rec["red"], rec["green"], rec["blue"] = rgb.T
+    rec["intensity"] = inten
+    rec["nx"] = 1
+    head = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\n" % n
+            + "".join("property %s %s\n" % (t, nm) for t, nm in
+                      [("double", "x"), ("double", "y"), ("double", "z"), ("uchar", "red"),
+                       ("uchar", "green"), ("uchar", "blue"), ("float", "intensity"),
+                       ("float", "nx")]) + "end_header\n")
+    (tmp_path / "c.ply").write_bytes(head.encode() + rec.tobytes())
+    pts, nrm, _, attrs = jetfit.read(tmp_path / "c.ply")
+    assert np.array_equal(pts, p) and nrm is None
+    assert list(attrs) == ["red", "green", "blue", "intensity", "nx"]
+    for k, c in enumerate(("red", "green", "blue")):
+        assert attrs[c].dtype == np.uint8 and np.array_equal(attrs[c], rgb[:, k])
+    assert attrs["intensity"].dtype == np.float32
+    assert np.array_equal(attrs["intensity"], inten)
+    with open(tmp_path / "c.csv", "w") as f:
+        f.write("id,X,Y,Z,label,w,big\n")
+        for i in range(n):
+            f.write("%d,%.17g,%.17g,%.17g,%d,%.17g,%d\n" % (i, *p[i], 300 + i, 0.1 * i, -70000))
+    pts, _, _, attrs = jetfit.read(tmp_path / "c.csv")
+    assert np.array_equal(pts, p)
+    assert list(attrs) == ["id", "label", "w", "big"]
+    assert attrs["id"].dtype == np.uint8 and np.array_equal(attrs["id"], np.arange(n))
+    assert attrs["label"].dtype == np.uint16 and np.array_equal(attrs["label"], 300 + np.arange(n))
+    assert attrs["w"].dtype == np.float64 and np.array_equal(attrs["w"], 0.1 * np.arange(n))
+    assert attrs["big"].dtype == np.int32 and (attrs["big"] == -70000).all()
+    _, _, _, attrs = jetfit.read(save_xyz(tmp_path / "plain.xyz", p))
+    assert attrs == {}
+
+
+def test_read_attributes_las(tmp_path, cmd):
+    """A LAS file's dimensions, decoded from the record bits, and the
+    extra bytes of a LAS file jetfit wrote: its columns read back."""
+    src = os.path.join(TOP, "tests", "data", "las", "simple.las")
+    raw = open(src, "rb").read()
+    off, = struct.unpack_from("<I", raw, 96)
+    rl, = struct.unpack_from("<H", raw, 105)
+    n, = struct.unpack_from("<I", raw, 107)
+    recs = np.frombuffer(raw, np.uint8, n * rl, off).reshape(n, rl)
+    pts, _, _, attrs = jetfit.read(src)
+    assert pts.shape == (n, 3)
+    assert attrs["intensity"].dtype == np.uint16
+    assert np.array_equal(attrs["intensity"], recs[:, 12:14].copy().view("<u2").ravel())
+    assert np.array_equal(attrs["return_number"], recs[:, 14] & 7)
+    assert np.array_equal(attrs["number_of_returns"], (recs[:, 14] >> 3) & 7)
+    assert np.array_equal(attrs["classification"], recs[:, 15] & 31)
+    assert np.array_equal(attrs["gps_time"], recs[:, 20:28].copy().view("<f8").ravel())
+    assert np.array_equal(attrs["blue"], recs[:, 32:34].copy().view("<u2").ravel())
+    cmd("estimate", src, "-o", tmp_path / "o.las", "--quiet", "--neighbors", "knn:10")
+    cmd("estimate", src, "-o", tmp_path / "o.csv", "--quiet", "--neighbors", "knn:10")
+    pts2, _, _, attrs2 = jetfit.read(tmp_path / "o.las")
+    ref = np.genfromtxt(tmp_path / "o.csv", delimiter=",", names=True)
+    assert np.array_equal(pts2, pts)
+    assert list(attrs2)[:len(attrs)] == list(attrs)
+    for name in ref.dtype.names[3:]:
+        assert np.array_equal(attrs2[name], ref[name], equal_nan=True), name
+    assert attrs2["degree"].dtype == np.int32 and attrs2["nx"].dtype == np.float64

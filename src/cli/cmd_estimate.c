@@ -13,6 +13,7 @@
 #include "cmd.h"
 #include "jetfit.h"
 #include "opts.h"
+#include "rows.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -25,7 +26,7 @@ static void usage(FILE *f)
         "\n"
         "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
         "and writes one row per input point, in input order.\n"
-        "INPUT: .ply .xyz .pts .txt .csv .off    OUTPUT: .ply .csv .xyz .txt\n"
+        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx   OUTPUT: .ply .csv .xyz .txt .las\n"
         "\n"
         "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
         "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
@@ -64,6 +65,16 @@ static void usage(FILE *f)
         "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
+        "  --memory SIZE         memory for the points and their k-d tree, e.g. 8G,\n"
+        "                        256M (K, M, G, T: powers of 1024; default: the\n"
+        "                        available memory, MemAvailable); when ~64 bytes per\n"
+        "                        point would not fit, the cloud is fitted in parts\n"
+        "                        with exact halos, one at a time (same output)\n"
+        "  --keep MODE           all (default): the input's other per-point values\n"
+        "                        (PLY properties, named CSV columns, LAS dimensions;\n"
+        "                        a LAS output keeps the LAS records) go to the output\n"
+        "                        after x y z, a name that clashes renamed in_NAME;\n"
+        "                        none: jetfit's columns only\n"
         "  --quiet               no progress line, no summary\n"
         "  -h, --help            this text\n"
         "\n"
@@ -71,6 +82,18 @@ static void usage(FILE *f)
         "         degree neighbors cond residual status\n"
         "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
         JF_MAX_DEGREE, p.degree, p.max_cond, omp_get_max_threads());
+}
+
+/* MemAvailable of /proc/meminfo in bytes, or 0 when unknown. */
+static unsigned long long mem_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    char line[256];
+    unsigned long long kb = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+    if (f) fclose(f);
+    return kb * 1024ULL;
 }
 
 static int bad_option(const char *opt, const char *val, const char *why)
@@ -116,40 +139,54 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void summary(const jf_result *r, size_t n, size_t nbad, double secs, const char *out)
+/* What the summary counts, per thread (the sink runs on the fit's
+ * threads), padded so that threads do not share a cache line. */
+typedef struct {
+    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1];
+    char pad[64];
+} tally;
+
+static void tally_add(tally *t, const jf_result *r)
 {
-    size_t flags[32] = {0}, ok = 0, deg[JF_MAX_DEGREE + 1] = {0};
-    for (size_t i = 0; i < n; i++) {
-        if (!r[i].status) ok++;
-        for (int b = 0; b < 32; b++)
-            if (r[i].status & (1u << b)) flags[b]++;
-        if (r[i].degree >= 0 && r[i].degree <= JF_MAX_DEGREE) deg[r[i].degree]++;
+    if (!r->status) t->ok++;
+    for (int b = 0; b < 32; b++)
+        if (r->status & (1u << b)) t->flags[b]++;
+    if (r->degree >= 0 && r->degree <= JF_MAX_DEGREE) t->deg[r->degree]++;
+}
+
+/* cond[i] of every point (NaN skipped); nt tallies summed. */
+static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
+                    const char *out)
+{
+    tally t = {{0}, 0, {0}, {0}};
+    for (int k = 0; k < nt; k++) {
+        t.ok += tl[k].ok;
+        for (int b = 0; b < 32; b++) t.flags[b] += tl[k].flags[b];
+        for (int d = 0; d <= JF_MAX_DEGREE; d++) t.deg[d] += tl[k].deg[d];
     }
     fprintf(stderr, "jetfit: %zu points in %.2f s (%.0f points/s)\n", n, secs,
             secs > 0 ? (double)n / secs : 0.0);
-    fprintf(stderr, "  status: ok %zu", ok);
+    fprintf(stderr, "  status: ok %zu", t.ok);
     for (int b = 0; b < 32; b++) {
         char name[64];
-        if (flags[b])
+        if (t.flags[b])
             fprintf(stderr, ", %s %zu", jf_point_status_str(1u << b, name, sizeof name),
-                    flags[b]);
+                    t.flags[b]);
     }
     fprintf(stderr, "\n  degree:");
     for (int d = 0; d <= JF_MAX_DEGREE; d++)
-        if (deg[d]) fprintf(stderr, " %d: %zu", d, deg[d]);
+        if (t.deg[d]) fprintf(stderr, " %d: %zu", d, t.deg[d]);
     fputc('\n', stderr);
-    double *c = malloc((n ? n : 1) * sizeof *c);
     size_t m = 0;
-    if (c) {
+    if (cond) {
         for (size_t i = 0; i < n; i++)
-            if (isfinite(r[i].cond)) c[m++] = r[i].cond;
-        qsort(c, m, sizeof *c, cmp_double);
+            if (isfinite(cond[i])) cond[m++] = cond[i];
+        qsort(cond, m, sizeof *cond, cmp_double);
     }
     if (m)
         fprintf(stderr, "  cond: p50 %.3g, p90 %.3g, p99 %.3g, max %.3g\n",
-                c[(m - 1) / 2], c[(size_t)(0.9 * (double)(m - 1))],
-                c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
-    free(c);
+                cond[(m - 1) / 2], cond[(size_t)(0.9 * (double)(m - 1))],
+                cond[(size_t)(0.99 * (double)(m - 1))], cond[m - 1]);
     if (nbad)
         fprintf(stderr, "  bad rows: %zu (kept as NaN rows, status nonfinite)\n", nbad);
     fprintf(stderr, "  output: %s\n", out);
@@ -157,108 +194,56 @@ static void summary(const jf_result *r, size_t n, size_t nbad, double secs, cons
 
 /* ---- output ------------------------------------------------------------ */
 
-static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",  "k1",
-                                        "k2",  "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
-static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
-static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
+/* ---- rows straight to the output ------------------------------------- */
 
-static size_t make_columns(int monge, jf_column *cols)
-{
-    size_t n = 0;
-    for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
-    if (monge >= 3)
-        for (size_t j = 0; j < 4; j++) cols[n++] = (jf_column){b_cols[j], JF_COL_F64};
-    if (monge >= 4)
-        for (size_t j = 0; j < 5; j++) cols[n++] = (jf_column){c_cols[j], JF_COL_F64};
-    cols[n++] = (jf_column){"degree", JF_COL_I32};
-    cols[n++] = (jf_column){"neighbors", JF_COL_I32};
-    cols[n++] = (jf_column){"cond", JF_COL_F64};
-    cols[n++] = (jf_column){"residual", JF_COL_F64};
-    cols[n++] = (jf_column){"status", JF_COL_I32};
-    return n;
-}
+/* design (docs/scale.md): results are never held for the whole cloud.
+ * jf_estimate_blocks hands over blocks of <= 256 results from the fit's
+ * threads; each block becomes rows written at their input index
+ * (jf_writer_put: in place for binary PLY and LAS, through a binary spool
+ * for text).  What stays per point: the coordinates, the index, and the
+ * condition numbers for the summary's quantiles. */
+typedef struct {
+    jf_writer *w;
+    const double *xyz;
+    int monge, nt;
+    size_t ncols;
+    double *rows;    /* nt x 256 x ncols: one block per thread          */
+    tally *tl;       /* nt                                              */
+    double *cond;    /* n, or NULL (--quiet)                            */
+    int wfail;       /* a jf_writer_put failed (atomic)                 */
+} sinkctx;
 
-static size_t make_row(const double *p, const jf_result *r, int monge, double *v)
+static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
 {
-    size_t n = 0;
-    for (int j = 0; j < 3; j++) v[n++] = p[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->normal[j];
-    v[n++] = r->k1;
-    v[n++] = r->k2;
-    for (int j = 0; j < 3; j++) v[n++] = r->d1[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->d2[j];
-    if (monge >= 3)
-        for (int j = 0; j < 4; j++) v[n++] = r->b[j];
-    if (monge >= 4)
-        for (int j = 0; j < 5; j++) v[n++] = r->c[j];
-    v[n++] = r->degree;
-    v[n++] = r->n_used;
-    v[n++] = r->cond;
-    v[n++] = r->residual;
-    v[n++] = (double)r->status;
-    return n;
+    sinkctx *s = user;
+    int t = omp_get_thread_num();
+    if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
+    double *v = s->rows + (size_t)t * 256 * s->ncols;
+    for (size_t j = 0; j < m; j++) {
+        jf_cli_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        tally_add(&s->tl[t], &res[j]);
+        if (s->cond) s->cond[idx[j]] = res[j].cond;
+    }
+    jf_status st = jf_writer_put(s->w, idx, v, m);
+    if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
+    return st;
 }
 
 /* ---- the command ---------------------------------------------------------- */
 
 int jf_cmd_estimate(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL;
-    int quiet = 0, ascii = 0;
-    jf_cli_est e;
+    jf_cli_estimate_cmd cmd;
     jf_cli_bad bad;
-    jf_cli_est_init(&e);
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            usage(stdout);
-            return 0;
-        }
-        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            quiet = 1;
-            continue;
-        }
-        if (!strcmp(a, "--ascii")) {
-            ascii = 1;
-            continue;
-        }
-        if (jf_cli_est_takes_value(a) == 0) {
-            (void)jf_cli_est_option(&e, a, NULL, &bad);
-            continue;
-        }
-        if (a[0] != '-' || !a[1]) {
-            if (in) return bad_option("argument", a, "only one INPUT file is accepted");
-            in = a;
-            continue;
-        }
-        /* every other option takes a value: "--opt VALUE" or "--opt=VALUE" */
-        char name[32];
-        const char *val = NULL, *eq = strchr(a, '=');
-        if (eq && (size_t)(eq - a) < sizeof name) {
-            memcpy(name, a, (size_t)(eq - a));
-            name[eq - a] = '\0';
-            val = eq + 1;
-        } else {
-            snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc)
-                return strcmp(name, "-o") && strcmp(name, "--output") &&
-                               jf_cli_est_takes_value(name) != 1
-                           ? bad_option("unknown option", a, "not an option of estimate")
-                           : bad_option(a, "", "needs a value");
-            val = argv[++i];
-        }
-        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
-            out = val;
-        } else if (jf_cli_est_takes_value(name) != 1) {
-            return bad_option("unknown option", a, "not an option of estimate");
-        } else if (jf_cli_est_option(&e, name, val, &bad)) {
-            return bad_option(bad.opt, bad.val, bad.why);
-        }
+    if (jf_cli_estimate_parse(argc, argv, &cmd, &bad)) return bad_option(bad.opt, bad.val, bad.why);
+    if (cmd.help) {
+        usage(stdout);
+        return 0;
     }
-    if (!in) return bad_option("INPUT", "", "missing input file");
-    if (!out) return bad_option("-o", "", "missing output file");
-    if (jf_cli_est_finish(&e, &bad)) return bad_option(bad.opt, bad.val, bad.why);
+    jf_cli_est e = cmd.e;
+    const char *in = cmd.in, *out = cmd.out;
+    int quiet = cmd.quiet, ascii = cmd.ascii, keep = cmd.keep;
+    unsigned long long memory = cmd.memory; /* --memory; 0: MemAvailable */
     jf_estimate_opts o = e.o;
     int monge = e.monge;
     jf_error err = {{0}};
@@ -272,6 +257,7 @@ int jf_cmd_estimate(int argc, char **argv)
                 out, in);
         return 1;
     }
+    e.ro.no_attrs = !keep; /* --keep none: not even read */
     jf_status st = jf_cloud_read(in, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
@@ -298,7 +284,7 @@ int jf_cmd_estimate(int argc, char **argv)
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[32];
-    size_t ncols = make_columns(monge, cols);
+    size_t ncols = jf_cli_columns(monge, cols);
     jf_writer *w = NULL;
     st = jf_writer_open(out, cols, ncols, c.n, ascii, &w, &err);
     if (st != JF_OK) {
@@ -310,10 +296,32 @@ int jf_cmd_estimate(int argc, char **argv)
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
     (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
-    jf_result *r = malloc(c.n * sizeof *r);
-    if (!r) {
-        fprintf(stderr, "jetfit: out of memory (%zu results)\n", c.n);
+    /* the input's attributes after x y z (a LAS output from a LAS input
+     * keeps its records) */
+    st = jf_writer_attrs(w, &c.attrs);
+    if (st != JF_OK) {
+        fprintf(stderr, "jetfit: %s: cannot carry the input's attributes to %s: %s (use "
+                        "--keep none)\n", in, out,
+                st == JF_ERR_TOO_LARGE ? "a LAS record would exceed 65535 bytes or 341 "
+                                         "Extra Bytes"
+                                       : jf_strerror(st));
         jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
+    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
+                  calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
+    if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
+        /* a failed begin is reported by commit's message below */
+        if (!sk.rows || !sk.tl || (!quiet && !sk.cond))
+            fprintf(stderr, "jetfit: out of memory (%zu points)\n", c.n);
+        st = jf_writer_commit(w, &err);
+        if (st != JF_OK && sk.rows && sk.tl && (quiet || sk.cond))
+            fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        free(sk.rows);
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
@@ -322,42 +330,52 @@ int jf_cmd_estimate(int argc, char **argv)
         o.progress = progress;
         o.progress_user = &ps;
     }
-    st = jf_estimate(&c, &o, r, &err);
+    /* --memory: parts when the points and their tree (about 64 bytes per
+     * point) would not fit; then each part's tree and halo take about
+     * half of it (docs/scale.md) */
+    if (!memory) memory = mem_available();
+    int nparts = 1;
+    if (memory && 64.0 * (double)c.n > (double)memory) {
+        double p = ceil(128.0 * (double)c.n / (double)memory);
+        nparts = p > 65536 ? 65536 : (int)p;
+        if (o.nb.kind == JF_NB_RINGS || o.nb.kind == JF_NB_NATURAL || o.orient == JF_ORIENT_MST) {
+            if (!quiet)
+                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
+                                "natural and mst need the whole cloud: fitting it whole\n",
+                        c.n, memory >> 20);
+            nparts = 1;
+        }
+    }
+    st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
+                    : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
+    free(sk.rows);
     if (st != JF_OK) {
-        fprintf(stderr, "jetfit: %s: %s\n", in, err.msg[0] ? err.msg : jf_strerror(st));
-        jf_writer_abort(w);
-        free(r);
+        /* a failed write: the writer's own message says which file and
+         * why (commit fails on it, and removes the temporary) */
+        jf_error werr = {{0}};
+        if (sk.wfail && jf_writer_commit(w, &werr) != JF_OK && werr.msg[0]) {
+            fprintf(stderr, "jetfit: %s\n", werr.msg);
+        } else {
+            if (!sk.wfail) jf_writer_abort(w);
+            fprintf(stderr, "jetfit: %s: %s\n", in, err.msg[0] ? err.msg : jf_strerror(st));
+        }
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
-    /* rows built and formatted in parallel, a block at a time (16 MB) */
-    enum { BLOCK = 65536 };
-    double *rows = malloc((c.n < BLOCK ? c.n : BLOCK) * ncols * sizeof *rows);
-    if (!rows) {
-        fprintf(stderr, "jetfit: out of memory (output rows)\n");
-        jf_writer_abort(w);
-        free(r);
-        jf_cloud_free(&c);
-        return 1;
-    }
-    for (size_t b0 = 0; b0 < c.n; b0 += BLOCK) {
-        const long nb = (long)(c.n - b0 < BLOCK ? c.n - b0 : BLOCK);
-#pragma omp parallel for num_threads(o.threads > 0 ? o.threads : omp_get_max_threads())
-        for (long k = 0; k < nb; k++)
-            make_row(c.xyz + 3 * (b0 + (size_t)k), &r[b0 + (size_t)k], monge, rows + (size_t)k * ncols);
-        if (jf_writer_rows(w, rows, (size_t)nb, o.threads) != JF_OK) break;
-    }
-    free(rows);
     /* commit reports a failed row too, and removes the temporary */
     st = jf_writer_commit(w, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
-        free(r);
+        free(sk.tl);
+        free(sk.cond);
         jf_cloud_free(&c);
         return 1;
     }
-    if (!quiet) summary(r, c.n, c.nbad, now_s() - t0, out);
-    free(r);
+    if (!quiet) summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+    free(sk.tl);
+    free(sk.cond);
     jf_cloud_free(&c);
     return 0;
 }

@@ -33,6 +33,8 @@ static void usage(FILE *out)
         "  sphere      radius 1; area-uniform samples\n"
         "  ellipsoid   x^2 + (y/0.75)^2 + (z/0.5)^2 = 1; area-uniform samples\n"
         "  cylinder    radius 0.5, z in [-1,1], open; area-uniform samples\n"
+        "  torus       (sqrt(x^2+y^2) - 1)^2 + z^2 = 0.4^2 (closed, with a hole;\n"
+        "              hyperbolic inside); area-uniform samples\n"
         "              closed surfaces: outward normal (so convex k < 0)\n"
         "\n"
         "  -o FILE          output: .ply (binary; --ascii for ascii), .off, .xyz,\n"
@@ -40,11 +42,11 @@ static void usage(FILE *out)
         "  --n N            N random samples (default %d); with --mesh, a grid\n"
         "                   of about N vertices\n"
         "  --grid-h H       a grid of side H in parameter space instead (graphs:\n"
-        "                   x,y; sphere/ellipsoid: theta,phi in radians; cylinder:\n"
-        "                   arc length); vertices only unless --mesh\n"
+        "                   x,y; sphere/ellipsoid: theta,phi in radians; cylinder,\n"
+        "                   torus: arc length); vertices only unless --mesh\n"
         "  --mesh           triangulated grid (graphs: squares split along one\n"
         "                   diagonal; sphere/ellipsoid: closed UV mesh with one\n"
-        "                   vertex per pole; cylinder: open tube)\n"
+        "                   vertex per pole; cylinder: open tube; torus: closed)\n"
         "  --perturb D      grids: move each vertex by (d h, d' h), d, d' uniform\n"
         "                   in [0, D] (default 0.9, the paper's 6.1; 0 = regular)\n"
         "  --noise S        Gaussian noise, sigma = S x bounding-box diagonal,\n"
@@ -100,6 +102,44 @@ static int has_ext(const char *path, const char *ext)
     if (!dot || (sl && dot < sl))
         return 0;
     return !strcasecmp(dot, ext);
+}
+
+/* A random cloud without truth, noise or outliers, written a chunk of
+ * 2^20 points at a time (issue 12.1: 10^8 points without holding their
+ * parameters and truth).  jf_sample_random draws point after point from
+ * rng, so chunks give the points of one call, and the writer the bytes
+ * of jf_cloud_write. */
+static int stream_random(jf_surface surf, const char *surf_name, uint64_t n, jf_density d,
+                         jf_rng *rng, const char *out, int ascii)
+{
+    enum { CHUNK = 1 << 20 };
+    static const jf_column cols[3] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64}};
+    jf_error err = {{0}};
+    jf_writer *w = NULL;
+    if (n > (uint64_t)UINT32_MAX - 2) {
+        fprintf(stderr, "jetfit generate: --n %llu: at most 2^32 - 2 points\n",
+                (unsigned long long)n);
+        return 1;
+    }
+    jf_status st = jf_writer_open(out, cols, 3, (size_t)n, ascii, &w, &err);
+    for (uint64_t k = 0; st == JF_OK && k < n; k += CHUNK) {
+        jf_sample s;
+        size_t m = n - k < CHUNK ? (size_t)(n - k) : CHUNK;
+        if ((st = jf_sample_random(surf, m, d, rng, &s)) != JF_OK) {
+            fprintf(stderr, "jetfit generate: cannot sample %s: %s\n", surf_name,
+                    jf_strerror(st));
+            jf_writer_abort(w);
+            return 1;
+        }
+        st = jf_writer_rows(w, s.xyz, m, 1); /* binary rows: copying, not worth threads */
+        jf_sample_free(&s);
+    }
+    if (w) st = jf_writer_commit(w, &err);
+    if (st) {
+        fprintf(stderr, "jetfit generate: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        return 1;
+    }
+    return 0;
 }
 
 static jf_status write_truth(const char *path, const jf_sample *s, int dirs,
@@ -229,9 +269,9 @@ int jf_cmd_generate(int argc, char **argv)
     }
     jf_surface surf;
     if (!surf_name)
-        return fail("%s", "which SURFACE? (exp, paraboloid, revolution, sphere, ellipsoid, cylinder)");
+        return fail("%s", "which SURFACE? (exp, paraboloid, revolution, sphere, ellipsoid, cylinder, torus)");
     if (jf_surface_parse(surf_name, &surf))
-        return fail("unknown surface '%s' (exp, paraboloid, revolution, sphere, ellipsoid, cylinder)", surf_name);
+        return fail("unknown surface '%s' (exp, paraboloid, revolution, sphere, ellipsoid, cylinder, torus)", surf_name);
     if (!out)
         return fail("%s", "-o FILE is required");
     if (n && grid_h > 0)
@@ -248,6 +288,9 @@ int jf_cmd_generate(int argc, char **argv)
     jf_rng_seed(&rng, (uint64_t)seed);
     jf_sample s;
     jf_status st;
+    if (!grid && !truth && !(noise > 0) && !(noise_u > 0) && !(outliers > 0) &&
+        !has_ext(out, ".off") && !has_ext(out, ".las")) /* LAS: needs the bbox first */
+        return stream_random(surf, surf_name, n ? n : DEFAULT_N, density, &rng, out, ascii);
     if (grid) {
         double h = grid_h > 0 ? grid_h : jf_sample_grid_h_for(surf, n ? n : DEFAULT_N);
         st = jf_sample_grid(surf, h, perturb, mesh, &rng, &s);

@@ -38,7 +38,7 @@ static void usage(FILE *out)
         "         [--point-size S] [--title TEXT] [--size W,H] [--small]\n"
         "\n"
         "  RESULT        jetfit estimate output or a generate truth file (.ply,\n"
-        "                .csv, .xyz/.txt): columns x y z, k1 k2 for --color,\n"
+        "                .csv, .xyz/.txt, .las): columns x y z, k1 k2 for --color,\n"
         "                d1x..d2z for --directions (mesh faces are not drawn:\n"
         "                the vertices are)\n"
         "  -o FILE.png   the picture (PNG, gnuplot's pngcairo terminal)\n"

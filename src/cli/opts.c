@@ -215,3 +215,103 @@ int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad)
         return bad_(bad, "parameters", bf ? bf : "?", "invalid combination");
     return 0;
 }
+
+/* ---- the whole estimate command line ---------------------------------- */
+
+static int bad_set(jf_cli_bad *bad, const char *opt, const char *val, const char *why)
+{
+    bad->opt = opt, bad->val = val, bad->why = why;
+    return -1;
+}
+
+unsigned long long jf_cli_parse_size(const char *s)
+{
+    char *end = NULL;
+    if (!s || !*s || *s == '-') return 0;
+    double v = strtod(s, &end);
+    if (end == s || !(v > 0)) return 0;
+    double mul = 1;
+    switch (*end) {
+    case 'k': case 'K': mul = 1024.0, end++; break;
+    case 'm': case 'M': mul = 1048576.0, end++; break;
+    case 'g': case 'G': mul = 1073741824.0, end++; break;
+    case 't': case 'T': mul = 1099511627776.0, end++; break;
+    default: break;
+    }
+    if (*end == 'b' || *end == 'B') end++;
+    if (*end || !(v * mul < 1.8e19) || v * mul < 1) return 0;
+    return (unsigned long long)(v * mul);
+}
+
+
+int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad)
+{
+    memset(cmd, 0, sizeof *cmd);
+    cmd->keep = 1;
+    jf_cli_est *e = &cmd->e;
+    jf_cli_est_init(e);
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            cmd->help = 1;
+            return 0;
+        }
+        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            cmd->quiet = 1;
+            continue;
+        }
+        if (!strcmp(a, "--ascii")) {
+            cmd->ascii = 1;
+            continue;
+        }
+        if (jf_cli_est_takes_value(a) == 0) {
+            (void)jf_cli_est_option(e, a, NULL, bad);
+            continue;
+        }
+        if (a[0] != '-' || !a[1]) {
+            if (cmd->in) return bad_set(bad, "argument", a, "only one INPUT file is accepted");
+            cmd->in = a;
+            continue;
+        }
+        /* every other option takes a value: "--opt VALUE" or "--opt=VALUE" */
+        char name[32];
+        const char *val = NULL, *eq = strchr(a, '=');
+        if (eq && (size_t)(eq - a) < sizeof name) {
+            memcpy(name, a, (size_t)(eq - a));
+            name[eq - a] = '\0';
+            val = eq + 1;
+        } else {
+            snprintf(name, sizeof name, "%s", a);
+            if (i + 1 >= argc)
+                return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--keep") &&
+                               strcmp(name, "--memory") &&
+                               jf_cli_est_takes_value(name) != 1
+                           ? bad_set(bad, "unknown option", a, "not an option of estimate")
+                           : bad_set(bad, a, "", "needs a value");
+            val = argv[++i];
+        }
+        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
+            cmd->out = val;
+        } else if (!strcmp(name, "--memory")) {
+            if (!(cmd->memory = jf_cli_parse_size(val)))
+                return bad_set(bad, "--memory", val, "expected a size such as 8G, 256M or 1500000000");
+        } else if (!strcmp(name, "--keep")) {
+            if (!strcmp(val, "all")) cmd->keep = 1;
+            else if (!strcmp(val, "none")) cmd->keep = 0;
+            else return bad_set(bad, "--keep", val, "expected all or none");
+        } else if (jf_cli_est_takes_value(name) != 1) {
+            return bad_set(bad, "unknown option", a, "not an option of estimate");
+        } else if (jf_cli_est_option(e, name, val, bad)) {
+            if (bad->opt == name) { /* name dies with this loop */
+                memcpy(cmd->badname, name, sizeof cmd->badname);
+                bad->opt = cmd->badname;
+            }
+            return -1;
+        }
+    }
+    if (!cmd->in) return bad_set(bad, "INPUT", "", "missing input file");
+    if (!cmd->out) return bad_set(bad, "-o", "", "missing output file");
+    if (jf_cli_est_finish(e, bad)) return -1;
+    return 0;
+}

@@ -46,4 +46,21 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
  * and max_neighbors, validates.  0, or -1 with *bad. */
 int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad);
 
+/* The whole `jetfit estimate` (and `jetfit-mpi estimate`) command line. */
+typedef struct {
+    jf_cli_est e;
+    const char *in, *out;
+    int quiet, ascii, keep, help;  /* keep: --keep all (1) or none (0) */
+    unsigned long long memory;     /* --memory in bytes, 0 = not given  */
+    char badname[32];              /* the option *bad names, when cut from "--opt=VALUE" */
+} jf_cli_estimate_cmd;
+
+/* Parses argv[1..] (argv[0] is the command's name).  0, or -1 with *bad
+ * (option, value, why: the command prints them). */
+int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad);
+
+/* SIZE: bytes with an optional K, M, G or T (powers of 1024, an optional
+ * trailing B).  0 if it is not one. */
+unsigned long long jf_cli_parse_size(const char *s);
+
 #endif

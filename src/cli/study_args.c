@@ -25,7 +25,8 @@ static void usage(FILE *f)
         "  INPUT, --truth TRUTH  a cloud and its truth: a `generate` truth file,\n"
         "                  PCPNet .normals (with .curv beside it when present),\n"
         "                  or a reference result (e.g. estimated on a cleaner scan)\n"
-        "  SURFACE         exp, paraboloid, revolution, sphere, ellipsoid, cylinder:\n"
+        "  SURFACE         exp, paraboloid, revolution, sphere, ellipsoid, cylinder,\n"
+        "                  torus:\n"
         "                  `jetfit generate SURFACE --n N --seed S+r` with exact truth\n"
         "  -o DIR          the folder (made if missing): study.csv, best.csv,\n"
         "                  normal.png, curvature.png, k.png, report.html\n"
@@ -330,7 +331,7 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
     s->input = pos;
     if (!s->truth) {
         if (jf_surface_parse(pos, &c->surf))
-            return bad_opt("SURFACE", pos, "not a surface (exp, paraboloid, revolution, sphere, ellipsoid, cylinder); an INPUT file needs --truth");
+            return bad_opt("SURFACE", pos, "not a surface (exp, paraboloid, revolution, sphere, ellipsoid, cylinder, torus); an INPUT file needs --truth");
         c->is_surface = 1;
         if (!c->npoints) c->npoints = JF_STUDY_DEFAULT_N;
     } else if (c->npoints || c->mesh) {

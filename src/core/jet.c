@@ -329,7 +329,7 @@ static void job_finish(fit_job *j)
         int c = 0, q;
         double m = frexp(h, &q), mk = 1.0;
         for (int k = 0; k <= deg; k++, mk *= m)
-            for (int i = 0; i <= k; i++, c++) f->coef[c] = ldexp(f->sol[c] / mk, -q * k);
+            for (int i = 0; i <= k; i++, c++) f->coef[c] = jf__ldexp(f->sol[c] / mk, -q * k);
     }
     const size_t cols = jf_jet_size(deg);
     /* weighted residual norm for free: after the QR, the components

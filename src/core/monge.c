@@ -187,13 +187,13 @@ void jf__quantities(const double *a_in, int deg, int monge_degree, const double 
     for (int k = 0; k < nc; k++) {
         int order = 0;
         while ((order + 1) * (order + 2) / 2 <= k) order++;
-        a[k] = ldexp(a_in[k], -e * (order - 1));
+        a[k] = jf__ldexp(a_in[k], -e * (order - 1));
     }
-    quantities(a, deg, monge_degree, r, ldexp(h, e), out); /* h in units of L */
-    out->k1 = ldexp(out->k1, e);
-    out->k2 = ldexp(out->k2, e);
-    for (int i = 0; i < 4; i++) out->b[i] = ldexp(out->b[i], 2 * e);
-    for (int i = 0; i < 5; i++) out->c[i] = ldexp(out->c[i], 3 * e);
+    quantities(a, deg, monge_degree, r, jf__ldexp(h, e), out); /* h in units of L */
+    out->k1 = jf__ldexp(out->k1, e);
+    out->k2 = jf__ldexp(out->k2, e);
+    for (int i = 0; i < 4; i++) out->b[i] = jf__ldexp(out->b[i], 2 * e);
+    for (int i = 0; i < 5; i++) out->c[i] = jf__ldexp(out->c[i], 3 * e);
     if ((deg >= 2 && !(isfinite(out->k1) && isfinite(out->k2))) ||
         !isfinite(out->normal[0]) || !isfinite(out->normal[1]) || !isfinite(out->normal[2])) {
         /* overflow: never a row that looks fitted */

@@ -34,6 +34,8 @@
 #include <stdint.h>
 #include "index_internal.h"
 #include "jetfit.h"
+#include "orient_internal.h"
+#include "parts.h"
 #include "planes_internal.h"
 
 #define CHUNK 256      /* points per scheduling unit (and progress tick) */
@@ -220,7 +222,7 @@ static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params 
         st = jf__planes_knn_jet(x->ix ? x->ix : own, c->xyz, n, x->want, prm, nt, x->nrm_own,
                                 proj, x->nflags);
     jf_index_free(own); /* before the triangulation: a lower peak */
-    if (st == JF_OK && (st = jf_natural_create(proj, n, &x->nt)) != JF_OK)
+    if (st == JF_OK && (st = jf_natural_create_threads(proj, n, nt, &x->nt)) != JF_OK)
         set_err(err, "natural neighbours: building the Delaunay triangulation failed");
     free(proj);
     if (st != JF_OK) return st;
@@ -263,7 +265,7 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         x->nrm = x->nrm_own;
     }
     if (src == JF_NORMAL_JET) return jet_setup(x, c, nt, prm, err);
-    jf_status st = jf_natural_create(c->xyz, n, &x->nt);
+    jf_status st = jf_natural_create_threads(c->xyz, n, nt, &x->nt);
     if (st != JF_OK) {
         set_err(err, "natural neighbours: building the Delaunay triangulation failed");
         return st;
@@ -330,6 +332,8 @@ typedef struct {
     jf_natural_ws *nws;
     uint32_t *idx;
     double *d2, *coords, *coords2;
+    jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
+    uint32_t *bidx;       /* and their input indices                    */
 } worker;
 
 static void worker_free(worker *w)
@@ -341,10 +345,12 @@ static void worker_free(worker *w)
     free(w->d2);
     free(w->coords);
     free(w->coords2);
+    free(w->blk);
+    free(w->bidx);
     memset(w, 0, sizeof *w);
 }
 
-static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x)
+static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int blocks)
 {
     memset(w, 0, sizeof *w);
     jf_status st = jf_fitter_create(p, &w->fit);
@@ -356,6 +362,11 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x)
         w->coords = malloc(3 * x->cap * sizeof *w->coords);
         w->coords2 = malloc(3 * x->cap * sizeof *w->coords2);
         if (!w->idx || !w->d2 || !w->coords || !w->coords2) st = JF_ERR_NOMEM;
+    }
+    if (st == JF_OK && blocks) {
+        w->blk = malloc(CHUNK * sizeof *w->blk);
+        w->bidx = malloc(CHUNK * sizeof *w->bidx);
+        if (!w->blk || !w->bidx) st = JF_ERR_NOMEM;
     }
     if (st != JF_OK) worker_free(w);
     return st;
@@ -440,7 +451,7 @@ static jf_status fit_one(worker *w, const nbctx *x, size_t i, const double *p, j
  * (x->plain) run side by side in one jf__fit_point_x2, the same bits as
  * one by one. */
 static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0, size_t i1,
-                         const double *p1, jf_result *out)
+                         const double *p1, jf_result *out0, jf_result *out1)
 {
     jf_result r0, r1;
     size_t n0 = 0, n1 = 0;
@@ -458,8 +469,8 @@ static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0,
     if (st != JF_OK) return st;
     if (fit0) r0.status |= fl0;
     if (fit1) r1.status |= fl1;
-    store_row(&out[i0], &r0);
-    store_row(&out[i1], &r1);
+    store_row(out0, &r0);
+    store_row(out1, &r1);
     return JF_OK;
 }
 
@@ -467,13 +478,178 @@ static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0,
 
 static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 
-jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
-                      jf_error *err)
+/* Where results go: out[i] (jf_estimate), or blocks to a sink
+ * (jf_estimate_blocks).  mst in block mode runs two passes: the first
+ * keeps only the normals and statuses (vn, vs) and the graph, Prim
+ * decides a flip per point (vf), the second fits again (the same bits:
+ * each result depends only on its neighbourhood) and flips per block. */
+typedef struct {
+    const jf_cloud *c;
+    const jf_estimate_opts *o;
+    nbctx *x;
+    const uint8_t *fit;   /* fit only where fit[i] (NULL: all; parts.h) */
+    jf_result *out;
+    jf_block_fn sink;
+    void *user;
+    int collect;          /* mst pass 1: fill vn, vs (and x->graph)    */
+    double *vn;
+    unsigned *vs;
+    unsigned char *vf;    /* mst pass 2: flip flags (NULL otherwise)   */
+    size_t done0, total;  /* progress: points done before this pass    */
+} runctx;
+
+/* A block of m results (input indices idx) leaves: kept for mst, or
+ * oriented point by point and handed to the sink.  Thread-safe as far as
+ * the sink is. */
+static jf_status deliver(const runctx *R, const uint32_t *idx, jf_result *res, size_t m)
+{
+    const jf_estimate_opts *o = R->o;
+    const jf_cloud *c = R->c;
+    if (R->collect) {
+        for (size_t j = 0; j < m; j++) {
+            memcpy(R->vn + 3 * (size_t)idx[j], res[j].normal, sizeof(double[3]));
+            R->vs[idx[j]] = res[j].status;
+        }
+        return JF_OK;
+    }
+    for (size_t j = 0; j < m; j++) {
+        const size_t i = idx[j];
+        const double *p = c->xyz + 3 * i, *s;
+        double dir[3];
+        switch (o->orient) {
+        case JF_ORIENT_INPUT: jf__orient_point(&res[j], c->nrm + 3 * i); break;
+        case JF_ORIENT_VIEWPOINT:
+        case JF_ORIENT_SCANNER:
+            s = o->orient == JF_ORIENT_VIEWPOINT ? o->viewpoint : c->scanner + 3 * (size_t)c->scan[i];
+            for (int k = 0; k < 3; k++) dir[k] = s[k] - p[k];
+            jf__orient_point(&res[j], dir);
+            break;
+        case JF_ORIENT_MST:
+            if (R->vf[i]) jf_result_flip(&res[j]);
+            res[j].status |= R->vs[i];
+            break;
+        default: break;
+        }
+    }
+    return R->sink(R->user, idx, res, m);
+}
+
+/* Step 2 over walk[0..nwalk-1] (coordinates from walk_xyz, the tree's
+ * copy, when not NULL): chunks of CHUNK points shared out dynamically. */
+static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *walk_xyz,
+                          size_t nwalk, int nt)
+{
+    const jf_estimate_opts *o = R->o;
+    const nbctx *x = R->x;
+    const int blocks = R->out == NULL;
+    size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = R->done0;
+    jf_status failed = JF_OK;
+#pragma omp parallel num_threads(nt)
+    {
+        worker w;
+        jf_status wst = worker_init(&w, &o->params, x, blocks);
+        if (wst != JF_OK) {
+#pragma omp atomic write
+            failed = wst;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (size_t ch = 0; ch < nchunks; ch++) {
+            jf_status seen;
+#pragma omp atomic read
+            seen = failed;
+            if (seen != JF_OK || wst != JF_OK) continue;
+            size_t beg = ch * CHUNK, end = beg + CHUNK < nwalk ? beg + CHUNK : nwalk;
+            const uint8_t *fit = R->fit;
+            size_t m = 0; /* block modes: results in w.blk */
+            for (size_t k = beg; k < end && wst == JF_OK;) {
+                const size_t i = walk[k];
+                const double *pt = walk_xyz ? walk_xyz + 3 * k : R->c->xyz + 3 * i;
+                if (fit && !fit[i]) { /* a halo point: a neighbour only */
+                    if (!blocks) nan_result(&R->out[i], JF_PT_NONFINITE);
+                    k++;
+                    continue;
+                }
+                if (blocks) w.bidx[m] = (uint32_t)i;
+                jf_result *d0 = blocks ? &w.blk[m++] : &R->out[i];
+                if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
+                    const size_t i1 = walk[k + 1];
+                    const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : R->c->xyz + 3 * i1;
+                    if (blocks) w.bidx[m] = (uint32_t)i1;
+                    wst = fit_two(&w, x, i, pt, i1, pt1, d0,
+                                  blocks ? &w.blk[m++] : &R->out[i1]);
+                    k += 2;
+                } else {
+                    wst = fit_one(&w, x, i, pt, d0);
+                    k++;
+                }
+            }
+            _mm_sfence(); /* the streamed rows (store_row), before anyone reads them */
+            if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.blk, m);
+            if (wst != JF_OK) {
+#pragma omp atomic write
+                failed = wst;
+            }
+            size_t now;
+#pragma omp atomic capture
+            now = done += end - beg;
+            /* the progress and cancel hooks run on the calling thread only;
+             * a stop is seen by every thread before its next block */
+            if (omp_get_thread_num() == 0) {
+                if (o->progress) o->progress(o->progress_user, now, R->total);
+                if (cancelled(o)) {
+#pragma omp atomic write
+                    failed = JF_ERR_CANCELLED;
+                }
+            }
+        }
+        worker_free(&w);
+    }
+    return failed;
+}
+
+/* The rows of the non-finite points (not in the k-d tree, so not in its
+ * walk), on the calling thread: to out, or in blocks to deliver. */
+static jf_status nonfinite_rows(const runctx *R, size_t n)
+{
+    jf_result blk[64];
+    uint32_t idx[64];
+    size_t m = 0;
+    jf_status st = JF_OK;
+    for (size_t i = 0; i < n && st == JF_OK; i++) {
+        if (finite3(R->c->xyz + 3 * i)) continue;
+        if (R->out) {
+            nonfinite_row(R->x, i, &R->out[i]);
+            continue;
+        }
+        nonfinite_row(R->x, i, &blk[m]);
+        idx[m++] = (uint32_t)i;
+        if (m == 64 || i + 1 == n) {
+            st = deliver(R, idx, blk, m);
+            m = 0;
+        }
+    }
+    if (st == JF_OK && m) st = deliver(R, idx, blk, m);
+    return st;
+}
+
+static jf_status pass_status(jf_status failed, jf_error *err)
+{
+    if (failed == JF_ERR_CANCELLED) return cancel_status(err);
+    if (failed != JF_OK)
+        set_err(err, failed == JF_ERR_NOMEM ? "out of memory (per-thread workspace)"
+                                            : "a neighbourhood query or fit failed");
+    return failed;
+}
+
+/* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
+ * parts.h's mask (NULL: every point). */
+static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                          jf_result *out, jf_block_fn sink, void *user, jf_error *err)
 {
     const char *bad = NULL;
     if (err) err->msg[0] = '\0';
-    if (!c || !o || (c->n && (!c->xyz || !out))) {
-        set_err(err, "jf_estimate: NULL argument");
+    if (!c || !o || (c->n && (!c->xyz || (!out && !sink)))) {
+        set_err(err, out || !sink ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
         return JF_ERR_INVALID;
     }
     if (jf_params_validate(&o->params, &bad) != JF_OK) {
@@ -500,6 +676,12 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         return JF_ERR_INVALID;
     }
     if (n == 0) return JF_OK;
+    if (!out && o->orient == JF_ORIENT_SCANNER)
+        for (size_t i = 0; i < n; i++) /* blocks go out oriented: check first */
+            if (c->scan[i] >= c->nscans) {
+                set_err(err, "orientation failed");
+                return JF_ERR_INVALID;
+            }
 
     int nt = o->threads > 0 ? o->threads : omp_get_max_threads();
     const jf_params *p = &o->params;
@@ -531,6 +713,8 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         return JF_ERR_INVALID;
     }
 
+    const int mst_blocks = !out && o->orient == JF_ORIENT_MST;
+    runctx R = {c, o, &x, fit, out, sink, user, mst_blocks, NULL, NULL, NULL, 0, mst_blocks ? 2 * n : n};
     jf_status st = JF_OK;
     jf_index *ix = NULL;
     uint32_t *order = NULL;
@@ -561,7 +745,11 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         }
         x.gk = o->orient_k;
         x.graph = malloc(n * x.gk * sizeof *x.graph);
-        if (!x.graph) {
+        if (mst_blocks) {
+            R.vn = malloc(3 * n * sizeof *R.vn);
+            R.vs = malloc(n * sizeof *R.vs);
+        }
+        if (!x.graph || (mst_blocks && (!R.vn || !R.vs))) {
             st = JF_ERR_NOMEM;
             set_err(err, "out of memory (orientation graph)");
             goto out;
@@ -570,14 +758,12 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
     /* the walk (step 2): where the neighbourhoods come from the k-d tree,
      * its leaf order over its own copy of the points, so a point and its
      * neighbours are read from a few adjacent leaves (the non-finite points,
-     * not in the tree, get their row here); else the Morton order */
+     * not in the tree, get their row first); else the Morton order */
     const uint32_t *walk;
     const double *walk_xyz = NULL;
     size_t nwalk = n;
     if (nb.kind <= JF_NB_KNN_RADIUS) {
         nwalk = jf__index_points(ix, &walk_xyz, &walk);
-        for (size_t i = 0; nwalk < n && i < n; i++)
-            if (!finite3(c->xyz + 3 * i)) nonfinite_row(&x, i, &out[i]);
     } else {
         order = malloc(n * sizeof *order);
         if (!order) {
@@ -592,77 +778,46 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *o
         walk = order;
     }
 
-    /* step 2 */
-    if (cancelled(o)) {
-        st = cancel_status(err);
-        goto out;
-    }
-    size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = n - nwalk;
-    jf_status failed = JF_OK;
-#pragma omp parallel num_threads(nt)
-    {
-        worker w;
-        jf_status wst = worker_init(&w, p, &x);
-        if (wst != JF_OK) {
-#pragma omp atomic write
-            failed = wst;
+    /* step 2 (twice for mst in block mode: see runctx) */
+    for (int pass = 0; pass < 1 + mst_blocks; pass++) {
+        if (cancelled(o)) {
+            st = cancel_status(err);
+            goto out;
         }
-#pragma omp for schedule(dynamic, 1)
-        for (size_t ch = 0; ch < nchunks; ch++) {
-            jf_status seen;
-#pragma omp atomic read
-            seen = failed;
-            if (seen != JF_OK || wst != JF_OK) continue;
-            size_t beg = ch * CHUNK, end = beg + CHUNK < nwalk ? beg + CHUNK : nwalk;
-            for (size_t k = beg; k < end && wst == JF_OK;) {
-                const size_t i = walk[k];
-                const double *pt = walk_xyz ? walk_xyz + 3 * k : c->xyz + 3 * i;
-                if (x.plain && k + 1 < end) {
-                    const size_t i1 = walk[k + 1];
-                    const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : c->xyz + 3 * i1;
-                    wst = fit_two(&w, &x, i, pt, i1, pt1, out);
-                    k += 2;
-                } else {
-                    wst = fit_one(&w, &x, i, pt, &out[i]);
-                    k++;
-                }
-            }
-            _mm_sfence(); /* the streamed rows (store_row) */
-            _mm_sfence(); /* the streamed rows, before anyone reads them */
-            if (wst != JF_OK) {
-#pragma omp atomic write
-                failed = wst;
-            }
-            size_t now;
-#pragma omp atomic capture
-            now = done += end - beg;
-            /* the progress and cancel hooks run on the calling thread only;
-             * a stop is seen by every thread before its next block */
-            if (omp_get_thread_num() == 0) {
-                if (o->progress) o->progress(o->progress_user, now, n);
-                if (cancelled(o)) {
-#pragma omp atomic write
-                    failed = JF_ERR_CANCELLED;
-                }
-            }
+        R.done0 = (size_t)pass * n + (n - nwalk);
+        if (nwalk < n && (st = nonfinite_rows(&R, n)) != JF_OK) {
+            set_err(err, "writing a block of results failed");
+            goto out;
         }
-        worker_free(&w);
-    }
-    if (failed == JF_ERR_CANCELLED) {
-        st = cancel_status(err);
-        goto out;
-    }
-    if (failed != JF_OK) {
-        st = failed;
-        set_err(err, failed == JF_ERR_NOMEM ? "out of memory (per-thread workspace)"
-                                            : "a neighbourhood query or fit failed");
-        goto out;
+        if ((st = pass_status(fit_pass(&R, walk, walk_xyz, nwalk, nt), err)) != JF_OK) goto out;
+        if (pass == 0 && mst_blocks) {
+            /* Prim on the normals alone; the second pass flips the rows */
+            R.vf = calloc(n, 1);
+            if (!R.vf) {
+                st = JF_ERR_NOMEM;
+                set_err(err, "out of memory (orientation)");
+                goto out;
+            }
+            st = jf__orient_mst_view(R.vn, R.vs, R.vf, c->xyz, n, x.graph, x.gk);
+            if (st != JF_OK) {
+                set_err(err, "orientation failed");
+                goto out;
+            }
+            free(R.vn);
+            free(x.graph);
+            R.vn = NULL;
+            x.graph = NULL;
+            x.gk = 0;
+            R.collect = 0;
+            for (size_t i = 0; i < n; i++) R.vs[i] &= JF_PT_ORIENT_UNKNOWN;
+        }
     }
     free(order);
     order = NULL;
     jf_index_free(ix); /* the orientation does not need it: lower peak */
     ix = NULL;
-    if (o->progress) o->progress(o->progress_user, n, n);
+    if (o->progress) o->progress(o->progress_user, R.total, R.total);
+    if (!out) goto out; /* blocks left oriented */
     if (o->orient != JF_ORIENT_NONE && cancelled(o)) {
         st = cancel_status(err);
         goto out;
@@ -688,5 +843,34 @@ out:
     free(x.nrm_own);
     free(x.nflags);
     free(x.graph);
+    free(R.vn);
+    free(R.vs);
+    free(R.vf);
     return st;
+}
+
+jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
+                      jf_error *err)
+{
+    return estimate(c, o, NULL, out, NULL, NULL, err);
+}
+
+/* parts.h: the points of a part's halo are neighbours, not fitted */
+jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
+                              jf_result *out, jf_error *err)
+{
+    return estimate(c, o, fit, out, NULL, NULL, err);
+}
+
+jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o, jf_block_fn sink,
+                             void *user, jf_error *err)
+{
+    return estimate(c, o, NULL, NULL, sink, user, err);
+}
+
+jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
+                                     const uint8_t *fit, jf_block_fn sink, void *user,
+                                     jf_error *err)
+{
+    return estimate(c, o, fit, NULL, sink, user, err);
 }

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "jetfit.h"
 
@@ -367,6 +368,33 @@ truncated:
     return JF_ERR_FORMAT;
 }
 
+/* ---- LAS: x y z and every dimension and Extra Byte (jetfit's columns
+ * among them), through the library's reader ---- */
+
+static jf_status read_las(const char *path, jf_eval_table *t, jf_error *err)
+{
+    jf_cloud c;
+    jf_status st = jf_cloud_read(path, NULL, &c, err);
+    if (st != JF_OK) return st;
+    size_t nc = 3 + c.attrs.nattrs;
+    if ((st = set_names(t, nc)) != JF_OK || !(t->v = malloc(c.n * nc * sizeof *t->v))) {
+        jf_cloud_free(&c);
+        snprintf(err->msg, sizeof err->msg, "%s: out of memory for %zu points", path, c.n);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t j = 0; j < 3; j++) snprintf(t->names[j], sizeof t->names[j], "%c", "xyz"[j]);
+    for (size_t j = 0; j < c.attrs.nattrs; j++)
+        snprintf(t->names[3 + j], sizeof t->names[j], "%.31s", c.attrs.attr[j].name);
+    for (size_t i = 0; i < c.n; i++) {
+        double *row = t->v + i * nc;
+        memcpy(row, c.xyz + 3 * i, 3 * sizeof *row);
+        for (size_t j = 0; j < c.attrs.nattrs; j++) row[3 + j] = jf_attr_get(&c.attrs, j, i);
+    }
+    t->nrows = c.n;
+    jf_cloud_free(&c);
+    return JF_OK;
+}
+
 jf_status jf_eval_table_read(const char *path, jf_eval_table *t, jf_error *err)
 {
     jf_error dummy;
@@ -380,6 +408,12 @@ jf_status jf_eval_table_read(const char *path, jf_eval_table *t, jf_error *err)
         return JF_ERR_IO;
     }
     const char *ext = ext_of(path);
+    if (!strcasecmp(ext, "las")) {
+        fclose(fp);
+        jf_status st = read_las(path, t, err);
+        if (st != JF_OK) jf_eval_table_free(t);
+        return st;
+    }
     jf_status st = !strcmp(ext, "ply") ? read_ply(fp, path, t, err)
                                        : read_text(fp, path, ext, t, err);
     fclose(fp);

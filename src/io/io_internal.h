@@ -37,30 +37,128 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
 /* The per-format readers called by jf_cloud_read_mem (c zeroed on entry;
  * on failure they may leave arrays in c: the caller frees them). */
 jf_status jf_read_ply(const char *buf, size_t len, const char *name,
-                      jf_cloud *c, jf_error *err);
+                      const jf_read_opts *o, jf_cloud *c, jf_error *err);
 jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                       const char *name, const jf_read_opts *o, jf_cloud *c,
                       jf_error *err);
 jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
-jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c,
-                      jf_error *err);
+jf_status jf_read_las(const char *buf, size_t len, const char *name,
+                      const jf_read_opts *o, jf_cloud *c, jf_error *err);
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
                       jf_error *err);
 
-/* LAS output (io_las_write.c), used by the table writer: the header and
- * Extra Bytes VLR size, the record size, the frame (scale, offset and
- * stored bounds) of a cloud, one record, and the header written at
+/* io_ply.c: a binary PLY whose elements all have fixed-size rows and
+ * whose length matches its header, read from fd (len bytes) a chunk at a
+ * time straight into c (no file image in memory; attributes too unless
+ * o->no_attrs; o may be NULL).  JF_ERR_UNSUPPORTED
+ * (c untouched, err not set) when the file does not qualify: read it
+ * whole.  Otherwise JF_OK, or JF_ERR_IO / _NOMEM with err set. */
+jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *o,
+                               jf_cloud *c, jf_error *err);
+
+/* io_ply.c: where the vertex rows of a binary PLY are (fixed-size rows,
+ * the file's length as its header says), for readers of a byte range of
+ * them (jetfit-mpi: each rank its own rows). */
+typedef struct {
+    uint64_t count;        /* vertices                                   */
+    uint64_t vertex_off;   /* file offset of vertex row 0                */
+    size_t row;            /* bytes per vertex row                       */
+    int has_normals;       /* nx ny nz are properties                    */
+    int swap;              /* byte order differs from the machine's      */
+    int type[6];           /* x y z nx ny nz: PLY scalar type            */
+    size_t off[6];         /* their offset in the row                    */
+} jf_ply_layout;
+
+/* The layout from the file's first len bytes (the whole header), the
+ * file being size bytes.  JF_ERR_FORMAT with err "NAME:LINE: reason" when
+ * it is not a binary PLY whose vertices have fixed-size rows that the
+ * file holds, or has no x y z. */
+jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_ply_layout *l, jf_error *err);
+/* Decodes k rows at raw into xyz (3k) and, if nrm and l->has_normals,
+ * nrm (3k), exactly as jf_read_ply would. */
+void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
+                  double *nrm);
+
+/* io_write.c, for rows written by other processes (jetfit-mpi): a binary
+ * little-endian PLY table without attributes or faces gets its header
+ * written and flushed; *header its size, *tmp the temporary's path (the
+ * rows go at header + row * row size).  placed: all nrows rows are in the
+ * file (commit then only renames).  row_le: one row in the file's bytes. */
+jf_status jf__writer_begin(jf_writer *w, uint64_t *header, const char **tmp);
+jf_status jf__writer_placed(jf_writer *w, size_t nrows);
+void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, char *o);
+
+/* io_spool.c: rows put in any order from any thread, drained in row
+ * order (the table writer's positioned rows).  open: a temporary beside
+ * `final` for nrows rows of ncols doubles, buckets of bucket_bytes of
+ * values (0: 32 MiB; small values are for tests).  put: thread-safe; JF_ERR_IO /
+ * _INVALID (a row >= nrows, or more rows than a bucket holds) stick.
+ * drain (once, one thread): every row must have been put exactly once;
+ * emit gets the rows in order, a bucket (up to 32 MiB of values) at a
+ * time; err "NAME: reason".  free: removes the temporary (NULL ok). */
+typedef struct jf_spool jf_spool;
+jf_status jf__spool_open(const char *final, size_t nrows, size_t ncols, size_t bucket_bytes,
+                         jf_spool **s, jf_error *err);
+jf_status jf__spool_put(jf_spool *s, const uint32_t *rows, const double *vals, size_t m);
+jf_status jf__spool_drain(jf_spool *s, jf_status (*emit)(void *, const double *, size_t),
+                          void *user, const char *name, jf_error *err);
+void jf__spool_free(jf_spool *s);
+
+/* LAS output (io_las_write.c), used by the table writer: what the output
+ * holds (the table's columns, x y z first; the attributes, NULL if none,
+ * and their output names; the frame of a format-0 output), the header and
+ * VLRs' size, the record size, the frame of a cloud, one record (the
+ * attributes of input row `row`), and the header and VLRs written at
  * offset 0 of fd at commit (0, or -1 on a write error). */
-size_t jf__las_prefix_size(size_t ncols);
-size_t jf__las_record_size(const jf_col_type *types, size_t ncols);
+typedef struct {
+    char *const *names;
+    const jf_col_type *types;
+    size_t ncols, nrows;
+    const jf_attrs *a;
+    char (*anames)[64];
+    double scale[3], offset[3], lo[3], hi[3];
+} jf_las_out;
+size_t jf__las_prefix_size(const jf_las_out *L);
+size_t jf__las_record_size(const jf_las_out *L);
 void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3],
                    double lo[3], double hi[3]);
-size_t jf__las_format_row(const double *vals, const jf_col_type *types, size_t ncols,
-                          const double scale[3], const double offset[3], char *o);
-int jf__las_write_prefix(int fd, char *const *names, const jf_col_type *types, size_t ncols,
-                         size_t nrows, const double scale[3], const double offset[3],
-                         const double lo[3], const double hi[3]);
+size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, char *o);
+int jf__las_write_prefix(int fd, const jf_las_out *L);
+/* The dimension names of point format 0 (as the LAS reader names them). */
+#define JF__LAS_FMT0_NDIMS 12
+extern const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS];
+/* 1 if the record (<= 65535 bytes) and the Extra Bytes VLR (<= 341
+ * descriptions) fit the format. */
+int jf__las_fits(const jf_las_out *L);
+
+/* ---- the attribute table (io_attrs.c) ---- */
+
+/* Bytes of a value of each jf_attr_type. */
+extern const unsigned jf_attr_size[10];
+/* dst = the name [s, s+len) cut to 63 bytes, blanks ',' '#' made '_'. */
+void jf__attr_name(char dst[64], const char *s, size_t len);
+/* Appends a description (the record layout is the caller's); 0 on
+ * allocation failure. */
+int jf__attrs_add(jf_attrs *a, const char *name, size_t len, jf_attr_type t,
+                  uint32_t offset, unsigned shift, unsigned bits);
+/* The output names: each attribute's, with `in_` put before it while it
+ * clashes with one of cols[0..ncols-1] or an earlier attribute.  -1 if a
+ * name cannot be made unique in 63 bytes. */
+int jf__attrs_names(const jf_attrs *a, char *const *cols, size_t ncols, char (*out)[64]);
+/* The type a value is written as (a bit field: U8), its PLY type name
+ * (64-bit integers: double). */
+jf_attr_type jf__attr_out_type(const jf_attr *at);
+const char *jf__attr_ply_type(const jf_attr *at);
+/* Formats the attributes of point `row` at o and returns the end: binary
+ * PLY little or big endian (64-bit integers as doubles), LAS Extra Bytes
+ * (little endian, every type as it is), or text (each value preceded by
+ * sep; integers exact, floats and doubles %.17g: exact).  At most 32 bytes a value. */
+enum { JF__ATTR_PLY_LE, JF__ATTR_PLY_BE, JF__ATTR_LAS, JF__ATTR_TEXT };
+char *jf__attrs_put(const jf_attrs *a, size_t row, int mode, char sep, char *o);
+/* Bytes of a row of attributes in a binary mode. */
+size_t jf__attrs_bin_size(const jf_attrs *a, int mode);
 
 /* Fills err (may be NULL) with "NAME:LINE: reason" (line > 0) or
  * "NAME: reason" (line == 0); returns st. */
@@ -74,9 +172,15 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
 /* Parses the whole token [s, e) as a double (decimal, exponent, "nan",
  * "inf", hex floats): 1 on success, 0 if the token is not one number.
  * Exact: <= 19 digits with mantissa <= 2^53 and |exp| <= 22 is Clinger's
- * one-rounding case; <= 19 digits with |exp| <= 27 use exact 128-bit
- * integers; everything else goes to strtod. */
+ * one-rounding case; other <= 19 digit numbers with |exp| <= 64 are
+ * Eisel-Lemire's (jf__lemire), and where it cannot tell, |exp| <= 27 use
+ * exact 128-bit integers; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
+
+/* m 10^q (m != 0) correctly rounded, by Eisel-Lemire (io_lemire.c): 1 and
+ * *out, or 0 when it cannot tell (subnormal or overflowing results, |q| >
+ * 64, the rare ambiguous products): the caller's exact path decides. */
+int jf__lemire(uint64_t m, int q, double *out);
 
 /* 5^k for 0 <= k <= 27 (5^27 < 2^63): the exact decimal paths of
  * jf_parse_double and jf_fmt_g17. */

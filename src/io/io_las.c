@@ -7,8 +7,12 @@
  * records' int32 X Y Z into coordinates (x = X * scale + offset).  Every
  * record format starts with X Y Z; what follows (intensity, returns,
  * classification, GPS time, colour, waveform, Extra Bytes) is not needed
- * for the fit and is skipped by the record length.  VLRs and EVLRs are not
- * read.  Compressed LAZ (the compression bit of the format byte, as laszip
+ * for the fit: unless attributes are refused (jf_read_opts.no_attrs) the
+ * records are kept whole as the cloud's attribute table, described
+ * dimension by dimension (laspy's names, bit fields included), the Extra
+ * Bytes by the "LASF_Spec" record 4 VLR's descriptions (so a file jetfit
+ * wrote reads back with its columns); the header, VLRs and EVLRs are kept
+ * verbatim for a LAS output.  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
  * sets it) is refused with how to convert it.  Every header field that
  * points into the file is checked against its size before use, so a lying
  * header is a one-line error, never a read past the end.
@@ -38,8 +42,135 @@ static double f64(const unsigned char *p)
     return d;
 }
 
-jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c,
-                      jf_error *err)
+/* The dimensions of each point data record format (LAS 1.4 R15 tables
+ * 7-17), after X Y Z: name, type, offset, bit shift and width. */
+typedef struct {
+    const char *name;
+    jf_attr_type t;
+    unsigned off, shift, bits;
+} dim;
+
+static const dim legacy_dims[] = { /* formats 0-5 */
+    {"intensity", JF_ATTR_U16, 12, 0, 0},
+    {"return_number", JF_ATTR_U8, 14, 0, 3},
+    {"number_of_returns", JF_ATTR_U8, 14, 3, 3},
+    {"scan_direction_flag", JF_ATTR_U8, 14, 6, 1},
+    {"edge_of_flight_line", JF_ATTR_U8, 14, 7, 1},
+    {"classification", JF_ATTR_U8, 15, 0, 5},
+    {"synthetic", JF_ATTR_U8, 15, 5, 1},
+    {"key_point", JF_ATTR_U8, 15, 6, 1},
+    {"withheld", JF_ATTR_U8, 15, 7, 1},
+    {"scan_angle_rank", JF_ATTR_I8, 16, 0, 0},
+    {"user_data", JF_ATTR_U8, 17, 0, 0},
+    {"point_source_id", JF_ATTR_U16, 18, 0, 0},
+};
+static const dim extended_dims[] = { /* formats 6-10 */
+    {"intensity", JF_ATTR_U16, 12, 0, 0},
+    {"return_number", JF_ATTR_U8, 14, 0, 4},
+    {"number_of_returns", JF_ATTR_U8, 14, 4, 4},
+    {"synthetic", JF_ATTR_U8, 15, 0, 1},
+    {"key_point", JF_ATTR_U8, 15, 1, 1},
+    {"withheld", JF_ATTR_U8, 15, 2, 1},
+    {"overlap", JF_ATTR_U8, 15, 3, 1},
+    {"scanner_channel", JF_ATTR_U8, 15, 4, 2},
+    {"scan_direction_flag", JF_ATTR_U8, 15, 6, 1},
+    {"edge_of_flight_line", JF_ATTR_U8, 15, 7, 1},
+    {"classification", JF_ATTR_U8, 16, 0, 0},
+    {"user_data", JF_ATTR_U8, 17, 0, 0},
+    {"scan_angle", JF_ATTR_I16, 18, 0, 0},
+    {"point_source_id", JF_ATTR_U16, 20, 0, 0},
+    {"gps_time", JF_ATTR_F64, 22, 0, 0},
+};
+static const char *const wave_names[7] = {"wavepacket_index", "wavepacket_offset",
+                                          "wavepacket_size", "return_point_wave_location",
+                                          "x_t", "y_t", "z_t"};
+static const jf_attr_type wave_types[7] = {JF_ATTR_U8, JF_ATTR_U64, JF_ATTR_U32, JF_ATTR_F32,
+                                           JF_ATTR_F32, JF_ATTR_F32, JF_ATTR_F32};
+static const unsigned wave_rel[7] = {0, 1, 9, 13, 17, 21, 25};
+
+/* Describes the dimensions of format fmt; 0 on allocation failure. */
+static int add_dims(jf_attrs *a, unsigned fmt)
+{
+    const dim *d = fmt < 6 ? legacy_dims : extended_dims;
+    size_t nd = fmt < 6 ? sizeof legacy_dims / sizeof *d : sizeof extended_dims / sizeof *d;
+    for (size_t k = 0; k < nd; k++)
+        if (!jf__attrs_add(a, d[k].name, strlen(d[k].name), d[k].t, d[k].off, d[k].shift,
+                           d[k].bits))
+            return 0;
+    /* GPS time (1, 3, 4, 5), colour (2, 3, 5, 7, 8, 10), NIR (8, 10),
+     * wave packets (4, 5, 9, 10) */
+    static const int gps_at[11] = {0, 20, 0, 20, 20, 20, 0, 0, 0, 0, 0};
+    static const int rgb_at[11] = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
+    static const int wave_at[11] = {0, 0, 0, 0, 28, 34, 0, 0, 0, 30, 38};
+    if (gps_at[fmt] && !jf__attrs_add(a, "gps_time", 8, JF_ATTR_F64, (uint32_t)gps_at[fmt], 0, 0))
+        return 0;
+    for (int k = 0; rgb_at[fmt] && k < 3; k++)
+        if (!jf__attrs_add(a, k == 0 ? "red" : k == 1 ? "green" : "blue", k == 1 ? 5 : k ? 4 : 3,
+                           JF_ATTR_U16, (uint32_t)(rgb_at[fmt] + 2 * k), 0, 0))
+            return 0;
+    if ((fmt == 8 || fmt == 10) && !jf__attrs_add(a, "nir", 3, JF_ATTR_U16, 36, 0, 0))
+        return 0;
+    for (int k = 0; wave_at[fmt] && k < 7; k++)
+        if (!jf__attrs_add(a, wave_names[k], strlen(wave_names[k]), wave_types[k],
+                           (uint32_t)wave_at[fmt] + wave_rel[k], 0, 0))
+            return 0;
+    return 1;
+}
+
+/* Bytes of an Extra Bytes value of data_type dt (LAS 1.4 R15 table 24):
+ * 1-10 scalars, 11-30 the deprecated 2- and 3-vectors, 0 `options`
+ * undocumented bytes; 0 for a reserved type. */
+static unsigned eb_size(unsigned dt, unsigned options)
+{
+    static const unsigned base[10] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+    if (dt == 0)
+        return options;
+    if (dt <= 10)
+        return base[dt - 1];
+    if (dt <= 30)
+        return base[(dt - 11) % 10] * (dt <= 20 ? 2 : 3);
+    return 0;
+}
+
+/* The Extra Bytes described by the VLRs in [hsize, data_off) (VLR
+ * "LASF_Spec", record 4): scalar ones become attributes at base_len on;
+ * a description that runs past the record ends the list (what follows is
+ * kept in the record, undescribed). */
+static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, size_t data_off,
+                           uint32_t nvlr, unsigned base, unsigned rec_len)
+{
+    static const jf_attr_type eb_type[10] = {JF_ATTR_U8,  JF_ATTR_I8,  JF_ATTR_U16, JF_ATTR_I16,
+                                             JF_ATTR_U32, JF_ATTR_I32, JF_ATTR_U64, JF_ATTR_I64,
+                                             JF_ATTR_F32, JF_ATTR_F64};
+    size_t p = hsize;
+    for (uint32_t v = 0; v < nvlr && p + 54 <= data_off; v++) {
+        size_t rl = u16(b + p + 20);
+        if (rl > data_off - p - 54)
+            break; /* a VLR past the point data: not trusted */
+        int eb = !memcmp(b + p + 2, "LASF_Spec\0", 10) && u16(b + p + 18) == 4;
+        if (eb) {
+            unsigned off = base;
+            for (size_t d = p + 54; d + 192 <= p + 54 + rl; d += 192) {
+                unsigned dt = b[d + 2], sz = eb_size(dt, b[d + 3]);
+                if (!sz || sz > rec_len - off)
+                    break;
+                if (dt >= 1 && dt <= 10) {
+                    const char *nm = (const char *)b + d + 4;
+                    size_t nl = strnlen(nm, 32);
+                    if (!jf__attrs_add(a, nm, nl, eb_type[dt - 1], off, 0, 0))
+                        return 0;
+                }
+                off += sz;
+            }
+            return 1; /* one Extra Bytes VLR */
+        }
+        p += 54 + rl;
+    }
+    return 1;
+}
+
+jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err)
 {
     const unsigned char *b = (const unsigned char *)buf;
     if (len < 4 || memcmp(b, "LASF", 4))
@@ -114,5 +245,33 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, jf_cloud *c
     for (size_t i = 0; i < c->n; i++, r += rec_len)
         for (int a = 0; a < 3; a++)
             c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
+    if (o->no_attrs)
+        return JF_OK;
+    /* the records whole, the header and VLRs, the EVLRs (1.4: the count
+     * and start in the header; 1.3: the waveform data record) */
+    jf_attrs *at = &c->attrs;
+    at->stride = rec_len;
+    at->rec = malloc(c->n * rec_len);
+    at->las_head = malloc(data_off);
+    if (!at->rec || !at->las_head)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
+    memcpy(at->rec, b + data_off, c->n * rec_len);
+    memcpy(at->las_head, b, data_off);
+    at->las_head_len = data_off;
+    size_t end = data_off + c->n * rec_len;
+    uint64_t evlr = 0;
+    if (minor >= 4 && u32(b + 243))
+        evlr = u64(b + 235);
+    else if (minor == 3 && (u16(b + 6) & 2) && hsize >= 235)
+        evlr = u64(b + 227); /* internal waveform data */
+    if (evlr >= end && evlr < len) {
+        at->las_evlr_len = len - (size_t)evlr;
+        if (!(at->las_evlr = malloc(at->las_evlr_len)))
+            return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the EVLRs");
+        memcpy(at->las_evlr, b + evlr, at->las_evlr_len);
+    }
+    if (!add_dims(at, fmt) ||
+        !add_extra_bytes(at, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
     return JF_OK;
 }

@@ -12,6 +12,16 @@
  * row; the header, which holds the point count and the bounds, is written
  * over the placeholder at offset 0 when the table is committed.  A non-finite
  * point is stored at the offset (status says nonfinite).
+ *
+ * Attributes (issue 13.2, 13.4): from a LAS input (jf_attrs.las_head) the
+ * output keeps the input's records byte for byte -- same point format,
+ * scale, offset, bounds, header fields (file source ID, global encoding,
+ * GUID, system identifier, creation date), VLRs (the CRS ones among them)
+ * and EVLRs -- and appends jetfit's columns as Extra Bytes after the
+ * input's own (whose descriptions are copied, renamed when they clash:
+ * `nx` -> `in_nx`; undescribed bytes get an "undocumented" description so
+ * the offsets stay right).  From any other input, format 0 as above with
+ * the attributes as Extra Bytes of their own type ahead of jetfit's.
  */
 #include <math.h>
 #include <stdint.h>
@@ -42,18 +52,6 @@ static void putd(unsigned char *p, double d)
     put64(p, b);
 }
 
-size_t jf__las_prefix_size(size_t ncols)
-{
-    return LAS_HEADER + VLR_HEADER + EB_DESC * (ncols - 3);
-}
-
-size_t jf__las_record_size(const jf_col_type *types, size_t ncols)
-{
-    size_t n = 20;
-    for (size_t j = 3; j < ncols; j++) n += types[j] == JF_COL_F64 ? 8 : 4;
-    return n;
-}
-
 void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3],
                    double lo[3], double hi[3])
 {
@@ -77,30 +75,153 @@ void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3
     }
 }
 
-size_t jf__las_format_row(const double *vals, const jf_col_type *types, size_t ncols,
-                          const double scale[3], const double offset[3], char *o)
+const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS] = {
+    "intensity", "return_number", "number_of_returns", "scan_direction_flag",
+    "edge_of_flight_line", "classification", "synthetic", "key_point", "withheld",
+    "scan_angle_rank", "user_data", "point_source_id"};
+
+/* Extra Bytes data_type of each jf_attr_type (LAS 1.4 R15 table 24). */
+static const unsigned char eb_code[10] = {2, 1, 4, 3, 6, 5, 8, 7, 9, 10};
+static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+
+static int keep(const jf_las_out *L) { return L->a && L->a->las_head; }
+
+static uint16_t g16(const unsigned char *p) { return (uint16_t)(p[0] | p[1] << 8); }
+static uint32_t g32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static uint64_t g64(const unsigned char *p) { return g32(p) | (uint64_t)g32(p + 4) << 32; }
+
+static size_t jetfit_eb_bytes(const jf_las_out *L)
+{
+    size_t n = 0;
+    for (size_t j = 3; j < L->ncols; j++) n += L->types[j] == JF_COL_F64 ? 8 : 4;
+    return n;
+}
+
+size_t jf__las_record_size(const jf_las_out *L)
+{
+    if (keep(L)) return L->a->stride + jetfit_eb_bytes(L);
+    return 20 + (L->a ? jf__attrs_bin_size(L->a, JF__ATTR_LAS) : 0) + jetfit_eb_bytes(L);
+}
+
+/* The input's point format and header size (keep mode). */
+static unsigned in_fmt(const jf_las_out *L) { return L->a->las_head[104] & 0x3f; }
+static size_t in_hsize(const jf_las_out *L) { return g16(L->a->las_head + 94); }
+
+/* Walks the input's VLRs: calls f on each (offset, total size) that lies
+ * inside the header block; returns the number visited. */
+typedef void (*vlr_fn)(void *u, const unsigned char *v, size_t len);
+static uint32_t walk_vlrs(const jf_las_out *L, vlr_fn f, void *u)
+{
+    const unsigned char *h = L->a->las_head;
+    size_t p = in_hsize(L), end = L->a->las_head_len;
+    uint32_t n = g32(h + 100), k = 0;
+    for (; k < n && p + 54 <= end; k++) {
+        size_t len = 54 + (size_t)g16(h + p + 20);
+        if (len > end - p) break;
+        f(u, h + p, len);
+        p += len;
+    }
+    return k;
+}
+
+static int is_eb(const unsigned char *v)
+{
+    return !memcmp(v + 2, "LASF_Spec\0", 10) && g16(v + 18) == 4;
+}
+
+/* The Extra Bytes VLR of the input (NULL if none) and its descriptions
+ * that fit the record (the reader's rule). */
+typedef struct { const unsigned char *eb; size_t len; } eb_find;
+static void find_eb(void *u, const unsigned char *v, size_t len)
+{
+    eb_find *e = u;
+    if (!e->eb && is_eb(v)) e->eb = v, e->len = len;
+}
+
+/* Descriptions kept from the input and the bytes they cover. */
+static size_t kept_descs(const jf_las_out *L, const unsigned char **first, size_t *covered)
+{
+    eb_find e = {NULL, 0};
+    walk_vlrs(L, find_eb, &e);
+    size_t room = L->a->stride - base_len[in_fmt(L)], off = 0, k = 0;
+    *first = e.eb ? e.eb + 54 : NULL;
+    for (; e.eb && 54 + 192 * (k + 1) <= e.len; k++) {
+        const unsigned char *d = e.eb + 54 + 192 * k;
+        static const unsigned base[10] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+        unsigned dt = d[2], sz = dt == 0 ? d[3] : dt <= 10 ? base[dt - 1]
+                               : dt <= 30 ? base[(dt - 11) % 10] * (dt <= 20 ? 2 : 3) : 0;
+        if (!sz || sz > room - off) break;
+        off += sz;
+    }
+    *covered = off;
+    return k;
+}
+
+/* Number of descriptions of the output's Extra Bytes VLR. */
+static size_t out_descs(const jf_las_out *L)
+{
+    size_t n = L->ncols - 3;
+    if (!keep(L)) return n + (L->a ? L->a->nattrs : 0);
+    const unsigned char *first;
+    size_t covered, k = kept_descs(L, &first, &covered);
+    size_t rest = L->a->stride - base_len[in_fmt(L)] - covered;
+    return n + k + (rest + 254) / 255; /* undocumented bytes, <= 255 a description */
+}
+
+typedef struct { size_t bytes; uint32_t n; } vlr_sum;
+static void sum_vlr(void *u, const unsigned char *v, size_t len)
+{
+    vlr_sum *s = u;
+    if (!is_eb(v)) s->bytes += len, s->n++;
+}
+
+int jf__las_fits(const jf_las_out *L)
+{
+    return jf__las_record_size(L) <= 65535 && out_descs(L) <= 65535 / EB_DESC &&
+           jf__las_prefix_size(L) <= UINT32_MAX;
+}
+
+size_t jf__las_prefix_size(const jf_las_out *L)
+{
+    vlr_sum s = {0, 0};
+    if (keep(L)) walk_vlrs(L, sum_vlr, &s);
+    return LAS_HEADER + s.bytes + VLR_HEADER + EB_DESC * out_descs(L);
+}
+
+size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, char *o)
 {
     unsigned char *b = (unsigned char *)o;
-    int finite = isfinite(vals[0]) && isfinite(vals[1]) && isfinite(vals[2]);
-    for (int a = 0; a < 3; a++) {
-        double q = finite ? (vals[a] - offset[a]) / scale[a] : 0.0;
-        long long v = llround(q);
-        if (v > INT32_MAX) v = INT32_MAX;
-        if (v < INT32_MIN) v = INT32_MIN;
-        put32(b + 4 * a, (uint32_t)(int32_t)v);
+    unsigned char *e;
+    if (keep(L)) {
+        memcpy(b, L->a->rec + row * L->a->stride, L->a->stride);
+        e = b + L->a->stride;
+    } else {
+        int finite = isfinite(vals[0]) && isfinite(vals[1]) && isfinite(vals[2]);
+        for (int a = 0; a < 3; a++) {
+            double q = finite ? (vals[a] - L->offset[a]) / L->scale[a] : 0.0;
+            long long v = llround(q);
+            if (v > INT32_MAX) v = INT32_MAX;
+            if (v < INT32_MIN) v = INT32_MIN;
+            put32(b + 4 * a, (uint32_t)(int32_t)v);
+        }
+        put16(b + 12, 0);      /* intensity */
+        b[14] = 1 | 1 << 3;    /* return 1 of 1 */
+        b[15] = 1;             /* classification: unclassified */
+        b[16] = 0;             /* scan angle rank */
+        b[17] = 0;             /* user data */
+        put16(b + 18, 0);      /* point source ID */
+        e = b + 20;
+        if (L->a && L->a->nattrs)
+            e = (unsigned char *)jf__attrs_put(L->a, row, JF__ATTR_LAS, 0, (char *)e);
     }
-    put16(b + 12, 0);      /* intensity */
-    b[14] = 1 | 1 << 3;    /* return 1 of 1 */
-    b[15] = 1;             /* classification: unclassified */
-    b[16] = 0;             /* scan angle rank */
-    b[17] = 0;             /* user data */
-    put16(b + 18, 0);      /* point source ID */
-    unsigned char *e = b + 20;
-    for (size_t j = 3; j < ncols; j++) {
-        if (types[j] == JF_COL_F64) {
+    for (size_t j = 3; j < L->ncols; j++) {
+        if (L->types[j] == JF_COL_F64) {
             putd(e, vals[j]);
             e += 8;
-        } else if (types[j] == JF_COL_F32) {
+        } else if (L->types[j] == JF_COL_F32) {
             float f = (float)vals[j];
             uint32_t u;
             memcpy(&u, &f, 4);
@@ -116,11 +237,63 @@ size_t jf__las_format_row(const double *vals, const jf_col_type *types, size_t n
     return (size_t)(e - b);
 }
 
-int jf__las_write_prefix(int fd, char *const *names, const jf_col_type *types, size_t ncols,
-                         size_t nrows, const double scale[3], const double offset[3],
-                         const double lo[3], const double hi[3])
+typedef struct { unsigned char *o; } vlr_copy;
+static void copy_vlr(void *u, const unsigned char *v, size_t len)
 {
-    size_t len = jf__las_prefix_size(ncols);
+    vlr_copy *c = u;
+    if (is_eb(v)) return;
+    memcpy(c->o, v, len);
+    c->o += len;
+}
+
+/* One description: type, name, and description text. */
+static void put_desc(unsigned char *d, unsigned code, const char *name, const char *what)
+{
+    d[2] = (unsigned char)code;
+    snprintf((char *)d + 4, 32, "%s", name);
+    snprintf((char *)d + 160, 32, "%s", what);
+}
+
+/* The header fields a keep-mode output copies or recomputes. */
+static void keep_header(const jf_las_out *L, unsigned char *b, size_t prefix)
+{
+    const unsigned char *h = L->a->las_head;
+    unsigned minor = h[25], fmt = in_fmt(L);
+    memcpy(b + 4, h + 4, 4);       /* file source ID, global encoding */
+    memcpy(b + 8, h + 8, 16);      /* project GUID */
+    memcpy(b + 26, h + 26, 32);    /* system identifier */
+    memcpy(b + 90, h + 90, 4);     /* creation day and year */
+    b[104] = (unsigned char)fmt;
+    memcpy(b + 131, h + 131, 96);  /* scale, offset, bounds */
+    uint64_t n = L->nrows;
+    put32(b + 107, fmt < 6 && n <= UINT32_MAX ? (uint32_t)n : 0);
+    if (fmt < 6) memcpy(b + 111, h + 111, 20); /* legacy points by return */
+    if (minor >= 4 && in_hsize(L) >= 375) {
+        memcpy(b + 255, h + 255, 120);
+    } else {
+        for (int r = 0; r < 5; r++) put64(b + 255 + 8 * r, g32(h + 111 + 4 * r));
+    }
+    /* EVLRs move: they follow the records, which grew */
+    size_t evlr_at = prefix + (size_t)n * jf__las_record_size(L);
+    /* the 1.3 field exists only in a header that long (a 1.3 file may
+     * declare a 227-byte header) */
+    int has_wave = minor >= 3 && in_hsize(L) >= 235;
+    uint64_t wave = has_wave ? g64(h + 227) : 0;
+    uint64_t old_evlr = minor >= 4 ? g64(h + 235) : wave;
+    if (L->a->las_evlr) {
+        put64(b + 235, evlr_at);
+        put32(b + 243, minor >= 4 ? g32(h + 243) : 1);
+        /* internal waveform data inside the EVLRs moves with them */
+        if (wave >= old_evlr && wave - old_evlr < L->a->las_evlr_len)
+            put64(b + 227, evlr_at + (wave - old_evlr));
+    } else if (wave && !(g16(h + 6) & 2)) {
+        put64(b + 227, wave); /* external waveform file: no offset in ours */
+    }
+}
+
+int jf__las_write_prefix(int fd, const jf_las_out *L)
+{
+    size_t len = jf__las_prefix_size(L);
     unsigned char *b = calloc(1, len);
     if (!b) return -1;
     memcpy(b, "LASF", 4);
@@ -130,30 +303,71 @@ int jf__las_write_prefix(int fd, char *const *names, const jf_col_type *types, s
     snprintf((char *)b + 58, 32, "jetfit " JF_VERSION_STRING);
     put16(b + 94, LAS_HEADER);
     put32(b + 96, (uint32_t)len);
-    put32(b + 100, 1); /* one VLR: the Extra Bytes descriptions */
     b[104] = 0;
-    put16(b + 105, (unsigned)jf__las_record_size(types, ncols));
-    uint32_t legacy = nrows <= UINT32_MAX ? (uint32_t)nrows : 0;
+    put16(b + 105, (unsigned)jf__las_record_size(L));
+    uint32_t legacy = L->nrows <= UINT32_MAX ? (uint32_t)L->nrows : 0;
     put32(b + 107, legacy);
     put32(b + 111, legacy); /* all points are first returns */
     for (int a = 0; a < 3; a++) {
-        putd(b + 131 + 8 * a, scale[a]);
-        putd(b + 155 + 8 * a, offset[a]);
-        putd(b + 179 + 16 * a, hi[a]);
-        putd(b + 187 + 16 * a, lo[a]);
+        putd(b + 131 + 8 * a, L->scale[a]);
+        putd(b + 155 + 8 * a, L->offset[a]);
+        putd(b + 179 + 16 * a, L->hi[a]);
+        putd(b + 187 + 16 * a, L->lo[a]);
     }
-    put64(b + 247, nrows);
-    put64(b + 255, nrows);
+    put64(b + 247, L->nrows);
+    put64(b + 255, L->nrows);
     unsigned char *v = b + LAS_HEADER;
+    uint32_t nvlr = 1;
+    if (keep(L)) {
+        memset(b + 111, 0, 20);
+        memset(b + 255, 0, 8);
+        keep_header(L, b, len);
+        vlr_copy c = {v};
+        vlr_sum s = {0, 0};
+        walk_vlrs(L, sum_vlr, &s);
+        walk_vlrs(L, copy_vlr, &c);
+        v = c.o;
+        nvlr += s.n;
+    }
+    put32(b + 100, nvlr); /* the input's VLRs, then the Extra Bytes one */
+    size_t nd = out_descs(L);
     snprintf((char *)v + 2, 16, "LASF_Spec");
     put16(v + 18, 4);
-    put16(v + 20, (unsigned)(EB_DESC * (ncols - 3)));
+    put16(v + 20, (unsigned)(EB_DESC * nd));
     snprintf((char *)v + 22, 32, "jetfit columns");
-    for (size_t j = 3; j < ncols; j++) {
-        unsigned char *d = v + VLR_HEADER + EB_DESC * (j - 3);
-        d[2] = types[j] == JF_COL_F64 ? 10 : types[j] == JF_COL_F32 ? 9 : 6;
-        snprintf((char *)d + 4, 32, "%s", names[j]);
-        snprintf((char *)d + 160, 32, "jetfit %s", names[j]);
+    unsigned char *d = v + VLR_HEADER;
+    if (keep(L)) {
+        /* the input's descriptions, scalar ones named as the columns they
+         * became (an attribute per scalar, in order, after the format's
+         * dimensions), then undocumented bytes in 255-byte pieces */
+        const unsigned char *first;
+        size_t covered, k = kept_descs(L, &first, &covered), m = 0;
+        unsigned base = base_len[in_fmt(L)];
+        for (size_t q = 0; q < k; q++, d += EB_DESC) {
+            memcpy(d, first + EB_DESC * q, EB_DESC);
+            if (d[2] >= 1 && d[2] <= 10) {
+                while (m < L->a->nattrs && L->a->attr[m].offset < base) m++;
+                if (m < L->a->nattrs) {
+                    memset(d + 4, 0, 32);
+                    snprintf((char *)d + 4, 32, "%s", L->anames[m++]);
+                }
+            }
+        }
+        for (size_t rest = L->a->stride - base - covered; rest; d += EB_DESC) {
+            unsigned piece = rest > 255 ? 255 : (unsigned)rest;
+            d[3] = (unsigned char)piece; /* data_type 0: options = bytes */
+            snprintf((char *)d + 160, 32, "undocumented extra bytes");
+            rest -= piece;
+        }
+    } else {
+        for (size_t j = 0; L->a && j < L->a->nattrs; j++, d += EB_DESC)
+            put_desc(d, eb_code[jf__attr_out_type(&L->a->attr[j])], L->anames[j], "input attribute");
+    }
+    for (size_t j = 3; j < L->ncols; j++, d += EB_DESC) {
+        char what[32];
+        snprintf(what, sizeof what, "jetfit %s", L->names[j]);
+        put_desc(d, L->types[j] == JF_COL_F64 ? 10 : L->types[j] == JF_COL_F32 ? 9 : 6,
+                 L->names[j], what);
     }
     size_t done = 0;
     while (done < len) {

@@ -9,10 +9,13 @@
  * left are checked: a binary row needs at least its fixed size, an ascii
  * row a byte per value.  Ascii rows are one line each.
  */
+#define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
 static const char *const type_names[][2] = {
@@ -202,7 +205,38 @@ static double load(const unsigned char *p, int type, int swap)
 typedef struct {
     double *dst[MAX_PROPS]; /* scalar destination row pointer or NULL */
     int face_list;          /* index of the face list property, or -1 */
+    unsigned char *adst[MAX_PROPS]; /* attribute: its place in record 0 */
+    size_t astride;         /* attribute record size                  */
 } ply_plan;
+
+/* The jf_attr_type of each PLY type. */
+static const jf_attr_type attr_type[] = {JF_ATTR_U8, JF_ATTR_I8, JF_ATTR_U8, JF_ATTR_I16,
+                                         JF_ATTR_U16, JF_ATTR_I32, JF_ATTR_U32, JF_ATTR_F32,
+                                         JF_ATTR_F64};
+
+/* Stores v (a value of PLY type t, so exact in a double) into an attribute
+ * record, little endian; an ascii value outside the type's range is
+ * clamped (NaN: 0). */
+static void store_attr(unsigned char *p, int t, double v)
+{
+    static const double lo[] = {0, -128, 0, -32768, 0, -2147483648.0, 0};
+    static const double hi[] = {0, 127, 255, 32767, 65535, 2147483647.0, 4294967295.0};
+    uint64_t b;
+    if (t == T_F32) {
+        float f = (float)v;
+        uint32_t u;
+        memcpy(&u, &f, 4);
+        b = u;
+    } else if (t == T_F64) {
+        memcpy(&b, &v, 8);
+    } else {
+        double c = v == v ? v : 0;
+        c = c < lo[t] ? lo[t] : c > hi[t] ? hi[t] : c;
+        b = (uint64_t)(int64_t)c;
+    }
+    for (unsigned k = 0; k < type_size[t]; k++)
+        p[k] = (unsigned char)(b >> (8 * k));
+}
 
 /* Stores a face index (checked: integral, in range when known). */
 static jf_status face_index(ply *h, jf_uvec *fi, double v, size_t line,
@@ -258,8 +292,13 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
         }
         if (scalar && row && (uint64_t)(h->end - h->p) / row >= el->count) {
             for (uint64_t r = 0; r < el->count; r++, h->p += row)
-                for (int k = 0; k < el->nprops; k++)
-                    if (pl->dst[k]) pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
+                for (int k = 0; k < el->nprops; k++) {
+                    if (pl->dst[k])
+                        pl->dst[k][3 * r] = load(h->p + off[k], el->props[k].type, swap);
+                    if (pl->adst[k]) /* normals too: also an attribute */
+                        store_attr(pl->adst[k] + r * pl->astride, el->props[k].type,
+                                   load(h->p + off[k], el->props[k].type, swap));
+                }
             return JF_OK;
         }
     }
@@ -329,6 +368,9 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                 } else if (!list && pl->dst[k]) {
                     pl->dst[k][3 * r] = v;
                 }
+                if (!list && pl->adst[k]) {
+                    store_attr(pl->adst[k] + r * pl->astride, pr->type, v);
+                }
             }
         }
         if (!h->format && jf_next_token(&q, le, 0, &ts, &te)) {
@@ -378,7 +420,7 @@ static int prop_index(const ply_elem *el, const char *name, int list)
 }
 
 jf_status jf_read_ply(const char *buf, size_t len, const char *name,
-                      jf_cloud *c, jf_error *err)
+                      const jf_read_opts *o, jf_cloud *c, jf_error *err)
 {
     ply *h = calloc(1, sizeof *h);
     if (!h)
@@ -404,7 +446,7 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     }
     for (int e = 0; st == JF_OK && e < h->nelems; e++) {
         const ply_elem *el = &h->elems[e];
-        ply_plan pl = {{0}, -1};
+        ply_plan pl = {{0}, -1, {0}, 0};
         int is_vertex = !seen_vertex && !strcmp(el->name, "vertex");
         int is_face = !seen_face && !strcmp(el->name, "face");
         /* room check: bytes a row needs at least */
@@ -466,6 +508,37 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
             pl.dst[ix] = c->xyz;
             pl.dst[iy] = c->xyz + 1;
             pl.dst[iz] = c->xyz + 2;
+            /* every other scalar property is carried (normals too: an
+             * output names them in_nx ...), in its own type */
+            jf_attrs *a = &c->attrs;
+            for (int k = 0; k < el->nprops && !o->no_attrs; k++) {
+                const ply_prop *pr = &el->props[k];
+                if (k == ix || k == iy || k == iz || pr->count_type != T_NONE)
+                    continue;
+                if (!jf__attrs_add(a, pr->name, strlen(pr->name), attr_type[pr->type],
+                                   (uint32_t)a->stride, 0, 0)) {
+                    st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+                    break;
+                }
+                a->stride += type_size[pr->type];
+            }
+            if (st == JF_OK && a->nattrs) {
+                a->rec = malloc((n ? n : 1) * a->stride);
+                if (!a->rec) {
+                    st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
+                                    "out of memory for the attributes of %zu vertices", n);
+                    break;
+                }
+                for (int k = 0, j = 0; k < el->nprops; k++) {
+                    const ply_prop *pr = &el->props[k];
+                    if (k == ix || k == iy || k == iz || pr->count_type != T_NONE)
+                        continue;
+                    pl.adst[k] = a->rec + a->attr[j++].offset;
+                }
+                pl.astride = a->stride;
+            }
+            if (st != JF_OK)
+                break;
         } else if (is_face) {
             seen_face = 1;
             pl.face_list = prop_index(el, "vertex_indices", 1);
@@ -525,6 +598,238 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
     c->face_idx = fi.v;
     if (st == JF_OK && c->nfaces && !c->face_idx) /* all faces empty */
         c->face_idx = malloc(sizeof(uint32_t));
+    free(h);
+    return st;
+}
+
+/* ---- the vertex layout of a binary PLY (io_internal.h) ----------------- */
+
+/* Offsets of the vertex element's rows and, per property, within a row;
+ * 0 when an element has a list property or the file does not hold what
+ * the header announces (lenient by less than one row, as the readers). */
+static int vertex_rows(const ply *h, size_t body, uint64_t len, int *iv, uint64_t *at,
+                       uint64_t *vrow)
+{
+    uint64_t total = body;
+    *iv = -1;
+    *vrow = 0;
+    for (int k = 0; k < h->nelems; k++) {
+        const ply_elem *el = &h->elems[k];
+        uint64_t row = 0;
+        for (int j = 0; j < el->nprops; j++) {
+            if (el->props[j].count_type != T_NONE) return 0;
+            row += type_size[el->props[j].type];
+        }
+        if (row && el->count > (UINT64_MAX - total) / row) return 0;
+        if (*iv < 0 && !strcmp(el->name, "vertex")) {
+            *iv = k;
+            *vrow = row;
+            *at = total;
+        }
+        total += row * el->count;
+    }
+    return *iv >= 0 && *vrow && total <= len && len - total < *vrow;
+}
+
+jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_ply_layout *l, jf_error *err)
+{
+    ply *h = calloc(1, sizeof *h);
+    size_t body = 0;
+    int iv;
+    uint64_t at, vrow;
+    memset(l, 0, sizeof *l);
+    if (!h) return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+    h->name = name;
+    h->err = err;
+    jf_status st = parse_header(h, buf, len, &body);
+    if (st == JF_OK && h->format == 0)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "an ascii PLY: distributed runs read "
+                        "binary PLY (jetfit estimate IN -o OUT.ply converts)");
+    else if (st == JF_OK && !vertex_rows(h, body, size, &iv, &at, &vrow))
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "needs vertex rows of fixed size (no "
+                        "lists) and a file as long as its header says");
+    if (st == JF_OK) {
+        const ply_elem *el = &h->elems[iv];
+        static const char *const nm[6] = {"x", "y", "z", "nx", "ny", "nz"};
+        int ip[6];
+        for (int j = 0; j < 6; j++) ip[j] = prop_index(el, nm[j], 0);
+        if (ip[0] < 0 || ip[1] < 0 || ip[2] < 0)
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "element vertex has no x y z");
+        else if (el->count > JF_MAX_POINTS)
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "too many vertices");
+        for (int j = 0; st == JF_OK && j < 6; j++) {
+            size_t o = 0;
+            for (int q = 0; q < ip[j]; q++) o += type_size[el->props[q].type];
+            l->off[j] = o;
+            l->type[j] = ip[j] >= 0 ? el->props[ip[j]].type : T_NONE;
+        }
+        const uint16_t one = 1;
+        l->count = el->count;
+        l->vertex_off = at;
+        l->row = (size_t)vrow;
+        l->has_normals = ip[3] >= 0 && ip[4] >= 0 && ip[5] >= 0;
+        l->swap = (h->format == 1) != (*(const unsigned char *)&one == 1);
+    }
+    free(h);
+    return st;
+}
+
+void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
+                  double *nrm)
+{
+    for (size_t r = 0; r < k; r++, raw += l->row) {
+        for (int j = 0; j < 3; j++) xyz[3 * r + j] = load(raw + l->off[j], l->type[j], l->swap);
+        if (nrm && l->has_normals)
+            for (int j = 0; j < 3; j++)
+                nrm[3 * r + j] = load(raw + l->off[3 + j], l->type[3 + j], l->swap);
+    }
+}
+
+/* ---- binary PLY read in chunks (jf_cloud_read) ------------------------ */
+
+/* design (issue 12.1): a 10^8-point binary PLY must not be held twice (the
+ * file image and the coordinates).  When every element has fixed-size
+ * rows (scalar properties only: a point cloud, no face lists) and the
+ * file's length is exactly what the header announces (up to the
+ * tolerated trailing bytes), the rows are read with pread(2) a chunk at a
+ * time straight into the coordinate arrays, by the same decoding as the
+ * whole-file path.  Anything else (ascii, lists, a size that does not
+ * match: whatever the whole-file path would refuse or treat specially)
+ * returns JF_ERR_UNSUPPORTED with *c untouched, and the caller reads the
+ * whole file as before, so results and messages stay the same. */
+#define HEAD_MAX (1u << 20)
+#define CHUNK_BYTES (4u << 20)
+
+static int pread_all(int fd, unsigned char *p, size_t n, uint64_t at, int *e)
+{
+    while (n) {
+        ssize_t k = pread(fd, p, n, (off_t)at);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            *e = k < 0 ? errno : 0;
+            return 0;
+        }
+        p += k, n -= (size_t)k, at += (uint64_t)k;
+    }
+    return 1;
+}
+
+jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *ro,
+                               jf_cloud *c, jf_error *err)
+{
+    size_t got = len < HEAD_MAX ? len : HEAD_MAX;
+    unsigned char *buf = malloc(got > CHUNK_BYTES ? got : CHUNK_BYTES);
+    ply *h = calloc(1, sizeof *h);
+    jf_status st = JF_ERR_UNSUPPORTED;
+    int e = 0;
+    size_t body = 0;
+    if (!buf || !h) {
+        st = JF_ERR_UNSUPPORTED; /* the whole-file path says out of memory */
+        goto out;
+    }
+    h->name = name;
+    if (!pread_all(fd, buf, got, 0, &e)) {
+        st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
+                        e ? strerror(e) : "the file shrank while it was read");
+        goto out;
+    }
+    /* a header line cut by the prefix's end would parse differently */
+    if (parse_header(h, (const char *)buf, got, &body) != JF_OK || h->format == 0 ||
+        (body >= got && got < len))
+        goto out;
+    uint64_t at = 0, vrow = 0;
+    int iv = -1;
+    if (!vertex_rows(h, body, len, &iv, &at, &vrow) || h->elems[iv].count == 0 ||
+        h->elems[iv].count > JF_MAX_POINTS)
+        goto out;
+    const ply_elem *el = &h->elems[iv];
+    int ix = prop_index(el, "x", 0), iy = prop_index(el, "y", 0), iz = prop_index(el, "z", 0);
+    int inx = prop_index(el, "nx", 0), iny = prop_index(el, "ny", 0),
+        inz = prop_index(el, "nz", 0);
+    if (ix < 0 || iy < 0 || iz < 0)
+        goto out;
+    size_t n = (size_t)el->count;
+    double *xyz = malloc((n ? n : 1) * 3 * sizeof(double)), *nrm = NULL;
+    int has_n = inx >= 0 && iny >= 0 && inz >= 0;
+    if (has_n)
+        nrm = malloc((n ? n : 1) * 3 * sizeof(double));
+    if (!xyz || (has_n && !nrm)) {
+        free(xyz);
+        free(nrm);
+        st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu vertices", n);
+        goto out;
+    }
+    double *dst[MAX_PROPS] = {0};
+    dst[ix] = xyz, dst[iy] = xyz + 1, dst[iz] = xyz + 2;
+    if (has_n)
+        dst[inx] = nrm, dst[iny] = nrm + 1, dst[inz] = nrm + 2;
+    /* the attributes, as the whole-file path describes them */
+    jf_attrs ta = {0};
+    unsigned char *adst[MAX_PROPS] = {0};
+    for (int j = 0; j < el->nprops && !(ro && ro->no_attrs); j++) {
+        if (j == ix || j == iy || j == iz)
+            continue;
+        if (!jf__attrs_add(&ta, el->props[j].name, strlen(el->props[j].name),
+                           attr_type[el->props[j].type], (uint32_t)ta.stride, 0, 0)) {
+            ta.stride = SIZE_MAX;
+            break;
+        }
+        ta.stride += type_size[el->props[j].type];
+    }
+    if (ta.stride == SIZE_MAX || (ta.nattrs && !(ta.rec = malloc(n * ta.stride)))) {
+        free(xyz);
+        free(nrm);
+        jf_attrs_free(&ta);
+        st = jf_io_fail(err, JF_ERR_NOMEM, name, 0,
+                        "out of memory for the attributes of %zu vertices", n);
+        goto out;
+    }
+    for (int j = 0, k = 0; ta.nattrs && j < el->nprops; j++)
+        if (j != ix && j != iy && j != iz)
+            adst[j] = ta.rec + ta.attr[k++].offset;
+    size_t off[MAX_PROPS], o = 0;
+    for (int j = 0; j < el->nprops; j++) {
+        off[j] = o;
+        o += type_size[el->props[j].type];
+    }
+    const uint16_t one = 1;
+    int swap = (h->format == 1) != (*(const unsigned char *)&one == 1);
+    size_t per = CHUNK_BYTES / vrow ? CHUNK_BYTES / vrow : 1;
+    if (per * vrow > (got > CHUNK_BYTES ? got : CHUNK_BYTES)) {
+        free(xyz);
+        free(nrm);
+        jf_attrs_free(&ta);
+        goto out; /* a row over the chunk: the whole-file path */
+    }
+    for (size_t r0 = 0; r0 < n; r0 += per) {
+        size_t m = n - r0 < per ? n - r0 : per;
+        if (!pread_all(fd, buf, m * vrow, at + r0 * vrow, &e)) {
+            free(xyz);
+            free(nrm);
+            jf_attrs_free(&ta);
+            st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
+                            e ? strerror(e) : "the file shrank while it was read");
+            goto out;
+        }
+        const unsigned char *p = buf;
+        for (size_t r = r0; r < r0 + m; r++, p += vrow)
+            for (int j = 0; j < el->nprops; j++) {
+                if (dst[j])
+                    dst[j][3 * r] = load(p + off[j], el->props[j].type, swap);
+                if (adst[j])
+                    store_attr(adst[j] + r * ta.stride, el->props[j].type,
+                               load(p + off[j], el->props[j].type, swap));
+            }
+    }
+    c->n = n;
+    c->xyz = xyz;
+    c->nrm = nrm;
+    c->attrs = ta;
+    st = JF_OK;
+out:
+    free(buf);
     free(h);
     return st;
 }

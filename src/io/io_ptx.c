@@ -14,8 +14,17 @@
  * Points are stored in the scanner's own frame and moved to the registered
  * frame by M.  The scanner position line is, per the same description, the
  * scanner's position "after any registration/transformation", i.e. already
- * in the registered frame: it is kept as given (not transformed again) in
- * c->scanner, and c->scan[i] names the scan of point i (--orient scanner).
+ * in the registered frame: it is never transformed again.  But the same
+ * text says M also holds the user coordinate system (UCS) active at export
+ * ("the 4x4 matrix may not be identity if there is a UCS applied", e.g. an
+ * unregistered scan, position line 0 0 0, exported in a UCS), which the
+ * position line does not: then the points land in the UCS frame and the
+ * scanner, at the origin of its own frame, lands at [0 0 0 1] M, the
+ * translation row.  So c->scanner is the translation row when M is not the
+ * identity (equal to the position line whenever no UCS was set, as in
+ * Leica's examples), and the position line when M is the identity (points
+ * exported already registered).  c->scan[i] names the scan of point i
+ * (--orient scanner).
  * A point "0 0 0" is the scanner's "no return": kept as a row of NaN (the
  * pipeline marks it nonfinite) so rows stay one per grid cell.
  */
@@ -113,7 +122,10 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
             !jf_dvec_reserve(&sc, 3 * (nscans + 1)))
             FAIL(JF_ERR_NOMEM, head_line, "out of memory for %llu points",
                  (unsigned long long)cnt);
-        memcpy(sc.v + 3 * nscans, h[0], 3 * sizeof(double));
+        int identity = 1;
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++) identity &= m[i][j] == (i == j);
+        memcpy(sc.v + 3 * nscans, identity ? h[0] : m[3], 3 * sizeof(double));
         for (uint64_t i = 0; i < cnt; i++) {
             if (!jf_text_line(&t, &ls, &le))
                 FAIL(JF_ERR_FORMAT, t.line, "scan %zu: the file ends after %llu of its "

@@ -3,9 +3,11 @@
  * file, and holds the pieces every reader shares (messages, exact number
  * parsing, growable arrays).
  *
- * design: the file is mapped (or read whole when it cannot be mapped) and
- * the reader parses the byte range in place: no copy, no allocation per
- * token, no reading past the end.  Counts read from headers are checked
+ * design: the file is read whole (never mapped: issue 11) and the reader
+ * parses the byte range in place: no copy, no allocation per token, no
+ * reading past the end.  A binary PLY point cloud is read in chunks
+ * straight into the coordinates instead (io_ply.c, jf__read_ply_chunked),
+ * so that a 10^8-point file is not held twice.  Counts read from headers are checked
  * against the bytes left before anything is allocated from them.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -32,6 +34,7 @@ void jf_read_opts_init(jf_read_opts *o)
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
     o->bad_rows = 0;
+    o->no_attrs = 0;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -44,6 +47,7 @@ void jf_cloud_free(jf_cloud *c)
     free(c->face_idx);
     free(c->scan);
     free(c->scanner);
+    jf_attrs_free(&c->attrs);
     memset(c, 0, sizeof *c);
 }
 
@@ -205,7 +209,8 @@ int jf_parse_double(const char *s, const char *e, double *out)
         return slow_double(s, e, out); /* hex float, or not a number */
     if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22) {
         double v;
-        if (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v))
+        if (!jf__lemire(m, exp10, &v) &&
+            (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v)))
             return slow_double(s, e, out);
         *out = neg ? -v : v;
         return 1;
@@ -303,7 +308,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
-        st = jf_read_ply(buf, len, name, c, err);
+        st = jf_read_ply(buf, len, name, o, c, err);
         break;
     case JF_FMT_XYZ:
     case JF_FMT_PTS:
@@ -314,7 +319,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_read_off(buf, len, name, c, err);
         break;
     case JF_FMT_LAS:
-        st = jf_read_las(buf, len, name, c, err);
+        st = jf_read_las(buf, len, name, o, c, err);
         break;
     case JF_FMT_PTX:
         st = jf_read_ptx(buf, len, name, c, err);
@@ -374,6 +379,14 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     if (len == 0) {
         close(fd);
         return jf_io_fail(err, JF_ERR_FORMAT, path, 0, "empty file");
+    }
+    if (fmt == JF_FMT_PLY) {
+        /* binary point clouds without a second copy (io_ply.c) */
+        jf_status cs = jf__read_ply_chunked(fd, len, path, o, c, err);
+        if (cs != JF_ERR_UNSUPPORTED) {
+            close(fd);
+            return cs;
+        }
     }
     char *buf = malloc(len);
     if (!buf) {

@@ -149,7 +149,7 @@ jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err)
             suf[k] = abc[rnd[k] % (sizeof abc - 1)];
         suf[10] = '\0';
         snprintf(t->tmp, cap, "%.*s.%.*s.%s.tmp", (int)dirlen, t->target, (int)blen, base, suf);
-        t->fd = open(t->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        t->fd = open(t->tmp, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (t->fd >= 0 || errno != EEXIST)
             break;
     }

@@ -9,10 +9,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <omp.h>
 
@@ -31,8 +33,18 @@ struct jf_writer {
     const size_t *foff;
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
-    double las_scale[3], las_off[3], las_lo[3], las_hi[3];
+    jf_las_out las;                  /* LAS: what the output holds       */
+    const jf_attrs *attrs;           /* carried attributes, or NULL      */
+    char (*anames)[64];              /* their output names               */
+    size_t row_max;                  /* bytes a formatted row may take   */
+    /* positioned rows (jf_writer_begin_put / _put) */
+    int put;                         /* begun, not yet drained           */
+    int put_threads;                 /* for the drain's formatting       */
+    jf_spool *spool;                 /* io_spool.c                       */
 };
+
+/* The attribute columns go after column 2 (x y z). */
+#define ATTRS_AFTER 2
 
 static int host_little(void)
 {
@@ -57,10 +69,10 @@ static jf_status write_header(jf_writer *w)
     if (w->fmt == FMT_LAS) {
         /* a placeholder of the header's size: the real one, with the
          * count and bounds, is written over it at commit */
-        if (!w->las_framed)
+        if (!w->las_framed && !(w->attrs && w->attrs->las_head))
             return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
                                                  "(jf_writer_las_frame) before the rows");
-        size_t n = jf__las_prefix_size(w->ncols);
+        size_t n = jf__las_prefix_size(&w->las);
         while (n && f->st == JF_OK) {
             size_t k = n < 4096 ? n : 4096;
             char *o = jf_wf_room(f, k);
@@ -85,6 +97,13 @@ static jf_status write_header(jf_writer *w)
             jf_wf_puts(f, " ");
             jf_wf_puts(f, w->names[j]);
             jf_wf_puts(f, "\n");
+            for (size_t k = 0; j == ATTRS_AFTER && w->attrs && k < w->attrs->nattrs; k++) {
+                jf_wf_puts(f, "property ");
+                jf_wf_puts(f, jf__attr_ply_type(&w->attrs->attr[k]));
+                jf_wf_puts(f, " ");
+                jf_wf_puts(f, w->anames[k]);
+                jf_wf_puts(f, "\n");
+            }
         }
         if (w->foff) {
             snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
@@ -98,6 +117,10 @@ static jf_status write_header(jf_writer *w)
         if (j)
             jf_wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
         jf_wf_puts(f, w->names[j]);
+        for (size_t k = 0; j == ATTRS_AFTER && w->attrs && k < w->attrs->nattrs; k++) {
+            jf_wf_puts(f, w->fmt == FMT_CSV ? "," : " ");
+            jf_wf_puts(f, w->anames[k]);
+        }
     }
     return jf_wf_puts(f, "\n");
 }
@@ -145,6 +168,7 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     w->nrows = nrows;
     w->types = malloc(ncols * sizeof *w->types);
     w->names = calloc(ncols, sizeof *w->names);
+    w->row_max = ncols * 32 + 2;
     jf_status st = JF_OK;
     /* a row takes at most 32 bytes per value */
     if (jf_wf_open(&w->f, path, ncols * 32 + 64) != JF_OK)
@@ -155,6 +179,10 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
         else
             w->types[j] = cols[j].type;
     }
+    w->las.names = w->names;
+    w->las.types = w->types;
+    w->las.ncols = ncols;
+    w->las.nrows = nrows;
     if (st != JF_OK) {
         if (err) {
             *err = w->f.err;
@@ -174,8 +202,67 @@ jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n)
         return JF_ERR_INVALID;
     if (w->fmt != FMT_LAS)
         return JF_OK;
-    jf__las_frame(xyz, n, w->las_scale, w->las_off, w->las_lo, w->las_hi);
+    jf__las_frame(xyz, n, w->las.scale, w->las.offset, w->las.lo, w->las.hi);
     w->las_framed = 1;
+    return JF_OK;
+}
+
+jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
+{
+    if (!w || w->header_done || w->attrs || w->f.st != JF_OK)
+        return JF_ERR_INVALID;
+    if (!a || (!a->nattrs && !(a->las_head && w->fmt == FMT_LAS)))
+        return JF_OK; /* nothing to carry */
+    if (w->ncols < 3 || (a->nattrs && !a->rec) || (a->las_head && !a->rec))
+        return JF_ERR_INVALID;
+    char (*nm)[64] = calloc(a->nattrs ? a->nattrs : 1, sizeof *nm);
+    if (!nm)
+        return JF_ERR_NOMEM;
+    /* a format 0 LAS output also has its own dimensions: an Extra Byte
+     * named as one (intensity, classification, ...) would be a second
+     * dimension of that name to LAS readers */
+    int fmt0 = w->fmt == FMT_LAS && !a->las_head;
+    size_t nn = w->ncols + (fmt0 ? JF__LAS_FMT0_NDIMS : 0);
+    char **taken = malloc(nn * sizeof *taken);
+    if (!taken) {
+        free(nm);
+        return JF_ERR_NOMEM;
+    }
+    memcpy(taken, w->names, w->ncols * sizeof *taken);
+    for (size_t k = w->ncols; k < nn; k++) taken[k] = (char *)jf__las_fmt0_dims[k - w->ncols];
+    int bad = jf__attrs_names(a, taken, nn, nm) != 0;
+    free(taken);
+    if (bad) {
+        free(nm);
+        return JF_ERR_INVALID;
+    }
+    size_t need = w->row_max + a->nattrs * 32;
+    w->las.a = a;
+    w->las.anames = nm;
+    if (w->fmt == FMT_LAS) {
+        size_t rec = jf__las_record_size(&w->las);
+        if (!jf__las_fits(&w->las)) {
+            w->las.a = NULL;
+            w->las.anames = NULL;
+            free(nm);
+            return JF_ERR_TOO_LARGE;
+        }
+        need = rec > need ? rec : need;
+    }
+    if (need > w->f.cap) { /* nothing is buffered yet: the header is not written */
+        char *b = realloc(w->f.buf, need);
+        if (!b) {
+            w->las.a = NULL;
+            w->las.anames = NULL;
+            free(nm);
+            return JF_ERR_NOMEM;
+        }
+        w->f.buf = b;
+        w->f.cap = need;
+    }
+    w->row_max = need;
+    w->attrs = a;
+    w->anames = nm;
     return JF_OK;
 }
 
@@ -197,13 +284,15 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
     return JF_OK;
 }
 
-/* One row, formatted into o (room for ncols * 32 + 2 bytes); returns the
- * number of bytes.  Reads w only: safe from several threads at once. */
-static size_t format_row(const jf_writer *w, const double *vals, char *o)
+/* One row, formatted into o (room for w->row_max bytes); `row` is the
+ * input index of the point, whose attributes the row carries.  Returns
+ * the number of bytes.  Reads w only: safe from several threads at once. */
+static size_t format_row(const jf_writer *w, const double *vals, size_t row, char *o)
 {
     char *o0 = o;
+    const jf_attrs *at = w->attrs;
     if (w->fmt == FMT_LAS)
-        return jf__las_format_row(vals, w->types, w->ncols, w->las_scale, w->las_off, o);
+        return jf__las_format_row(&w->las, row, vals, o);
     if (w->fmt == FMT_PLY && !w->ascii && host_little()) {
         /* the usual case, kept tight (it runs once per point): fixed-size
          * copies, no per-value memcpy call */
@@ -221,6 +310,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                 memcpy(o, &x, 4);
                 o += 4;
             }
+            if (j == ATTRS_AFTER && at) /* the attributes after x y z */
+                o = jf__attrs_put(at, row, JF__ATTR_PLY_LE, 0, o);
         }
     } else if (w->fmt == FMT_PLY && !w->ascii) {
         int little = host_little();
@@ -243,6 +334,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                     o[i] = (char)b[n - 1 - i];
             }
             o += n;
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, little ? JF__ATTR_PLY_LE : JF__ATTR_PLY_BE, 0, o);
         }
     } else {
         char sep = w->fmt == FMT_CSV ? ',' : ' ';
@@ -264,6 +357,8 @@ static size_t format_row(const jf_writer *w, const double *vals, char *o)
                     *o++ = '-';
                 o = jf_fmt_uint(o, x < 0 ? (uint64_t)(-(int64_t)x) : (uint64_t)x);
             }
+            if (j == ATTRS_AFTER && at)
+                o = jf__attrs_put(at, row, JF__ATTR_TEXT, sep, o);
         }
         *o++ = '\n';
     }
@@ -279,6 +374,8 @@ static jf_status ready_for(jf_writer *w, size_t nrows)
         return f->st;
     if (!w->header_done && write_header(w) != JF_OK)
         return f->st;
+    if (w->put)
+        return jf_wf_fail(f, JF_ERR_INVALID, "rows appended to a table of positioned rows");
     if (nrows > w->nrows - w->rows)
         return jf_wf_fail(f, JF_ERR_INVALID, "more rows than the %zu announced", w->nrows);
     return JF_OK;
@@ -291,10 +388,10 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
     jf_wfile *f = &w->f;
     if (ready_for(w, 1) != JF_OK)
         return f->st;
-    char *o = jf_wf_room(f, w->ncols * 32 + 2);
+    char *o = jf_wf_room(f, w->row_max);
     if (!o)
         return f->st;
-    f->len += format_row(w, vals, o);
+    f->len += format_row(w, vals, w->rows, o);
     w->rows++;
     return JF_OK;
 }
@@ -311,7 +408,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
     const int nt = threads > 0 ? threads : omp_get_max_threads();
-    const size_t row_max = w->ncols * 32 + 2, slot = ROWS_BLOCK * row_max;
+    const size_t row_max = w->row_max, slot = ROWS_BLOCK * row_max;
     char *scratch = malloc((size_t)nt * slot);
     size_t *len = malloc((size_t)nt * sizeof *len);
     if (!scratch || !len) {
@@ -329,7 +426,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
             char *o = scratch + (size_t)t * slot;
             len[t] = 0;
             for (size_t r = a; r < b && r < nrows; r++)
-                len[t] += format_row(w, vals + r * w->ncols, o + len[t]);
+                len[t] += format_row(w, vals + r * w->ncols, w->rows + r, o + len[t]);
         }
         for (int t = 0; t < nt && f->st == JF_OK; t++)
             jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
@@ -338,6 +435,58 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     free(len);
     if (f->st == JF_OK)
         w->rows += nrows;
+    return f->st;
+}
+
+/* ---- positioned rows --------------------------------------------------- */
+
+/* design: the rows go to a row spool (io_spool.c: a bucket sort through a
+ * temporary beside the output) and come back in row order at commit,
+ * where jf_writer_rows formats and appends them as it always does: the
+ * bytes of a whole-array write, for every format. */
+jf_status jf_writer_begin_put(jf_writer *w, int threads)
+{
+    if (!w || w->put || w->rows)
+        return JF_ERR_INVALID;
+    jf_wfile *f = &w->f;
+    if (ready_for(w, 0) != JF_OK)
+        return f->st;
+    jf_error e = {{0}};
+    if (jf__spool_open(w->f.final, w->nrows, w->ncols, 0, &w->spool, &e) != JF_OK)
+        return jf_wf_fail(f, JF_ERR_IO, "cannot create the row spool beside it");
+    w->put = 1;
+    w->put_threads = threads;
+    return JF_OK;
+}
+
+jf_status jf_writer_put(jf_writer *w, const uint32_t *rows, const double *vals, size_t m)
+{
+    if (!w || !w->put || (m && (!rows || !vals)))
+        return JF_ERR_INVALID;
+    return jf__spool_put(w->spool, rows, vals, m);
+}
+
+static jf_status emit_rows(void *user, const double *vals, size_t nrows)
+{
+    jf_writer *w = user;
+    return jf_writer_rows(w, vals, nrows, w->put_threads);
+}
+
+/* Commit of a put table: the spool drained in row order through
+ * jf_writer_rows (which counts the rows). */
+static jf_status put_finish(jf_writer *w)
+{
+    jf_wfile *f = &w->f;
+    w->put = 0; /* jf_writer_rows appends again */
+    jf_error e = {{0}};
+    if (f->st == JF_OK && jf__spool_drain(w->spool, emit_rows, w, w->f.final, &e) != JF_OK &&
+        f->st == JF_OK) {
+        /* the spool's own message, "FINAL: reason", without the name */
+        const char *why = strstr(e.msg, ": ");
+        jf_wf_fail(f, JF_ERR_IO, "%s", why ? why + 2 : e.msg);
+    }
+    jf__spool_free(w->spool);
+    w->spool = NULL;
     return f->st;
 }
 
@@ -375,12 +524,59 @@ static jf_status write_faces(jf_writer *w)
 }
 
 /* Frees the writer itself (its file is closed by jf_wf_close). */
+/* ---- rows written by other processes (jetfit-mpi, io_internal.h) ------- */
+
+jf_status jf__writer_begin(jf_writer *w, uint64_t *header, const char **tmp)
+{
+    if (!w || w->fmt != FMT_PLY || w->ascii || w->attrs || w->foff || w->rows || w->put)
+        return JF_ERR_INVALID;
+    jf_wfile *f = &w->f;
+    if (ready_for(w, 0) != JF_OK || jf_wf_flush(f) != JF_OK)
+        return f->st;
+    off_t at = lseek(f->fd, 0, SEEK_CUR);
+    if (at < 0)
+        return jf_wf_fail(f, JF_ERR_IO, "%s", strerror(errno));
+    *header = (uint64_t)at;
+    *tmp = f->t.tmp;
+    return JF_OK;
+}
+
+jf_status jf__writer_placed(jf_writer *w, size_t nrows)
+{
+    if (!w || nrows != w->nrows || w->rows)
+        return JF_ERR_INVALID;
+    w->rows = nrows;
+    return JF_OK;
+}
+
+void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, char *o)
+{
+    for (size_t j = 0; j < ncols; j++) {
+        unsigned char b[8];
+        size_t n;
+        if (types[j] == JF_COL_F64) {
+            memcpy(b, &vals[j], 8), n = 8;
+        } else if (types[j] == JF_COL_F32) {
+            float x = (float)vals[j];
+            memcpy(b, &x, 4), n = 4;
+        } else {
+            int32_t x = to_i32(vals[j]);
+            memcpy(b, &x, 4), n = 4;
+        }
+        for (size_t i = 0; i < n; i++)
+            o[i] = (char)(host_little() ? b[i] : b[n - 1 - i]);
+        o += n;
+    }
+}
+
 static void free_writer(jf_writer *w)
 {
+    jf__spool_free(w->spool);
     for (size_t j = 0; w->names && j < w->ncols; j++)
         free(w->names[j]);
     free(w->names);
     free(w->types);
+    free(w->anames);
     free(w);
 }
 
@@ -391,14 +587,19 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
     jf_wfile *f = &w->f;
     if (f->st == JF_OK && !w->header_done)
         write_header(w);
+    if (w->put)
+        put_finish(w);
     if (f->st == JF_OK && w->rows != w->nrows)
         jf_wf_fail(f, JF_ERR_INVALID, "%zu rows written, %zu announced",
                 w->rows, w->nrows);
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
+    /* LAS: the input's EVLRs after the records, then the header */
+    if (f->st == JF_OK && w->fmt == FMT_LAS && w->attrs && w->attrs->las_head &&
+        w->attrs->las_evlr)
+        jf_wf_write(f, (const char *)w->attrs->las_evlr, w->attrs->las_evlr_len);
     if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
-        jf__las_write_prefix(f->fd, w->names, w->types, w->ncols, w->nrows, w->las_scale,
-                             w->las_off, w->las_lo, w->las_hi) != 0)
+        jf__las_write_prefix(f->fd, &w->las) != 0)
         jf_wf_fail(f, JF_ERR_IO, "cannot write the LAS header");
     jf_status st = jf_wf_close(f, err);
     free_writer(w);

@@ -17,12 +17,29 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The header-named columns other than x y z, carried as attributes:
+ * read as doubles into v (row-major, grown by doubling), then packed in
+ * the smallest exact type of each column (text_attrs_pack). */
+typedef struct {
+    int ncols;          /* header fields                               */
+    const char **nm;    /* their names in the file, and lengths        */
+    size_t *nml;
+    int *acol;          /* attribute index of each header field, or -1 */
+    int na;             /* attributes                                  */
+    int maxcol;         /* largest column of an attribute, -1 if none  */
+    double *v;          /* rows * na values                            */
+    size_t rows_cap;
+    unsigned char *text;/* per attribute: a field that is not a number
+                           was seen (the column is dropped)            */
+} text_attrs;
+
 typedef struct {
     const char *name;
     jf_error *err;
     int csv;        /* fields split at ',' only (else whitespace , ;) */
     int col[6];     /* column of x y z nx ny nz, -1 = not read */
     int maxcol;     /* largest column needed */
+    text_attrs *ta; /* NULL: attributes not wanted */
 } tab;
 
 /* Next field of a row; csv fields are trimmed and may be empty. */
@@ -94,10 +111,24 @@ static jf_status csv_header(tab *t, const char *ls, const char *le,
     static const char *const names[6] = {"x", "y", "z", "nx", "ny", "nz"};
     int found[6] = {-1, -1, -1, -1, -1, -1};
     const char *p = ls, *fs, *fe;
+    text_attrs *ta = t->ta;
+    if (ta) {
+        int nf = count_fields(t, ls, le);
+        ta->nm = malloc((size_t)(nf ? nf : 1) * sizeof *ta->nm);
+        ta->nml = malloc((size_t)(nf ? nf : 1) * sizeof *ta->nml);
+        ta->acol = malloc((size_t)(nf ? nf : 1) * sizeof *ta->acol);
+        if (!ta->nm || !ta->nml || !ta->acol)
+            return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, line, "out of memory");
+    }
     for (int j = 0; next_field(t, &p, le, &fs, &fe); j++) {
         if (fe - fs >= 2 && (*fs == '"' || *fs == '\'') && fe[-1] == *fs) {
             fs++;
             fe--;
+        }
+        if (ta) {
+            ta->nm[j] = fs;
+            ta->nml[j] = (size_t)(fe - fs);
+            ta->ncols = j + 1;
         }
         for (int k = 0; k < 6; k++) {
             if (!lower_eq(fs, fe, names[k]))
@@ -121,6 +152,113 @@ static jf_status csv_header(tab *t, const char *ls, const char *le,
     if ((want_names & 2) && found[3] >= 0 && found[4] >= 0 && found[5] >= 0)
         for (int k = 3; k < 6; k++)
             t->col[k] = found[k];
+    /* every other named column is an attribute (normals too: an output
+     * names them in_nx ...) */
+    if (ta) {
+        ta->maxcol = -1;
+        for (int j = 0; j < ta->ncols; j++) {
+            int xyz = j == t->col[0] || j == t->col[1] || j == t->col[2];
+            ta->acol[j] = xyz || !ta->nml[j] ? -1 : ta->na++;
+            if (ta->acol[j] >= 0)
+                ta->maxcol = j;
+        }
+        ta->text = calloc((size_t)(ta->na ? ta->na : 1), 1);
+        if (!ta->text)
+            return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, line, "out of memory");
+    }
+    return JF_OK;
+}
+
+/* Attribute values of row n: fields [0, maxcol] of the line (NaN when the
+ * row is bad or a field is empty; a field that is not a number marks its
+ * column as text). */
+static int text_attrs_row(const tab *t, size_t n, const char *ls, const char *le, int bad)
+{
+    text_attrs *ta = t->ta;
+    if (n >= ta->rows_cap) {
+        size_t cap = ta->rows_cap ? 2 * ta->rows_cap : 1024;
+        double *q = realloc(ta->v, cap * (size_t)ta->na * sizeof *q);
+        if (!q)
+            return 0;
+        ta->v = q;
+        ta->rows_cap = cap;
+    }
+    double *v = ta->v + n * (size_t)ta->na;
+    for (int k = 0; k < ta->na; k++)
+        v[k] = NAN;
+    if (bad)
+        return 1;
+    const char *p = ls, *fs, *fe;
+    for (int j = 0; j <= ta->maxcol && next_field(t, &p, le, &fs, &fe); j++) {
+        int k = ta->acol[j];
+        if (k >= 0 && fs < fe && !jf_parse_double(fs, fe, &v[k]))
+            ta->text[k] = 1;
+    }
+    return 1;
+}
+
+/* The smallest type holding every value of attribute k exactly: integers
+ * (no -0) in uchar, ushort or int range, else double. */
+static jf_attr_type text_attr_type(const text_attrs *ta, int k, size_t n)
+{
+    double lo = 0, hi = 0;
+    for (size_t i = 0; i < n; i++) {
+        double x = ta->v[i * (size_t)ta->na + (size_t)k];
+        if (!(x == floor(x)) || (x == 0 && signbit(x)) || !(fabs(x) <= 2147483648.0))
+            return JF_ATTR_F64;
+        lo = x < lo ? x : lo;
+        hi = x > hi ? x : hi;
+    }
+    if (lo >= 0 && hi <= 255)
+        return JF_ATTR_U8;
+    if (lo >= 0 && hi <= 65535)
+        return JF_ATTR_U16;
+    return lo >= -2147483648.0 && hi <= 2147483647.0 ? JF_ATTR_I32 : JF_ATTR_F64;
+}
+
+/* Moves the values into c->attrs, packed. */
+static jf_status text_attrs_pack(const tab *t, size_t n, jf_cloud *c)
+{
+    text_attrs *ta = t->ta;
+    jf_attrs *a = &c->attrs;
+    int *type = malloc((size_t)(ta->na ? ta->na : 1) * sizeof *type);
+    if (!type)
+        return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+    for (int j = 0; j < ta->ncols; j++) {
+        int k = ta->acol[j];
+        if (k < 0 || ta->text[k])
+            continue; /* a column of words is not carried */
+        jf_attr_type at = text_attr_type(ta, k, n);
+        type[k] = at;
+        if (!jf__attrs_add(a, ta->nm[j], ta->nml[j], at, (uint32_t)a->stride, 0, 0)) {
+            free(type);
+            return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+        }
+        a->stride += jf_attr_size[at];
+    }
+    if (a->nattrs && !(a->rec = malloc(n * a->stride))) {
+        free(type);
+        return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0,
+                          "out of memory for the attributes of %zu points", n);
+    }
+    for (int j = 0, m = 0; j < ta->ncols; j++) {
+        int k = ta->acol[j];
+        if (k < 0 || ta->text[k])
+            continue;
+        const jf_attr *at = &a->attr[m++];
+        for (size_t i = 0; i < n; i++) {
+            double x = ta->v[i * (size_t)ta->na + (size_t)k];
+            unsigned char *d = a->rec + i * a->stride + at->offset;
+            uint64_t b;
+            if (at->type == JF_ATTR_F64)
+                memcpy(&b, &x, 8);
+            else
+                b = (uint64_t)(int64_t)x;
+            for (unsigned q = 0; q < jf_attr_size[at->type]; q++)
+                d[q] = (unsigned char)(b >> (8 * q));
+        }
+    }
+    free(type);
     return JF_OK;
 }
 
@@ -199,11 +337,11 @@ static int set_maxcol(tab *t)
     return t->maxcol;
 }
 
-jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
-                      const char *name, const jf_read_opts *o, jf_cloud *c,
-                      jf_error *err)
+static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
+                         const char *name, const jf_read_opts *o, jf_cloud *c,
+                         jf_error *err, text_attrs *ta)
 {
-    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1};
+    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta};
     int setx = 0, setn = 0;
     for (int k = 0; k < 6; k++) {
         if (o->columns[k] < -1 || o->columns[k] > 4095)
@@ -272,7 +410,10 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                                           (setx ? 0 : 1) | (setn ? 0 : 2));
                 if (st != JF_OK)
                     return st;
+                if (ta && !ta->na)
+                    t.ta = ta = NULL; /* only x y z are named */
             } else {
+                t.ta = ta = NULL; /* no names: nothing to carry */
                 if (!setx)
                     t.col[0] = 0, t.col[1] = 1, t.col[2] = 2;
                 if (!setn && fmt != JF_FMT_PTS && default_normals(&t, ls, le))
@@ -331,7 +472,15 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                 v[k] = NAN;
         } else if (nf0 < 0) {
             nf0 = nf;
+            /* the rows are narrower than the header: its last names
+             * name nothing */
+            if (ta)
+                for (int jj = nf; jj < ta->ncols; jj++)
+                    if (ta->acol[jj] >= 0)
+                        ta->text[ta->acol[jj]] = 1;
         }
+        if (ta && !text_attrs_row(&t, n, ls, le, bad))
+            return jf_io_fail(err, JF_ERR_NOMEM, name, tx.line, "out of memory");
         if (n == cap) /* cannot happen for rows that parse: the bound */
             return jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
                               "more rows than supported");
@@ -355,5 +504,20 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
         c->xyz = q;
     if (have_nrm && (q = realloc(c->nrm, n * 3 * sizeof(double))) != NULL)
         c->nrm = q;
-    return JF_OK;
+    return ta ? text_attrs_pack(&t, n, c) : JF_OK;
+}
+
+jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
+                      const char *name, const jf_read_opts *o, jf_cloud *c,
+                      jf_error *err)
+{
+    text_attrs ta = {0};
+    ta.maxcol = -1;
+    jf_status st = read_xyz(buf, len, fmt, name, o, c, err, o->no_attrs ? NULL : &ta);
+    free(ta.nm);
+    free(ta.nml);
+    free(ta.acol);
+    free(ta.v);
+    free(ta.text);
+    return st;
 }

@@ -67,32 +67,49 @@ static jf_status from_bridge(int rc) {
 }
 
 jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out) {
+    return jf_natural_create_threads(xyz, n, 0, out);
+}
+
+jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads, jf_natural **out) {
     if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
     *out = NULL;
+#ifdef _OPENMP
+    int nthr = threads > 0 ? threads : omp_get_num_procs();
+#else
+    int nthr = 1;
+    (void)threads;
+#endif
     jf_natural *nt = calloc(1, sizeof *nt);
     if (!nt) return JF_ERR_NOMEM;
-    jf_status st = from_bridge(jfb_delaunay_build(xyz, n, &nt->d));
+    jf_status st = from_bridge(jfb_delaunay_build(xyz, n, nthr, &nt->d));
     if (st != JF_OK) {
         free(nt);
         return st;
     }
-    size_t nv = nt->d.nv;
+    size_t nv = nt->d.nv, max_deg = 0;
     nt->vxyz = malloc((3 * nv + 1) * sizeof(double));
     nt->nn = malloc((nv + 1) * sizeof(double));
     if (!nt->vxyz || !nt->nn) {
         jf_natural_free(nt);
         return JF_ERR_NOMEM;
     }
-    for (size_t v = 0; v < nv; v++) {
+    long nvl = (long)nv;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static) num_threads(nthr)
+#endif
+    for (long v = 0; v < nvl; v++) {
         const double *p = xyz + 3 * (size_t)nt->d.rep[v];
         memcpy(nt->vxyz + 3 * v, p, 3 * sizeof(double));
     }
     /* the nearest neighbour is always a Delaunay neighbour */
-    for (size_t v = 0; v < nv; v++) {
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static) num_threads(nthr) reduction(max : max_deg)
+#endif
+    for (long v = 0; v < nvl; v++) {
         const double *p = nt->vxyz + 3 * v;
         double best = INFINITY;
         size_t b = nt->d.adj_off[v], e = nt->d.adj_off[v + 1];
-        if (e - b > nt->max_deg) nt->max_deg = e - b;
+        if (e - b > max_deg) max_deg = e - b;
         for (size_t k = b; k < e; k++) {
             const double *q = nt->vxyz + 3 * (size_t)nt->d.adj[k];
             double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
@@ -101,6 +118,7 @@ jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out) {
         }
         nt->nn[v] = sqrt(best);
     }
+    nt->max_deg = max_deg;
     *out = nt;
     return JF_OK;
 }
@@ -122,6 +140,8 @@ void jf_natural_get_stats(const jf_natural *nt, jf_natural_stats *st) {
     st->nvertices = nt->d.nv;
     st->nduplicates = nt->d.nduplicates;
     st->nnonfinite = nt->d.nnonfinite;
+    memcpy(st->seconds, nt->d.seconds, sizeof st->seconds);
+    memcpy(st->cpu_seconds, nt->d.cpu_seconds, sizeof st->cpu_seconds);
 }
 
 size_t jf_natural_kept(const jf_natural *nt, size_t i) {
@@ -391,14 +411,25 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
     return 1;
 }
 
-/* Sorts list[a..b) by distance, then vertex id (insertion sort: rings
- * are short). */
+/* Lexicographic (x, y, z) order of two distinct vertices: the tie-break
+ * of equal distances (grids), a function of the points alone, so the
+ * cut ring does not depend on vertex ids (the spatial sort's order). */
+static int lex_greater(const jf_natural *nt, uint32_t a, uint32_t b) {
+    const double *p = nt->vxyz + 3 * (size_t)a, *q = nt->vxyz + 3 * (size_t)b;
+    if (p[0] != q[0]) return p[0] > q[0];
+    if (p[1] != q[1]) return p[1] > q[1];
+    return p[2] > q[2];
+}
+
+/* Sorts list[a..b) by distance, then lexicographically (insertion sort:
+ * rings are short). */
 static void sort_ring(jf_natural_ws *ws, size_t a, size_t b) {
     for (size_t k = a + 1; k < b; k++) {
         uint32_t v = ws->list[k];
         double d = ws->dist[k];
         size_t j = k;
-        while (j > a && (ws->dist[j - 1] > d || (ws->dist[j - 1] == d && ws->list[j - 1] > v))) {
+        while (j > a && (ws->dist[j - 1] > d ||
+                         (ws->dist[j - 1] == d && lex_greater(ws->nt, ws->list[j - 1], v)))) {
             ws->list[j] = ws->list[j - 1], ws->dist[j] = ws->dist[j - 1];
             j--;
         }

@@ -12,8 +12,10 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "jetfit.h"
+#include "orient_internal.h"
 
 /* A result whose normal can be oriented (and can orient others). */
 static int orientable(const jf_result *r)
@@ -167,6 +169,39 @@ static void seed_sort(const double *xyz, uint32_t *o, size_t len)
     }
 }
 
+/* What prim reads and changes: the normals (3n), the statuses (n) and a
+ * flip flag per point (n, toggled with each negation), so that the
+ * streaming pipeline can orient from 29 bytes per point instead of whole
+ * results (orient_internal.h). */
+typedef struct {
+    double *nrm;
+    unsigned *status;
+    unsigned char *flip;
+} oview;
+
+static int v_orientable(const oview *o, size_t i)
+{
+    const double *m = o->nrm + 3 * i;
+    return !(o->status[i] & (JF_PT_FAILED | JF_PT_NONFINITE)) && isfinite(m[0]) &&
+           isfinite(m[1]) && isfinite(m[2]);
+}
+
+static void v_flip(const oview *o, size_t i)
+{
+    for (int j = 0; j < 3; j++) o->nrm[3 * i + j] = -o->nrm[3 * i + j];
+    o->flip[i] ^= 1;
+}
+
+/* orient_along on the view. */
+static void v_along(const oview *o, size_t i, const double dir[3])
+{
+    double d = dot3(o->nrm + 3 * i, dir);
+    if (d < 0)
+        v_flip(o, i);
+    else if (!(d > 0))
+        o->status[i] |= JF_PT_ORIENT_UNKNOWN;
+}
+
 /* Where the graph's edges come from: k-NN queries, or stored lists. */
 typedef struct {
     const jf_index *ix;   /* query k+1 nearest (the point itself drops out) */
@@ -197,9 +232,9 @@ static jf_status get_neighbours(const nbsrc *src, uint32_t u, uint32_t *nb, size
  *  2. Pop the lightest reached point, flip it to agree with its parent,
  *     relax its k nearest neighbours with w = 1 - |ni.nj|.
  *  A seed with no orientable neighbour gets JF_PT_ORIENT_UNKNOWN. */
-static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *src)
+static jf_status prim(const oview *res, const double *xyz, size_t n, const nbsrc *src)
 {
-    if (n && (!res || !xyz || !(src->ix || src->g))) return JF_ERR_INVALID;
+    if (n && (!res->nrm || !xyz || !(src->ix || src->g))) return JF_ERR_INVALID;
     if (src->k < 1 || src->k > 1024) return JF_ERR_INVALID;
     if (n >= DONE) return JF_ERR_TOO_LARGE;
     size_t k = src->k;
@@ -217,7 +252,7 @@ static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *
     }
     size_t nseeds = 0;
     for (size_t i = 0; i < n; i++) {
-        int ok = orientable(&res[i]);
+        int ok = v_orientable(res, i);
         h.pos[i] = ok ? NOT_SEEN : DONE;
         if (ok) seeds[nseeds++] = (uint32_t)i;
     }
@@ -235,20 +270,20 @@ static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *
         int neighbours = 0;
         for (size_t j = 0; j < found; j++) {
             uint32_t v = nb[j];
-            if (v >= n || v == s || !orientable(&res[v])) continue;
+            if (v >= n || v == s || !v_orientable(res, v)) continue;
             neighbours = 1;
-            double w = 1.0 - fabs(dot3(res[s].normal, res[v].normal));
+            double w = 1.0 - fabs(dot3(res->nrm + 3 * (size_t)s, res->nrm + 3 * (size_t)v));
             if (h.pos[v] == DONE && w < bestw) {
                 bestw = w;
                 best = v;
             }
         }
         if (best != NOT_SEEN) {
-            orient_along(&res[s], res[best].normal);
-        } else if (res[s].normal[2] < 0) {
-            jf_result_flip(&res[s]); /* a new component: face +z */
+            v_along(res, s, res->nrm + 3 * (size_t)best);
+        } else if (res->nrm[3 * (size_t)s + 2] < 0) {
+            v_flip(res, s); /* a new component: face +z */
         }
-        if (!neighbours) res[s].status |= JF_PT_ORIENT_UNKNOWN;
+        if (!neighbours) res->status[s] |= JF_PT_ORIENT_UNKNOWN;
         h.key[s] = 0;
         h.heap[0] = s;
         h.pos[s] = 0;
@@ -257,13 +292,13 @@ static jf_status prim(jf_result *res, const double *xyz, size_t n, const nbsrc *
         /* step 2: grow the tree */
         while (h.len) {
             uint32_t u = heap_pop(&h);
-            if (parent[u] != u) orient_along(&res[u], res[parent[u]].normal);
+            if (parent[u] != u) v_along(res, u, res->nrm + 3 * (size_t)parent[u]);
             st = get_neighbours(src, u, nb, &found);
             if (st != JF_OK) goto out;
             for (size_t j = 0; j < found; j++) {
                 uint32_t v = nb[j];
                 if (v >= n || h.pos[v] == DONE) continue;
-                double w = 1.0 - fabs(dot3(res[u].normal, res[v].normal));
+                double w = 1.0 - fabs(dot3(res->nrm + 3 * (size_t)u, res->nrm + 3 * (size_t)v));
                 if (h.pos[v] == NOT_SEEN) {
                     h.key[v] = w;
                     parent[v] = u;
@@ -289,16 +324,54 @@ out:
     return st;
 }
 
+/* prim on whole results: their normals and statuses copied to a view,
+ * the flips and flags applied back (29 bytes per point for the call). */
+static jf_status prim_results(jf_result *res, const double *xyz, size_t n, const nbsrc *src)
+{
+    if (n && !res) return JF_ERR_INVALID;
+    oview v = {malloc((n ? n : 1) * 3 * sizeof *v.nrm), malloc((n ? n : 1) * sizeof *v.status),
+               calloc(n ? n : 1, 1)};
+    jf_status st = JF_ERR_NOMEM;
+    if (v.nrm && v.status && v.flip) {
+        for (size_t i = 0; i < n; i++) {
+            memcpy(v.nrm + 3 * i, res[i].normal, sizeof(double[3]));
+            v.status[i] = res[i].status;
+        }
+        st = prim(&v, xyz, n, src);
+        for (size_t i = 0; st == JF_OK && i < n; i++) {
+            if (v.flip[i]) jf_result_flip(&res[i]);
+            res[i].status = v.status[i];
+        }
+    }
+    free(v.nrm);
+    free(v.status);
+    free(v.flip);
+    return st;
+}
+
+jf_status jf__orient_mst_view(double *nrm, unsigned *status, unsigned char *flip,
+                              const double *xyz, size_t n, const uint32_t *nbr, size_t k)
+{
+    oview v = {nrm, status, flip};
+    nbsrc src = {NULL, nbr, xyz, k};
+    return prim(&v, xyz, n, &src);
+}
+
+void jf__orient_point(jf_result *r, const double dir[3])
+{
+    if (orientable(r)) orient_along(r, dir);
+}
+
 jf_status jf_orient_mst(jf_result *res, const double *xyz, size_t n,
                         const jf_index *ix, size_t k)
 {
     nbsrc src = {ix, NULL, xyz, k};
-    return prim(res, xyz, n, &src);
+    return prim_results(res, xyz, n, &src);
 }
 
 jf_status jf_orient_mst_graph(jf_result *res, const double *xyz, size_t n,
                               const uint32_t *nbr, size_t k)
 {
     nbsrc src = {NULL, nbr, xyz, k};
-    return prim(res, xyz, n, &src);
+    return prim_results(res, xyz, n, &src);
 }

@@ -65,7 +65,8 @@ static void x_range(jf_surface s, double *x0, double *x1)
         *x0 = lo[0];
         *x1 = hi[0];
     } else {
-        jf_surface_point(s, M_PI / 2, 0.0, X); /* widest point on +x */
+        /* widest point on +x (torus: phi = 0, on the outer equator) */
+        jf_surface_point(s, s == JF_SURF_TORUS ? 0.0 : M_PI / 2, 0.0, X);
         *x0 = -X[0];
         *x1 = X[0];
     }
@@ -110,6 +111,12 @@ jf_status jf_sample_random(jf_surface surf, size_t n, jf_density d,
                 if (jf_rng_uniform(rng) * a * b >= g)
                     continue;
             }
+        } else if (surf == JF_SURF_TORUS) {
+            /* area element (R + r cos psi) dphi dpsi, at most R + r */
+            u = 2.0 * M_PI * jf_rng_uniform(rng);
+            v = 2.0 * M_PI * jf_rng_uniform(rng);
+            if (jf_rng_uniform(rng) * 1.4 >= 1.0 + 0.4 * cos(v))
+                continue;
         } else {
             u = lo[0] + (hi[0] - lo[0]) * jf_rng_uniform(rng);
             v = lo[1] + (hi[1] - lo[1]) * jf_rng_uniform(rng);
@@ -136,27 +143,37 @@ double jf_sample_grid_h_for(jf_surface s, size_t n)
     }
     if (s == JF_SURF_CYLINDER) /* (2 pi R / h)(2 / h) vertices */
         return sqrt(4.0 * M_PI * 0.5 / (double)n);
+    if (s == JF_SURF_TORUS) /* (2 pi 1 / h)(2 pi 0.4 / h) vertices */
+        return 2.0 * M_PI * sqrt(0.4 / (double)n);
     return M_PI * sqrt(2.0 / (double)n); /* (pi / h)(2 pi / h) */
 }
 
 /* Triangles of an nu x nv vertex grid (vertex (i,j) = j*nu + i), split
  * along the (i,j)-(i+1,j+1) diagonal, counter-clockwise in (u,v);
- * wrap_u joins column nu-1 to column 0 (a seam). */
-static void grid_faces(uint32_t *idx, size_t nu, size_t nv, int wrap_u,
-                       uint32_t base)
+ * wrap_u joins column nu-1 to column 0 (a seam), wrap_v row nv-1 to row 0
+ * (the torus). */
+static void grid_faces2(uint32_t *idx, size_t nu, size_t nv, int wrap_u,
+                        int wrap_v, uint32_t base)
 {
-    size_t f = 0, cols = wrap_u ? nu : nu - 1;
-    for (size_t j = 0; j + 1 < nv; j++)
+    size_t f = 0, cols = wrap_u ? nu : nu - 1, rows = wrap_v ? nv : nv - 1;
+    for (size_t j = 0; j < rows; j++)
         for (size_t i = 0; i < cols; i++) {
             uint32_t i1 = (uint32_t)((i + 1) % nu);
+            size_t j1 = (j + 1) % nv;
             uint32_t a = base + (uint32_t)(j * nu + i);
             uint32_t b = base + (uint32_t)(j * nu + i1);
-            uint32_t c = base + (uint32_t)((j + 1) * nu + i);
-            uint32_t d = base + (uint32_t)((j + 1) * nu + i1);
+            uint32_t c = base + (uint32_t)(j1 * nu + i);
+            uint32_t d = base + (uint32_t)(j1 * nu + i1);
             uint32_t t[6] = {a, b, d, a, d, c};
             memcpy(idx + 3 * f, t, sizeof t);
             f += 2;
         }
+}
+
+static void grid_faces(uint32_t *idx, size_t nu, size_t nv, int wrap_u,
+                       uint32_t base)
+{
+    grid_faces2(idx, nu, nv, wrap_u, 0, base);
 }
 
 jf_status jf_sample_graph_grid(jf_surface s, double h, int m, double perturb,
@@ -239,8 +256,16 @@ jf_status jf_sample_grid(jf_surface s, double h, double perturb,
     jf_surface_domain(s, lo, hi);
     size_t nu, nv;
     double hu = h, hv = h;
-    int wrap = 0;
-    if (s == JF_SURF_CYLINDER) { /* u = phi (arc step h on radius 0.5) */
+    int wrap = 0, wrap_v = 0;
+    if (s == JF_SURF_TORUS) { /* phi: arc h on the central circle (R = 1),
+                                 psi: arc h on the tube (r = 0.4) */
+        double ku = fmax(3.0, round(2 * M_PI / h)), kv = fmax(3.0, round(2 * M_PI * 0.4 / h));
+        if (ku * kv > MAX_VERTS)
+            return JF_ERR_TOO_LARGE;
+        nu = (size_t)ku, nv = (size_t)kv;
+        hu = 2 * M_PI / ku, hv = 2 * M_PI / kv;
+        wrap = wrap_v = 1;
+    } else if (s == JF_SURF_CYLINDER) { /* u = phi (arc step h on radius 0.5) */
         double k = fmax(3.0, round(2 * M_PI * 0.5 / h));
         if (k > MAX_VERTS)
             return JF_ERR_TOO_LARGE;
@@ -253,13 +278,15 @@ jf_status jf_sample_grid(jf_surface s, double h, double perturb,
             return JF_ERR_TOO_LARGE;
         nu = (size_t)k;
     }
-    double kv = floor((hi[1] - lo[1]) / h + 1e-9) + 1;
-    if (kv * (double)nu > MAX_VERTS)
-        return JF_ERR_TOO_LARGE;
-    nv = (size_t)kv;
+    if (!wrap_v) {
+        double kv = floor((hi[1] - lo[1]) / h + 1e-9) + 1;
+        if (kv * (double)nu > MAX_VERTS)
+            return JF_ERR_TOO_LARGE;
+        nv = (size_t)kv;
+    }
     if (nu < 2 || nv < 2)
         return JF_ERR_INVALID;
-    size_t nf = with_faces ? 2 * (wrap ? nu : nu - 1) * (nv - 1) : 0;
+    size_t nf = with_faces ? 2 * (wrap ? nu : nu - 1) * (wrap_v ? nv : nv - 1) : 0;
     jf_status st = alloc_sample(out, nu * nv, nf);
     if (st)
         return st;
@@ -271,7 +298,7 @@ jf_status jf_sample_grid(jf_surface s, double h, double perturb,
                        lo[1] + ((double)j + dv) * hv);
         }
     if (with_faces)
-        grid_faces(out->face_idx, nu, nv, wrap, 0);
+        grid_faces2(out->face_idx, nu, nv, wrap, wrap_v, 0);
     return JF_OK;
 }
 

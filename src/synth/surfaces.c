@@ -8,7 +8,10 @@
  * d2 are its eigenpairs.  Graphs get S from the exact derivatives of f
  * (I and II of the Monge patch X = (x, y, f)); quadrics from their
  * implicit equation F = 0: n = grad F/|grad F|, S = -P Hess(F) P/|grad F|
- * (regular everywhere, unlike the UV parametrisation at the poles). */
+ * (regular everywhere, unlike the UV parametrisation at the poles).
+ * The torus has its principal frame in closed form: d_phi along the
+ * parallels, d_psi along the tube's circles, curvatures (outward normal)
+ * -cos psi / (R + r cos psi) and -1/r (never equal: no umbilics). */
 #include <math.h>
 #include <string.h>
 
@@ -18,9 +21,11 @@
 #define ELL_B 0.75
 #define ELL_C 0.5
 #define CYL_R 0.5
+#define TOR_R 1.0 /* central circle */
+#define TOR_r 0.4 /* tube */
 
 static const char *const names[JF_SURF_COUNT] = {
-    "exp", "paraboloid", "revolution", "sphere", "ellipsoid", "cylinder"};
+    "exp", "paraboloid", "revolution", "sphere", "ellipsoid", "cylinder", "torus"};
 
 const char *jf_surface_name(jf_surface s)
 {
@@ -66,6 +71,10 @@ void jf_surface_domain(jf_surface s, double lo[2], double hi[2])
         hi[0] = M_PI;
         lo[1] = 0.0;
         hi[1] = 2.0 * M_PI;
+        break;
+    case JF_SURF_TORUS:
+        lo[0] = lo[1] = 0.0;
+        hi[0] = hi[1] = 2.0 * M_PI;
         break;
     default: /* cylinder */
         lo[0] = 0.0;
@@ -133,6 +142,11 @@ void jf_surface_point(jf_surface s, double u, double v, double X[3])
         X[0] = CYL_R * cos(u);
         X[1] = CYL_R * sin(u);
         X[2] = v;
+        return;
+    case JF_SURF_TORUS:
+        X[0] = (TOR_R + TOR_r * cos(v)) * cos(u);
+        X[1] = (TOR_R + TOR_r * cos(v)) * sin(u);
+        X[2] = TOR_r * sin(v);
         return;
     default:
         graph_derivs(s, u, v, d);
@@ -256,12 +270,28 @@ static void truth_quadric(const double D[3], jf_truth *t)
     finish(-a / gl, -b / gl, -c / gl, e1, e2, t);
 }
 
+/* Torus at (phi, psi) = (u, v): outward normal (cos v cos u, cos v sin u,
+ * sin v); e1 = d_phi = (-sin u, cos u, 0) with normal curvature
+ * -cos v / (R + r cos v) (the parallel's curvature 1/(R + r cos v) times
+ * the cosine of its angle with the surface), e2 = n x e1 (along the tube)
+ * with -1/r.  S is diagonal in (e1, e2). */
+static void truth_torus(double u, double v, jf_truth *t)
+{
+    double n[3] = {cos(v) * cos(u), cos(v) * sin(u), sin(v)};
+    double e1[3] = {-sin(u), cos(u), 0.0}, e2[3];
+    memcpy(t->normal, n, sizeof n);
+    cross3(n, e1, e2);
+    finish(-cos(v) / (TOR_R + TOR_r * cos(v)), 0.0, -1.0 / TOR_r, e1, e2, t);
+}
+
 void jf_surface_truth(jf_surface s, double u, double v, jf_truth *t)
 {
     jf_surface_point(s, u, v, t->xyz);
     t->valid = 1;
     if (jf_surface_is_graph(s)) {
         truth_graph(s, u, v, t);
+    } else if (s == JF_SURF_TORUS) {
+        truth_torus(u, v, t);
     } else {
         double D[3];
         if (s == JF_SURF_SPHERE) {

@@ -7,7 +7,7 @@
  * it, i.e. near the point the surface is z = (k1 x^2 + k2 y^2)/2 along the
  * normal with x along d1, y along d2, and d1 x d2 = n.  Graphs z = f(x,y)
  * use the upward normal (-f_x, -f_y, 1)/W; closed surfaces (sphere,
- * ellipsoid, cylinder) the outward normal, so their convex curvatures are
+ * ellipsoid, cylinder, torus) the outward normal, so their convex curvatures are
  * negative (sphere of radius 1: k1 = k2 = -1).
  * Nothing here prints or allocates per point except the sampling calls,
  * which allocate their output arrays once.  Everything is deterministic
@@ -33,6 +33,9 @@ typedef enum {
     JF_SURF_ELLIPSOID,   /* x^2/1 + y^2/0.75^2 + z^2/0.5^2 = 1 (4 umbilics
                             in the xz plane)                              */
     JF_SURF_CYLINDER,    /* x^2 + y^2 = 0.5^2, z in [-1, 1], open         */
+    JF_SURF_TORUS,       /* (sqrt(x^2 + y^2) - 1)^2 + z^2 = 0.4^2: closed,
+                            with a hole; elliptic outside, hyperbolic
+                            inside, parabolic on its top/bottom circles */
     JF_SURF_COUNT
 } jf_surface;
 
@@ -46,7 +49,7 @@ typedef struct {
 } jf_truth;
 
 /* Name ("exp", "paraboloid", "revolution", "sphere", "ellipsoid",
- * "cylinder") <-> surface.  jf_surface_parse returns -1 if unknown. */
+ * "cylinder", "torus") <-> surface.  jf_surface_parse returns -1 if unknown. */
 const char *jf_surface_name(jf_surface s);
 int jf_surface_parse(const char *name, jf_surface *s);
 
@@ -58,7 +61,9 @@ int jf_surface_is_graph(jf_surface s);
 int jf_surface_has_directions(jf_surface s);
 
 /* The parameter rectangle: graphs (x,y); sphere/ellipsoid (theta polar
- * in [0,pi], phi in [0,2pi)); cylinder (phi in [0,2pi), z in [-1,1]). */
+ * in [0,pi], phi in [0,2pi)); cylinder (phi in [0,2pi), z in [-1,1]);
+ * torus (phi around the z axis, psi around the tube, both [0,2pi):
+ * X = ((1 + 0.4 cos psi) cos phi, (1 + 0.4 cos psi) sin phi, 0.4 sin psi)). */
 void jf_surface_domain(jf_surface s, double lo[2], double hi[2]);
 
 /* The parametrisation X(u,v) (what tests differentiate numerically). */
@@ -106,7 +111,8 @@ void jf_sample_free(jf_sample *s);
 
 /* n random points: graphs and the cylinder uniform in parameters (for
  * the cylinder that is area-uniform); sphere and ellipsoid area-uniform
- * (ellipsoid by rejection on the sphere's area element).  A density
+ * (ellipsoid by rejection on the sphere's area element), the torus
+ * area-uniform (rejection on its area element 1 + 0.4 cos psi).  A density
  * other than uniform thins by rejection until n points are kept. */
 jf_status jf_sample_random(jf_surface s, size_t n, jf_density d,
                            jf_rng *rng, jf_sample *out);
@@ -118,7 +124,8 @@ jf_status jf_sample_random(jf_surface s, size_t n, jf_density d,
  * valence 6).  Sphere/ellipsoid: a closed UV sphere, rings of constant
  * theta (spacing pi/round(pi/h)), phi wrapping at the seam, one vertex
  * per pole with a triangle fan (poles are not perturbed).  Cylinder: an
- * open tube, phi wrapping.  with_faces = 0 gives the vertices only. */
+ * open tube, phi wrapping.  Torus: phi and psi both wrapping (arc step
+ * about h on the tube and on the central circle).  with_faces = 0 gives the vertices only. */
 jf_status jf_sample_grid(jf_surface s, double h, double perturb,
                          int with_faces, jf_rng *rng, jf_sample *out);
 

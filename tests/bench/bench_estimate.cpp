@@ -4,10 +4,12 @@
 // z = 0.1 exp(2x + y - y^2) in random order, stored twice: as binary PLY
 // and as .xyz text (%.17g, as scanners' exports and our own writer).
 //
-//   bench_estimate [N] [--normals] [--keep DIR]
+//   bench_estimate [N] [--normals] [--keep DIR] [--also JETFIT]
 //       (needs the built jetfit next to it: JF_BUILD_DIR/jetfit)
-//   --normals   also run CGAL's jet_estimate_normals (binary PLY only)
-//   --keep DIR  write the inputs into DIR and keep them (for profiling)
+//   --normals      also run CGAL's jet_estimate_normals (binary PLY only)
+//   --keep DIR     write the inputs into DIR and keep them (for profiling)
+//   --also JETFIT  also run another jetfit binary (e.g. an older build) on
+//                  one thread: before and after in the same run
 //
 // Every contender runs in its own child process (fork), so its peak
 // memory (wait4's ru_maxrss) is its own, and starts with no output file
@@ -110,11 +112,13 @@ template <class F> static Run in_child(F f)
     return {secs, cpu, ru.ru_maxrss, WIFEXITED(status) && WEXITSTATUS(status) == 0};
 }
 
+static const char *g_jetfit = JF_BUILD_DIR "/jetfit";
+
 static int run_jetfit(const std::string &in, int k, int degree, int threads)
 {
     std::string out = g_dir + "/jetfit_out.ply", nb = "knn:" + std::to_string(k);
     std::string deg = std::to_string(degree), th = std::to_string(threads);
-    const char *argv[] = {JF_BUILD_DIR "/jetfit", "estimate", in.c_str(), "-o", out.c_str(),
+    const char *argv[] = {g_jetfit, "estimate", in.c_str(), "-o", out.c_str(),
                           "--neighbors", nb.c_str(), "--degree", deg.c_str(), "--threads",
                           th.c_str(), "--quiet", nullptr};
     execv(argv[0], (char *const *)argv);
@@ -211,10 +215,11 @@ int main(int argc, char **argv)
 {
     size_t n = 1000000;
     bool normals = false;
-    const char *keep = nullptr;
+    const char *keep = nullptr, *also = nullptr;
     for (int a = 1; a < argc; a++) {
         if (!std::strcmp(argv[a], "--normals")) normals = true;
         else if (!std::strcmp(argv[a], "--keep") && a + 1 < argc) keep = argv[++a];
+        else if (!std::strcmp(argv[a], "--also") && a + 1 < argc) also = argv[++a];
         else n = std::strtoul(argv[a], nullptr, 10);
     }
     char tmpl[] = "/tmp/jf_bench_XXXXXX";
@@ -229,7 +234,7 @@ int main(int argc, char **argv)
                 n, jf_cgalref::cgal_svd_name);
     loadavg("before");
     const int cfg[2][2] = {{16, 2}, {32, 3}};
-    double ratio[2][2] = {{0, 0}, {0, 0}};
+    double ratio[2][2] = {{0, 0}, {0, 0}}, cratio[2][2] = {{0, 0}, {0, 0}};
     for (int ci = 0; ci < 2; ci++)
         for (int fi = 0; fi < 2; fi++) {
             int k = cfg[ci][0], d = cfg[ci][1];
@@ -241,6 +246,14 @@ int main(int argc, char **argv)
                 Run jn = in_child([&] { return run_cgal_jet_normals(in, k, d); });
                 report("  CGAL jet_estimate_normals (seq)", n, jn, &cg);
             }
+            if (also) {
+                const char *own = g_jetfit;
+                g_jetfit = also;
+                Run ja = in_child([&] { return run_jetfit(in, k, d, 1); });
+                g_jetfit = own;
+                std::string what = std::string("  ") + also + " --threads 1";
+                report(what.c_str(), n, ja, &cg);
+            }
             Run j1 = in_child([&] { return run_jetfit(in, k, d, 1); });
             report("  jetfit estimate --threads 1", n, j1, &cg);
             Run j2 = in_child([&] { return run_jetfit(in, k, d, 2); });
@@ -248,12 +261,16 @@ int main(int argc, char **argv)
             if (j1.ok && j2.ok)
                 std::printf("  jetfit speed-up 1 -> 2 threads: x%.2f\n", j1.secs / j2.secs);
             if (cg.ok && j1.ok) ratio[ci][fi] = cg.secs / j1.secs;
+            if (cg.ok && j1.ok) cratio[ci][fi] = cg.cpu / j1.cpu;
             std::printf("\n");
         }
     loadavg("after");
     std::printf("one thread, wall, jetfit vs CGAL: knn:16 d2 PLY x%.2f, xyz x%.2f; "
                 "knn:32 d3 PLY x%.2f, xyz x%.2f\n",
                 ratio[0][0], ratio[0][1], ratio[1][0], ratio[1][1]);
+    std::printf("one thread, cpu,  jetfit vs CGAL: knn:16 d2 PLY x%.2f, xyz x%.2f; "
+                "knn:32 d3 PLY x%.2f, xyz x%.2f\n",
+                cratio[0][0], cratio[0][1], cratio[1][0], cratio[1][1]);
     for (const char *f : {"jetfit_out.ply", "cgal_out.ply", "cgal_normals.ply"})
         std::remove((g_dir + "/" + f).c_str());
     if (!keep) {

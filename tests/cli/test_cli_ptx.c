@@ -73,6 +73,27 @@ START_TEST(scanner_without_positions_refused)
 }
 END_TEST
 
+/* The same on a LAS file (issue 13: "refused with a clear line"); the LAS
+ * comes from `jetfit generate -o s.las`, which also checks that the
+ * generator writes LAS at all. */
+START_TEST(scanner_on_las_refused)
+{
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "200", "-o", cli_path("s.las"), NULL), 0);
+    ck_assert(cli_exists(cli_path("s.las")));
+    int rc = cli_run("estimate", cli_path("s.las"), "-o", cli_path("o.las"), "--orient", "scanner",
+                     NULL);
+    ck_assert_int_eq(rc, 1);
+    ck_assert_msg(strstr(cli_err, "s.las: --orient scanner needs the scanner positions"), "%s",
+                  cli_err);
+    ck_assert_msg(!strchr(cli_err, '\n') || strchr(cli_err, '\n')[1] == '\0', "one line: %s", cli_err);
+    ck_assert(!cli_exists(cli_path("o.las")));
+    /* without the option the LAS file is estimated */
+    ck_assert_int_eq(cli_run("estimate", cli_path("s.las"), "-o", cli_path("o.las"), "--quiet",
+                             NULL), 0);
+    ck_assert(cli_exists(cli_path("o.las")));
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_ptx");
@@ -81,6 +102,7 @@ int main(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, normals_face_their_scanner);
     tcase_add_test(tc, scanner_without_positions_refused);
+    tcase_add_test(tc, scanner_on_las_refused);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -666,7 +666,7 @@ START_TEST(bad_input_one_line_no_folder)
     ck_assert_int_eq(count_str(cli_err, "\n"), 1);
     ck_assert(!cli_exists(dir));
     /* neither a surface nor an input with truth */
-    ck_assert_int_eq(cli_run("study", "torus", "-o", dir, NULL), 2);
+    ck_assert_int_eq(cli_run("study", "klein", "-o", dir, NULL), 2);
     ck_assert(!cli_exists(dir));
     cli_teardown();
 }

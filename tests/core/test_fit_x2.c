@@ -2,7 +2,8 @@
  * lanes of jf__eig3_x2 and the fast path's QL) give the bits of the
  * one-at-a-time path, and jf_estimate on the k-NN path (pairs, streamed
  * rows) gives the bits of the plain per-point loop this test keeps:
- * jf_index_knn then jf_fit_point, point by point.  Cases: the §6.1
+ * jf_index_knn then jf_fit_point, point by point; and jf__ldexp is
+ * ldexp.  Cases: the §6.1
  * surface, noisy and exact paraboloids, planes (umbilics), offsets of
  * 1e6, clusters (kappa > 1e3: the SVD path), collinear and duplicated
  * points, too few points (lowered degrees), non-finite neighbours, and
@@ -106,6 +107,29 @@ START_TEST(test_eig3_x2_bits)
             ck_assert_msg(same_bits(ev[k], ev1, 3) && same_bits(vec[k], vec1, 9),
                           "eig3 lane %d differs at %d", k, t);
         }
+    }
+}
+END_TEST
+
+/* jf__ldexp (one multiplication) against ldexp, bit for bit, over the
+ * whole range: subnormal, overflowing, zero, infinite and NaN results. */
+START_TEST(test_ldexp_bits)
+{
+    rng_state = 7;
+    static const double special[] = {0.0, -0.0, INFINITY, -INFINITY, NAN, 0x1p-1074, 0x1p-1022,
+                                     0x1.fffffffffffffp+1023, 1.0, -3.0, 0x1.8p-1060};
+    for (int t = 0; t < 2000000; t++) {
+        double x;
+        if (t < 11 * 64) {
+            x = special[t % 11];
+        } else {
+            uint64_t u = (uint64_t)(urand() * 0x1p53) << 11 ^ (uint64_t)(urand() * 2048);
+            memcpy(&x, &u, sizeof x);
+        }
+        int e = (int)(urand() * 2300) - 1150;
+        double a = jf__ldexp(x, e), b = ldexp(x, e);
+        ck_assert_msg(memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b)),
+                      "ldexp(%a, %d): %a vs %a", x, e, a, b);
     }
 }
 END_TEST
@@ -234,6 +258,7 @@ int main(void)
     Suite *s = suite_create("fit_x2");
     TCase *tc = tcase_create("core");
     tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_ldexp_bits);
     tcase_add_test(tc, test_eig3_x2_bits);
     tcase_add_test(tc, test_fit_x2_bits);
     tcase_add_test(tc, test_estimate_vs_loop);

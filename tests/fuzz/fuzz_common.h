@@ -42,6 +42,20 @@ static void jf_fuzz_check(const uint8_t *data, size_t size, jf_format fmt,
     volatile double sum = 0;
     for (size_t i = 0; i < 3 * c.n; i++)
         sum += c.xyz[i] + (c.nrm ? c.nrm[i] : 0);
+    /* the attributes (issue 13.4): every description inside its record,
+     * every value readable */
+    const jf_attrs *a = &c.attrs;
+    if (a->nattrs && (!a->rec || !a->attr))
+        abort();
+    for (size_t j = 0; j < a->nattrs; j++) {
+        static const unsigned sz[10] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+        const jf_attr *at = &a->attr[j];
+        if ((unsigned)at->type > JF_ATTR_F64 || at->offset + sz[at->type] > a->stride ||
+            at->shift + at->bits > 8 || !memchr(at->name, '\0', sizeof at->name))
+            abort();
+        for (size_t i = 0; i < c.n; i++)
+            sum += jf_attr_get(a, j, i);
+    }
     (void)sum;
     jf_cloud_free(&c);
 }

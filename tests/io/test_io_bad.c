@@ -260,6 +260,43 @@ START_TEST(fuzz_regressions)
 }
 END_TEST
 
+/* The fuzzers' seeds (tests/fuzz/corpus/<reader>/) are valid files: each
+ * reads, as a whole file through its reader, with at least one point (the
+ * xyz harness's seeds start with a format byte and are left out). */
+START_TEST(fuzz_seeds_read)
+{
+    static const struct { const char *dir; jf_format fmt; } r[] = {
+        {"ply", JF_FMT_PLY}, {"off", JF_FMT_OFF}, {"las", JF_FMT_LAS}, {"ptx", JF_FMT_PTX}};
+    for (size_t i = 0; i < sizeof r / sizeof r[0]; i++) {
+        char dir[512];
+        snprintf(dir, sizeof dir, "%s/fuzz/corpus/%s", JF_TESTS_DIR, r[i].dir);
+        DIR *d = opendir(dir);
+        ck_assert_msg(d != NULL, "%s", dir);
+        int seeds = 0;
+        struct dirent *de;
+        while ((de = readdir(d)) != NULL) {
+            if (de->d_name[0] == '.')
+                continue;
+            char path[1024];
+            snprintf(path, sizeof path, "%s/%s", dir, de->d_name);
+            FILE *f = fopen(path, "rb");
+            ck_assert_ptr_nonnull(f);
+            char buf[1 << 16];
+            size_t len = fread(buf, 1, sizeof buf, f);
+            fclose(f);
+            jf_cloud c;
+            jf_error e;
+            jf_status st = jf_cloud_read_mem(buf, len, r[i].fmt, path, NULL, &c, &e);
+            ck_assert_msg(st == JF_OK && c.n > 0, "%s: %s", path, e.msg);
+            jf_cloud_free(&c);
+            seeds++;
+        }
+        closedir(d);
+        ck_assert_msg(seeds > 0, "no seeds in %s", dir);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("io_bad");
@@ -272,6 +309,7 @@ int main(void)
     tcase_add_test(tc, faces_out_of_range);
     tcase_add_test(tc, text_rows);
     tcase_add_test(tc, fuzz_regressions);
+    tcase_add_test(tc, fuzz_seeds_read);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

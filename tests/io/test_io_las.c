@@ -91,6 +91,41 @@ START_TEST(every_format)
 }
 END_TEST
 
+/* Every version 1.0-1.4 with its own header size (227 up to 1.2, 235 for
+ * 1.3, 375 for 1.4: the point data starts after it), formats 0 and 1. */
+START_TEST(every_version)
+{
+    static const unsigned hsz[5] = {227, 227, 227, 235, 375};
+    for (unsigned minor = 0; minor <= 4; minor++)
+        for (unsigned fmt = 0; fmt <= 1; fmt++) {
+            unsigned char *b;
+            size_t len0 = make_las(fmt, 0, 30, &b), rl = base_len[fmt];
+            /* move the records behind a header of hsz[minor] bytes */
+            size_t len = hsz[minor] + 30 * rl;
+            unsigned char *m = calloc(1, len);
+            memcpy(m, b, 227);
+            memcpy(m + hsz[minor], b + (len0 - 30 * rl), 30 * rl);
+            m[25] = (unsigned char)minor;
+            put16(m + 94, hsz[minor]);
+            put32(m + 96, hsz[minor]);
+            if (minor == 4) put64(m + 247, 30);
+            const char *p = fixture("v.las", m, len);
+            jf_cloud c;
+            jf_error e;
+            ck_assert_msg(jf_cloud_read(p, NULL, &c, &e) == JF_OK, "1.%u format %u: %s", minor, fmt,
+                          e.msg);
+            ck_assert_uint_eq(c.n, 30);
+            for (size_t i = 0; i < 30; i++) {
+                ck_assert(c.xyz[3 * i] == (1000.0 * (double)i - 7) * 0.001 + 1e6);
+                ck_assert(c.xyz[3 * i + 2] == (double)(i * i) * 0.01 + 350);
+            }
+            jf_cloud_free(&c);
+            free(m);
+            free(b);
+        }
+}
+END_TEST
+
 /* laspy's samples against the x y z listings made from them (3 decimals,
  * so to half a millimetre; the scale is 0.01 or 0.001). */
 static void sample(const char *las, const char *xyz, size_t n)
@@ -354,6 +389,7 @@ int main(void)
     TCase *tc = tcase_create("las");
     tcase_add_checked_fixture(tc, setup, teardown);
     tcase_add_test(tc, every_format);
+    tcase_add_test(tc, every_version);
     tcase_add_test(tc, real_samples);
     tcase_add_test(tc, header_lies);
     tcase_add_test(tc, writer_round_trip);

@@ -141,6 +141,48 @@ START_TEST(lies_refused)
 }
 END_TEST
 
+/* Where the scanner is (Leica's PTX description, quoted in io_ptx.c): the
+ * position line is already registered, never moved by the 4x4 M; but M
+ * may also hold the export's UCS, which the line does not.  Scan 1: an
+ * unregistered scan (line 0 0 0, axes identity) exported in a UCS (M a
+ * rotation and a translation): its points and its scanner land in the UCS
+ * frame, the scanner at M's translation row.  Scan 2: M the identity,
+ * points written already registered: the position line.  Scan 3: Leica's
+ * usual registered export (line = translation row): that position. */
+START_TEST(scanner_position)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/ucs.ptx", tmpdir);
+    FILE *f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs("1\n2\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+          "0 1 0 0\n-1 0 0 0\n0 0 1 0\n100 200 30 1\n"
+          "2 0 0 0.5\n0 3 0 0.5\n", f);
+    fputs("1\n1\n7 8 9\n1 0 0\n0 1 0\n0 0 1\n"
+          "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+          "9 8 7 0.5\n", f);
+    fputs("1\n1\n5 6 7\n0 1 0\n-1 0 0\n0 0 1\n"
+          "0 1 0 0\n-1 0 0 0\n0 0 1 0\n5 6 7 1\n"
+          "1 0 0 0.5\n", f);
+    fclose(f);
+    jf_cloud c;
+    jf_error e = {{0}};
+    ck_assert_msg(jf_cloud_read(path, NULL, &c, &e) == JF_OK, "%s", e.msg);
+    ck_assert_uint_eq(c.nscans, 3);
+    ck_assert_uint_eq(c.n, 4);
+    /* scan 1: (2 0 0) M = (100, 202, 30), (0 3 0) M = (97, 200, 30) */
+    static const double want_xyz[4][3] = {{100, 202, 30}, {97, 200, 30}, {9, 8, 7}, {5, 7, 7}};
+    static const double want_sc[3][3] = {{100, 200, 30}, {7, 8, 9}, {5, 6, 7}};
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++) ck_assert(c.xyz[3 * i + a] == want_xyz[i][a]);
+    for (int s = 0; s < 3; s++)
+        for (int a = 0; a < 3; a++)
+            ck_assert_msg(c.scanner[3 * s + a] == want_sc[s][a], "scan %d axis %d: %g", s + 1, a,
+                          c.scanner[3 * s + a]);
+    jf_cloud_free(&c);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("io_ptx");
@@ -149,6 +191,7 @@ static Suite *suite(void)
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, two_scans_exact);
     tcase_add_test(tc, lies_refused);
+    tcase_add_test(tc, scanner_position);
     suite_add_tcase(s, tc);
     return s;
 }

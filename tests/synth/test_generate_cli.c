@@ -187,7 +187,7 @@ START_TEST(bad_options)
     static const struct {
         const char *args, *msg;
     } cases[] = {
-        {"generate torus -o x.ply", "unknown surface 'torus'"},
+        {"generate klein -o x.ply", "unknown surface 'klein'"},
         {"generate exp", "-o FILE is required"},
         {"generate exp --n 0 -o x.ply", "--n wants a positive integer"},
         {"generate exp --n 12abc -o x.ply", "--n wants a positive integer"},

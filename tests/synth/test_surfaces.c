@@ -237,6 +237,83 @@ START_TEST(cylinder_mesh_outward)
 }
 END_TEST
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The torus (R = 1, r = 0.4): closed-form values on its outer equator
+ * (elliptic, k1 = -1/1.4 along the parallel), inner equator (hyperbolic,
+ * k1 = +1/0.6), top circle (parabolic, k1 = 0), each point on the
+ * implicit surface with the implicit gradient as normal; the closed mesh
+ * (both seams joined: every edge in exactly two faces, faces outward);
+ * area-uniform sampling (the outer half psi in (-pi/2, pi/2) holds
+ * (pi R + 2 r) / (2 pi R) = 0.6273 of the area; the parameter-uniform
+ * half would hold 0.5). */
+START_TEST(torus)
+{
+    jf_truth t;
+    jf_surface_truth(JF_SURF_TORUS, 0.3, 0.0, &t);
+    ck_assert(fabs(t.k1 + 1 / 1.4) < 1e-14 && fabs(t.k2 + 2.5) < 1e-14);
+    ck_assert(fabs(t.normal[0] - cos(0.3)) < 1e-15 && fabs(t.normal[1] - sin(0.3)) < 1e-15);
+    ck_assert(fabs(t.d1[0] + sin(0.3)) < 1e-15 && fabs(t.d1[1] - cos(0.3)) < 1e-15); /* along the parallel */
+    jf_surface_truth(JF_SURF_TORUS, 1.1, M_PI, &t);
+    ck_assert(fabs(t.k1 - 1 / 0.6) < 1e-13 && fabs(t.k2 + 2.5) < 1e-14);
+    ck_assert(fabs(hypot(t.xyz[0], t.xyz[1]) - 0.6) < 1e-15);
+    ck_assert(t.normal[0] * t.xyz[0] + t.normal[1] * t.xyz[1] < 0); /* outward = towards the axis */
+    jf_surface_truth(JF_SURF_TORUS, 2.0, M_PI / 2, &t);
+    ck_assert(fabs(t.k1) < 1e-14 && fabs(t.k2 + 2.5) < 1e-14 && fabs(t.normal[2] - 1) < 1e-15);
+    jf_rng r;
+    jf_rng_seed(&r, 3);
+    for (int i = 0; i < 200; i++) {
+        double u = 2 * M_PI * jf_rng_uniform(&r), v = 2 * M_PI * jf_rng_uniform(&r);
+        jf_surface_truth(JF_SURF_TORUS, u, v, &t);
+        double rho = hypot(t.xyz[0], t.xyz[1]);
+        ck_assert(fabs((rho - 1) * (rho - 1) + t.xyz[2] * t.xyz[2] - 0.16) < 1e-14);
+        double g[3] = {2 * (rho - 1) * t.xyz[0] / rho, 2 * (rho - 1) * t.xyz[1] / rho, 2 * t.xyz[2]};
+        double gl = sqrt(dot3(g, g));
+        for (int k = 0; k < 3; k++)
+            ck_assert(fabs(g[k] / gl - t.normal[k]) < 1e-12);
+        ck_assert(t.k1 > t.k2);
+    }
+
+    jf_sample s;
+    ck_assert_int_eq(jf_sample_grid(JF_SURF_TORUS, 0.05, 0.0, 1, &r, &s), JF_OK);
+    size_t nu = (size_t)round(2 * M_PI / 0.05), nv = (size_t)round(2 * M_PI * 0.4 / 0.05);
+    ck_assert_uint_eq(s.n, nu * nv);
+    ck_assert_uint_eq(s.nfaces, 2 * nu * nv); /* closed: V - E + F = 0 */
+    /* every directed edge once and its reverse once: closed, oriented */
+    size_t ne = 3 * s.nfaces;
+    uint64_t *e = malloc(ne * sizeof *e);
+    for (size_t f = 0; f < s.nfaces; f++) {
+        const uint32_t *q = s.face_idx + 3 * f;
+        double nf[3];
+        face_normal(&s, f, nf);
+        ck_assert(dot3(nf, s.truth[q[0]].normal) > 0); /* outward */
+        for (int k = 0; k < 3; k++)
+            e[3 * f + k] = (uint64_t)q[k] * s.n + q[(k + 1) % 3];
+    }
+    qsort(e, ne, sizeof *e, cmp_u64);
+    for (size_t k = 0; k + 1 < ne; k++)
+        ck_assert(e[k] != e[k + 1]);
+    for (size_t k = 0; k < ne; k++) {
+        uint64_t rev = (e[k] % s.n) * s.n + e[k] / s.n;
+        ck_assert(bsearch(&rev, e, ne, sizeof *e, cmp_u64) != NULL);
+    }
+    free(e);
+    jf_sample_free(&s);
+
+    size_t n = 40000, outer = 0;
+    ck_assert_int_eq(jf_sample_random(JF_SURF_TORUS, n, JF_DENSITY_UNIFORM, &r, &s), JF_OK);
+    for (size_t i = 0; i < n; i++)
+        outer += cos(s.uv[2 * i + 1]) > 0;
+    /* binomial sd sqrt(p q / n) = 0.0024: 5 sd */
+    ck_assert(fabs((double)outer / n - (M_PI + 0.8) / (2 * M_PI)) < 0.012);
+    jf_sample_free(&s);
+}
+END_TEST
+
 START_TEST(graph_grid_layout_and_determinism)
 {
     jf_rng r1, r2;
@@ -310,6 +387,7 @@ int main(void)
     tcase_add_test(tc, random_samples_lie_on_surface);
     tcase_add_test(tc, closed_meshes_are_closed_and_outward);
     tcase_add_test(tc, cylinder_mesh_outward);
+    tcase_add_test(tc, torus);
     tcase_add_test(tc, graph_grid_layout_and_determinism);
     tcase_add_test(tc, noise_models);
     suite_add_tcase(s, tc);

@@ -1,0 +1,388 @@
+/* jetfit_mpi.c -- `mpirun -np N jetfit-mpi estimate INPUT -o OUTPUT [options]`:
+ * the estimate of `jetfit estimate`, over MPI, byte for byte the same file.
+ *
+ * design: the options are parsed by the command's own code (src/cli/opts.c)
+ * and the rows made by it (src/cli/rows.c); mpi_dist.c gives each rank its
+ * part of the cloud and the part's exact halo; the fit is the pipeline's
+ * (jf__estimate_masked: the halo points are neighbours, not fitted); each
+ * rank writes its rows with MPI-IO at their input-order offsets into the
+ * temporary of rank 0's table writer (header written by it), which rank 0
+ * renames onto OUTPUT once every rank has succeeded.  Text outputs (.csv,
+ * .xyz, .txt, --ascii) go through a binary temporary that rank 0 converts
+ * in one sequential pass with the same writer.  Refused with one line:
+ * natural and rings neighbourhoods, --orient mst and scanner (they need
+ * the whole cloud at once), inputs other than binary PLY, LAS output. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <omp.h>
+
+#include "io_internal.h"
+#include "mpi_internal.h"
+#include "opts.h"
+#include "rows.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: mpirun -np N jetfit-mpi estimate INPUT -o OUTPUT [options]\n"
+        "\n"
+        "The estimate of `jetfit estimate` over N MPI ranks: the same options and\n"
+        "the same output file, byte for byte.  Each rank reads 1/N of INPUT, owns\n"
+        "one spatial part of the cloud and fetches the exact halo it needs; no rank\n"
+        "holds the whole cloud.  Options: jetfit estimate --help.\n"
+        "INPUT: binary PLY.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
+        "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
+        "(they need the whole cloud at once), LAS input and output; the input's\n"
+        "other properties are not carried (the output is that of --keep none).\n"
+        "docs/scale.md \"Distributed runs\" says how to run on a cluster.\n");
+}
+
+static void on_fatal_signal(int sig)
+{
+    jf_tmpfiles_remove_all(); /* rank 0's temporary: no partial output */
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void catch_signals(void)
+{
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_fatal_signal;
+    sigemptyset(&sa.sa_mask);
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) sigaction(sigs[i], &sa, NULL);
+}
+
+/* Rank 0's writers: `bin` the binary PLY the ranks write into (OUTPUT
+ * itself, or for text outputs a side file never committed), `txt` the
+ * text OUTPUT. */
+typedef struct {
+    jf_writer *bin, *txt;
+    uint64_t header;
+    char tmp[4096];
+} outputs;
+
+static void open_outputs(jf_mpi *m, const char *out, int ascii, const jf_column *cols,
+                         size_t ncols, uint64_t nrows, outputs *o)
+{
+    jf_error err = {{0}};
+    const char *tmp = NULL;
+    jf_format fmt = jf_format_from_path(out);
+    int text = ascii || fmt != JF_FMT_PLY;
+    char *side = NULL;
+    if (text) {
+        if (jf_writer_open(out, cols, ncols, (size_t)nrows, ascii, &o->txt, &err) != JF_OK) {
+            jf_mpi_fail(m, "%s", err.msg);
+            return;
+        }
+        side = malloc(strlen(out) + 16);
+        if (!side) {
+            jf_mpi_fail(m, "out of memory");
+            return;
+        }
+        sprintf(side, "%s.mpi-rows.ply", out);
+    }
+    if (jf_writer_open(side ? side : out, cols, ncols, (size_t)nrows, 0, &o->bin, &err) != JF_OK)
+        jf_mpi_fail(m, "%s", err.msg);
+    else if (jf__writer_begin(o->bin, &o->header, &tmp) != JF_OK)
+        jf_mpi_fail(m, "%s: cannot write the header", side ? side : out);
+    else if (strlen(tmp) >= sizeof o->tmp)
+        jf_mpi_fail(m, "%s: path too long", out);
+    else
+        strcpy(o->tmp, tmp);
+    free(side);
+}
+
+static void abort_outputs(outputs *o)
+{
+    jf_writer_abort(o->bin);
+    jf_writer_abort(o->txt);
+    o->bin = o->txt = NULL;
+}
+
+/* Each rank writes its own rows at header + index * row size (collective
+ * writes in rounds of BLOCK rows, so MPI-IO can gather them). */
+static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const jf_result *res,
+                       const jf_column *cols, size_t ncols, int monge, int threads)
+{
+    enum { BLOCK = 16384 };
+    jf_col_type types[JF_CLI_MAX_COLS];
+    size_t rowb = 0;
+    for (size_t j = 0; j < ncols; j++) {
+        types[j] = cols[j].type;
+        rowb += cols[j].type == JF_COL_F64 ? 8 : 4;
+    }
+    MPI_File fh;
+    char path[4096];
+    memcpy(path, o->tmp, sizeof path);
+    MPI_Bcast(path, (int)sizeof path, MPI_CHAR, 0, m->comm);
+    int rc = MPI_File_open(m->comm, path, MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
+    if (rc != MPI_SUCCESS) jf_mpi_fail(m, "%s: cannot open the output with MPI-IO", path);
+    if (jf_mpi_check(m)) {
+        if (rc == MPI_SUCCESS) MPI_File_close(&fh);
+        return;
+    }
+    size_t *pos = malloc(BLOCK * sizeof *pos);
+    double *vals = malloc((size_t)BLOCK * ncols * sizeof *vals);
+    char *buf = malloc((size_t)BLOCK * rowb);
+    MPI_Aint *disp = malloc(BLOCK * sizeof *disp);
+    if (!pos || !vals || !buf || !disp) jf_mpi_fail(m, "out of memory (output rows)");
+    uint64_t mine = (c->nown + BLOCK - 1) / BLOCK, rounds = 0;
+    MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, m->comm);
+    size_t j = 0; /* next local point */
+    for (uint64_t r = 0; r < rounds; r++) {
+        int k = 0;
+        while (!m->failed && k < BLOCK && j < c->n) {
+            if (c->own[j]) pos[k++] = j;
+            j++;
+        }
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads())
+        for (int t = 0; t < k; t++) {
+            const size_t p = pos[t];
+            double *v = vals + (size_t)t * ncols;
+            jf_cli_row(c->xyz + 3 * p, &res[p], monge, v);
+            jf__ply_row_le(types, ncols, v, buf + (size_t)t * rowb);
+        }
+        for (int t = 0; t < k; t++) disp[t] = (MPI_Aint)(o->header + (uint64_t)c->gid[pos[t]] * rowb);
+        MPI_Datatype ft = MPI_BYTE;
+        if (k) {
+            MPI_Type_create_hindexed_block(k, (int)rowb, disp, MPI_BYTE, &ft);
+            MPI_Type_commit(&ft);
+        }
+        rc = MPI_File_set_view(fh, 0, MPI_BYTE, ft, "native", MPI_INFO_NULL);
+        MPI_Status st;
+        if (rc == MPI_SUCCESS) rc = MPI_File_write_all(fh, buf, (int)((size_t)k * rowb), MPI_BYTE, &st);
+        if (rc != MPI_SUCCESS) jf_mpi_fail(m, "%s: MPI-IO write failed (disk full?)", path);
+        if (k) MPI_Type_free(&ft);
+    }
+    if (MPI_File_close(&fh) != MPI_SUCCESS) jf_mpi_fail(m, "%s: MPI-IO close failed", path);
+    free(pos);
+    free(vals);
+    free(buf);
+    free(disp);
+}
+
+/* Rank 0: the binary rows read back in order into the text writer. */
+static void convert_text(jf_mpi *m, outputs *o, const jf_column *cols, size_t ncols,
+                         uint64_t nrows, int threads)
+{
+    enum { BLOCK = 16384 };
+    size_t rowb = 0;
+    for (size_t j = 0; j < ncols; j++) rowb += cols[j].type == JF_COL_F64 ? 8 : 4;
+    int fd = open(o->tmp, O_RDONLY);
+    char *buf = malloc(BLOCK * rowb);
+    double *vals = malloc((size_t)BLOCK * ncols * sizeof *vals);
+    if (fd < 0 || !buf || !vals) jf_mpi_fail(m, "%s: cannot read the rows back", o->tmp);
+    for (uint64_t r0 = 0; !m->failed && r0 < nrows; r0 += BLOCK) {
+        size_t k = nrows - r0 < BLOCK ? (size_t)(nrows - r0) : BLOCK, got = 0;
+        while (got < k * rowb) {
+            ssize_t n = pread(fd, buf + got, k * rowb - got,
+                              (off_t)(o->header + r0 * rowb + got));
+            if (n <= 0) break;
+            got += (size_t)n;
+        }
+        if (got < k * rowb) {
+            jf_mpi_fail(m, "%s: rows missing in the binary temporary", o->tmp);
+            break;
+        }
+        for (size_t t = 0; t < k; t++) {
+            const char *p = buf + t * rowb;
+            for (size_t j = 0; j < ncols; j++) {
+                if (cols[j].type == JF_COL_F64) {
+                    memcpy(&vals[t * ncols + j], p, 8);
+                    p += 8;
+                } else {
+                    int32_t x;
+                    memcpy(&x, p, 4);
+                    vals[t * ncols + j] = x;
+                    p += 4;
+                }
+            }
+        }
+        if (jf_writer_rows(o->txt, vals, k, threads) != JF_OK) break; /* commit says why */
+    }
+    if (fd >= 0) close(fd);
+    free(buf);
+    free(vals);
+}
+
+static int refuse(jf_mpi *m, const char *fmt, const char *what)
+{
+    if (m->rank == 0) {
+        fprintf(stderr, "jetfit-mpi: ");
+        fprintf(stderr, fmt, what);
+        fputc('\n', stderr);
+    }
+    return 1;
+}
+
+static int estimate(jf_mpi *m, int argc, char **argv)
+{
+    jf_cli_estimate_cmd cmd;
+    jf_cli_bad bad;
+    if (jf_cli_estimate_parse(argc, argv, &cmd, &bad)) {
+        if (m->rank == 0)
+            fprintf(stderr, "jetfit-mpi estimate: %s '%s': %s (jetfit estimate --help)\n",
+                    bad.opt, bad.val ? bad.val : "", bad.why);
+        return 2;
+    }
+    if (cmd.help) {
+        if (m->rank == 0) usage(stdout);
+        return 0;
+    }
+    jf_estimate_opts o = cmd.e.o;
+    const char *in = cmd.in, *out = cmd.out;
+    char nbs[64];
+    jf_nb_format(&o.nb, nbs, sizeof nbs);
+    if (o.nb.kind == JF_NB_NATURAL || o.nb.kind == JF_NB_RINGS)
+        return refuse(m, "--neighbors %s: not supported in distributed runs (it needs the whole "
+                         "triangulation or mesh); use knn, radius or knn,radius, or jetfit "
+                         "estimate", nbs);
+    if (o.orient == JF_ORIENT_MST || o.orient == JF_ORIENT_SCANNER)
+        return refuse(m, "--orient %s: not supported in distributed runs (it needs the whole "
+                         "cloud at once); use none, input or viewpoint:X,Y,Z, or jetfit estimate",
+                      o.orient == JF_ORIENT_MST ? "mst" : "scanner");
+    jf_format fin = jf_format_from_path(in), fout = jf_format_from_path(out);
+    if (fin != JF_FMT_PLY)
+        return refuse(m, "%s: distributed runs read binary PLY only (jetfit estimate reads the "
+                         "other formats; a PLY tool or jetfit can convert)", in);
+    if (fout == JF_FMT_LAS)
+        return refuse(m, "%s: LAS output is not supported in distributed runs (write .ply, "
+                         ".csv or .xyz)", out);
+    if (m->rank == 0 && jf_same_file(in, out)) {
+        fprintf(stderr, "jetfit-mpi: %s: is the input file (%s); write the result to another "
+                        "file\n", out, in);
+        return 1;
+    }
+    if (jf_same_file(in, out)) return 1;
+
+    double t0 = MPI_Wtime();
+    jf_ply_layout lay;
+    jf_mpi_probe(m, in, &lay);
+    if (jf_mpi_check(m)) return 1;
+    if (!cmd.e.orient_set && lay.has_normals) o.orient = JF_ORIENT_INPUT;
+    if (o.orient == JF_ORIENT_INPUT && !lay.has_normals)
+        return refuse(m, "%s: --orient input: the input file has no normals", in);
+    jf_part_query q;
+    if (jf__part_query_init(&o, &q) != JF_OK)
+        return refuse(m, "%s: invalid parameters", in);
+
+    jf_column cols[JF_CLI_MAX_COLS];
+    size_t ncols = jf_cli_columns(cmd.e.monge, cols);
+    outputs w;
+    memset(&w, 0, sizeof w);
+    /* open the output first: a missing folder fails before the work */
+    if (m->rank == 0) open_outputs(m, out, cmd.ascii, cols, ncols, lay.count, &w);
+    if (jf_mpi_check(m)) {
+        abort_outputs(&w);
+        return 1;
+    }
+    MPI_Bcast(&w.header, 1, MPI_UINT64_T, 0, m->comm);
+
+    jf_mpi_cloud c;
+    int normals = o.orient == JF_ORIENT_INPUT;
+    jf_mpi_load(m, in, &lay, &q, normals, o.threads, &c);
+    int failed = m->failed;
+    double t1 = MPI_Wtime();
+    jf_result *res = NULL;
+    if (!failed) {
+        res = malloc((c.n ? c.n : 1) * sizeof *res);
+        jf_cloud lc = {0};
+        lc.n = c.n;
+        lc.xyz = c.xyz;
+        lc.nrm = c.nrm;
+        jf_error err = {{0}};
+        jf_status st = res ? jf__estimate_masked(&lc, &o, c.own, res, &err) : JF_ERR_NOMEM;
+        if (st != JF_OK) jf_mpi_fail(m, "%s: %s", in, err.msg[0] ? err.msg : jf_strerror(st));
+        /* fault injection for tests/mpi/test_mpi.sh: this rank fails here */
+        const char *inj = getenv("JETFIT_MPI_TEST_FAIL");
+        if (inj && *inj && atoi(inj) == m->rank)
+            jf_mpi_fail(m, "rank %d: injected failure (JETFIT_MPI_TEST_FAIL)", m->rank);
+        failed = jf_mpi_check(m);
+    }
+    double t2 = MPI_Wtime();
+    if (!failed) {
+        write_rows(m, &w, &c, res, cols, ncols, cmd.e.monge, o.threads);
+        failed = jf_mpi_check(m);
+    }
+    free(res);
+    double t3 = MPI_Wtime();
+    if (!failed && m->rank == 0) {
+        jf_error err = {{0}};
+        if (w.txt) {
+            convert_text(m, &w, cols, ncols, lay.count, o.threads);
+            jf_writer_abort(w.bin); /* the side file's temporary goes */
+            w.bin = NULL;
+            jf_writer *t = w.txt;
+            w.txt = NULL;
+            if (jf_writer_commit(t, &err) != JF_OK) jf_mpi_fail(m, "%s", err.msg);
+        } else {
+            jf_writer *b = w.bin;
+            w.bin = NULL;
+            if (jf__writer_placed(b, (size_t)lay.count) != JF_OK) {
+                jf_writer_abort(b);
+                jf_mpi_fail(m, "%s: rows missing", out);
+            } else if (jf_writer_commit(b, &err) != JF_OK)
+                jf_mpi_fail(m, "%s", err.msg);
+        }
+    }
+    if (failed || m->failed) abort_outputs(&w);
+    if (!failed) failed = jf_mpi_check(m); /* rank 0's commit */
+    /* figures: the slowest rank's time in each step, the halo's total */
+    double mine[3] = {m->t_exchange, t2 - t1, t3 - t2}, worst[3];
+    uint64_t hl[2] = {c.nhalo, c.fetched}, hall[2];
+    MPI_Reduce(mine, worst, 3, MPI_DOUBLE, MPI_MAX, 0, m->comm);
+    MPI_Reduce(hl, hall, 2, MPI_UINT64_T, MPI_SUM, 0, m->comm);
+    if (!failed && !cmd.quiet && m->rank == 0) {
+        double secs = MPI_Wtime() - t0;
+        fprintf(stderr, "jetfit-mpi: %llu points on %d ranks in %.2f s (%.0f points/s)\n",
+                (unsigned long long)lay.count, m->size, secs,
+                secs > 0 ? (double)lay.count / secs : 0.0);
+        fprintf(stderr, "  exchange %.2f s, fit %.2f s, write %.2f s (slowest rank)\n",
+                worst[0], worst[1], worst[2]);
+        fprintf(stderr, "  halo: %llu points kept, %llu fetched (%.4f, %.4f of the points)\n",
+                (unsigned long long)hall[0], (unsigned long long)hall[1],
+                lay.count ? (double)hall[0] / (double)lay.count : 0.0,
+                lay.count ? (double)hall[1] / (double)lay.count : 0.0);
+        fprintf(stderr, "  output: %s\n", out);
+    }
+    jf_mpi_cloud_free(&c);
+    return failed ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    int provided = 0;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    jf_mpi m;
+    memset(&m, 0, sizeof m);
+    m.comm = MPI_COMM_WORLD;
+    MPI_Comm_rank(m.comm, &m.rank);
+    MPI_Comm_size(m.comm, &m.size);
+    MPI_Comm_set_errhandler(m.comm, MPI_ERRORS_ARE_FATAL);
+    int rc;
+    if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
+        if (m.rank == 0) usage(stdout);
+        rc = 0;
+    } else if (argc < 2 || strcmp(argv[1], "estimate")) {
+        if (m.rank == 0) {
+            fprintf(stderr, "jetfit-mpi: expected the command 'estimate'\n");
+            usage(stderr);
+        }
+        rc = 2;
+    } else {
+        if (m.rank == 0) catch_signals();
+        rc = estimate(&m, argc - 1, argv + 1);
+    }
+    MPI_Finalize();
+    return rc;
+}

@@ -1,0 +1,423 @@
+/* parts.c -- partition of a cloud into P parts and the exact halo of each
+ * (parts.h says how the distributed run and the bounded-memory estimate
+ * use it).
+ *
+ * design:
+ *  - partition: Morton keys of the finite points (the cube over their
+ *    bounding box, 21 bits per axis, as order.c), sorted with the input
+ *    index as tie (jf_spatial_order), cut into P equal runs.  A run of the
+ *    Z curve is spatially compact; its bounding box is the part's region
+ *    for the halo test.  Equal points may fall in two parts (duplicates
+ *    straddling a cut): the halo handles them as any other point.
+ *  - halo (why one round is exact): q's neighbourhood over the whole cloud
+ *    is the top k in the (d2, index) order within a bound b.  If q's own
+ *    part holds k points within b, the k-th of them, t, bounds the whole
+ *    cloud's k-th: every remote neighbour x has d2(x) <= t and is in its
+ *    own part's top k within t.  So each point asks (k, min(t, b)) of the
+ *    parts whose box is within that bound, once; there is nothing to
+ *    iterate.  knn+radius's fallback (fewer than the floor within R: the
+ *    floor nearest at any distance) is a second request, sent only when
+ *    the own part has fewer than the floor within R (if the whole cloud
+ *    has, so does any part answering).
+ *  - rounding: box distances use the k-d tree's lower-bound arithmetic
+ *    (kdtree.c), so a box is never skipped when a point inside qualifies;
+ *    bounds are inclusive (a remote point at exactly the k-th distance and
+ *    a smaller index wins the tie, so it must be fetched).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <omp.h>
+
+#include "index_internal.h"
+#include "parts.h"
+
+#define MORTON_BITS 21
+
+static int finite3(const double *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
+
+jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q)
+{
+    if (!o || !q) return JF_ERR_INVALID;
+    if (jf_params_validate(&o->params, NULL) != JF_OK) return JF_ERR_INVALID;
+    if (o->nb.kind > JF_NB_KNN_RADIUS) return JF_ERR_UNSUPPORTED;
+    const jf_params *p = &o->params;
+    /* the same sizes as jf_estimate's (pipeline.c) */
+    memset(q, 0, sizeof *q);
+    q->nb = o->nb;
+    if (q->nb.kind == JF_NB_KNN)
+        for (int j = 0; j < p->nscales; j++) q->nb.k = max_sz(q->nb.k, p->scales[j]);
+    q->min_count = jf_jet_size(p->degree);
+    q->cap = p->max_neighbors;
+    if (q->nb.kind == JF_NB_KNN) q->cap = q->nb.k;
+    if (q->nb.kind == JF_NB_KNN_RADIUS) q->cap = o->nb.k;
+    q->cap = max_sz(q->cap, 1);
+    if (q->cap > p->max_neighbors) return JF_ERR_INVALID;
+    if (q->nb.kind != JF_NB_KNN && !(q->nb.r >= 0 && isfinite(q->nb.r))) return JF_ERR_INVALID;
+    if (q->nb.kind != JF_NB_RADIUS && !q->nb.k) return JF_ERR_INVALID;
+    return JF_OK;
+}
+
+/* ---------------------------------------------------------------- keys */
+
+/* Spreads the low 21 bits of v so that bit i moves to bit 3i. */
+static uint64_t spread3(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
+static uint64_t quantise(double v, double lo, double scale)
+{
+    double t = (v - lo) * scale;
+    if (!(t > 0)) return 0;
+    if (t >= (double)((1u << MORTON_BITS) - 1)) return (1u << MORTON_BITS) - 1;
+    return (uint64_t)t;
+}
+
+double jf__morton_scale(const double box[6])
+{
+    double ext = 0;
+    for (int d = 0; d < 3; d++)
+        if (box[3 + d] - box[d] > ext) ext = box[3 + d] - box[d];
+    return ext > 0 && isfinite(ext) ? (double)((1u << MORTON_BITS) - 1) / ext : 0.0;
+}
+
+uint64_t jf__morton_key(const double p[3], const double box[6], double scale)
+{
+    return spread3(quantise(p[0], box[0], scale)) | spread3(quantise(p[1], box[1], scale)) << 1 |
+           spread3(quantise(p[2], box[2], scale)) << 2;
+}
+
+size_t jf__parts_bbox(const double *xyz, size_t n, double box[6])
+{
+    size_t m = 0;
+    for (int d = 0; d < 3; d++) {
+        box[d] = INFINITY;
+        box[3 + d] = -INFINITY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        if (!finite3(p)) continue;
+        m++;
+        for (int d = 0; d < 3; d++) {
+            if (p[d] < box[d]) box[d] = p[d];
+            if (p[d] > box[3 + d]) box[3 + d] = p[d];
+        }
+    }
+    return m;
+}
+
+/* ---------------------------------------------------------- partition */
+
+jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part)
+{
+    if ((n && (!xyz || !part)) || nparts < 1 || nparts > JF_PARTS_MAX) return JF_ERR_INVALID;
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    if (!n) return JF_OK;
+    uint32_t *order = malloc(n * sizeof *order);
+    if (!order) return JF_ERR_NOMEM;
+    /* (key, index) order, non-finite points last: the same keys as
+     * jf__morton_key over jf__parts_bbox (order.c) */
+    jf_status st = jf_spatial_order(xyz, n, order);
+    if (st != JF_OK) {
+        free(order);
+        return st;
+    }
+    size_t nf = 0;
+    for (size_t i = 0; i < n; i++) nf += finite3(xyz + 3 * i);
+    for (size_t j = 0; j < n; j++)
+        part[order[j]] = j < nf ? (int32_t)(((uint64_t)j * (uint64_t)nparts) / nf) : -1;
+    free(order);
+    return JF_OK;
+}
+
+/* ---------------------------------------------------------------- halo */
+
+double jf__box_dist2(const double box[6], const double q[3])
+{
+    if (!(box[0] <= box[3])) return INFINITY; /* empty */
+    double g[3];
+    for (int d = 0; d < 3; d++) {
+        /* as kdtree.c: g <= |q - p| for every p in the box, rounded alike */
+        double a = box[d] - q[d], b = q[d] - box[3 + d];
+        g[d] = a > 0 ? a : (b > 0 ? b : 0);
+    }
+    return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+}
+
+/* The own part's answer to (k, bound): tightened to its k-th distance. */
+static double tighten(const jf_index *own, const double p[3], size_t k, double bound,
+                      uint32_t *idx, double *d2, size_t *found)
+{
+    *found = 0;
+    if (jf__index_query(own, p, k, bound, idx, d2, NULL, found) != JF_OK) return bound;
+    return *found == k && k ? d2[k - 1] : bound;
+}
+
+int jf__halo_requests(const jf_index *own, const jf_part_query *q, const double p[3],
+                      uint32_t *idx, double *d2, jf_halo_req req[2])
+{
+    if (!finite3(p)) return 0;
+    size_t found = 0;
+    switch (q->nb.kind) {
+    case JF_NB_KNN: {
+        size_t k = q->nb.k < q->cap ? q->nb.k : q->cap;
+        req[0].k = k;
+        req[0].bound = tighten(own, p, k, INFINITY, idx, d2, &found);
+        return 1;
+    }
+    case JF_NB_RADIUS:
+        req[0].k = q->cap;
+        req[0].bound = tighten(own, p, q->cap, q->nb.r * q->nb.r, idx, d2, &found);
+        return 1;
+    case JF_NB_KNN_RADIUS: {
+        size_t want = q->nb.k < q->cap ? q->nb.k : q->cap;
+        size_t floor = q->min_count < want ? q->min_count : want;
+        req[0].k = want;
+        req[0].bound = tighten(own, p, want, q->nb.r * q->nb.r, idx, d2, &found);
+        if (found >= floor) return 1;
+        req[1].k = floor;
+        req[1].bound = tighten(own, p, floor, INFINITY, idx, d2, &found);
+        return 2;
+    }
+    default: return 0;
+    }
+}
+
+/* Growable list of input indices (one per thread). */
+typedef struct {
+    uint32_t *v;
+    size_t n, cap;
+} ivec;
+
+static int ivec_push(ivec *a, uint32_t x)
+{
+    if (a->n == a->cap) {
+        size_t nc = a->cap ? 2 * a->cap : 1024;
+        uint32_t *nv = realloc(a->v, nc * sizeof *nv);
+        if (!nv) return 0;
+        a->v = nv;
+        a->cap = nc;
+    }
+    a->v[a->n++] = x;
+    return 1;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Sorts [start, a->n) and drops repeats. */
+static void sort_unique(ivec *a, size_t start)
+{
+    if (a->n <= start) return; /* an empty tail may have no array at all */
+    qsort(a->v + start, a->n - start, sizeof *a->v, cmp_u32);
+    size_t w = start;
+    for (size_t j = start; j < a->n; j++)
+        if (j == start || a->v[j] != a->v[w - 1]) a->v[w++] = a->v[j];
+    a->n = w;
+}
+
+int jf__halo_cmp(const void *a, const void *b)
+{
+    const jf_halo_cand *x = a, *y = b;
+    if (x->d2 != y->d2) return x->d2 < y->d2 ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+/* One thread's buffers. */
+typedef struct {
+    ivec cand, need;
+    jf_halo_cand *m;  /* one request's candidates, own and remote        */
+    size_t mn, mcap;
+    uint32_t *idx;
+    double *d2;
+} hworker;
+
+static int cand_push(hworker *w, double d2, uint32_t id, int remote)
+{
+    if (w->mn == w->mcap) {
+        size_t nc = w->mcap ? 2 * w->mcap : 1024;
+        jf_halo_cand *nv = realloc(w->m, nc * sizeof *nv);
+        if (!nv) return 0;
+        w->m = nv;
+        w->mcap = nc;
+    }
+    w->m[w->mn++] = (jf_halo_cand){d2, id, (uint32_t)remote};
+    return 1;
+}
+
+jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int nparts,
+                          const jf_part_query *q, int threads, size_t *halo_off,
+                          uint32_t **halo, jf_halo_stats *stats)
+{
+    if (!halo || !halo_off || !q || (n && (!xyz || !part)) || nparts < 1 ||
+        nparts > JF_PARTS_MAX)
+        return JF_ERR_INVALID;
+    *halo = NULL;
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    const int nt = threads > 0 ? threads : omp_get_max_threads();
+    const size_t P = (size_t)nparts, scratch = max_sz(q->cap, q->min_count) + 1;
+    jf_status st = JF_OK;
+    /* members of each part (CSR, ascending input index), their coordinates,
+     * boxes and indexes */
+    size_t *moff = calloc(P + 1, sizeof *moff);
+    uint32_t *mem = malloc((n ? n : 1) * sizeof *mem);
+    double *mxyz = malloc((n ? n : 1) * 3 * sizeof *mxyz);
+    double *box = malloc(P * 6 * sizeof *box);
+    jf_index **ix = calloc(P, sizeof *ix);
+    hworker *tw = calloc((size_t)nt, sizeof *tw);
+    ivec all = {0};
+    size_t nreq = 0, nfetched = 0;
+    if (!moff || !mem || !mxyz || !box || !ix || !tw) {
+        st = JF_ERR_NOMEM;
+        goto out;
+    }
+    for (int t = 0; t < nt; t++) {
+        tw[t].idx = malloc(scratch * sizeof *tw[t].idx);
+        tw[t].d2 = malloc(scratch * sizeof *tw[t].d2);
+        if (!tw[t].idx || !tw[t].d2) {
+            st = JF_ERR_NOMEM;
+            goto out;
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (part[i] >= nparts) {
+            st = JF_ERR_INVALID;
+            goto out;
+        }
+        if (part[i] >= 0 && finite3(xyz + 3 * i)) moff[part[i] + 1]++;
+    }
+    for (size_t a = 0; a < P; a++) moff[a + 1] += moff[a];
+    {
+        size_t *fill = malloc(P * sizeof *fill);
+        if (!fill) {
+            st = JF_ERR_NOMEM;
+            goto out;
+        }
+        memcpy(fill, moff, P * sizeof *fill);
+        for (size_t i = 0; i < n; i++) {
+            if (part[i] < 0 || !finite3(xyz + 3 * i)) continue;
+            size_t at = fill[part[i]]++;
+            mem[at] = (uint32_t)i;
+            memcpy(mxyz + 3 * at, xyz + 3 * i, sizeof(double[3]));
+        }
+        free(fill);
+    }
+    for (size_t a = 0; a < P && st == JF_OK; a++) {
+        size_t m = moff[a + 1] - moff[a];
+        jf__parts_bbox(mxyz + 3 * moff[a], m, box + 6 * a);
+        st = jf__index_build_threads(mxyz + 3 * moff[a], m, nt, &ix[a]);
+    }
+    if (st != JF_OK) goto out;
+
+    halo_off[0] = 0;
+    for (size_t a = 0; a < P; a++) {
+        const size_t beg = moff[a], m = moff[a + 1] - beg;
+        jf_status fail = JF_OK;
+#pragma omp parallel num_threads(nt) reduction(+ : nreq)
+        {
+            hworker *w = &tw[omp_get_thread_num()];
+            int ok = 1;
+#pragma omp for schedule(dynamic, 256)
+            for (size_t j = 0; j < m; j++) {
+                if (!ok) continue;
+                const double *p = mxyz + 3 * (beg + j);
+                jf_halo_req req[2];
+                int nr = jf__halo_requests(ix[a], q, p, w->idx, w->d2, req);
+                for (int r = 0; r < nr && ok; r++) {
+                    /* the request's candidates: own top k, then each
+                     * answering part's; the merged top k is the
+                     * neighbourhood, its remote points the halo */
+                    size_t found = 0;
+                    w->mn = 0;
+                    ok = jf__index_query(ix[a], p, req[r].k, req[r].bound, w->idx, w->d2, NULL,
+                                         &found) == JF_OK;
+                    for (size_t t = 0; t < found && ok; t++)
+                        ok = cand_push(w, w->d2[t], mem[beg + w->idx[t]], 0);
+                    for (size_t b = 0; b < P && ok; b++) {
+                        if (b == a || !(jf__box_dist2(box + 6 * b, p) <= req[r].bound)) continue;
+                        nreq++;
+                        ok = jf__index_query(ix[b], p, req[r].k, req[r].bound, w->idx, w->d2,
+                                             NULL, &found) == JF_OK;
+                        for (size_t t = 0; t < found && ok; t++) {
+                            uint32_t g = mem[moff[b] + w->idx[t]];
+                            ok = cand_push(w, w->d2[t], g, 1) && ivec_push(&w->cand, g);
+                        }
+                    }
+                    if (!ok) break;
+                    size_t keep = w->mn < req[r].k ? w->mn : req[r].k;
+                    if (w->mn > 1) qsort(w->m, w->mn, sizeof *w->m, jf__halo_cmp);
+                    for (size_t t = 0; t < keep && ok; t++)
+                        if (w->m[t].remote) ok = ivec_push(&w->need, w->m[t].id);
+                }
+            }
+            if (!ok) {
+#pragma omp atomic write
+                fail = JF_ERR_NOMEM;
+            }
+        }
+        if (fail != JF_OK) {
+            st = fail;
+            goto out;
+        }
+        /* gather the threads' lists, sort, drop repeats */
+        size_t start = all.n;
+        for (int t = 0; t < nt && st == JF_OK; t++) {
+            for (size_t j = 0; j < tw[t].need.n; j++)
+                if (!ivec_push(&all, tw[t].need.v[j])) st = JF_ERR_NOMEM;
+            tw[t].need.n = 0;
+            if (t && st == JF_OK) /* candidates: counted, distinct per part */
+                for (size_t j = 0; j < tw[t].cand.n; j++)
+                    if (!ivec_push(&tw[0].cand, tw[t].cand.v[j])) st = JF_ERR_NOMEM;
+            if (t) tw[t].cand.n = 0;
+        }
+        if (st != JF_OK) goto out;
+        sort_unique(&all, start);
+        sort_unique(&tw[0].cand, 0);
+        nfetched += tw[0].cand.n;
+        tw[0].cand.n = 0;
+        halo_off[a + 1] = all.n;
+    }
+    *halo = all.v ? all.v : malloc(1);
+    all.v = NULL;
+    if (!*halo) st = JF_ERR_NOMEM;
+    if (stats) {
+        stats->requests = nreq;
+        stats->fetched = nfetched;
+    }
+out:
+    if (ix)
+        for (size_t a = 0; a < P; a++) jf_index_free(ix[a]);
+    if (tw)
+        for (int t = 0; t < nt; t++) {
+            free(tw[t].cand.v);
+            free(tw[t].need.v);
+            free(tw[t].m);
+            free(tw[t].idx);
+            free(tw[t].d2);
+        }
+    free(tw);
+    free(all.v);
+    free(ix);
+    free(box);
+    free(mxyz);
+    free(mem);
+    free(moff);
+    return st;
+}

@@ -1,0 +1,130 @@
+/* parts.h -- space cut into parts, and the exact halo each part needs to
+ * compute its points' k-NN / radius neighbourhoods as one index over the
+ * whole cloud would (src/spatial/parts.c; not part of the public API).
+ *
+ * Used by `jetfit-mpi` (one part per rank, src/mpi/) and by the bounded-
+ * memory estimate (parts processed one at a time).  Both follow the same
+ * steps:
+ *  1. partition: the finite points sorted by (Morton key over the cloud's
+ *     bounding box, input index) and cut into P runs of equal count
+ *     (within one point); non-finite points belong to no part (they are
+ *     nobody's neighbour; their row is NaN).
+ *  2. each part indexes its own points; each point turns its neighbourhood
+ *     into at most two requests "top k within squared distance <= bound"
+ *     (jf__halo_requests), bound tightened by what its own part holds;
+ *  3. every other part whose bounding box is within the bound answers with
+ *     its own top k within the bound: the union of the answers is the halo.
+ *  4. an index over own points + halo, ordered by input index (so the k-d
+ *     tree's tie rule, smaller position first, is the input index's),
+ *     gives every own point exactly the neighbourhood of the whole cloud.
+ */
+#ifndef JF_PARTS_H
+#define JF_PARTS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jetfit.h"
+
+/* The neighbourhood query jf_estimate makes for a kind the k-d tree
+ * answers (knn, radius, knn+radius), with the pipeline's sizes. */
+typedef struct {
+    jf_nb_spec nb;    /* knn: K raised to the largest --scales entry    */
+    size_t cap;       /* largest neighbourhood (radius: max_neighbors)  */
+    size_t min_count; /* N_n of the degree: knn+radius's fallback floor */
+} jf_part_query;
+
+/* Fills *q from estimate options as jf_estimate does.  JF_OK, or
+ * JF_ERR_UNSUPPORTED (rings, natural: not a k-d tree query),
+ * JF_ERR_INVALID (bad parameters). */
+jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q);
+
+/* Morton keys as jf_spatial_order makes them: 21 bits per axis over the
+ * cube of side max extent from lo (box = lo xyz, hi xyz of the finite
+ * points).  *scale for jf__morton_key. */
+double jf__morton_scale(const double box[6]);
+uint64_t jf__morton_key(const double p[3], const double box[6], double scale);
+
+/* Bounding box of the finite points of xyz[3n] (lo xyz, hi xyz); with no
+ * finite point lo = +inf, hi = -inf.  Returns the number of finite points. */
+size_t jf__parts_bbox(const double *xyz, size_t n, double box[6]);
+
+/* Step 1 in one process: part[i] in 0..nparts-1 for each finite point,
+ * -1 for the others.  Part r holds the finite points of ranks
+ * [nf r / P, nf (r+1) / P) in the (Morton key, index) order (nf finite
+ * points): balanced within one point; parts may be empty when nf < P.
+ * JF_OK, JF_ERR_INVALID (nparts < 1 or > JF_PARTS_MAX), JF_ERR_NOMEM,
+ * JF_ERR_TOO_LARGE (n >= 2^32 - 1). */
+#define JF_PARTS_MAX 65536
+jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part);
+
+/* Squared distance from q to the box, a lower bound of the distance to
+ * every point inside computed by the same rounded operations (never
+ * larger: a part is skipped only if none of its points can qualify).
+ * +inf for an empty box (lo > hi). */
+double jf__box_dist2(const double box[6], const double q[3]);
+
+/* A request a point sends to the other parts. */
+typedef struct {
+    size_t k;     /* the answer: the k nearest ...                      */
+    double bound; /* ... within squared distance <= bound (may be inf)  */
+} jf_halo_req;
+
+/* Step 2 for a point q of a part indexed by `own` (its own points only):
+ * fills req[0..] and returns their number (1 or 2; 0 if q is not
+ * finite).  idx, d2: scratch of max(q->cap, q->min_count) entries.
+ * knn K: (K, the K-th own distance, or inf if the part has fewer).
+ * radius R: (cap, R^2 tightened likewise).  knn+radius: (K, R^2
+ * tightened) and, when fewer than the floor own points lie within R,
+ * (floor, inf tightened) for the fallback query.  Exact: every point of
+ * another part that is in q's neighbourhood over the whole cloud is in
+ * its part's answer to one of the requests (the own k-th distance bounds
+ * the whole cloud's).  Thread-safe. */
+int jf__halo_requests(const jf_index *own, const jf_part_query *q, const double p[3],
+                      uint32_t *idx, double *d2, jf_halo_req req[2]);
+
+/* A candidate of a request: squared distance, input index, and whether
+ * it came from another part.  jf__halo_cmp orders by (d2, index), the
+ * k-d tree's order: a request's neighbourhood is the first k of its
+ * merged candidates. */
+typedef struct {
+    double d2;
+    uint32_t id;
+    uint32_t remote;
+} jf_halo_cand;
+int jf__halo_cmp(const void *a, const void *b);
+
+typedef struct {
+    size_t requests; /* (point, part) requests sent                      */
+    size_t fetched;  /* distinct candidates the answers carried, summed
+                        over the parts (what a distributed run sends)    */
+} jf_halo_stats;
+
+/* Steps 2-3 for every part in one process (a reference, for the tests and
+ * the halo figures, and for parts processed one at a time): halo_off[
+ * nparts + 1] (caller-owned) and *halo (malloc'ed, caller frees) list,
+ * for part a, the input indices of the points of other parts that are in
+ * the neighbourhood of one of its points, ascending, at halo[halo_off[a]
+ * .. halo_off[a+1]): each request's answers are merged with the own
+ * candidates and only the first k kept, so a part whose points are far
+ * from each other (a Z-curve run may be in two pieces) keeps no more than
+ * its points' real neighbours.  stats may be NULL.  threads <= 0: all
+ * cores.  JF_OK, JF_ERR_INVALID, JF_ERR_NOMEM. */
+jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int nparts,
+                          const jf_part_query *q, int threads, size_t *halo_off,
+                          uint32_t **halo, jf_halo_stats *stats);
+
+/* jf_estimate on c fitting only the points with fit[i] != 0 (fit NULL:
+ * all); the others get a NONFINITE row (NaN, left alone by the
+ * orientation) and are still neighbours.  Defined in core/pipeline.c. */
+jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o,
+                              const uint8_t *fit, jf_result *out, jf_error *err);
+
+/* jf_estimate_blocks with the same mask: only the points with fit[i] != 0
+ * are fitted and handed to the sink (the halo points are neighbours
+ * only).  Defined in core/pipeline.c; used by core/parts_run.c. */
+jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
+                                     const uint8_t *fit, jf_block_fn sink, void *user,
+                                     jf_error *err);
+
+#endif /* JF_PARTS_H */

@@ -1,0 +1,98 @@
+#!/bin/sh
+# test_mpi.sh JETFIT JETFIT_MPI WORKDIR MODE -- jetfit-mpi against jetfit
+# estimate (registered by tests/mpi.cmake; exit 77 = skipped).
+#   equal-knn, equal-more: `mpirun -np 1|2|3 jetfit-mpi estimate` writes the
+#       same bytes (cmp) as `jetfit estimate` on the clouds of make_clouds.py
+#       (part boundaries through a lattice's shared planes and ties,
+#       duplicates straddling a cut, K above the parts' counts, an empty
+#       part, NaN rows, big-endian floats with normals), for knn, radius,
+#       knn+radius, every fit option, orientation none/input/viewpoint, and
+#       the text outputs.
+#   errors: refused options and inputs, bad files and a failing rank end
+#       every rank with one line, exit 1, no output (an old one intact),
+#       no temporary left.
+set -u
+jetfit=$1 jmpi=$2 work=$3 mode=$4
+here=$(cd "$(dirname "$0")" && pwd)
+command -v mpirun >/dev/null 2>&1 || { echo "SKIP: mpirun not found"; exit 77; }
+command -v python3 >/dev/null 2>&1 || { echo "SKIP: python3 not found"; exit 77; }
+[ -x "$jmpi" ] || { echo "SKIP: jetfit-mpi not built"; exit 77; }
+d="$work/mpi-$mode"
+rm -rf "$d" && mkdir -p "$d" && python3 "$here/make_clouds.py" "$d" || exit 1
+export OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
+mpi() { np=$1; shift; mpirun --allow-run-as-root --oversubscribe -q -np "$np" "$jmpi" "$@"; }
+fail=0
+bad() { echo "FAIL: $*"; fail=1; }
+
+# same NPS CLOUD OUT-EXT [options]: every np in NPS gives jetfit's bytes
+same() {
+  nps=$1 cloud=$2 ext=$3; shift 3
+  "$jetfit" estimate "$d/$cloud" -o "$d/ref.$ext" --quiet --threads 1 --keep none "$@" ||
+    { bad "jetfit estimate $cloud $*"; return; }
+  for np in $nps; do
+    rm -f "$d/got.$ext"
+    mpi "$np" estimate "$d/$cloud" -o "$d/got.$ext" --quiet "$@" ||
+      { bad "np $np: jetfit-mpi estimate $cloud $* exited non-zero"; continue; }
+    cmp -s "$d/ref.$ext" "$d/got.$ext" && echo "ok   np $np $cloud .$ext $*" ||
+      bad "np $np: $cloud .$ext $*: output differs from jetfit estimate"
+  done
+}
+
+# refused EXPECT-IN-MESSAGE NP [args]: exit 1, one line, no output
+refused() {
+  want=$1 np=$2; shift 2
+  rm -f "$d/err.ply"
+  mpi "$np" estimate "$@" 2>"$d/stderr" >/dev/null; rc=$?
+  lines=$(grep -c . "$d/stderr")
+  if [ $rc -ne 1 ] || [ "$lines" -ne 1 ] || ! grep -q -- "$want" "$d/stderr"; then
+    bad "np $np $*: expected exit 1 and one line with '$want', got exit $rc:"; cat "$d/stderr"
+  elif [ -e "$d/err.ply" ]; then bad "np $np $*: an output file was left"
+  else echo "ok   refused: $(cat "$d/stderr")"; fi
+}
+
+case $mode in
+equal-knn)
+  same "1 2 3" lattice.ply ply --neighbors knn:16
+  same "2 3" lattice.ply ply --neighbors knn:12 --scales 6,12 --degree 3
+  same "3" lattice.ply ply --neighbors knn:24 --robust huber
+  same "2" lattice.ply ply --neighbors knn:30 --degree 4 --monge-degree 4 --fit approx
+  same "3" lattice.ply ply --neighbors knn:16 --degree-select 1 --dist-weight 0.5 \
+       --orient viewpoint:0,0,10 --frame axis
+  same "2 3" clusters.ply ply                       # knn:32, orient input (normals)
+  same "3" tiny.ply ply --neighbors knn:4           # an empty part
+  same "3" ten.ply ply --neighbors knn:8 --fit interp --degree 2
+  ;;
+equal-more)
+  same "2 3" lattice.ply ply --neighbors radius:1.2
+  same "1 3" lattice.ply ply --neighbors knn:20,radius:1.05 --degree 3
+  same "3" clusters.ply ply --neighbors radius:0.004 --orient none --robust tukey
+  same "2" clusters.ply ply --neighbors knn:10,radius:0.0005 --max-cond 100
+  same "3" lattice.ply csv --neighbors knn:16
+  same "2" lattice.ply xyz --neighbors knn:16 --monge-degree 3 --degree 3
+  same "3" clusters.ply ply --ascii --neighbors knn:16
+  ;;
+errors)
+  refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --neighbors natural
+  refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --orient mst
+  refused "binary PLY only" 2 "$d/lattice.csv" -o "$d/err.ply"
+  refused "No such file" 3 "$d/missing.ply" -o "$d/err.ply"
+  printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n' >"$d/ascii.ply"
+  refused "ascii PLY" 2 "$d/ascii.ply" -o "$d/err.ply"
+  head -c 3000 "$d/lattice.ply" >"$d/cut.ply"
+  refused "cut.ply" 3 "$d/cut.ply" -o "$d/err.ply"
+  refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
+  # a rank that fails mid-run: one line, exit 1, the old output intact
+  echo old >"$d/keep.ply"
+  JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -q -x JETFIT_MPI_TEST_FAIL \
+    -np 3 "$jmpi" estimate "$d/lattice.ply" -o "$d/keep.ply" --quiet 2>"$d/stderr"; rc=$?
+  if [ $rc -ne 1 ] || [ "$(grep -c . "$d/stderr")" -ne 1 ] || ! grep -q "rank 2" "$d/stderr"; then
+    bad "failing rank: exit $rc:"; cat "$d/stderr"
+  elif [ "$(cat "$d/keep.ply")" != old ]; then bad "failing rank: the old output was changed"
+  else echo "ok   failing rank: $(cat "$d/stderr")"; fi
+  left=$(ls -A "$d" | grep -c tmp)
+  [ "$left" -eq 0 ] || bad "temporaries left: $(ls -A "$d")"
+  ;;
+*) echo "unknown mode $mode"; exit 2 ;;
+esac
+[ $fail -eq 0 ] && echo "test_mpi $mode: all passed"
+exit $fail
