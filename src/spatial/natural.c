@@ -18,9 +18,12 @@
  *    and the labels of its edges are q's planar natural neighbours.
  *    Planar ring r+1 = the planar neighbours of ring r, each found from
  *    its own 3D adjacency: no candidate set can be too small.
- *  - Unbounded planar cells are clipped by a box 1e3 times the reach of
- *    the vertex's 3D neighbours: an adjacency farther out than that is
- *    missed (only at the rim of an open scan).
+ *  - Unbounded planar cells (at the rim of an open scan) are clipped by a
+ *    box twice the reach of the vertex's 3D neighbours.  The far ends of
+ *    neighbouring rim cells touch each other: with a box 1e3 times the
+ *    reach the rings ran along the rim, and natural:128's normals on the
+ *    clean §6.1 patch were 9.75 deg off at the rim (0.10 with 2x; knn:128
+ *    0.02; docs/natural.md).
  */
 #include <math.h>
 #ifdef _OPENMP
@@ -33,7 +36,7 @@
 #include "jetfit.h"
 
 #define NONE UINT32_MAX
-#define BOX_SCALE 1e3      /* box half-size / farthest 3D neighbour     */
+#define BOX_SCALE 2.0      /* box half-size / farthest 3D neighbour     */
 #define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
 #define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
 

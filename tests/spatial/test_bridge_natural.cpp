@@ -88,15 +88,38 @@ static void check_planar(double zamp) {
     jf_natural_ws *ws;
     ck_assert_int_eq(jf_natural_ws_create(nt, &ws), JF_OK);
     const double up[3] = {0, 0, 1};
-    size_t mismatch = 0;
+    // Where the planar cell lies within twice the reach of the 3D
+    // neighbours, ring 1 is exactly the Delaunay_2 star.  A cell reaching
+    // farther (unbounded on the hull, or long at the rim) is clipped there
+    // (natural.c), which may cut an adjacency whose Voronoi edge lies far
+    // out along the rim: ring 1 is then a subset of the star (>= 2 points).
+    size_t mismatch = 0, clipped = 0;
     for (size_t i = 0; i < np; i++) {
         std::set<unsigned> ref;
         auto c = dt.incident_vertices(vh[i]), c0 = c;
         do
             if (!dt.is_infinite(c)) ref.insert(c->info());
         while (++c != c0);
-        if (ring1(nt, ws, i, up) != ref) mismatch++;
+        const K::Point_2 pi(p[3 * i], p[3 * i + 1]);
+        double reach = 0, far = 0;
+        for (unsigned q : ref)
+            reach = std::max(reach, std::hypot(p[3 * q] - p[3 * i], p[3 * q + 1] - p[3 * i + 1]));
+        auto f = dt.incident_faces(vh[i]), f0 = f;
+        do
+            far = dt.is_infinite(f) ? HUGE_VAL
+                                    : std::max(far, std::sqrt(CGAL::to_double(CGAL::squared_distance(
+                                                        pi, dt.circumcenter(f)))));
+        while (++f != f0);
+        std::set<unsigned> got = ring1(nt, ws, i, up);
+        if (far < 1.9 * reach) {
+            mismatch += got != ref;
+            continue;
+        }
+        clipped++;
+        for (unsigned q : got) mismatch += !ref.count(q);
+        mismatch += got.size() < 2;
     }
+    ck_assert_uint_lt(clipped, np / 10); /* the rim only */
     ck_assert_msg(mismatch == 0, "zamp %g: %zu of %zu rings differ from Delaunay_2", zamp, mismatch, np);
     jf_natural_ws_free(ws);
     jf_natural_free(nt);
