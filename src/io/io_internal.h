@@ -57,29 +57,36 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
 jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *o,
                                jf_cloud *c, jf_error *err);
 
-/* io_ply.c: where the vertex rows of a binary PLY are (fixed-size rows,
- * the file's length as its header says), for readers of a byte range of
- * them (jetfit-mpi: each rank its own rows). */
+/* Where the point rows of a binary PLY (io_ply.c) or a LAS file
+ * (io_las.c) are -- fixed-size rows, the file's length as its header says
+ * -- for readers of a byte range of them (jetfit-mpi: each rank its own
+ * rows). */
 typedef struct {
-    uint64_t count;        /* vertices                                   */
-    uint64_t vertex_off;   /* file offset of vertex row 0                */
-    size_t row;            /* bytes per vertex row                       */
-    int has_normals;       /* nx ny nz are properties                    */
-    int swap;              /* byte order differs from the machine's      */
-    int type[6];           /* x y z nx ny nz: PLY scalar type            */
-    size_t off[6];         /* their offset in the row                    */
-} jf_ply_layout;
+    uint64_t count;        /* points                                     */
+    uint64_t vertex_off;   /* file offset of row 0                       */
+    size_t row;            /* bytes per row                              */
+    int has_normals;       /* PLY: nx ny nz are properties               */
+    int swap;              /* PLY: byte order differs from the machine's */
+    int type[6];           /* PLY: x y z nx ny nz scalar types           */
+    size_t off[6];         /* PLY: their offsets in the row              */
+    int las;               /* LAS: x y z are int32 at 0, 4, 8, then      */
+    double scale[3], offset[3]; /* value * scale + offset                */
+} jf_row_layout;
 
 /* The layout from the file's first len bytes (the whole header), the
- * file being size bytes.  JF_ERR_FORMAT with err "NAME:LINE: reason" when
- * it is not a binary PLY whose vertices have fixed-size rows that the
- * file holds, or has no x y z. */
+ * file being size bytes.  JF_ERR_FORMAT (or the LAS reader's status) with
+ * err "NAME:LINE: reason" when it is not a binary PLY whose vertices have
+ * fixed-size rows that the file holds, with x y z; or for LAS, every
+ * header rule of jf_read_las. */
 jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
-                         jf_ply_layout *l, jf_error *err);
+                         jf_row_layout *l, jf_error *err);
+jf_status jf__las_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_row_layout *l, jf_error *err);
 /* Decodes k rows at raw into xyz (3k) and, if nrm and l->has_normals,
- * nrm (3k), exactly as jf_read_ply would. */
-void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
-                  double *nrm);
+ * nrm (3k), exactly as jf_read_ply / jf_read_las would. */
+void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz,
+                     double *nrm);
+void jf__las_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz);
 
 /* io_write.c, for rows written by other processes (jetfit-mpi): a binary
  * little-endian PLY table without attributes or faces gets its header

@@ -169,16 +169,24 @@ static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, si
     return 1;
 }
 
-jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_read_opts *o,
-                      jf_cloud *c, jf_error *err)
+/* The header's checks (every lie named), from the first `have` bytes of a
+ * file of `size` bytes. */
+typedef struct {
+    unsigned minor, hsize, fmt, rec_len;
+    uint32_t data_off;
+    uint64_t n;
+    double scale[3], offset[3];
+} las_hdr;
+
+static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, const char *name,
+                            las_hdr *h, jf_error *err)
 {
-    const unsigned char *b = (const unsigned char *)buf;
-    if (len < 4 || memcmp(b, "LASF", 4))
+    if (have < 4 || memcmp(b, "LASF", 4))
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "not a LAS file (no LASF signature)");
-    if (len < 227)
+    if (have < 227)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
-                          "header: %zu bytes, a LAS header has at least 227", len);
+                          "header: %zu bytes, a LAS header has at least 227", have);
     unsigned major = b[24], minor = b[25];
     if (major != 1 || minor > 4)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
@@ -195,12 +203,12 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
     if (fmt > 10)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                           "header: point data record format %u (0 to 10 are read)", fmt);
-    if (hsize < 227 || hsize > len)
+    if (hsize < 227 || hsize > size || hsize > have)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
-                          "header: header size %u (at least 227, at most the file's %zu bytes)",
-                          hsize, len);
+                          "header: header size %u (at least 227, at most the file's %llu bytes)",
+                          hsize, (unsigned long long)size);
     if (minor >= 4) {
-        if (hsize < 375)
+        if (hsize < 375 || have < 375)
             return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                               "header: LAS 1.4 header size %u (at least 375)", hsize);
         uint64_t n14 = u64(b + 247);
@@ -211,31 +219,47 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "header: point record length %u is shorter than format %u's %u bytes",
                           rec_len, fmt, base_len[fmt]);
-    if (data_off < hsize || data_off > len)
+    if (data_off < hsize || data_off > size)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "header: offset to point data %u is outside the file (header %u, "
-                          "file %zu bytes)", (unsigned)data_off, hsize, len);
+                          "file %llu bytes)", (unsigned)data_off, hsize, (unsigned long long)size);
     if (n == 0)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
-    if (n > (len - data_off) / rec_len) /* name the first record that is not whole */
+    if (n > (size - data_off) / rec_len) /* name the first record that is not whole */
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0,
                           "header: point count %llu: records of %u bytes cannot fit in the %zu "
                           "bytes after the offset to point data (point record %llu is missing "
                           "or cut short: count too large or file truncated)",
-                          (unsigned long long)n, rec_len, len - data_off,
-                          (unsigned long long)((len - data_off) / rec_len + 1));
+                          (unsigned long long)n, rec_len, (size_t)(size - data_off),
+                          (unsigned long long)((size - data_off) / rec_len + 1));
     if (n > JF_MAX_POINTS)
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: more than supported",
                           (unsigned long long)n);
-    double scale[3], off[3];
     for (int a = 0; a < 3; a++) {
-        scale[a] = f64(b + 131 + 8 * a);
-        off[a] = f64(b + 155 + 8 * a);
-        if (!(scale[a] != 0.0 && scale[a] == scale[a] && scale[a] - scale[a] == 0.0) ||
-            !(off[a] - off[a] == 0.0))
+        h->scale[a] = f64(b + 131 + 8 * a);
+        h->offset[a] = f64(b + 155 + 8 * a);
+        if (!(h->scale[a] != 0.0 && h->scale[a] == h->scale[a] && h->scale[a] - h->scale[a] == 0.0) ||
+            !(h->offset[a] - h->offset[a] == 0.0))
             return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                               "header: the %c scale or offset is zero or not finite", "xyz"[a]);
     }
+    h->minor = minor, h->hsize = hsize, h->fmt = fmt, h->rec_len = rec_len;
+    h->data_off = data_off, h->n = n;
+    return JF_OK;
+}
+
+jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err)
+{
+    const unsigned char *b = (const unsigned char *)buf;
+    las_hdr h;
+    jf_status st = las_header(b, len, len, name, &h, err);
+    if (st != JF_OK)
+        return st;
+    const unsigned minor = h.minor, hsize = h.hsize, fmt = h.fmt, rec_len = h.rec_len;
+    const uint32_t data_off = h.data_off;
+    const uint64_t n = h.n;
+    const double *scale = h.scale, *off = h.offset;
     c->xyz = malloc((size_t)n * 3 * sizeof(double));
     if (!c->xyz)
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
@@ -274,4 +298,30 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
         !add_extra_bytes(at, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
     return JF_OK;
+}
+
+/* ---- point rows for readers of a byte range (io_internal.h) ----------- */
+
+jf_status jf__las_layout(const char *buf, size_t len, uint64_t size, const char *name,
+                         jf_row_layout *l, jf_error *err)
+{
+    las_hdr h;
+    memset(l, 0, sizeof *l);
+    jf_status st = las_header((const unsigned char *)buf, len, size, name, &h, err);
+    if (st != JF_OK)
+        return st;
+    l->count = h.n;
+    l->vertex_off = h.data_off;
+    l->row = h.rec_len;
+    l->las = 1;
+    memcpy(l->scale, h.scale, sizeof l->scale);
+    memcpy(l->offset, h.offset, sizeof l->offset);
+    return JF_OK;
+}
+
+void jf__las_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz)
+{
+    for (size_t i = 0; i < k; i++, raw += l->row)
+        for (int a = 0; a < 3; a++)
+            xyz[3 * i + a] = (double)i32(raw + 4 * a) * l->scale[a] + l->offset[a];
 }

@@ -632,7 +632,7 @@ static int vertex_rows(const ply *h, size_t body, uint64_t len, int *iv, uint64_
 }
 
 jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char *name,
-                         jf_ply_layout *l, jf_error *err)
+                         jf_row_layout *l, jf_error *err)
 {
     ply *h = calloc(1, sizeof *h);
     size_t body = 0;
@@ -675,9 +675,13 @@ jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char 
     return st;
 }
 
-void jf__ply_rows(const unsigned char *raw, size_t k, const jf_ply_layout *l, double *xyz,
-                  double *nrm)
+void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz,
+                     double *nrm)
 {
+    if (l->las) {
+        jf__las_rows(raw, k, l, xyz);
+        return;
+    }
     for (size_t r = 0; r < k; r++, raw += l->row) {
         for (int j = 0; j < 3; j++) xyz[3 * r + j] = load(raw + l->off[j], l->type[j], l->swap);
         if (nrm && l->has_normals)

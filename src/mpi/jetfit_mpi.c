@@ -11,7 +11,7 @@
  * .xyz, .txt, --ascii) go through a binary temporary that rank 0 converts
  * in one sequential pass with the same writer.  Refused with one line:
  * natural and rings neighbourhoods, --orient mst and scanner (they need
- * the whole cloud at once), inputs other than binary PLY, LAS output. */
+ * the whole cloud at once), inputs other than binary PLY and LAS, LAS output. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
@@ -38,9 +38,9 @@ static void usage(FILE *f)
         "the same output file, byte for byte.  Each rank reads 1/N of INPUT, owns\n"
         "one spatial part of the cloud and fetches the exact halo it needs; no rank\n"
         "holds the whole cloud.  Options: jetfit estimate --help.\n"
-        "INPUT: binary PLY.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
+        "INPUT: binary PLY or LAS.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
         "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
-        "(they need the whole cloud at once), LAS input and output; the input's\n"
+        "(they need the whole cloud at once), LAS output; the input's\n"
         "other properties are not carried (the output is that of --keep none).\n"
         "docs/scale.md \"Distributed runs\" says how to run on a cluster.\n");
 }
@@ -252,9 +252,9 @@ static int estimate(jf_mpi *m, int argc, char **argv)
                          "cloud at once); use none, input or viewpoint:X,Y,Z, or jetfit estimate",
                       o.orient == JF_ORIENT_MST ? "mst" : "scanner");
     jf_format fin = jf_format_from_path(in), fout = jf_format_from_path(out);
-    if (fin != JF_FMT_PLY)
-        return refuse(m, "%s: distributed runs read binary PLY only (jetfit estimate reads the "
-                         "other formats; a PLY tool or jetfit can convert)", in);
+    if (fin != JF_FMT_PLY && fin != JF_FMT_LAS)
+        return refuse(m, "%s: distributed runs read binary PLY and LAS only (jetfit estimate "
+                         "reads the other formats; a PLY tool or jetfit can convert)", in);
     if (fout == JF_FMT_LAS)
         return refuse(m, "%s: LAS output is not supported in distributed runs (write .ply, "
                          ".csv or .xyz)", out);
@@ -266,7 +266,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     if (jf_same_file(in, out)) return 1;
 
     double t0 = MPI_Wtime();
-    jf_ply_layout lay;
+    jf_row_layout lay;
     jf_mpi_probe(m, in, &lay);
     if (jf_mpi_check(m)) return 1;
     if (!cmd.e.orient_set && lay.has_normals) o.orient = JF_ORIENT_INPUT;

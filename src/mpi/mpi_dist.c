@@ -87,7 +87,7 @@ static int read_at(int fd, void *buf, size_t len, uint64_t at)
     return 0;
 }
 
-void jf_mpi_probe(jf_mpi *m, const char *path, jf_ply_layout *l)
+void jf_mpi_probe(jf_mpi *m, const char *path, jf_row_layout *l)
 {
     memset(l, 0, sizeof *l);
     int fd = open(path, O_RDONLY);
@@ -106,7 +106,8 @@ void jf_mpi_probe(jf_mpi *m, const char *path, jf_ply_layout *l)
     jf_error err = {{0}};
     if (!buf) jf_mpi_fail(m, "out of memory");
     else if (read_at(fd, buf, len, 0)) jf_mpi_fail(m, "%s: %s", path, strerror(errno));
-    else if (jf__ply_layout(buf, len, (uint64_t)sb.st_size, path, l, &err) != JF_OK)
+    else if ((jf_format_from_path(path) == JF_FMT_LAS ? jf__las_layout : jf__ply_layout)(
+                 buf, len, (uint64_t)sb.st_size, path, l, &err) != JF_OK)
         jf_mpi_fail(m, "%s", err.msg);
     free(buf);
     close(fd);
@@ -224,7 +225,7 @@ static int owner(uint64_t pos, uint64_t nf, int P)
 /* ---- step 1 and 2: read, partition -------------------------------------- */
 
 /* Reads this rank's rows into *pts (finite, keyed) and *bad (non-finite). */
-static void read_rows(jf_mpi *m, const char *path, const jf_ply_layout *l, int normals,
+static void read_rows(jf_mpi *m, const char *path, const jf_row_layout *l, int normals,
                       prec **pts, size_t *npts, prec **bad, size_t *nbad)
 {
     const uint64_t N = l->count, first = N * (uint64_t)m->rank / (uint64_t)m->size,
@@ -248,7 +249,7 @@ static void read_rows(jf_mpi *m, const char *path, const jf_ply_layout *l, int n
                         errno ? strerror(errno) : "file shorter than its header says");
             break;
         }
-        jf__ply_rows(raw, k, l, xyz, normals ? nrm : NULL);
+        jf__layout_rows(raw, k, l, xyz, normals ? nrm : NULL);
         for (size_t j = 0; j < k; j++) {
             prec p = {0, (uint32_t)(first + r0 + j), 0, {0}, {0}};
             memcpy(p.xyz, xyz + 3 * j, sizeof p.xyz);
@@ -582,7 +583,7 @@ out:
 
 /* ---- the whole load ------------------------------------------------------ */
 
-void jf_mpi_load(jf_mpi *m, const char *path, const jf_ply_layout *l, const jf_part_query *q,
+void jf_mpi_load(jf_mpi *m, const char *path, const jf_row_layout *l, const jf_part_query *q,
                  int normals, int threads, jf_mpi_cloud *c)
 {
     memset(c, 0, sizeof *c);

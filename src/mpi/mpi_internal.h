@@ -55,14 +55,14 @@ void jf_mpi_cloud_free(jf_mpi_cloud *c);
 
 /* Reads the header of the binary PLY `path` (every rank, no collective).
  * On failure m->failed. */
-void jf_mpi_probe(jf_mpi *m, const char *path, jf_ply_layout *l);
+void jf_mpi_probe(jf_mpi *m, const char *path, jf_row_layout *l);
 
 /* Reads this rank's rows of the binary PLY `path` (1/size of them),
  * partitions the finite points into one part per rank (parts.h: Morton
  * order, equal runs), exchanges them, and fetches the halo that the query
  * q needs.  normals: read nx ny nz too (the file must have them).
  * threads for the local trees.  Collective; on failure m->failed. */
-void jf_mpi_load(jf_mpi *m, const char *path, const jf_ply_layout *l, const jf_part_query *q,
+void jf_mpi_load(jf_mpi *m, const char *path, const jf_row_layout *l, const jf_part_query *q,
                  int normals, int threads, jf_mpi_cloud *c);
 
 #endif

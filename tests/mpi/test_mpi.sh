@@ -61,6 +61,11 @@ equal-knn)
   same "2 3" clusters.ply ply                       # knn:32, orient input (normals)
   same "3" tiny.ply ply --neighbors knn:4           # an empty part
   same "3" ten.ply ply --neighbors knn:8 --fit interp --degree 2
+  # LAS input: each rank decodes its byte range of the records (scale, offset)
+  "$jetfit" estimate "$d/clusters.ply" -o "$d/clusters.las" --quiet --keep none ||
+    bad "jetfit estimate clusters.ply -o clusters.las"
+  same "1 2 3" clusters.las ply --neighbors knn:16
+  same "2" clusters.las csv --neighbors knn:24,radius:0.01 --degree 3
   ;;
 equal-more)
   same "2 3" lattice.ply ply --neighbors radius:1.2
@@ -74,12 +79,15 @@ equal-more)
 errors)
   refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --neighbors natural
   refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --orient mst
-  refused "binary PLY only" 2 "$d/lattice.csv" -o "$d/err.ply"
+  refused "binary PLY and LAS only" 2 "$d/lattice.csv" -o "$d/err.ply"
   refused "No such file" 3 "$d/missing.ply" -o "$d/err.ply"
   printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n' >"$d/ascii.ply"
   refused "ascii PLY" 2 "$d/ascii.ply" -o "$d/err.ply"
   head -c 3000 "$d/lattice.ply" >"$d/cut.ply"
   refused "cut.ply" 3 "$d/cut.ply" -o "$d/err.ply"
+  "$jetfit" estimate "$d/lattice.ply" -o "$d/lattice.las" --quiet --keep none
+  head -c 5000 "$d/lattice.las" >"$d/cut.las" # past the VLRs, into the records
+  refused "point record" 2 "$d/cut.las" -o "$d/err.ply"
   refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
   # a rank that fails mid-run: one line, exit 1, the old output intact
   echo old >"$d/keep.ply"
