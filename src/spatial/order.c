@@ -13,52 +13,21 @@
 #include <stdlib.h>
 
 #include "jetfit.h"
+#include "parts.h"
 
 #define ORD_BITS 21
 #define ORD_DIGIT 11
-
-/* Spreads the low 21 bits of v so that bit i moves to bit 3i. */
-static uint64_t spread3(uint64_t v)
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-}
-
-static uint64_t quantise(double v, double lo, double scale)
-{
-    double t = (v - lo) * scale;
-    if (!(t > 0)) return 0;
-    if (t >= (double)((1u << ORD_BITS) - 1)) return (1u << ORD_BITS) - 1;
-    return (uint64_t)t;
-}
 
 jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order)
 {
     if ((!xyz || !order) && n) return JF_ERR_INVALID;
     if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
     if (!n) return JF_OK;
-    double lo[3] = {INFINITY, INFINITY, INFINITY};
-    double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < n; i++) {
-        const double *p = xyz + 3 * i;
-        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
-        for (int d = 0; d < 3; d++) {
-            if (p[d] < lo[d]) lo[d] = p[d];
-            if (p[d] > hi[d]) hi[d] = p[d];
-        }
-    }
-    /* one scale for all axes keeps the cells cubic (true Z-order) */
-    double ext = 0;
-    for (int d = 0; d < 3; d++)
-        if (hi[d] - lo[d] > ext) ext = hi[d] - lo[d];
-    double scale = ext > 0 && isfinite(ext)
-                       ? (double)((1u << ORD_BITS) - 1) / ext
-                       : 0.0;
+    /* the Morton keys of parts.c: one scale for all axes keeps the cells
+     * cubic (true Z-order) */
+    double box[6];
+    jf__parts_bbox(xyz, n, box);
+    const double scale = jf__morton_scale(box);
     uint64_t *key = malloc(2 * n * sizeof *key);
     uint32_t *tmp = malloc(n * sizeof *tmp);
     if (!key || !tmp) {
@@ -76,9 +45,7 @@ jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order)
             any_bad = 1;
             continue;
         }
-        key[i] = spread3(quantise(p[0], lo[0], scale)) |
-                 spread3(quantise(p[1], lo[1], scale)) << 1 |
-                 spread3(quantise(p[2], lo[2], scale)) << 2;
+        key[i] = jf__morton_key(p, box, scale);
     }
     /* LSD radix sort on 63 bits (64 if a UINT64_MAX key is present) */
     int nbits = any_bad ? 64 : 3 * ORD_BITS;
