@@ -94,10 +94,13 @@ enum {
                                       than the largest candidate        */
     JF_PT_MESH_NONMANIFOLD = 1u << 14,/* rings: the vertex is on a mesh
                                       edge shared by more than 2 faces  */
-    JF_PT_NORMAL_JET = 1u << 15    /* natural: tangent plane from the jet
+    JF_PT_NORMAL_JET = 1u << 15,   /* natural: tangent plane from the jet
                                       of the N nearest points, ring on
                                       the jet-projected cloud (noisy
                                       cloud, docs/natural.md)           */
+    JF_PT_NORMAL_PCA = 1u << 16    /* natural: tangent plane from the PCA
+                                      of the 16 nearest points (clean
+                                      cloud, or --normal pca)           */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf
@@ -894,7 +897,9 @@ typedef enum {
                               rings on the points projected on their jet
                               (not computed here)                        */
     JF_NORMAL_AUTO = 5     /* jf_estimate's default: JET when the cloud is
-                              noisy (JF_NATURAL_NOISY_*), else POLES     */
+                              noisy (JF_NATURAL_NOISY_*), else PCA; the
+                              cells from k-NN candidates (no
+                              triangulation: jf_natural_create_knn)     */
 } jf_normal_source;
 
 /* A pole whose reliability (pole distance / nearest-neighbour distance)
@@ -932,6 +937,21 @@ jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out);
 jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
                                     jf_natural **out);
 void jf_natural_free(jf_natural *nt);
+
+/* The same neighbourhoods without a triangulation: each cell is clipped
+ * by the point's nearest samples from a k-d tree (16 kept per point,
+ * about 100 bytes per point with the tree), and is exact (the same as the
+ * triangulation's up to rounding) once a certificate holds: every vertex
+ * of the cell is within half the distance of the next candidate; the
+ * query widens to 144 candidates before a cell is accepted as clipped
+ * by the box (the rim of an open scan).  No vertex merging (identical
+ * points stay separate; only one of them is anyone's neighbour), no
+ * poles: jf_natural_normals returns JF_ERR_INVALID on it, the caller
+ * brings the normals (jf_estimate: PCA or jet).  jf_natural_get_stats
+ * reports dimension 3 and no timings.  Same returns as create; the
+ * result does not depend on the thread count. */
+jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads,
+                                jf_natural **out);
 
 typedef struct {
     int dimension;       /* 3; 2 = all coplanar (no poles: mincirc);

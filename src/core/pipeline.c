@@ -125,29 +125,39 @@ static int pca_normal(const double *pts, size_t m, double nrm[3])
     return 1;
 }
 
-/* --normal pca: the PCA normal of the PCA_K nearest points, in parallel. */
-static jf_status pca_normals(const jf_index *ix, const double *xyz, size_t n, int nt,
-                             double *nrm, unsigned *flags)
+/* PCA plane of point i from the PCA_K nearest points; 0: none. */
+static int pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3])
 {
-    jf_status st = JF_OK;
-#pragma omp parallel num_threads(nt)
-    {
-        uint32_t idx[PCA_K];
-        double d2[PCA_K], pts[3 * PCA_K];
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            size_t found = 0;
-            int ok = finite3(xyz + 3 * i) &&
-                     jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) == JF_OK;
-            for (size_t j = 0; ok && j < found; j++)
-                memcpy(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3]));
-            if (!ok || !pca_normal(pts, found, nrm + 3 * i)) {
-                nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
-                flags[i] |= JF_PT_FAILED;
-            }
-        }
+    uint32_t idx[PCA_K];
+    double d2[PCA_K], pts[3 * PCA_K];
+    size_t found = 0;
+    if (!finite3(xyz + 3 * i) || jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) != JF_OK)
+        return 0;
+    for (size_t j = 0; j < found; j++) memcpy(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3]));
+    return pca_normal(pts, found, nrm);
+}
+
+/* PCA planes of every point from the k-NN form's candidates (nt made
+ * from ix): the point and its PCA_K - 1 nearest others, in the tree's
+ * order (no second query).  Flags JF_PT_NORMAL_PCA, or JF_PT_FAILED. */
+static void pca_normals(const jf_natural *ntl, const jf_index *ix, size_t n, int nt, double *nrm,
+                        unsigned *flags)
+{
+    const double *tp;
+    const uint32_t *id;
+    size_t m = jf__index_points(ix, &tp, &id);
+    for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
+#pragma omp parallel for schedule(static, 1024) num_threads(nt)
+    for (size_t v = 0; v < m; v++) {
+        double pts[3 * PCA_K];
+        const uint32_t *c;
+        size_t k = jf__natural_candidates(ntl, v, &c);
+        if (k > PCA_K - 1) k = PCA_K - 1;
+        memcpy(pts, tp + 3 * v, sizeof(double[3]));
+        for (size_t j = 0; j < k; j++) memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[j], sizeof(double[3]));
+        size_t i = id[v];
+        flags[i] |= pca_normal(pts, k + 1, nrm + 3 * i) ? JF_PT_NORMAL_PCA : JF_PT_FAILED;
     }
-    return st;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -204,51 +214,38 @@ static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const doub
 }
 
 /* JF_NORMAL_JET (planes.c): the plane of point i is the jet normal of its
- * N nearest points, and the triangulation is built on the points moved to
- * their jets; the fit later uses the original points (x->xyz).  A point
- * whose jet failed (too few points) gets the pole or mincirc normal of
- * that triangulation, with its flags. */
+ * N nearest points, and the cells are made on the points moved to their
+ * jets (the k-NN form, over a tree of its own); the fit later uses the
+ * original points (x->xyz).  A point whose jet failed (too few points)
+ * gets its PCA plane. */
 static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params *prm,
                            jf_error *err)
 {
     size_t n = c->n;
-    jf_index *own = NULL;
     double *proj = malloc(3 * n * sizeof *proj);
     jf_status st = proj ? JF_OK : JF_ERR_NOMEM;
-    if (st == JF_OK && !x->ix && (st = jf__index_build_threads(c->xyz, n, nt, &own)) != JF_OK)
-        set_err(err, "building the k-d tree failed");
     /* x->nflags holds "jet ok" until turned into flags below */
     if (st == JF_OK)
-        st = jf__planes_knn_jet(x->ix ? x->ix : own, c->xyz, n, x->want, prm, nt, x->nrm_own,
-                                proj, x->nflags);
-    jf_index_free(own); /* before the triangulation: a lower peak */
-    if (st == JF_OK && (st = jf_natural_create_threads(proj, n, nt, &x->nt)) != JF_OK)
-        set_err(err, "natural neighbours: building the Delaunay triangulation failed");
+        st = jf__planes_knn_jet(x->ix, c->xyz, n, x->want, prm, nt, x->nrm_own, proj, x->nflags);
+    if (st == JF_OK && (st = jf_natural_create_knn(proj, n, nt, &x->nt)) != JF_OK)
+        set_err(err, "natural neighbours: the k-NN candidates failed");
     free(proj);
-    if (st != JF_OK) return st;
-    size_t nfail = 0;
-    for (size_t i = 0; i < n; i++) {
-        nfail += !x->nflags[i] && finite3(c->xyz + 3 * i);
-        x->nflags[i] = x->nflags[i] ? JF_PT_NORMAL_JET : 0;
-    }
-    if (!nfail) return JF_OK;
-    double *pn = malloc(3 * n * sizeof *pn);
-    unsigned *pf = calloc(n, sizeof *pf);
-    if (!pn || !pf) st = JF_ERR_NOMEM;
-    if (st == JF_OK) st = jf_natural_normals(x->nt, JF_NORMAL_POLES, nt, pn, pf, NULL);
-    for (size_t i = 0; st == JF_OK && i < n; i++)
-        if (!x->nflags[i] && finite3(c->xyz + 3 * i)) {
-            memcpy(x->nrm_own + 3 * i, pn + 3 * i, sizeof(double[3]));
-            x->nflags[i] = pf[i];
+    for (size_t i = 0; st == JF_OK && i < n; i++) {
+        if (x->nflags[i]) {
+            x->nflags[i] = JF_PT_NORMAL_JET;
+        } else if (finite3(c->xyz + 3 * i)) {
+            double *m = x->nrm_own + 3 * i;
+            x->nflags[i] = pca_one(x->ix, c->xyz, i, m) ? JF_PT_NORMAL_PCA : JF_PT_FAILED;
+            if (x->nflags[i] == JF_PT_FAILED) m[0] = m[1] = m[2] = NAN;
         }
-    free(pn);
-    free(pf);
-    if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
+    }
     return st;
 }
 
-/* Step 1 for natural[:N]: triangulation and tangent-plane normals.  AUTO
- * is POLES on a clean cloud and JET on a noisy one (docs/natural.md). */
+/* Step 1 for natural[:N]: the cells' structure and the tangent-plane
+ * normals.  POLES and MINCIRC need the 3D Delaunay triangulation; every
+ * other source uses the k-NN form over x->ix (docs/natural.md, "Speed").
+ * AUTO is PCA on a clean cloud and JET on a noisy one. */
 static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src, int nt,
                                const jf_params *prm, jf_error *err)
 {
@@ -265,9 +262,12 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         x->nrm = x->nrm_own;
     }
     if (src == JF_NORMAL_JET) return jet_setup(x, c, nt, prm, err);
-    jf_status st = jf_natural_create_threads(c->xyz, n, nt, &x->nt);
+    int delaunay = src == JF_NORMAL_POLES || src == JF_NORMAL_MINCIRC;
+    jf_status st = delaunay ? jf_natural_create_threads(c->xyz, n, nt, &x->nt)
+                            : jf__natural_from_index(x->ix, nt, &x->nt);
     if (st != JF_OK) {
-        set_err(err, "natural neighbours: building the Delaunay triangulation failed");
+        set_err(err, delaunay ? "natural neighbours: building the Delaunay triangulation failed"
+                              : "natural neighbours: the k-NN candidates failed");
         return st;
     }
     if (src == JF_NORMAL_INPUT) {
@@ -275,17 +275,19 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         for (size_t i = 0; i < n; i++) x->nflags[i] = JF_PT_NORMAL_INPUT;
         return JF_OK;
     }
-    if (src == JF_NORMAL_PCA) return pca_normals(x->ix, c->xyz, n, nt, x->nrm_own, x->nflags);
-    st = jf_natural_normals(x->nt, src == JF_NORMAL_AUTO ? JF_NORMAL_POLES : src, nt,
-                            x->nrm_own, x->nflags, NULL);
+    if (delaunay) {
+        st = jf_natural_normals(x->nt, src, nt, x->nrm_own, x->nflags, NULL);
+        if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
+        return st;
+    }
+    pca_normals(x->nt, x->ix, n, nt, x->nrm_own, x->nflags);
     int noisy = 0;
-    if (st == JF_OK && src == JF_NORMAL_AUTO) st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy);
-    if (st != JF_OK) {
-        set_err(err, "natural neighbours: tangent-plane normals failed");
+    if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy)) != JF_OK) {
+        set_err(err, "natural neighbours: the noise test failed");
         return st;
     }
     if (!noisy) return JF_OK;
-    jf_natural_free(x->nt); /* rebuilt on the projected points */
+    jf_natural_free(x->nt); /* made anew on the projected points */
     x->nt = NULL;
     memset(x->nflags, 0, n * sizeof *x->nflags);
     return jet_setup(x, c, nt, prm, err);
@@ -718,8 +720,10 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const ui
     jf_status st = JF_OK;
     jf_index *ix = NULL;
     uint32_t *order = NULL;
-    int need_index = nb.kind <= JF_NB_KNN_RADIUS ||
-                     (o->nb.kind == JF_NB_NATURAL && o->normal == JF_NORMAL_PCA);
+    /* natural: the k-NN form's candidates and planes come from the tree */
+    int knn_cells = o->nb.kind == JF_NB_NATURAL && o->normal != JF_NORMAL_POLES &&
+                    o->normal != JF_NORMAL_MINCIRC;
+    int need_index = nb.kind <= JF_NB_KNN_RADIUS || knn_cells;
     if (need_index && (st = jf__index_build_threads(c->xyz, n, nt, &ix)) != JF_OK) {
         set_err(err, "building the k-d tree failed");
         goto out;
@@ -762,7 +766,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const ui
     const uint32_t *walk;
     const double *walk_xyz = NULL;
     size_t nwalk = n;
-    if (nb.kind <= JF_NB_KNN_RADIUS) {
+    if (need_index) {
         nwalk = jf__index_points(ix, &walk_xyz, &walk);
     } else {
         order = malloc(n * sizeof *order);
@@ -814,6 +818,8 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const ui
     }
     free(order);
     order = NULL;
+    jf_natural_free(x.nt); /* may borrow ix */
+    x.nt = NULL;
     jf_index_free(ix); /* the orientation does not need it: lower peak */
     ix = NULL;
     if (o->progress) o->progress(o->progress_user, R.total, R.total);

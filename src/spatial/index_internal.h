@@ -28,6 +28,22 @@ size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t *
 jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
                           uint32_t *idx, double *d2, double *xyz, size_t *found);
 
+/* n given to the build (jf_index_size counts the finite ones only). */
+size_t jf__index_input_size(const jf_index *ix);
+
+/* jf_index_knn's query leaving positions in the tree's order (indices
+ * into *pts of jf__index_points) in pos instead of input indices. */
+jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
+                            double *d2, size_t *found);
+
+/* natural.c: natural neighbourhoods over k-NN candidates of the tree's
+ * points (borrowed: ix must outlive *out); see jf_natural_create_knn. */
+jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out);
+
+/* The k-NN form's candidates of vertex v (tree position v of the tree it
+ * was made from), nearest first: their count (at most 16) and *pos. */
+size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos);
+
 /* neighbors.c: jf_nb_query, and the coordinates of the neighbours to xyz
  * (3 * cap entries, caller-owned) unless NULL. */
 jf_status jf__nb_query_xyz(const jf_index *ix, const jf_nb_spec *s, size_t min_count,

@@ -226,6 +226,8 @@ void jf_index_free(jf_index *ix)
 
 size_t jf_index_size(const jf_index *ix) { return ix ? ix->m : 0; }
 
+size_t jf__index_input_size(const jf_index *ix) { return ix ? ix->n : 0; }
+
 size_t jf_index_memory(const jf_index *ix)
 {
     if (!ix) return 0;
@@ -421,8 +423,9 @@ static void run_query(kd_query *s)
     }
 }
 
-jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
-                          uint32_t *idx, double *d2, double *xyz, size_t *found)
+/* The query proper; ids = 0 leaves tree positions in idx. */
+static jf_status query(const jf_index *ix, const double q[3], size_t k, double bound,
+                       uint32_t *idx, double *d2, double *xyz, size_t *found, int ids)
 {
     if (found) *found = 0;
     if (!ix || !q || !found || (k && !idx)) return JF_ERR_INVALID;
@@ -439,13 +442,25 @@ jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, doubl
                   k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX};
     run_query(&s);
     if (keys != d2 && keys != stack_keys) free(keys);
-    for (size_t j = 0; j < s.cnt; j++) {
+    for (size_t j = 0; ids && j < s.cnt; j++) {
         const uint32_t pos = idx[j];
         if (xyz) memcpy(xyz + 3 * j, ix->pts + 3 * (size_t)pos, 3 * sizeof(double));
         idx[j] = ix->id[pos];
     }
     *found = s.cnt;
     return JF_OK;
+}
+
+jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
+                          uint32_t *idx, double *d2, double *xyz, size_t *found)
+{
+    return query(ix, q, k, bound, idx, d2, xyz, found, 1);
+}
+
+jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
+                            double *d2, size_t *found)
+{
+    return query(ix, q, k, INFINITY, pos, d2, NULL, found, 0);
 }
 
 jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,

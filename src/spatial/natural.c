@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "cgal_bridge.h"
+#include "index_internal.h"
 #include "jetfit.h"
 
 #define NONE UINT32_MAX
@@ -40,11 +41,21 @@
 #define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
 #define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
 
+#define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
+#define CAND_MAX 144       /* and queried at most (16 -> 48 -> 144)     */
+
+/* Two sources of the cells' cutting neighbours: the 3D Delaunay
+ * neighbours (exact by construction), or the k-NN candidates of the k-d
+ * tree, nearest first, with a certificate (knn_cell).  In the k-NN form
+ * vertices are the tree's positions, d.adj holds CAND_K candidates per
+ * vertex (NONE-padded), d.adj_off, d.pole, d.hull are NULL. */
 struct jf_natural {
     jfb_delaunay d;
     double *vxyz; /* [3nv] coordinates of each vertex                  */
     double *nn;   /* [nv] distance to the nearest Delaunay neighbour    */
     size_t max_deg;
+    const jf_index *ix; /* k-NN form: the tree (owned if ix_own)        */
+    jf_index *ix_own;
 };
 
 struct jf_natural_ws {
@@ -57,6 +68,8 @@ struct jf_natural_ws {
     double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
     uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
     double *sx, *sy, *sr;      /* projected neighbours of the cell     */
+    uint32_t *cpos;            /* k-NN form: a wider candidate query   */
+    double *cd2;
 };
 
 static jf_status from_bridge(int rc) {
@@ -126,11 +139,86 @@ jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads, jf
     return JF_OK;
 }
 
+/* The k-NN form over the tree ix: vertex v = tree position v; its
+ * CAND_K nearest other vertices by (distance, input index). */
+jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out) {
+    if (!ix || !out) return JF_ERR_INVALID;
+    *out = NULL;
+#ifdef _OPENMP
+    int nthr = threads > 0 ? threads : omp_get_num_procs();
+#else
+    int nthr = 1;
+    (void)threads;
+#endif
+    jf_natural *nt = calloc(1, sizeof *nt);
+    if (!nt) return JF_ERR_NOMEM;
+    const double *pts;
+    const uint32_t *id;
+    size_t m = jf__index_points(ix, &pts, &id), n = jf__index_input_size(ix);
+    nt->ix = ix;
+    nt->vxyz = (double *)pts; /* borrowed: never freed in this form */
+    nt->max_deg = CAND_MAX;
+    nt->d.dimension = 3;
+    nt->d.n = n;
+    nt->d.nv = m;
+    nt->d.vertex_of = malloc((n + 1) * sizeof *nt->d.vertex_of);
+    nt->d.rep = malloc((m + 1) * sizeof *nt->d.rep);
+    nt->d.adj = malloc((m * CAND_K + 1) * sizeof *nt->d.adj);
+    if (!nt->d.vertex_of || !nt->d.rep || !nt->d.adj) {
+        jf_natural_free(nt);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++) nt->d.vertex_of[i] = NONE;
+    for (size_t v = 0; v < m; v++) nt->d.rep[v] = id[v], nt->d.vertex_of[id[v]] = (uint32_t)v;
+    long ml = (long)m;
+    int bad = 0;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static, 1024) num_threads(nthr) reduction(| : bad)
+#endif
+    for (long v = 0; v < ml; v++) {
+        uint32_t pos[CAND_K + 1], *a = nt->d.adj + (size_t)v * CAND_K;
+        double d2[CAND_K + 1];
+        size_t f = 0, c = 0;
+        bad |= jf__index_knn_pos(ix, pts + 3 * v, CAND_K + 1, pos, d2, &f) != JF_OK;
+        for (size_t j = 0; j < f && c < CAND_K; j++)
+            if (pos[j] != (uint32_t)v) a[c++] = pos[j];
+        while (c < CAND_K) a[c++] = NONE;
+    }
+    if (bad) {
+        jf_natural_free(nt);
+        return JF_ERR_INTERNAL;
+    }
+    *out = nt;
+    return JF_OK;
+}
+
+size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos) {
+    if (!nt || !nt->ix || v >= nt->d.nv) return 0;
+    size_t c = 0;
+    *pos = nt->d.adj + v * CAND_K;
+    while (c < CAND_K && (*pos)[c] != NONE) c++;
+    return c;
+}
+
+jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_natural **out) {
+    if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
+    *out = NULL;
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    jf_index *ix = NULL;
+    jf_status st = jf__index_build_threads(xyz, n, threads, &ix);
+    if (st == JF_OK && (st = jf__natural_from_index(ix, threads, out)) == JF_OK)
+        (*out)->ix_own = ix;
+    else
+        jf_index_free(ix);
+    return st;
+}
+
 void jf_natural_free(jf_natural *nt) {
     if (!nt) return;
     jfb_delaunay_release(&nt->d);
-    free(nt->vxyz);
+    if (!nt->ix) free(nt->vxyz);
     free(nt->nn);
+    jf_index_free(nt->ix_own);
     free(nt);
 }
 
@@ -218,7 +306,7 @@ static double pole_normal(const jf_natural *nt, size_t v, double n[3]) {
 
 jf_status jf_natural_normals(const jf_natural *nt, jf_normal_source src, int threads,
                              double *nrm, unsigned *flags, double *reliability) {
-    if (!nt || !nrm || !flags) return JF_ERR_INVALID;
+    if (!nt || !nrm || !flags || nt->ix) return JF_ERR_INVALID; /* k-NN form: no poles */
     if (src != JF_NORMAL_POLES && src != JF_NORMAL_MINCIRC) return JF_ERR_INVALID;
     long n = (long)nt->d.n;
 #ifdef _OPENMP
@@ -270,6 +358,8 @@ jf_status jf_natural_ws_create(const jf_natural *nt, jf_natural_ws **out) {
     for (size_t k = 0; k < sizeof bufs / sizeof *bufs; k++) ok &= (*bufs[k] = malloc(m * sizeof(double))) != NULL;
     ok &= (ws->pl = malloc(m * sizeof(uint32_t))) != NULL;
     ok &= (ws->ql = malloc(m * sizeof(uint32_t))) != NULL;
+    ok &= (ws->cpos = malloc(m * sizeof(uint32_t))) != NULL;
+    ok &= (ws->cd2 = malloc(m * sizeof(double))) != NULL;
     if (!ok) {
         jf_natural_ws_free(ws);
         return JF_ERR_NOMEM;
@@ -286,6 +376,7 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws->px), free(ws->py), free(ws->qx), free(ws->qy);
     free(ws->sx), free(ws->sy), free(ws->sr);
     free(ws->pl), free(ws->ql);
+    free(ws->cpos), free(ws->cd2);
     free(ws);
 }
 
@@ -323,11 +414,11 @@ static void project(const plane *h, const double *q, double *x, double *y, doubl
 /* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
  * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
  * the clip line gets label s. */
-static void clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
+static int clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
     size_t n = *m, o = 0, k0;
     for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
         if (ax * ws->px[k0] + ay * ws->py[k0] > b) break;
-    if (k0 == n) return;
+    if (k0 == n) return 0;
     for (size_t k = 0; k < n; k++) {
         size_t k1 = k + 1 == n ? 0 : k + 1;
         double fu = ax * ws->px[k] + ay * ws->py[k] - b;
@@ -352,6 +443,7 @@ static void clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, u
     ws->px = ws->qx, ws->py = ws->qy, ws->pl = ws->ql;
     ws->qx = tx, ws->qy = ty, ws->ql = tl;
     *m = o;
+    return 1;
 }
 
 static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
@@ -369,6 +461,8 @@ static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
     ws->dist[(*len)++] = d2;
     return 1;
 }
+
+static int cell_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len);
 
 /* Appends to the list the planar natural neighbours of vertex u not yet
  * collected (the edge labels of u's clipped power cell). */
@@ -398,6 +492,13 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
         }
         clip(ws, &np, 2 * ws->sx[k], 2 * ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
     }
+    return cell_labels(ws, h, np, reach, len);
+}
+
+/* Appends the labels of the clipped cell's edges (np vertices) not yet
+ * collected; edges shorter than EDGE_EPS x reach are no adjacency. */
+static int cell_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len) {
+    const jf_natural *nt = ws->nt;
     const double *p = h->o;
     for (size_t k = 0; k < np; k++) {
         uint32_t s = ws->pl[k];
@@ -412,6 +513,65 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
         if (!push(ws, len, s, d2)) return 0;
     }
     return 1;
+}
+
+/* k-NN form of cell_neighbors: u's planar cell clipped by its
+ * candidates, nearest first.  Certificate: a sample s at 3D distance
+ * d_s from u cannot cut the cell at a vertex x (in H) with
+ * |x - u| <= d_s / 2, since |x - s| >= d_s - |x - u| >= |x - u|.  So
+ * once the next candidate is at least twice as far as every vertex of
+ * the polygon, no sample further out cuts it either and the cell is
+ * exact.  The candidates run out before that only where the cell is
+ * large (rim of an open scan, sparse or far-off-plane u): the query
+ * widens to CAND_MAX, then the cell is taken as clipped by the box. */
+static int knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    const double *U = nt->vxyz + 3 * (size_t)u;
+    const uint32_t *c = nt->d.adj + (size_t)u * CAND_K;
+    size_t cnt = 0, K = CAND_K, np = 4, j = 0;
+    while (cnt < CAND_K && c[cnt] != NONE) cnt++;
+    if (!cnt) return 1;
+    double ux, uy, uz;
+    project(h, U, &ux, &uy, &uz);
+    const double *L = nt->vxyz + 3 * (size_t)c[cnt - 1];
+    double reach = sqrt((L[0] - U[0]) * (L[0] - U[0]) + (L[1] - U[1]) * (L[1] - U[1]) +
+                        (L[2] - U[2]) * (L[2] - U[2]));
+    double B = BOX_SCALE * reach;
+    double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
+    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
+    double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
+    for (;;) {
+        for (; j < cnt && np > 0; j++) {
+            const double *S = nt->vxyz + 3 * (size_t)c[j];
+            double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
+            if (dx * dx + dy * dy + dz * dz >= 4 * r2) goto exact;
+            double x, y, z;
+            project(h, S, &x, &y, &z);
+            double sx = x - ux, sy = y - uy, sr = sx * sx + sy * sy + (z - uz) * (z + uz);
+            if (sx == 0 && sy == 0) {
+                if (sr < 0) np = 0; /* s straight above u, nearer H */
+                continue;
+            }
+            if (!clip(ws, &np, 2 * sx, 2 * sy, sr, c[j])) continue;
+            r2 = 0;
+            for (size_t k = 0; k < np; k++) {
+                double q = ws->px[k] * ws->px[k] + ws->py[k] * ws->py[k];
+                if (q > r2) r2 = q;
+            }
+            r2 += uz * uz;
+        }
+        if (np == 0 || cnt < K || K >= CAND_MAX) break;
+        /* widen: the first j of the wider list are the same candidates */
+        K = 3 * K < CAND_MAX ? 3 * K : CAND_MAX;
+        size_t f = 0, m = 0;
+        if (jf__index_knn_pos(nt->ix, U, K + 1, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+        for (size_t k = 0; k < f; k++)
+            if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
+        c = ws->cpos;
+        cnt = m;
+    }
+exact:
+    return cell_labels(ws, h, np, reach, len);
 }
 
 /* Lexicographic (x, y, z) order of two distinct vertices: the tie-break
@@ -460,7 +620,9 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (ring_end) ring_end[0] = 1;
     for (int r = 1; r <= maxrings && *len < want; r++) {
         for (size_t k = a; k < b; k++)
-            if (!cell_neighbors(ws, &h, ws->list[k], len)) return JF_ERR_NOMEM;
+            if (!(nt->ix ? knn_cell(ws, &h, ws->list[k], len)
+                         : cell_neighbors(ws, &h, ws->list[k], len)))
+                return JF_ERR_NOMEM;
         if (*len == b) break; /* the cloud ran out */
         sort_ring(ws, b, *len);
         a = b, b = *len;
