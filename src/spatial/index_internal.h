@@ -31,10 +31,11 @@ jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, doubl
 /* n given to the build (jf_index_size counts the finite ones only). */
 size_t jf__index_input_size(const jf_index *ix);
 
-/* jf_index_knn's query leaving positions in the tree's order (indices
- * into *pts of jf__index_points) in pos instead of input indices. */
-jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
-                            double *d2, size_t *found);
+/* jf__index_query (no coordinates) leaving positions in the tree's order
+ * (indices into *pts of jf__index_points) in pos instead of input
+ * indices. */
+jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, double bound,
+                            uint32_t *pos, double *d2, size_t *found);
 
 /* natural.c: natural neighbourhoods over k-NN candidates of the tree's
  * points (borrowed: ix must outlive *out); see jf_natural_create_knn. */

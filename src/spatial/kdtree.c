@@ -457,10 +457,10 @@ jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, doubl
     return query(ix, q, k, bound, idx, d2, xyz, found, 1);
 }
 
-jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
-                            double *d2, size_t *found)
+jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, double bound,
+                            uint32_t *pos, double *d2, size_t *found)
 {
-    return query(ix, q, k, INFINITY, pos, d2, NULL, found, 0);
+    return query(ix, q, k, bound, pos, d2, NULL, found, 0);
 }
 
 jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,

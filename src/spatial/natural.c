@@ -42,7 +42,8 @@
 #define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
 
 #define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
-#define CAND_MAX 144       /* and queried at most (16 -> 48 -> 144)     */
+#define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
+#define CAND_MAX 144       /* and at most                               */
 
 /* Two sources of the cells' cutting neighbours: the 3D Delaunay
  * neighbours (exact by construction), or the k-NN candidates of the k-d
@@ -179,7 +180,7 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
         uint32_t pos[CAND_K + 1], *a = nt->d.adj + (size_t)v * CAND_K;
         double d2[CAND_K + 1];
         size_t f = 0, c = 0;
-        bad |= jf__index_knn_pos(ix, pts + 3 * v, CAND_K + 1, pos, d2, &f) != JF_OK;
+        bad |= jf__index_knn_pos(ix, pts + 3 * v, CAND_K + 1, INFINITY, pos, d2, &f) != JF_OK;
         for (size_t j = 0; j < f && c < CAND_K; j++)
             if (pos[j] != (uint32_t)v) a[c++] = pos[j];
         while (c < CAND_K) a[c++] = NONE;
@@ -561,10 +562,14 @@ static int knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) 
             r2 += uz * uz;
         }
         if (np == 0 || cnt < K || K >= CAND_MAX) break;
-        /* widen: the first j of the wider list are the same candidates */
-        K = 3 * K < CAND_MAX ? 3 * K : CAND_MAX;
+        const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
+        double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
+        if (dx * dx + dy * dy + dz * dz >= 4 * r2) break; /* the last cut shrank it enough */
+        /* widen to the samples within 2 |x - u| (at most K of them): the
+         * first j are the same candidates; fewer than K found: all */
+        K = K == CAND_K ? CAND_MID : CAND_MAX;
         size_t f = 0, m = 0;
-        if (jf__index_knn_pos(nt->ix, U, K + 1, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+        if (jf__index_knn_pos(nt->ix, U, K + 1, 4 * r2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
         for (size_t k = 0; k < f; k++)
             if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
         c = ws->cpos;
