@@ -148,9 +148,12 @@ static int run_profile() {
     jf_index *ix;
     if (jf_index_build(g_xyz.data(), n, &ix) != JF_OK) return 1;
     std::vector<double> nrm(3 * n, NAN);
+    std::vector<uint32_t> order(n);  // walked in space order, as the pipeline
+    if (jf_spatial_order(g_xyz.data(), n, order.data()) != JF_OK) return 1;
     double t2 = now(), c2 = cpu_self();
 #pragma omp parallel for num_threads(g_threads) schedule(static)
-    for (long i = 0; i < (long)n; i++) {
+    for (long o = 0; o < (long)n; o++) {
+        long i = order[o];
         uint32_t idx[16];
         double d2[16], m[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0};
         size_t f = 0;
@@ -192,8 +195,8 @@ static int run_profile() {
         std::vector<uint32_t> idx(64);
         if (jf_natural_ws_create(nt, &ws) == JF_OK) {
 #pragma omp for schedule(dynamic, 4096)
-            for (long i = 0; i < (long)n; i++) {
-                size_t f = 0;
+            for (long o = 0; o < (long)n; o++) {
+                size_t f = 0, i = order[o];
                 if (std::isfinite(nrm[3 * i]))
                     jf_natural_neighbors(nt, ws, (size_t)i, &nrm[3 * i], 16, idx.data(), idx.size(), &f);
                 total += f;
