@@ -24,6 +24,8 @@
  *    reach the rings ran along the rim, and natural:128's normals on the
  *    clean §6.1 patch were 9.75 deg off at the rim (0.10 with 2x; knn:128
  *    0.02; docs/natural.md).
+ *  - The same cells without a triangulation (the k-NN form, the default
+ *    of jf_estimate): natural_knn.c; the rings below serve both.
  */
 #include <math.h>
 #ifdef _OPENMP
@@ -32,46 +34,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cgal_bridge.h"
 #include "index_internal.h"
-#include "jetfit.h"
+#include "natural_internal.h"
 
-#define NONE UINT32_MAX
-#define BOX_SCALE 2.0      /* box half-size / farthest 3D neighbour     */
-#define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
 #define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
 
-#define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
-#define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
-#define CAND_MAX 144       /* and at most                               */
 
-/* Two sources of the cells' cutting neighbours: the 3D Delaunay
- * neighbours (exact by construction), or the k-NN candidates of the k-d
- * tree, nearest first, with a certificate (knn_cell).  In the k-NN form
- * vertices are the tree's positions, d.adj holds CAND_K candidates per
- * vertex (NONE-padded), d.adj_off, d.pole, d.hull are NULL. */
-struct jf_natural {
-    jfb_delaunay d;
-    double *vxyz; /* [3nv] coordinates of each vertex                  */
-    double *nn;   /* [nv] distance to the nearest Delaunay neighbour    */
-    size_t max_deg;
-    const jf_index *ix; /* k-NN form: the tree (owned if ix_own)        */
-    jf_index *ix_own;
-};
 
-struct jf_natural_ws {
-    const jf_natural *nt;
-    uint32_t *stamp; /* [nv] == gen: vertex already collected          */
-    uint32_t gen;
-    uint32_t *list;  /* collected vertices, in ring order              */
-    double *dist;    /* their squared distance to p                    */
-    size_t listcap;
-    double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
-    uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
-    double *sx, *sy, *sr;      /* projected neighbours of the cell     */
-    uint32_t *cpos;            /* k-NN form: a wider candidate query   */
-    double *cd2;
-};
+int jf__natural_threads(int threads) {
+#ifdef _OPENMP
+    return threads > 0 ? threads : omp_get_num_procs();
+#else
+    (void)threads;
+    return 1;
+#endif
+}
 
 static jf_status from_bridge(int rc) {
     switch (rc) {
@@ -90,12 +67,7 @@ jf_status jf_natural_create(const double *xyz, size_t n, jf_natural **out) {
 jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads, jf_natural **out) {
     if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
     *out = NULL;
-#ifdef _OPENMP
-    int nthr = threads > 0 ? threads : omp_get_num_procs();
-#else
-    int nthr = 1;
-    (void)threads;
-#endif
+    int nthr = jf__natural_threads(threads);
     jf_natural *nt = calloc(1, sizeof *nt);
     if (!nt) return JF_ERR_NOMEM;
     jf_status st = from_bridge(jfb_delaunay_build(xyz, n, nthr, &nt->d));
@@ -140,79 +112,7 @@ jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads, jf
     return JF_OK;
 }
 
-/* The k-NN form over the tree ix: vertex v = tree position v; its
- * CAND_K nearest other vertices by (distance, input index). */
-jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out) {
-    if (!ix || !out) return JF_ERR_INVALID;
-    *out = NULL;
-#ifdef _OPENMP
-    int nthr = threads > 0 ? threads : omp_get_num_procs();
-#else
-    int nthr = 1;
-    (void)threads;
-#endif
-    jf_natural *nt = calloc(1, sizeof *nt);
-    if (!nt) return JF_ERR_NOMEM;
-    const double *pts;
-    const uint32_t *id;
-    size_t m = jf__index_points(ix, &pts, &id), n = jf__index_input_size(ix);
-    nt->ix = ix;
-    nt->vxyz = (double *)pts; /* borrowed: never freed in this form */
-    nt->max_deg = CAND_MAX;
-    nt->d.dimension = 3;
-    nt->d.n = n;
-    nt->d.nv = m;
-    nt->d.vertex_of = malloc((n + 1) * sizeof *nt->d.vertex_of);
-    nt->d.rep = malloc((m + 1) * sizeof *nt->d.rep);
-    nt->d.adj = malloc((m * CAND_K + 1) * sizeof *nt->d.adj);
-    if (!nt->d.vertex_of || !nt->d.rep || !nt->d.adj) {
-        jf_natural_free(nt);
-        return JF_ERR_NOMEM;
-    }
-    for (size_t i = 0; i < n; i++) nt->d.vertex_of[i] = NONE;
-    for (size_t v = 0; v < m; v++) nt->d.rep[v] = id[v], nt->d.vertex_of[id[v]] = (uint32_t)v;
-    long ml = (long)m;
-    int bad = 0;
-#ifdef _OPENMP
-#pragma omp parallel for schedule(static, 1024) num_threads(nthr) reduction(| : bad)
-#endif
-    for (long v = 0; v < ml; v++) {
-        uint32_t pos[CAND_K + 1], *a = nt->d.adj + (size_t)v * CAND_K;
-        double d2[CAND_K + 1];
-        size_t f = 0, c = 0;
-        bad |= jf__index_knn_pos(ix, pts + 3 * v, CAND_K + 1, INFINITY, pos, d2, &f) != JF_OK;
-        for (size_t j = 0; j < f && c < CAND_K; j++)
-            if (pos[j] != (uint32_t)v) a[c++] = pos[j];
-        while (c < CAND_K) a[c++] = NONE;
-    }
-    if (bad) {
-        jf_natural_free(nt);
-        return JF_ERR_INTERNAL;
-    }
-    *out = nt;
-    return JF_OK;
-}
 
-size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos) {
-    if (!nt || !nt->ix || v >= nt->d.nv) return 0;
-    size_t c = 0;
-    *pos = nt->d.adj + v * CAND_K;
-    while (c < CAND_K && (*pos)[c] != NONE) c++;
-    return c;
-}
-
-jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_natural **out) {
-    if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
-    *out = NULL;
-    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
-    jf_index *ix = NULL;
-    jf_status st = jf__index_build_threads(xyz, n, threads, &ix);
-    if (st == JF_OK && (st = jf__natural_from_index(ix, threads, out)) == JF_OK)
-        (*out)->ix_own = ix;
-    else
-        jf_index_free(ix);
-    return st;
-}
 
 void jf_natural_free(jf_natural *nt) {
     if (!nt) return;
@@ -310,12 +210,8 @@ jf_status jf_natural_normals(const jf_natural *nt, jf_normal_source src, int thr
     if (!nt || !nrm || !flags || nt->ix) return JF_ERR_INVALID; /* k-NN form: no poles */
     if (src != JF_NORMAL_POLES && src != JF_NORMAL_MINCIRC) return JF_ERR_INVALID;
     long n = (long)nt->d.n;
-#ifdef _OPENMP
-    int nthr = threads > 0 ? threads : omp_get_num_procs();
+    int nthr = jf__natural_threads(threads);
 #pragma omp parallel for schedule(static) num_threads(nthr)
-#else
-    (void)threads;
-#endif
     for (long i = 0; i < n; i++) {
         uint32_t v = nt->d.vertex_of[i];
         double *o = nrm + 3 * i;
@@ -381,10 +277,6 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws);
 }
 
-/* The tangent plane: orthonormal e1, e2 spanning it, n its unit normal. */
-typedef struct {
-    double o[3], e1[3], e2[3], n[3];
-} plane;
 
 static int make_plane(const double *o, const double nrm[3], plane *h) {
     double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
@@ -405,17 +297,11 @@ static int make_plane(const double *o, const double nrm[3], plane *h) {
     return 1;
 }
 
-static void project(const plane *h, const double *q, double *x, double *y, double *z) {
-    double d[3] = {q[0] - h->o[0], q[1] - h->o[1], q[2] - h->o[2]};
-    *x = d[0] * h->e1[0] + d[1] * h->e1[1] + d[2] * h->e1[2];
-    *y = d[0] * h->e2[0] + d[1] * h->e2[1] + d[2] * h->e2[2];
-    *z = d[0] * h->n[0] + d[1] * h->n[1] + d[2] * h->n[2];
-}
 
 /* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
  * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
  * the clip line gets label s. */
-static int clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
+int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
     size_t n = *m, o = 0, k0;
     for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
         if (ax * ws->px[k0] + ay * ws->py[k0] > b) break;
@@ -463,8 +349,6 @@ static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
     return 1;
 }
 
-static int cell_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len);
-
 /* Appends to the list the planar natural neighbours of vertex u not yet
  * collected (the edge labels of u's clipped power cell). */
 static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
@@ -491,14 +375,14 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
             if (ws->sr[k] < 0) np = 0; /* s straight above u, nearer H */
             continue;
         }
-        clip(ws, &np, 2 * ws->sx[k], 2 * ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
+        jf__natural_clip(ws, &np, 2 * ws->sx[k], 2 * ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
     }
-    return cell_labels(ws, h, np, reach, len);
+    return jf__natural_labels(ws, h, np, reach, len);
 }
 
 /* Appends the labels of the clipped cell's edges (np vertices) not yet
  * collected; edges shorter than EDGE_EPS x reach are no adjacency. */
-static int cell_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len) {
+int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len) {
     const jf_natural *nt = ws->nt;
     const double *p = h->o;
     for (size_t k = 0; k < np; k++) {
@@ -516,68 +400,6 @@ static int cell_labels(jf_natural_ws *ws, const plane *h, size_t np, double reac
     return 1;
 }
 
-/* k-NN form of cell_neighbors: u's planar cell clipped by its
- * candidates, nearest first.  Certificate: a sample s at 3D distance
- * d_s from u cannot cut the cell at a vertex x (in H) with
- * |x - u| <= d_s / 2, since |x - s| >= d_s - |x - u| >= |x - u|.  So
- * once the next candidate is at least twice as far as every vertex of
- * the polygon, no sample further out cuts it either and the cell is
- * exact.  The candidates run out before that only where the cell is
- * large (rim of an open scan, sparse or far-off-plane u): the query
- * widens to CAND_MAX, then the cell is taken as clipped by the box. */
-static int knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
-    const jf_natural *nt = ws->nt;
-    const double *U = nt->vxyz + 3 * (size_t)u;
-    const uint32_t *c = nt->d.adj + (size_t)u * CAND_K;
-    size_t cnt = 0, K = CAND_K, np = 4, j = 0;
-    while (cnt < CAND_K && c[cnt] != NONE) cnt++;
-    if (!cnt) return 1;
-    double ux, uy, uz;
-    project(h, U, &ux, &uy, &uz);
-    const double *L = nt->vxyz + 3 * (size_t)c[cnt - 1];
-    double reach = sqrt((L[0] - U[0]) * (L[0] - U[0]) + (L[1] - U[1]) * (L[1] - U[1]) +
-                        (L[2] - U[2]) * (L[2] - U[2]));
-    double B = BOX_SCALE * reach;
-    double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
-    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
-    double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
-    for (;;) {
-        for (; j < cnt && np > 0; j++) {
-            const double *S = nt->vxyz + 3 * (size_t)c[j];
-            double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
-            if (dx * dx + dy * dy + dz * dz >= 4 * r2) goto exact;
-            double x, y, z;
-            project(h, S, &x, &y, &z);
-            double sx = x - ux, sy = y - uy, sr = sx * sx + sy * sy + (z - uz) * (z + uz);
-            if (sx == 0 && sy == 0) {
-                if (sr < 0) np = 0; /* s straight above u, nearer H */
-                continue;
-            }
-            if (!clip(ws, &np, 2 * sx, 2 * sy, sr, c[j])) continue;
-            r2 = 0;
-            for (size_t k = 0; k < np; k++) {
-                double q = ws->px[k] * ws->px[k] + ws->py[k] * ws->py[k];
-                if (q > r2) r2 = q;
-            }
-            r2 += uz * uz;
-        }
-        if (np == 0 || cnt < K || K >= CAND_MAX) break;
-        const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
-        double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
-        if (dx * dx + dy * dy + dz * dz >= 4 * r2) break; /* the last cut shrank it enough */
-        /* widen to the samples within 2 |x - u| (at most K of them): the
-         * first j are the same candidates; fewer than K found: all */
-        K = K == CAND_K ? CAND_MID : CAND_MAX;
-        size_t f = 0, m = 0;
-        if (jf__index_knn_pos(nt->ix, U, K + 1, 4 * r2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
-        for (size_t k = 0; k < f; k++)
-            if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
-        c = ws->cpos;
-        cnt = m;
-    }
-exact:
-    return cell_labels(ws, h, np, reach, len);
-}
 
 /* Lexicographic (x, y, z) order of two distinct vertices: the tie-break
  * of equal distances (grids), a function of the points alone, so the
@@ -625,7 +447,7 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (ring_end) ring_end[0] = 1;
     for (int r = 1; r <= maxrings && *len < want; r++) {
         for (size_t k = a; k < b; k++)
-            if (!(nt->ix ? knn_cell(ws, &h, ws->list[k], len)
+            if (!(nt->ix ? jf__natural_knn_cell(ws, &h, ws->list[k], len)
                          : cell_neighbors(ws, &h, ws->list[k], len)))
                 return JF_ERR_NOMEM;
         if (*len == b) break; /* the cloud ran out */

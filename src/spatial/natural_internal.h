@@ -1,0 +1,76 @@
+/* natural_internal.h -- what natural.c (the triangulation's form, the
+ * rings) and natural_knn.c (the k-NN form's cells) share; not public. */
+#ifndef JF_NATURAL_INTERNAL_H
+#define JF_NATURAL_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cgal_bridge.h"
+#include "jetfit.h"
+
+#define NONE UINT32_MAX
+#define BOX_SCALE 2.0      /* box half-size / farthest 3D neighbour     */
+#define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
+
+#define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
+#define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
+#define CAND_MAX 144       /* and at most                               */
+
+/* Two sources of the cells' cutting neighbours: the 3D Delaunay
+ * neighbours (exact by construction), or the k-NN candidates of the k-d
+ * tree, nearest first, with a certificate (knn_cell).  In the k-NN form
+ * vertices are the tree's positions, d.adj holds CAND_K candidates per
+ * vertex (NONE-padded), d.adj_off, d.pole, d.hull are NULL. */
+struct jf_natural {
+    jfb_delaunay d;
+    double *vxyz; /* [3nv] coordinates of each vertex                  */
+    double *nn;   /* [nv] distance to the nearest Delaunay neighbour    */
+    size_t max_deg;
+    const jf_index *ix; /* k-NN form: the tree (owned if ix_own)        */
+    jf_index *ix_own;
+};
+
+struct jf_natural_ws {
+    const jf_natural *nt;
+    uint32_t *stamp; /* [nv] == gen: vertex already collected          */
+    uint32_t gen;
+    uint32_t *list;  /* collected vertices, in ring order              */
+    double *dist;    /* their squared distance to p                    */
+    size_t listcap;
+    double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
+    uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
+    double *sx, *sy, *sr;      /* projected neighbours of the cell     */
+    uint32_t *cpos;            /* k-NN form: a wider candidate query   */
+    double *cd2;
+};
+
+/* The tangent plane: orthonormal e1, e2 spanning it, n its unit normal. */
+typedef struct {
+    double o[3], e1[3], e2[3], n[3];
+} plane;
+
+static inline void project(const plane *h, const double *q, double *x, double *y, double *z) {
+    double d[3] = {q[0] - h->o[0], q[1] - h->o[1], q[2] - h->o[2]};
+    *x = d[0] * h->e1[0] + d[1] * h->e1[1] + d[2] * h->e1[2];
+    *y = d[0] * h->e2[0] + d[1] * h->e2[1] + d[2] * h->e2[2];
+    *z = d[0] * h->n[0] + d[1] * h->n[1] + d[2] * h->n[2];
+}
+
+/* OpenMP thread count of a call: threads, or every core when <= 0. */
+int jf__natural_threads(int threads);
+
+/* Clips the convex polygon (ws->px, py, pl)[0..*m) by a.x <= b, the new
+ * edge labelled s; returns 0 when nothing was cut (no copy made). */
+int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s);
+
+/* Appends the labels of the clipped cell's edges (np vertices) not yet
+ * collected; edges shorter than EDGE_EPS x reach are no adjacency.
+ * Returns 0 when out of memory. */
+int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len);
+
+/* natural_knn.c: vertex u's cell in the plane h from its k-NN candidates
+ * (the certificate), its labels appended as jf__natural_labels does. */
+int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len);
+
+#endif /* JF_NATURAL_INTERNAL_H */
