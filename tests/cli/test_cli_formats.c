@@ -270,6 +270,48 @@ START_TEST(progress_on_terminal)
 }
 END_TEST
 
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The summary's cond percentiles (a selection, not a sort) are the order
+ * statistics of the output's cond column: on a random surface sample and
+ * on a regular grid, where most points share one cond value. */
+START_TEST(summary_percentiles)
+{
+    const size_t side = 40, n = side * side;
+    double *xyz = malloc(3 * n * sizeof *xyz), *c = malloc(n * sizeof *c);
+    for (int grid = 0; grid < 2; grid++) {
+        if (grid)
+            for (size_t i = 0; i < n; i++)
+                xyz[3 * i] = (double)(i % side), xyz[3 * i + 1] = (double)(i / side), xyz[3 * i + 2] = 0;
+        else
+            cli_surface61(side, xyz, 7);
+        cli_write_xyz(cli_path("p.xyz"), xyz, NULL, n);
+        ck_assert_msg(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("p.csv"), "--neighbors",
+                              "knn:12", NULL) == 0, "%s", cli_err);
+        jf_eval_table t;
+        cli_read(cli_path("p.csv"), &t);
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            double v = cli_val(&t, i, "cond");
+            if (isfinite(v)) c[m++] = v;
+        }
+        jf_eval_table_free(&t);
+        ck_assert_uint_gt(m, n / 2);
+        qsort(c, m, sizeof *c, cmp_dbl);
+        char want[160];
+        snprintf(want, sizeof want, "  cond: p50 %.3g, p90 %.3g, p99 %.3g, max %.3g\n", c[(m - 1) / 2],
+                 c[(size_t)(0.9 * (double)(m - 1))], c[(size_t)(0.99 * (double)(m - 1))], c[m - 1]);
+        ck_assert_msg(strstr(cli_err, want) != NULL, "grid %d: want %s in %s", grid, want, cli_err);
+    }
+    free(xyz);
+    free(c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_formats");
@@ -282,6 +324,7 @@ int main(void)
     tcase_add_test(tc, columns_option);
     tcase_add_test(tc, neighbourhood_kinds);
     tcase_add_test(tc, progress_on_terminal);
+    tcase_add_test(tc, summary_percentiles);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
