@@ -6,6 +6,7 @@
  *    normals given to both forms: every neighbourhood identical at N = 16
  *    and 64, at most 2% differ at N = 128 (box-clipped far cells);
  *  - an open patch: identical away from the rim (the rim's box differs);
+ *    so is a flat cloud (2D triangulation) and a patch 1e6 from the origin;
  *  - small and odd clouds (0..5 points, non-finite points, duplicates)
  *    neither crash nor return out-of-range indices; no poles on this
  *    form (jf_natural_normals refuses it). */
@@ -110,6 +111,30 @@ START_TEST(open_patch_interior) {
 }
 END_TEST
 
+/* A flat random cloud (the triangulation is 2D there) and the same
+ * surface 1e6 away from the origin (georeferenced coordinates): the
+ * interior neighbourhoods agree. */
+START_TEST(flat_and_far) {
+    const size_t n = 3000;
+    double *p = malloc(3 * n * sizeof *p), *nrm = malloc(3 * n * sizeof *nrm);
+    unsigned char *keep = malloc(n);
+    for (int far = 0; far < 2; far++) {
+        double o = far ? 1e6 : 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double x = urand(), y = urand();
+            p[3 * i] = o + x, p[3 * i + 1] = o + y, p[3 * i + 2] = far ? o + 0.3 * x * x : 0.0;
+            nrm[3 * i] = far ? -0.6 * x : 0.0, nrm[3 * i + 1] = 0.0, nrm[3 * i + 2] = 1.0;
+            keep[i] = x > 0.2 && x < 0.8 && y > 0.2 && y < 0.8;
+        }
+        size_t bad = differing(p, nrm, n, 24, keep);
+        ck_assert_msg(bad == 0, "far %d: %zu interior neighbourhoods differ", far, bad);
+    }
+    free(p);
+    free(nrm);
+    free(keep);
+}
+END_TEST
+
 START_TEST(small_and_odd) {
     double p[3 * 8] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.1, 0.5, 0.5, 0.2, 0.5, 0.5, 0.2, NAN, 0, 0, 2, 2, 0};
     double z[3] = {0, 0, 1};
@@ -146,6 +171,7 @@ int main(void) {
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, closed_identical);
     tcase_add_test(tc, open_patch_interior);
+    tcase_add_test(tc, flat_and_far);
     tcase_add_test(tc, small_and_odd);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
