@@ -894,8 +894,10 @@ typedef enum {
     JF_NORMAL_PCA = 2,     /* the caller's (not computed here)           */
     JF_NORMAL_INPUT = 3,   /* the caller's (not computed here)           */
     JF_NORMAL_JET = 4,     /* jf_estimate: jet normal of knn:N, natural
-                              rings on the points projected on their jet
-                              (not computed here)                        */
+                              rings on the points projected on their jet,
+                              and those projected points fitted (the
+                              residual is still the raw ring's; not
+                              computed here)                             */
     JF_NORMAL_AUTO = 5     /* jf_estimate's default: JET when the cloud is
                               noisy (JF_NATURAL_NOISY_*), else PCA; the
                               cells from k-NN candidates (no

@@ -42,7 +42,14 @@ struct jf_fitter {
     double last_h;    /* its preconditioning scale h                   */
     size_t last_n;    /* n of the last surface fit (residuals)         */
     int have_last;
+    double last_p[3]; /* its origin (the point fitted)                 */
 };
+
+/* RMS of z - J(x, y) of n other points (world coordinates) in the last
+ * surface fit's frame: how far the jet fitted to moved points lies from
+ * the raw ones (natural neighbourhoods on a noisy cloud).  NaN when the
+ * last fit failed or no point is finite. */
+double jf__fitter_rms(const jf_fitter *f, const double *pts, size_t n);
 
 /* ldexp(x, e) as one multiplication by the exact double 2^e when that
  * is a normal number: a product is rounded once, as ldexp's result is

@@ -157,6 +157,7 @@ static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *
     f->last_n = n;
     f->have_last = 1;
     f->last_deg = 0;
+    memcpy(f->last_p, p, sizeof f->last_p);
     for (int k = 0; k < 3; k++) out->pca_eval[k] = NAN;
     if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
         fail_result(out, JF_PT_NONFINITE);
@@ -406,6 +407,29 @@ jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr, size_
                        jf_result *out)
 {
     return jf_fit_point_weighted(f, p, nbr, NULL, n, out);
+}
+
+double jf__fitter_rms(const jf_fitter *f, const double *pts, size_t n)
+{
+    const int deg = f->have_last ? f->last_deg : 0;
+    if (deg == 0) return NAN;
+    const size_t cols = jf_jet_size(deg);
+    const double ih = 1.0 / f->last_h, *r = f->frame, *o = f->last_p;
+    double mon[55], s2 = 0;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double d[3] = {pts[3 * i] - o[0], pts[3 * i + 1] - o[1], pts[3 * i + 2] - o[2]};
+        const double x = r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
+        const double y = r[3] * d[0] + r[4] * d[1] + r[5] * d[2];
+        const double z = r[6] * d[0] + r[7] * d[1] + r[8] * d[2];
+        if (!isfinite(x) || !isfinite(y) || !isfinite(z)) continue;
+        monomials(x * ih, y * ih, deg, mon);
+        double J = 0;
+        for (size_t c = 0; c < cols; c++) J += f->sol[c] * mon[c];
+        s2 += (z - J) * (z - J);
+        m++;
+    }
+    return m ? sqrt(s2 / (double)m) : NAN;
 }
 
 jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n)

@@ -96,6 +96,8 @@ typedef struct {
     double *nrm_own;      /* natural: normals we computed (3n)         */
     const double *nrm;    /* natural: the tangent-plane normals        */
     unsigned *nflags;     /* natural: JF_PT_NORMAL_* per point         */
+    int fit_moved;        /* natural, noisy: fit the ring's points moved
+                             onto their jets (nt's own coordinates)     */
     size_t min_count;     /* N_n of the asked degree                   */
     size_t want;          /* fewer found than this: FEW_NEIGHBORS      */
     size_t cap;           /* buffer size (largest neighbourhood)       */
@@ -227,6 +229,7 @@ static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params 
     /* x->nflags holds "jet ok" until turned into flags below */
     if (st == JF_OK)
         st = jf__planes_knn_jet(x->ix, c->xyz, n, x->want, prm, nt, x->nrm_own, proj, x->nflags);
+    x->fit_moved = 1;
     if (st == JF_OK && (st = jf_natural_create_knn(proj, n, nt, &x->nt)) != JF_OK)
         set_err(err, "natural neighbours: the k-NN candidates failed");
     free(proj);
@@ -334,6 +337,7 @@ typedef struct {
     jf_natural_ws *nws;
     uint32_t *idx;
     double *d2, *coords, *coords2;
+    double *raw, *raw2;   /* natural fit_moved: the raw ring of each    */
     jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
     uint32_t *bidx;       /* and their input indices                    */
 } worker;
@@ -347,6 +351,8 @@ static void worker_free(worker *w)
     free(w->d2);
     free(w->coords);
     free(w->coords2);
+    free(w->raw);
+    free(w->raw2);
     free(w->blk);
     free(w->bidx);
     memset(w, 0, sizeof *w);
@@ -363,7 +369,9 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->d2 = malloc(x->cap * sizeof *w->d2);
         w->coords = malloc(3 * x->cap * sizeof *w->coords);
         w->coords2 = malloc(3 * x->cap * sizeof *w->coords2);
-        if (!w->idx || !w->d2 || !w->coords || !w->coords2) st = JF_ERR_NOMEM;
+        w->raw = malloc(3 * x->cap * sizeof *w->raw);
+        w->raw2 = malloc(3 * x->cap * sizeof *w->raw2);
+        if (!w->idx || !w->d2 || !w->coords || !w->coords2 || !w->raw || !w->raw2) st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && blocks) {
         w->blk = malloc(CHUNK * sizeof *w->blk);
@@ -411,6 +419,21 @@ static void store_row(jf_result *out, const jf_result *r)
 /* Point i, at p (its coordinates, from the input or the tree's copy): its
  * neighbourhood into coords (*found points).  Returns 1 in *fit if it is
  * to be fitted; else its row is final in *row. */
+static double *raw_of(const worker *w, const double *coords)
+{
+    return coords == w->coords ? w->raw : w->raw2;
+}
+
+/* fit_moved: the residual of the raw ring about the jet fitted to the
+ * moved one (the moved points' own residual says nothing of the scan's
+ * noise); plain fits only (the last fit on f is the point's). */
+static void raw_residual(const worker *w, const nbctx *x, const jf_fitter *f, const double *coords,
+                         size_t found, jf_result *r)
+{
+    if (x->fit_moved && x->plain && !(r->status & JF_PT_FAILED))
+        r->residual = jf__fitter_rms(f, raw_of(w, coords), found);
+}
+
 static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, double *coords,
                          jf_result *row, size_t *found, unsigned *flags, int *fit)
 {
@@ -427,8 +450,12 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
         return JF_OK;
     }
     const int gathered = x->nb->kind <= JF_NB_KNN_RADIUS; /* by nb_query */
+    /* fit_moved: the moved points are fitted, the raw ones kept for the
+     * residual (raw_of: the buffer beside coords) */
+    double *raw = x->fit_moved ? raw_of(w, coords) : coords;
     for (size_t j = 0; !gathered && j < *found; j++)
-        memcpy(coords + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
+        memcpy(raw + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
+    if (x->fit_moved) jf__natural_coords(w->nws, *found, coords);
     *fit = 1;
     return JF_OK;
 }
@@ -443,6 +470,7 @@ static jf_status fit_one(worker *w, const nbctx *x, size_t i, const double *p, j
     if (st != JF_OK) return st;
     if (fit) {
         st = jf_fit_point_full(w->fit, p, w->coords, found, &r);
+        raw_residual(w, x, w->fit, w->coords, found, &r);
         r.status |= flags;
     }
     store_row(out, &r);
@@ -464,9 +492,13 @@ static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0,
     if (st != JF_OK) return st;
     if (fit0 && fit1) {
         st = jf__fit_point_x2(w->fit, p0, w->coords, n0, &r0, w->fit2, p1, w->coords2, n1, &r1);
+        raw_residual(w, x, w->fit, w->coords, n0, &r0);
+        raw_residual(w, x, w->fit2, w->coords2, n1, &r1);
     } else {
         if (fit0) st = jf_fit_point_full(w->fit, p0, w->coords, n0, &r0);
+        if (fit0) raw_residual(w, x, w->fit, w->coords, n0, &r0);
         if (fit1 && st == JF_OK) st = jf_fit_point_full(w->fit, p1, w->coords2, n1, &r1);
+        if (fit1) raw_residual(w, x, w->fit, w->coords2, n1, &r1);
     }
     if (st != JF_OK) return st;
     if (fit0) r0.status |= fl0;

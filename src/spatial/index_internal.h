@@ -45,6 +45,11 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
  * was made from), nearest first: their count (at most 16) and *pos. */
 size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos);
 
+/* After jf_natural_neighbors on ws (found points): their coordinates in
+ * the structure's own copy (for the jet form, the points moved onto their
+ * jets) to xyz[3 found]. */
+void jf__natural_coords(const jf_natural_ws *ws, size_t found, double *xyz);
+
 /* neighbors.c: jf_nb_query, and the coordinates of the neighbours to xyz
  * (3 * cap entries, caller-owned) unless NULL. */
 jf_status jf__nb_query_xyz(const jf_index *ix, const jf_nb_spec *s, size_t min_count,

@@ -70,6 +70,11 @@ size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **p
     return c;
 }
 
+void jf__natural_coords(const jf_natural_ws *ws, size_t found, double *xyz) {
+    for (size_t k = 0; k < found; k++)
+        memcpy(xyz + 3 * k, ws->nt->vxyz + 3 * (size_t)ws->list[k], sizeof(double[3]));
+}
+
 jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_natural **out) {
     if (!out || (!xyz && n > 0)) return JF_ERR_INVALID;
     *out = NULL;

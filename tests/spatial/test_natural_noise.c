@@ -1,10 +1,13 @@
 /* test_natural_noise.c -- natural neighbourhoods on a noisy cloud (issue
  * 15.1, docs/natural.md): with the default tangent plane (JF_NORMAL_AUTO)
- * natural:64's normal RMS error is at most 1.1x knn:64's on a noisy
- * ellipsoid, against the exact normals; the pole plane (the old default)
- * is not (the self-confirming ring: docs/natural.md); the status flags
- * say which plane each point used; a clean cloud takes the PCA plane
- * (bit normal_pca) and is as good as the pole plane; the jet plane gives the same bits on 1 and 2 threads. */
+ * natural:64's normal RMS error is at most 0.95x knn:64's on a noisy
+ * ellipsoid, against the exact normals (the ring's points moved onto
+ * their jets are fitted; the raw ring gave 1.01x), and its residual is
+ * the raw ring's; the pole plane (the old default) is not (the
+ * self-confirming ring); the status flags say which plane each point
+ * used; a clean cloud takes the PCA plane (bit normal_pca) and is as
+ * good as the pole plane; the jet plane gives the same bits on 1 and 2
+ * threads. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -87,17 +90,40 @@ static void plane_bits(const jf_result *r, unsigned want)
     for (size_t i = 0; i < NPTS; i++) ck_assert_uint_eq(r[i].status & planes, want);
 }
 
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median_residual(const jf_result *r)
+{
+    double *v = malloc(NPTS * sizeof *v), m;
+    for (size_t i = 0; i < NPTS; i++) v[i] = r[i].residual;
+    qsort(v, NPTS, sizeof *v, cmp_d);
+    m = v[NPTS / 2];
+    free(v);
+    return m;
+}
+
 START_TEST(noisy_ellipsoid)
 {
     double *xyz = malloc(3 * NPTS * sizeof *xyz), *nrm = malloc(3 * NPTS * sizeof *nrm);
     jf_result *r = malloc(NPTS * sizeof *r), *r2 = malloc(NPTS * sizeof *r2);
     ellipsoid(0.003, xyz, nrm);
     double knn = run(xyz, nrm, JF_NB_KNN, JF_NORMAL_AUTO, 2, r);
+    double knn_res = median_residual(r);
     double poles = run(xyz, nrm, JF_NB_NATURAL, JF_NORMAL_POLES, 2, r);
     double nat = run(xyz, nrm, JF_NB_NATURAL, JF_NORMAL_AUTO, 2, r);
-    printf("noisy ellipsoid (%d points, 0.3%%): knn:64 %.3f, natural:64 %.3f (poles %.3f) deg\n",
-           NPTS, knn, nat, poles);
-    ck_assert(nat <= 1.1 * knn);
+    double nat_res = median_residual(r);
+    printf("noisy ellipsoid (%d points, 0.3%%): knn:64 %.3f, natural:64 %.3f (poles %.3f) deg; "
+           "median residual knn %.3g, natural %.3g\n", NPTS, knn, nat, poles, knn_res, nat_res);
+    fflush(stdout);
+    /* the ring's points moved onto their jets are fitted: well below knn
+     * (the raw ring fitted gave 1.01x); the residual is the raw ring's,
+     * the scan's noise, not the moved points' (a few times smaller) */
+    ck_assert(nat <= 0.95 * knn);
+    ck_assert(nat_res > 0.7 * knn_res && nat_res < 1.4 * knn_res);
     ck_assert(poles > 1.3 * knn); /* what the jet plane fixes */
     plane_bits(r, JF_PT_NORMAL_JET); /* auto chose the jet plane */
     /* forced, on one thread: the same bits */
