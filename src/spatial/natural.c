@@ -257,6 +257,12 @@ jf_status jf_natural_ws_create(const jf_natural *nt, jf_natural_ws **out) {
     ok &= (ws->ql = malloc(m * sizeof(uint32_t))) != NULL;
     ok &= (ws->cpos = malloc(m * sizeof(uint32_t))) != NULL;
     ok &= (ws->cd2 = malloc(m * sizeof(double))) != NULL;
+    if (ok && nt->ix) {
+        ok &= (ws->wkey = malloc(WCACHE * sizeof *ws->wkey)) != NULL;
+        ok &= (ws->wlist = malloc((size_t)WCACHE * CAND_MID * sizeof *ws->wlist)) != NULL;
+        ok &= (ws->wcnt = malloc(WCACHE)) != NULL;
+        for (size_t k = 0; ok && k < WCACHE; k++) ws->wkey[k] = NONE;
+    }
     if (!ok) {
         jf_natural_ws_free(ws);
         return JF_ERR_NOMEM;
@@ -274,6 +280,7 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws->sx), free(ws->sy), free(ws->sr);
     free(ws->pl), free(ws->ql);
     free(ws->cpos), free(ws->cd2);
+    free(ws->wkey), free(ws->wlist), free(ws->wcnt);
     free(ws);
 }
 

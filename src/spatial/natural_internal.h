@@ -16,6 +16,7 @@
 #define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
 #define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
 #define CAND_MAX 144       /* and at most                               */
+#define WCACHE 2048        /* slots of the per-thread CAND_MID cache    */
 
 /* Two sources of the cells' cutting neighbours: the 3D Delaunay
  * neighbours (exact by construction), or the k-NN candidates of the k-d
@@ -43,6 +44,10 @@ struct jf_natural_ws {
     double *sx, *sy, *sr;      /* projected neighbours of the cell     */
     uint32_t *cpos;            /* k-NN form: a wider candidate query   */
     double *cd2;
+    uint32_t *wkey;            /* k-NN form: cache of CAND_MID-nearest */
+    uint32_t *wlist;           /* lists, slot u % WCACHE: key, list,   */
+    uint8_t *wcnt;             /* count (a vertex's is needed again by
+                                  the neighbouring points' rings)      */
 };
 
 /* The tangent plane: orthonormal e1, e2 spanning it, n its unit normal. */

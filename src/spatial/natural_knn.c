@@ -137,10 +137,28 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *
         const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
         double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
         if (dx * dx + dy * dy + dz * dz >= 4 * r2) break; /* the last cut shrank it enough */
-        /* widen to the samples within 2 |x - u| (at most K of them): the
-         * first j are the same candidates; fewer than K found: all */
-        K = K == CAND_K ? CAND_MID : CAND_MAX;
+        /* widen: the first j of a wider list are the same candidates.
+         * First the CAND_MID nearest, from the thread's cache (fewer: the
+         * whole cloud); then the samples within 2 |x - u| (at most
+         * CAND_MAX; fewer found: all of them) */
         size_t f = 0, m = 0;
+        if (K == CAND_K) {
+            K = CAND_MID;
+            size_t slot = u & (WCACHE - 1);
+            uint32_t *w = ws->wlist + slot * CAND_MID;
+            if (ws->wkey[slot] != u) {
+                if (jf__index_knn_pos(nt->ix, U, CAND_MID + 1, INFINITY, ws->cpos, ws->cd2, &f) != JF_OK)
+                    return 0;
+                for (size_t k = 0; k < f && m < CAND_MID; k++)
+                    if (ws->cpos[k] != u) w[m++] = ws->cpos[k];
+                ws->wkey[slot] = u;
+                ws->wcnt[slot] = (uint8_t)m;
+            }
+            c = w;
+            cnt = ws->wcnt[slot];
+            continue;
+        }
+        K = CAND_MAX;
         if (jf__index_knn_pos(nt->ix, U, K + 1, 4 * r2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
         for (size_t k = 0; k < f; k++)
             if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
