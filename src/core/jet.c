@@ -409,13 +409,22 @@ jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr, size_
     return jf_fit_point_weighted(f, p, nbr, NULL, n, out);
 }
 
+/* J(x, y) of the last fit (degree deg >= 1, local frame coordinates):
+ * sum Y_ij (x/h)^i (y/h)^j with the scaled solution Y kept in f. */
+static double last_jet_at(const jf_fitter *f, int deg, double ih, double x, double y)
+{
+    double mon[55], z = 0;
+    monomials(x * ih, y * ih, deg, mon);
+    for (size_t c = 0, cols = jf_jet_size(deg); c < cols; c++) z += f->sol[c] * mon[c];
+    return z;
+}
+
 double jf__fitter_rms(const jf_fitter *f, const double *pts, size_t n)
 {
     const int deg = f->have_last ? f->last_deg : 0;
     if (deg == 0) return NAN;
-    const size_t cols = jf_jet_size(deg);
     const double ih = 1.0 / f->last_h, *r = f->frame, *o = f->last_p;
-    double mon[55], s2 = 0;
+    double s2 = 0;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         const double d[3] = {pts[3 * i] - o[0], pts[3 * i + 1] - o[1], pts[3 * i + 2] - o[2]};
@@ -423,10 +432,8 @@ double jf__fitter_rms(const jf_fitter *f, const double *pts, size_t n)
         const double y = r[3] * d[0] + r[4] * d[1] + r[5] * d[2];
         const double z = r[6] * d[0] + r[7] * d[1] + r[8] * d[2];
         if (!isfinite(x) || !isfinite(y) || !isfinite(z)) continue;
-        monomials(x * ih, y * ih, deg, mon);
-        double J = 0;
-        for (size_t c = 0; c < cols; c++) J += f->sol[c] * mon[c];
-        s2 += (z - J) * (z - J);
+        const double e = z - last_jet_at(f, deg, ih, x, y);
+        s2 += e * e;
         m++;
     }
     return m ? sqrt(s2 / (double)m) : NAN;
@@ -438,19 +445,14 @@ jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n)
     /* computed on demand from the last fit's local points and scaled
      * solution Y (J(x,y) = sum Y_ij (x/h)^i (y/h)^j), kept in the fitter */
     const int deg = f->last_deg;
-    const size_t cols = jf_jet_size(deg);
     const double ih = deg > 0 ? 1.0 / f->last_h : 0.0;
-    double mon[55];
     for (size_t i = 0; i < n; i++) {
         const double *q = f->loc + 3 * i;
         if (deg == 0 || !isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
             res[i] = NAN;
             continue;
         }
-        monomials(q[0] * ih, q[1] * ih, deg, mon);
-        double z = 0;
-        for (size_t c = 0; c < cols; c++) z += f->sol[c] * mon[c];
-        res[i] = q[2] - z;
+        res[i] = q[2] - last_jet_at(f, deg, ih, q[0], q[1]);
     }
     return JF_OK;
 }

@@ -369,9 +369,12 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->d2 = malloc(x->cap * sizeof *w->d2);
         w->coords = malloc(3 * x->cap * sizeof *w->coords);
         w->coords2 = malloc(3 * x->cap * sizeof *w->coords2);
+        if (!w->idx || !w->d2 || !w->coords || !w->coords2) st = JF_ERR_NOMEM;
+    }
+    if (st == JF_OK && x->fit_moved) {
         w->raw = malloc(3 * x->cap * sizeof *w->raw);
         w->raw2 = malloc(3 * x->cap * sizeof *w->raw2);
-        if (!w->idx || !w->d2 || !w->coords || !w->coords2 || !w->raw || !w->raw2) st = JF_ERR_NOMEM;
+        if (!w->raw || !w->raw2) st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && blocks) {
         w->blk = malloc(CHUNK * sizeof *w->blk);
@@ -416,9 +419,6 @@ static void store_row(jf_result *out, const jf_result *r)
     *out = *r;
 }
 
-/* Point i, at p (its coordinates, from the input or the tree's copy): its
- * neighbourhood into coords (*found points).  Returns 1 in *fit if it is
- * to be fitted; else its row is final in *row. */
 static double *raw_of(const worker *w, const double *coords)
 {
     return coords == w->coords ? w->raw : w->raw2;
@@ -434,6 +434,9 @@ static void raw_residual(const worker *w, const nbctx *x, const jf_fitter *f, co
         r->residual = jf__fitter_rms(f, raw_of(w, coords), found);
 }
 
+/* Point i, at p (its coordinates, from the input or the tree's copy): its
+ * neighbourhood into coords (*found points).  Returns 1 in *fit if it is
+ * to be fitted; else its row is final in *row. */
 static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, double *coords,
                          jf_result *row, size_t *found, unsigned *flags, int *fit)
 {
@@ -495,10 +498,14 @@ static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0,
         raw_residual(w, x, w->fit, w->coords, n0, &r0);
         raw_residual(w, x, w->fit2, w->coords2, n1, &r1);
     } else {
-        if (fit0) st = jf_fit_point_full(w->fit, p0, w->coords, n0, &r0);
-        if (fit0) raw_residual(w, x, w->fit, w->coords, n0, &r0);
-        if (fit1 && st == JF_OK) st = jf_fit_point_full(w->fit, p1, w->coords2, n1, &r1);
-        if (fit1) raw_residual(w, x, w->fit, w->coords2, n1, &r1);
+        if (fit0) {
+            st = jf_fit_point_full(w->fit, p0, w->coords, n0, &r0);
+            raw_residual(w, x, w->fit, w->coords, n0, &r0);
+        }
+        if (fit1 && st == JF_OK) {
+            st = jf_fit_point_full(w->fit, p1, w->coords2, n1, &r1);
+            raw_residual(w, x, w->fit, w->coords2, n1, &r1);
+        }
     }
     if (st != JF_OK) return st;
     if (fit0) r0.status |= fl0;

@@ -39,8 +39,6 @@
 
 #define HULL_AGREE 0.7     /* cos 45 deg: hull direction vs -pole       */
 
-
-
 int jf__natural_threads(int threads) {
 #ifdef _OPENMP
     return threads > 0 ? threads : omp_get_num_procs();
@@ -111,8 +109,6 @@ jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads, jf
     *out = nt;
     return JF_OK;
 }
-
-
 
 void jf_natural_free(jf_natural *nt) {
     if (!nt) return;
@@ -284,7 +280,6 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws);
 }
 
-
 static int make_plane(const double *o, const double nrm[3], plane *h) {
     double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
     if (!(l > 0) || !isfinite(l)) return 0;
@@ -303,7 +298,6 @@ static int make_plane(const double *o, const double nrm[3], plane *h) {
     h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
     return 1;
 }
-
 
 /* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
  * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
@@ -406,7 +400,6 @@ int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reac
     }
     return 1;
 }
-
 
 /* Lexicographic (x, y, z) order of two distinct vertices: the tie-break
  * of equal distances (grids), a function of the points alone, so the

@@ -100,9 +100,8 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
     const jf_natural *nt = ws->nt;
     const double *U = nt->vxyz + 3 * (size_t)u;
-    const uint32_t *c = nt->d.adj + (size_t)u * CAND_K;
-    size_t cnt = 0, K = CAND_K, np = 4, j = 0;
-    while (cnt < CAND_K && c[cnt] != NONE) cnt++;
+    const uint32_t *c;
+    size_t cnt = jf__natural_candidates(nt, u, &c), K = CAND_K, np = 4, j = 0;
     if (!cnt) return 1;
     double ux, uy, uz;
     project(h, U, &ux, &uy, &uz);

@@ -59,6 +59,7 @@
 #include "cgal_bridge.h"
 #include "jetfit.h"
 extern "C" {
+#include "fitter_internal.h"
 #include "surfaces.h"
 }
 
@@ -135,7 +136,7 @@ static double cpu_self() {
 // the phases of natural:16's neighbourhoods (the k-NN form) on g_threads
 // threads, written to g_fd as wall[3] then cpu[3]: create (k-d tree and
 // candidates), the PCA planes of the 16 nearest (from a tree of the
-// bench's own, as the pipeline's plane), the neighbourhoods of every point
+// bench's own, jf__eig3 as the pipeline), the neighbourhoods of every point
 static int g_fd = -1;
 static int run_profile() {
     size_t n = g_xyz.size() / 3;
@@ -166,22 +167,10 @@ static int run_profile() {
             a[0] += d[0] * d[0], a[1] += d[0] * d[1], a[2] += d[0] * d[2];
             a[3] += d[1] * d[1], a[4] += d[1] * d[2], a[5] += d[2] * d[2];
         }
-        // smallest eigenvector by inverse iteration on the 3x3 (a bench
-        // plane, not the library's: only its cost matters here)
-        double v[3] = {1, 1, 1};
-        for (int it = 0; it < 8; it++) {
-            double r0[3] = {a[0], a[1], a[2]}, r1[3] = {a[1], a[3], a[4]}, r2[3] = {a[2], a[4], a[5]};
-            double cx[3] = {r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]};
-            double det = r0[0] * cx[0] + r0[1] * cx[1] + r0[2] * cx[2];
-            if (det == 0) break;
-            double cy[3] = {r2[1] * r0[2] - r2[2] * r0[1], r2[2] * r0[0] - r2[0] * r0[2], r2[0] * r0[1] - r2[1] * r0[0]};
-            double cz[3] = {r0[1] * r1[2] - r0[2] * r1[1], r0[2] * r1[0] - r0[0] * r1[2], r0[0] * r1[1] - r0[1] * r1[0]};
-            double u[3] = {(cx[0] * v[0] + cy[0] * v[1] + cz[0] * v[2]) / det,
-                           (cx[1] * v[0] + cy[1] * v[1] + cz[1] * v[2]) / det,
-                           (cx[2] * v[0] + cy[2] * v[1] + cz[2] * v[2]) / det};
-            double l = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            for (int k = 0; k < 3; k++) v[k] = u[k] / l;
-        }
+        // smallest-eigenvalue eigenvector: the library's 3x3 solver
+        double cov[9] = {a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5]}, ev[3], evec[9];
+        jf__eig3(cov, ev, evec);
+        const double *v = evec;
         for (int k = 0; k < 3; k++) nrm[3 * i + k] = v[k];
     }
     double t3 = now(), c3 = cpu_self();
