@@ -121,14 +121,20 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
 /* jf__svd_solve in steps, for two fits side by side (jet.c):
  * jf__qr_gram: the QR, then G = R^T R into f->x; returns 1, or 0 when
  * the fast path does not apply (no eigenvalues wanted).
- * jf__eigvals: G's eigenvalues into f->s; 1 ok, 0 failed.
+ * jf__eigvals (gram_eig.c): G's extreme eigenvalues into f->s (s[0] the
+ * largest, the rest the smallest; all of them for cols > 10); 1 ok, 0
+ * failed.
  * jf__eigvals_x2: the same for f0 and f1 (same cols) at once, bit for
  * bit; ok[i] as jf__eigvals' return.
+ * jf__sym_eigvals: all eigenvalues d of the symmetric n x n a (destroyed)
+ * by Householder and QL (n <= 55; e: n scratch); 0, or -1 when the QL did
+ * not converge.
  * jf__solve_after_eig: the rest (have_eig: the eigenvalues are in f->s);
  * returns as jf__svd_solve. */
 int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
 int jf__eigvals(jf_fitter *f, size_t cols);
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
+int jf__sym_eigvals(double *a, size_t n, double *d, double *e);
 int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond);
 
 /* jet.c */

@@ -15,9 +15,6 @@
  * instead: same results, but 2-3x slower fits (bench_fit 20000 3:
  * 1.1-2.0x CGAL against 3.2-3.8x), below the >= 3x goal: not the default. */
 #include <float.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <math.h>
 #include <stddef.h>
 
@@ -337,146 +334,6 @@ static int fast_finish(jf_fitter *f, size_t rows, size_t cols, double *cond)
     return 0;
 }
 
-/* ---- two at once ------------------------------------------------------
- * sym_eigvals of two matrices of the same size in the two lanes of SSE2
- * vectors, for two neighbourhoods fitted side by side (jet.c).  Each lane
- * does exactly the operations sym_eigvals does on its matrix, in the same
- * order; where the lanes' control flow differs (a zero column in the
- * tridiagonalisation, where T splits, how many QL steps an eigenvalue
- * takes) the lane with nothing to do keeps its values (masks), so each
- * lane's eigenvalues are bit for bit sym_eigvals'.  The QL steps are a
- * chain of dependent divisions: two chains in one costs about 0.7 of two
- * (measured on 50,000 of the §6.1 surface's 6x6 matrices: 1,970 against
- * 2,750 cycles a matrix). */
-typedef double v2d __attribute__((vector_size(16)));
-typedef long long v2l __attribute__((vector_size(16)));
-
-static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
-static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
-static inline v2d sqrt2(v2d x)
-{
-#if defined(__SSE2__)
-    return (v2d)_mm_sqrt_pd((__m128d)x);
-#else
-    return (v2d){sqrt(x[0]), sqrt(x[1])};
-#endif
-}
-
-/* a0, a1: n x n row-major (destroyed); d, e as sym_eigvals; rc[lane]: its
- * return value. */
-static void sym_eigvals_x2(double *a0, double *a1, size_t n, double *d0, double *e0,
-                           double *d1, double *e1, int rc[2])
-{
-    v2d a[100], d[10], e[10];
-    if (n > 10) { /* the workspace below is for jets up to degree 3 */
-        rc[0] = sym_eigvals(a0, n, d0, e0);
-        rc[1] = sym_eigvals(a1, n, d1, e1);
-        return;
-    }
-    for (size_t i = 0; i < n * n; i++) a[i] = (v2d){a0[i], a1[i]};
-    const v2d zero = {0.0, 0.0};
-    /* 1. Householder tridiagonalisation, as sym_eigvals */
-    for (size_t k = 0; k + 2 < n; k++) {
-        const size_t m = n - k - 1, o = k + 1;
-        v2d v[10], p[10], nx = zero;
-        for (size_t i = 0; i < m; i++) {
-            v[i] = a[(o + i) * n + k];
-            nx += v[i] * v[i];
-        }
-        d[k] = a[k * n + k];
-        e[k] = nx;
-        const v2l skip = (v2l)(nx == zero); /* that lane's `continue` */
-        if (skip[0] && skip[1]) continue;
-        const v2d x0 = v[0], rt = sqrt2(nx);
-        const v2d alpha = sel2((v2l)(x0 > zero), -rt, rt);
-        v[0] = x0 - alpha;
-        const v2d vv = 2.0 * (nx - x0 * alpha), beta = 2.0 / vv;
-        v2d vp = zero;
-        for (size_t i = 0; i < m; i++) {
-            const v2d *ai = a + (o + i) * n + o;
-            v2d t = zero;
-            for (size_t j = 0; j < m; j++) t += ai[j] * v[j];
-            p[i] = beta * t;
-            vp += v[i] * p[i];
-        }
-        const v2d kq = vp / vv;
-        for (size_t i = 0; i < m; i++) p[i] -= kq * v[i];
-        for (size_t i = 0; i < m; i++) {
-            v2d *ai = a + (o + i) * n + o;
-            for (size_t j = 0; j < m; j++) ai[j] = sel2(skip, ai[j], ai[j] - (v[i] * p[j] + p[i] * v[j]));
-        }
-    }
-    if (n >= 2) {
-        const v2d t = a[(n - 1) * n + n - 2];
-        d[n - 2] = a[(n - 2) * n + n - 2];
-        e[n - 2] = t * t;
-    }
-    d[n - 1] = a[(n - 1) * n + n - 1];
-    e[n - 1] = zero;
-    /* 2. QL, as sym_eigvals, each lane with its own split point m and
-     * step count; a lane that is done (or failed) sits the step out */
-    const double eps2 = DBL_EPSILON * DBL_EPSILON;
-    rc[0] = rc[1] = 0;
-    for (size_t l = 0; l < n; l++) {
-        int iter[2] = {0, 0};
-        for (;;) {
-            size_t mm[2];
-            int go[2];
-            for (int L = 0; L < 2; L++) {
-                size_t m = l;
-                for (; m + 1 < n; m++) {
-                    const double s = fabs(d[m][L]) + fabs(d[m + 1][L]);
-                    if (e[m][L] <= eps2 * s * s) break;
-                }
-                mm[L] = m;
-                go[L] = !rc[L] && m != l;
-                if (go[L] && iter[L]++ == 30) {
-                    rc[L] = -1;
-                    go[L] = 0;
-                }
-            }
-            if (!go[0] && !go[1]) break;
-            const v2l act = {go[0] ? -1 : 0, go[1] ? -1 : 0};
-            const size_t top = go[0] && (!go[1] || mm[0] > mm[1]) ? mm[0] : mm[1];
-            /* an idle lane computes on harmless values, then is masked */
-            const v2d rte = sqrt2(sel2(act, e[l], (v2d){1.0, 1.0}));
-            v2d sigma = (d[l + 1] - d[l]) / (2.0 * rte);
-            v2d r = sel2((v2l)(abs2(sigma) > (v2d){1e150, 1e150}), abs2(sigma),
-                         sqrt2(sigma * sigma + 1.0));
-            sigma = d[l] - rte / (sigma + sel2((v2l)(sigma >= zero), r, -r));
-            const v2d dm = {d[go[0] ? mm[0] : l][0], d[go[1] ? mm[1] : l][1]};
-            v2d c = {1.0, 1.0}, s = zero, gamma = dm - sigma, p = gamma * gamma;
-            for (size_t i = top; i-- > l;) {
-                const v2l on = act & (v2l){i < mm[0] ? -1 : 0, i < mm[1] ? -1 : 0};
-                const v2d bb = e[i];
-                r = p + bb;
-                if (i + 1 < top) {
-                    const v2l we = on & (v2l){i + 1 != mm[0] ? -1 : 0, i + 1 != mm[1] ? -1 : 0};
-                    e[i + 1] = sel2(we, s * r, e[i + 1]);
-                }
-                const v2d oldc = c, oldgam = gamma;
-                const v2d nc = p / r, ns = bb / r;
-                const v2d ng = nc * (d[i] - sigma) - ns * oldgam;
-                const v2d nd = oldgam + (d[i] - ng);
-                const v2d np = sel2((v2l)(nc != zero), ng * ng / nc, oldc * bb);
-                d[i + 1] = sel2(on, nd, d[i + 1]);
-                c = sel2(on, nc, c);
-                s = sel2(on, ns, s);
-                gamma = sel2(on, ng, gamma);
-                p = sel2(on, np, p);
-            }
-            e[l] = sel2(act, s * p, e[l]);
-            d[l] = sel2(act, sigma + gamma, d[l]);
-        }
-    }
-    for (size_t i = 0; i < n; i++) {
-        d0[i] = d[i][0];
-        d1[i] = d[i][1];
-        e0[i] = e[i][0];
-        e1[i] = e[i][1];
-    }
-}
-
 /* The SVD of R (after the QR, when the fast path declined). */
 static int svd_rest(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
@@ -498,15 +355,7 @@ int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, do
     return svd_rest(f, rows, cols, cond);
 }
 
-void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
-{
-    int rc[2];
-    sym_eigvals_x2(f0->x, f1->x, cols, f0->s, f0->work, f1->s, f1->work, rc);
-    ok[0] = rc[0] == 0;
-    ok[1] = rc[1] == 0;
-}
-
-int jf__eigvals(jf_fitter *f, size_t cols) { return sym_eigvals(f->x, cols, f->s, f->work) == 0; }
+int jf__sym_eigvals(double *a, size_t n, double *d, double *e) { return sym_eigvals(a, n, d, e); }
 
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
 {

@@ -3,6 +3,7 @@
  * frames), the paraboloid of the paper's Fig. 1, parameters, residuals,
  * and "no hidden state". */
 #include <check.h>
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -446,6 +447,79 @@ START_TEST(test_solver_fast_path)
 }
 END_TEST
 
+/* The fast path's kappa comes from the extreme eigenvalues of G = R^T R
+ * by Laguerre's iteration (gram_eig.c); it must agree with all of G's
+ * eigenvalues by the QL (solve.c, the previous method): both extremes to
+ * 8 cols eps lambda_max, kappa to 1e-12 relative up to kappa 30 (the
+ * §6.1 surface's p99 is ~14); on graded matrices and on ones with
+ * (nearly) multiple eigenvalues, where Laguerre converges slowest; and
+ * two at once (jf__eigvals_x2) bit for bit as one at a time. */
+START_TEST(test_gram_extremes)
+{
+    jf_params p;
+    jf_params_init(&p);
+    p.degree = 3;
+    p.max_neighbors = 64;
+    jf_fitter *f, *g;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    ck_assert_int_eq(jf_fitter_create(&p, &g), JF_OK);
+    rng_state = 7;
+    double a0[64 * 10], b0[64], x[10], xn, gq[100], ev[10], sc[10], gx[100];
+    int small = 0;
+    for (int t = 0; t < 400; t++) {
+        size_t rows = t % 2 ? 32 : 16, cols = t % 2 ? 10 : 6;
+        if (t % 4 < 2) { /* graded columns: kappa ~1 .. ~3e3 */
+            gsl_graded_lsq(rows, cols, pow(10.0, -0.1 * (double)(t % 35)), a0, b0, x, &xn);
+        } else { /* H diag(c): G = diag(c^2) up to rounding, c with repeats */
+            double v[32], vv = 0;
+            for (size_t i = 0; i < rows; i++) {
+                v[i] = 2 * urand() - 1;
+                vv += v[i] * v[i];
+            }
+            for (size_t j = 0; j < cols; j++) {
+                double c = 1.0 + (double)((j * (size_t)t) % 3);
+                for (size_t i = 0; i < rows; i++)
+                    a0[j * rows + i] = c * ((i == j) - 2 * v[i] * v[j] / vv);
+                b0[j] = 0;
+            }
+        }
+        for (int k = 0; k < 2; k++) {
+            jf_fitter *h = k ? g : f;
+            memcpy(h->m, a0, rows * cols * sizeof *a0);
+            memcpy(h->rhs, b0, rows * sizeof *b0);
+            ck_assert_int_eq(jf__qr_gram(h, rows, cols), 1);
+        }
+        memcpy(gq, f->x, cols * cols * sizeof *gq);
+        memcpy(gx, f->x, cols * cols * sizeof *gx);
+        ck_assert_int_eq(jf__sym_eigvals(gq, cols, ev, sc), 0);
+        double lmax = 0, lmin = INFINITY;
+        for (size_t j = 0; j < cols; j++) {
+            lmax = fmax(lmax, ev[j]);
+            lmin = fmin(lmin, ev[j]);
+        }
+        ck_assert_int_eq(jf__eigvals(f, cols), 1);
+        const double tol = 8.0 * (double)cols * DBL_EPSILON * lmax;
+        ck_assert_msg(fabs(f->s[0] - lmax) <= tol, "t %d max %.17g ql %.17g", t, f->s[0], lmax);
+        ck_assert_msg(fabs(f->s[1] - lmin) <= tol, "t %d min %.17g ql %.17g", t, f->s[1], lmin);
+        const double kq = sqrt(lmax / lmin), kl = sqrt(f->s[0] / f->s[1]);
+        if (kq <= 30) {
+            small++;
+            ck_assert_msg(fabs(kl - kq) <= 1e-12 * kq, "t %d kappa %.17g ql %.17g", t, kl, kq);
+        }
+        /* side by side: each lane as alone (g holds the same G) */
+        memcpy(f->x, gx, cols * cols * sizeof *gx);
+        const double s0 = f->s[0], s1 = f->s[1];
+        int ok[2];
+        jf__eigvals_x2(f, g, cols, ok);
+        ck_assert(ok[0] && ok[1]);
+        ck_assert(f->s[0] == s0 && f->s[1] == s1 && g->s[0] == s0 && g->s[1] == s1);
+    }
+    ck_assert_int_gt(small, 200);
+    jf_fitter_free(f);
+    jf_fitter_free(g);
+}
+END_TEST
+
 START_TEST(test_params)
 {
     jf_params p;
@@ -516,6 +590,7 @@ int main(void)
     tcase_add_test(tc, test_params);
     tcase_add_test(tc, test_solver_vs_gsl);
     tcase_add_test(tc, test_solver_fast_path);
+    tcase_add_test(tc, test_gram_extremes);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -1,0 +1,202 @@
+/* gram_eig.c -- the extreme eigenvalues of the Gram matrix G = R^T R of a
+ * jet fit (solve.c's fast path: kappa = sqrt(lambda_max / lambda_min)),
+ * for two fits at once in the two lanes of SSE2 vectors.
+ *
+ * Householder tridiagonalisation T = H G H (as solve.c's sym_eigvals),
+ * then Laguerre's iteration on det(T - x I), evaluated with its first two
+ * derivatives by the three-term recurrence, from Gershgorin's bounds: for
+ * a polynomial whose roots are all real, Laguerre's step from outside the
+ * roots moves monotonically and cubically to the nearest one (Wilkinson,
+ * The Algebraic Eigenvalue Problem, §7.37), so lambda_max comes from above
+ * and lambda_min from below, each in 4-7 steps of one division, against
+ * the QL iteration's chain of dependent divisions for all cols
+ * eigenvalues (measured: the QL was 85% of the eigen-step, itself 19% of
+ * a one-thread knn:16 run).  Both have an absolute error of ~eps
+ * lambda_max (test_jet: test_gram_extremes compares with the QL). */
+#include <float.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <math.h>
+#include <stddef.h>
+
+#include "fitter_internal.h"
+
+typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
+
+static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
+static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
+static inline v2d sqrt2(v2d x)
+{
+#if defined(__SSE2__)
+    return (v2d)_mm_sqrt_pd((__m128d)x);
+#else
+    return (v2d){sqrt(x[0]), sqrt(x[1])};
+#endif
+}
+
+#define GE_MAX 10    /* cols up to degree 3; larger: solve.c's QL       */
+#define GE_ITERS 100 /* Laguerre steps before a lane is declared failed */
+
+/* T = H A H for the two n x n row-major matrices in the lanes of a
+ * (destroyed): diagonal d, squared sub-diagonal e (e[n-1] = 0).  Each
+ * lane does exactly sym_eigvals' operations; a lane with a zero column
+ * keeps its values (mask). */
+static void tridiag_x2(v2d *a, size_t n, v2d *d, v2d *e)
+{
+    const v2d zero = {0.0, 0.0};
+    for (size_t k = 0; k + 2 < n; k++) {
+        const size_t m = n - k - 1, o = k + 1;
+        v2d v[GE_MAX], p[GE_MAX], nx = zero;
+        for (size_t i = 0; i < m; i++) {
+            v[i] = a[(o + i) * n + k];
+            nx += v[i] * v[i];
+        }
+        d[k] = a[k * n + k];
+        e[k] = nx;
+        const v2l skip = (v2l)(nx == zero); /* that lane's `continue` */
+        if (skip[0] && skip[1]) continue;
+        const v2d x0 = v[0], rt = sqrt2(nx);
+        const v2d alpha = sel2((v2l)(x0 > zero), -rt, rt);
+        v[0] = x0 - alpha;
+        const v2d vv = 2.0 * (nx - x0 * alpha), beta = 2.0 / vv;
+        v2d vp = zero;
+        for (size_t i = 0; i < m; i++) {
+            const v2d *ai = a + (o + i) * n + o;
+            v2d t = zero;
+            for (size_t j = 0; j < m; j++) t += ai[j] * v[j];
+            p[i] = beta * t;
+            vp += v[i] * p[i];
+        }
+        const v2d kq = vp / vv;
+        for (size_t i = 0; i < m; i++) p[i] -= kq * v[i];
+        for (size_t i = 0; i < m; i++) {
+            v2d *ai = a + (o + i) * n + o;
+            for (size_t j = 0; j < m; j++) ai[j] = sel2(skip, ai[j], ai[j] - (v[i] * p[j] + p[i] * v[j]));
+        }
+    }
+    if (n >= 2) {
+        const v2d t = a[(n - 1) * n + n - 2];
+        d[n - 2] = a[(n - 2) * n + n - 2];
+        e[n - 2] = t * t;
+    }
+    d[n - 1] = a[(n - 1) * n + n - 1];
+    e[n - 1] = zero;
+}
+
+/* det(T - xI) and its first two derivatives at x (per lane). */
+static inline void charpoly(const v2d *d, const v2d *e, size_t n, v2d x, v2d *p, v2d *p1,
+                            v2d *p2)
+{
+    v2d a = d[0] - x, a1 = {-1.0, -1.0}, a2 = {0.0, 0.0};
+    v2d b = {1.0, 1.0}, b1 = {0.0, 0.0}, b2 = {0.0, 0.0};
+    for (size_t k = 1; k < n; k++) {
+        const v2d t = d[k] - x, s = e[k - 1];
+        const v2d c = t * a - s * b, c1 = t * a1 - s * b1 - a, c2 = t * a2 - s * b2 - 2.0 * a1;
+        b = a, b1 = a1, b2 = a2;
+        a = c, a1 = c1, a2 = c2;
+    }
+    *p = a, *p1 = a1, *p2 = a2;
+}
+
+/* One Laguerre step for each lane of x (hi: toward the largest root from
+ * above, else the smallest from below).  A lane stays put and is marked
+ * done when it is already, when det(T - xI) is 0 or has the sign of the
+ * roots' other side (rounding carried x across the root), or when the
+ * step makes no progress in its direction. */
+static inline v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, v2l *done)
+{
+    v2d p, p1, p2;
+    charpoly(d, e, n, x, &p, &p1, &p2);
+    const v2d nn = {(double)n, (double)n}, zero = {0.0, 0.0};
+    /* outside the roots, det(T - xI) > 0 below them, (-1)^n p > 0 above */
+    const v2d sp = hi && (n & 1) ? -p : p;
+    const v2l live = ~*done & (v2l)(sp > zero);
+    const v2d ps = sel2(live, p, (v2d){1.0, 1.0});
+    const v2d g = p1 / ps, h = g * g - p2 / ps;
+    v2d disc = (nn - 1.0) * (nn * h - g * g);
+    disc = sqrt2(sel2((v2l)(disc > zero), disc, zero));
+    const v2d den = hi ? g + disc : g - disc;
+    const v2d xn = x - nn / sel2((v2l)(den != zero), den, (v2d){1.0, 1.0});
+    const v2l ok = live & (v2l)(den != zero) & (v2l)(hi ? xn < x : xn > x);
+    *done = ~ok;
+    return sel2(ok, xn, x);
+}
+
+/* Largest and smallest eigenvalue of each lane's T; rc[lane] -1 when the
+ * iteration did not settle (not finite, or GE_ITERS steps). */
+static void extremes_x2(v2d *d, v2d *e, size_t n, v2d *lmax, v2d *lmin, int rc[2])
+{
+    /* Gershgorin's interval, and a power of two bringing it to ~1 so the
+     * recurrence neither over- nor underflows (exact scaling) */
+    v2d ub = d[0], lb = d[0], bprev = {0.0, 0.0};
+    for (size_t k = 0; k < n; k++) {
+        const v2d b = sqrt2(e[k]); /* |T[k+1][k]| */
+        const v2d hi = d[k] + (bprev + b), lo = d[k] - (bprev + b);
+        ub = sel2((v2l)(hi > ub), hi, ub);
+        lb = sel2((v2l)(lo < lb), lo, lb);
+        bprev = b;
+    }
+    v2d sc, isc;
+    for (int L = 0; L < 2; L++) {
+        int q = 0;
+        frexp(fmax(fabs(ub[L]), fabs(lb[L])), &q);
+        sc[L] = ldexp(1.0, -q);
+        isc[L] = ldexp(1.0, q);
+    }
+    for (size_t k = 0; k < n; k++) {
+        d[k] *= sc;
+        e[k] *= sc * sc;
+    }
+    v2d xh = ub * sc, xl = lb * sc;
+    v2l dh = {0, 0}, dl = {0, 0};
+    int it = 0;
+    for (; it < GE_ITERS && !(dh[0] && dh[1] && dl[0] && dl[1]); it++) {
+        xh = laguerre(d, e, n, xh, 1, &dh);
+        xl = laguerre(d, e, n, xl, 0, &dl);
+    }
+    *lmax = xh * isc;
+    *lmin = xl * isc;
+    for (int L = 0; L < 2; L++)
+        rc[L] = dh[L] && dl[L] && isfinite((*lmax)[L]) && isfinite((*lmin)[L]) ? 0 : -1;
+}
+
+/* f->s[0] = lambda_max, f->s[1..cols-1] = lambda_min (fast_finish reads
+ * only the extremes) */
+static void put(jf_fitter *f, size_t cols, double hi, double lo)
+{
+    f->s[0] = hi;
+    for (size_t j = 1; j < cols; j++) f->s[j] = lo;
+}
+
+void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
+{
+    if (cols > GE_MAX || cols < 2) {
+        ok[0] = jf__eigvals(f0, cols);
+        ok[1] = jf__eigvals(f1, cols);
+        return;
+    }
+    v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX], hi, lo;
+    for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){f0->x[i], f1->x[i]};
+    tridiag_x2(a, cols, d, e);
+    int rc[2];
+    extremes_x2(d, e, cols, &hi, &lo, rc);
+    put(f0, cols, hi[0], lo[0]);
+    put(f1, cols, hi[1], lo[1]);
+    ok[0] = rc[0] == 0;
+    ok[1] = rc[1] == 0;
+}
+
+int jf__eigvals(jf_fitter *f, size_t cols)
+{
+    if (cols > GE_MAX || cols < 2) return jf__sym_eigvals(f->x, cols, f->s, f->work) == 0;
+    /* both lanes on the same matrix: the bits of jf__eigvals_x2's lanes */
+    v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX], hi, lo;
+    for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){f->x[i], f->x[i]};
+    tridiag_x2(a, cols, d, e);
+    int rc[2];
+    extremes_x2(d, e, cols, &hi, &lo, rc);
+    put(f, cols, hi[0], lo[0]);
+    return rc[0] == 0;
+}
