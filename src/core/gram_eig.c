@@ -38,6 +38,7 @@ static inline v2d sqrt2(v2d x)
 
 #define GE_MAX 10    /* cols up to degree 3; larger: solve.c's QL       */
 #define GE_ITERS 100 /* Laguerre steps before a lane is declared failed */
+#define GE_TOL (8 * DBL_EPSILON) /* last step, absolute, T scaled to ~1  */
 
 /* T = H A H for the two n x n row-major matrices in the lanes of a
  * (destroyed): diagonal d, squared sub-diagonal e (e[n-1] = 0).  Each
@@ -104,7 +105,8 @@ static inline void charpoly(const v2d *d, const v2d *e, size_t n, v2d x, v2d *p,
  * above, else the smallest from below).  A lane stays put and is marked
  * done when it is already, when det(T - xI) is 0 or has the sign of the
  * roots' other side (rounding carried x across the root), or when the
- * step makes no progress in its direction. */
+ * step makes no progress in its direction; the lane is done after a
+ * step of at most GE_TOL. */
 static inline v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, v2l *done)
 {
     v2d p, p1, p2;
@@ -120,7 +122,9 @@ static inline v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, 
     const v2d den = hi ? g + disc : g - disc;
     const v2d xn = x - nn / sel2((v2l)(den != zero), den, (v2d){1.0, 1.0});
     const v2l ok = live & (v2l)(den != zero) & (v2l)(hi ? xn < x : xn > x);
-    *done = ~ok;
+    /* a step below the evaluation's rounding (T is scaled to norm ~1)
+     * ends it: past that point the steps only wander in the noise */
+    *done = ~ok | (v2l)(abs2(xn - x) <= (v2d){GE_TOL, GE_TOL});
     return sel2(ok, xn, x);
 }
 

@@ -190,6 +190,47 @@ static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *
     return 1;
 }
 
+/* M' and B of degree d (§2.3) column by column, each column contiguous
+ * over the rows (vector loops): column (a, b) = w (x^a y^b) of the scaled
+ * coordinates, the products of monomials() in the same order, so the bits
+ * are its; powers are built in the pure columns before they are weighted.
+ * Column of x^a y^b: (a + b)(a + b + 1)/2 + b. */
+static void design(jf_fitter *f, size_t rows, int d, double ih)
+{
+    double *m = f->m, *w = m, *x = m + rows, *y = m + 2 * rows;
+    for (size_t t = 0; t < rows; t++) {
+        const size_t i = f->order[t];
+        const double *q = f->loc + 3 * i;
+        w[t] = f->w[i]; /* w (1 * 1) */
+        x[t] = q[0] * ih;
+        y[t] = q[1] * ih;
+        f->rhs[t] = f->w[i] * q[2];
+    }
+    for (int k = 2; k <= d; k++) {
+        double *xk = m + (size_t)(k * (k + 1) / 2) * rows, *yk = xk + (size_t)k * rows;
+        const double *xp = m + (size_t)((k - 1) * k / 2) * rows, *yp = xp + (size_t)(k - 1) * rows;
+        for (size_t t = 0; t < rows; t++) {
+            xk[t] = xp[t] * x[t];
+            yk[t] = yp[t] * y[t];
+        }
+    }
+    for (int k = 2; k <= d; k++)
+        for (int b = 1; b < k; b++) {
+            const int a = k - b;
+            double *c = m + (size_t)(k * (k + 1) / 2 + b) * rows;
+            const double *xa = m + (size_t)(a * (a + 1) / 2) * rows;
+            const double *yb = m + (size_t)(b * (b + 1) / 2 + b) * rows;
+            for (size_t t = 0; t < rows; t++) c[t] = w[t] * (xa[t] * yb[t]);
+        }
+    for (int k = 1; k <= d; k++) {
+        double *xk = m + (size_t)(k * (k + 1) / 2) * rows, *yk = xk + (size_t)k * rows;
+        for (size_t t = 0; t < rows; t++) {
+            xk[t] *= w[t];
+            yk[t] *= w[t];
+        }
+    }
+}
+
 static int job_system(fit_job *j);
 
 /* The rest of step 2 (the frame from the eigenvectors evec of j->cov;
@@ -249,7 +290,6 @@ static int job_system(fit_job *j)
 {
     jf_fitter *f = j->f;
     jf_result *out = j->out;
-    double mon[55];
     for (; j->d >= 1; j->d--) {
         const int d = j->d;
         size_t cols = jf_jet_size(d);
@@ -269,15 +309,7 @@ static int job_system(fit_job *j)
             out->cond = INFINITY;
             continue;
         }
-        const double ih = 1.0 / h;
-        for (size_t t = 0; t < rows; t++) {
-            size_t i = f->order[t];
-            const double *q = f->loc + 3 * i;
-            monomials(q[0] * ih, q[1] * ih, d, mon);
-            const double wi = f->w[i];
-            for (size_t c = 0; c < cols; c++) f->m[c * rows + t] = wi * mon[c];
-            f->rhs[t] = wi * q[2];
-        }
+        design(f, rows, d, 1.0 / h);
         j->rows = rows;
         j->h = h;
         return jf__qr_gram(f, rows, cols) ? 1 : 2;

@@ -200,11 +200,11 @@ static int cond_of(const double *s, size_t rows, size_t cols, double *cond)
 /* ---- the fast path: kappa from the eigenvalues of R^T R ----------------
  * A well-conditioned M' (the usual case: p99 of kappa is 15-50 on the
  * §6.1 surface) needs no singular vectors: the eigenvalues of the small
- * Gram matrix R^T R are the sigma_j^2, and Y = R^-1 (Q^T B) by
- * back-substitution.  Measured (callgrind, jetfit estimate knn:16 d2):
- * the Jacobi SVD with its vectors was most of the fit's instructions.
- * The eigenvalues have an absolute error of ~eps sigma_max^2, so kappa a
- * relative one of ~eps kappa^2: < 1e-10 below FAST_COND.  Above it, and
+ * Gram matrix R^T R are the sigma_j^2 (only the extremes are needed:
+ * gram_eig.c), and Y = R^-1 (Q^T B) by back-substitution.  Measured
+ * (callgrind, jetfit estimate knn:16 d2): the Jacobi SVD with its vectors
+ * was most of the fit's instructions.  kappa agrees with the SVD's to
+ * 1e-12 relative below FAST_COND (test_gram_extremes).  Above it, and
  * within FAST_MARGIN of max_cond (where the verdict of the adaptive degree
  * could differ from the SVD's), the Jacobi SVD below decides. */
 #define FAST_COND 1e3
