@@ -108,19 +108,28 @@ int jf__frame_cov(const double *q, const double *w, size_t n, double cov[9])
     }
     if (!(sw > 0) || !isfinite(sw)) return -1;
     for (int k = 0; k < 3; k++) c[k] /= sw;
-    /* pass 2: covariance about the centroid */
-    for (int k = 0; k < 9; k++) cov[k] = 0.0;
+    /* pass 2: covariance about the centroid, in locals (sums in cov[]
+     * would be stored and reloaded each point: cov may alias q and w) */
+    double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
     for (size_t i = 0; i < n; i++) {
         if (!(w[i] > 0)) continue;
-        double d[3] = {q[3 * i] - c[0], q[3 * i + 1] - c[1], q[3 * i + 2] - c[2]};
-        for (int a = 0; a < 3; a++)
-            for (int b = a; b < 3; b++) cov[3 * a + b] += w[i] * d[a] * d[b];
+        /* scalars: an array d[3] here is vectorised through the stack
+         * (partial stores reloaded whole: a store-forwarding stall) */
+        const double dx = q[3 * i] - c[0], dy = q[3 * i + 1] - c[1], dz = q[3 * i + 2] - c[2];
+        const double wx = w[i] * dx, wy = w[i] * dy, wz = w[i] * dz;
+        xx += wx * dx;
+        xy += wx * dy;
+        xz += wx * dz;
+        yy += wy * dy;
+        yz += wy * dz;
+        zz += wz * dz;
     }
-    for (int a = 0; a < 3; a++)
-        for (int b = a; b < 3; b++) {
-            cov[3 * a + b] /= sw;
-            cov[3 * b + a] = cov[3 * a + b];
-        }
+    cov[0] = xx / sw;
+    cov[1] = cov[3] = xy / sw;
+    cov[2] = cov[6] = xz / sw;
+    cov[4] = yy / sw;
+    cov[5] = cov[7] = yz / sw;
+    cov[8] = zz / sw;
     for (int k = 0; k < 9; k++)
         if (!isfinite(cov[k])) return -1;
     return 0;

@@ -20,7 +20,9 @@
 
 /* out = a * b truncated at order m (out must not alias a or b); a has no
  * terms below order amin, b none below bmin (the loops skip them). */
-static void tp_mul(const double *a, int amin, const double *b, int bmin, int m, double *out)
+static inline __attribute__((always_inline)) void tp_mul(const double *a, int amin,
+                                                         const double *b, int bmin, int m,
+                                                         double *out)
 {
     int sz = (m + 1) * (m + 2) / 2;
     for (int k = 0; k < sz; k++) out[k] = 0.0;
@@ -39,8 +41,9 @@ static void tp_mul(const double *a, int amin, const double *b, int bmin, int m, 
  * order) evaluated at (U, V), truncated at order m.  U, V have no
  * constant term, so jet terms above order m do not contribute and
  * U^i V^j starts at order i + j. */
-static void tp_compose(const double *a, int deg, int kmin, const double *u,
-                       const double *v, int m, double *out)
+static inline __attribute__((always_inline)) void tp_compose_m(const double *a, int deg, int kmin,
+                                                               const double *u, const double *v,
+                                                               int m, double *out)
 {
     double pw[JF_TP_ORDER + 1][JF_TP_ORDER + 1][JF_TP_SIZE];
     int sz = (m + 1) * (m + 2) / 2, top = deg < m ? deg : m;
@@ -56,6 +59,18 @@ static void tp_compose(const double *a, int deg, int kmin, const double *u,
             if (c == 0.0) continue;
             for (int t = k * (k + 1) / 2; t < sz; t++) out[t] += c * pw[k - j][j][t];
         }
+}
+
+/* tp_compose with the usual orders m as constants, so its loops unroll
+ * (the same operations in the same order: the same bits) */
+static void tp_compose(const double *a, int deg, int kmin, const double *u, const double *v,
+                       int m, double *out)
+{
+    switch (m) {
+    case 2: tp_compose_m(a, deg, kmin, u, v, 2, out); break;
+    case 3: tp_compose_m(a, deg, kmin, u, v, 3, out); break;
+    default: tp_compose_m(a, deg, kmin, u, v, m, out); break;
+    }
 }
 
 static void to_world(const double r[9], const double loc[3], double out[3])

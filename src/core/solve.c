@@ -309,6 +309,21 @@ static void gram(jf_fitter *f, size_t rows, size_t cols)
     }
 }
 
+/* R y = c (R_ij = m[j*rows + i], i <= j), y into y.  Scalar loops: the
+ * vectorised inner product loads y[j], y[j+1] whole just after y[j] was
+ * stored alone (a store-forwarding stall on every row). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-vectorize")))
+#endif
+static void back_subst(const double *m, const double *c, double *y, size_t rows, size_t cols)
+{
+    for (size_t i = cols; i-- > 0;) {
+        double t = c[i];
+        for (size_t j = i + 1; j < cols; j++) t -= m[j * rows + i] * y[j];
+        y[i] = t / m[i * rows + i];
+    }
+}
+
 /* With the eigenvalues of G in f->s: kappa, and Y by back-substitution on
  * R if kappa is safely small (above).  Returns 0, or -1 to leave it to
  * the SVD (R and Q^T B are left untouched). */
@@ -323,12 +338,7 @@ static int fast_finish(jf_fitter *f, size_t rows, size_t cols, double *cond)
     if (!(lmin > 0) || !isfinite(lmax)) return -1;
     const double kappa = sqrt(lmax / lmin);
     if (!(kappa <= FAST_COND) || !(kappa < f->p.max_cond * (1.0 - FAST_MARGIN))) return -1;
-    /* R y = (Q^T B)[0..cols-1], then undo the column pivoting */
-    for (size_t i = cols; i-- > 0;) {
-        double t = f->rhs[i];
-        for (size_t j = i + 1; j < cols; j++) t -= m[j * rows + i] * f->tmp[j];
-        f->tmp[i] = t / m[i * rows + i];
-    }
+    back_subst(m, f->rhs, f->tmp, rows, cols);
     for (size_t j = 0; j < cols; j++) f->sol[f->perm[j]] = f->tmp[j];
     *cond = kappa;
     return 0;
