@@ -213,6 +213,7 @@ int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out);
 typedef struct {
     const char *p, *end;
     size_t line;          /* number of the line last returned */
+    int no_cr;            /* the text has no '\r' (known): no search   */
 } jf_text;
 
 /* Next line as [*ls, *le) without its end: '\n', "\r\n", or a lone '\r'
@@ -225,7 +226,7 @@ static inline int jf_text_line(jf_text *t, const char **ls, const char **le)
     const char *nl = memchr(s, '\n', (size_t)(t->end - s));
     const char *e = nl ? nl : t->end;
     t->p = nl ? nl + 1 : t->end;
-    const char *cr = memchr(s, '\r', (size_t)(e - s));
+    const char *cr = t->no_cr ? NULL : memchr(s, '\r', (size_t)(e - s));
     if (cr && cr + 1 < e) { /* a lone CR ends the line */
         e = cr;
         t->p = cr + 1;

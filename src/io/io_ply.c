@@ -73,7 +73,7 @@ static int tok_is(const char *s, const char *e, const char *word)
 static jf_status parse_header(ply *h, const char *buf, size_t len,
                               size_t *body)
 {
-    jf_text t = {buf, buf + len, 0};
+    jf_text t = {buf, buf + len, 0, 0};
     const char *ls, *le, *ts, *te, *q;
     if (!jf_text_line(&t, &ls, &le) || !tok_is(ls, le, "ply"))
         return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, 1,
@@ -94,7 +94,7 @@ static jf_status parse_header(ply *h, const char *buf, size_t len,
                 return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, t.line,
                                   "no format line before end_header");
             *body = (size_t)(t.p - buf);
-            h->tx = (jf_text){t.p, buf + len, t.line};
+            h->tx = (jf_text){t.p, buf + len, t.line, 0};
             return JF_OK;
         }
         if (tok_is(ts, te, "format")) {

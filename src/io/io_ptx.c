@@ -67,7 +67,7 @@ static const char *const what[8] = {
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
                       jf_error *err)
 {
-    jf_text t = {buf, buf + len, 0};
+    jf_text t = {buf, buf + len, 0, 0};
     jf_dvec xyz = {0}, sc = {0};
     jf_uvec scan = {0};
     jf_status st = JF_OK;

@@ -17,6 +17,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Whether the row's first field could be a count (jf_parse_size: '+'
+ * and digits): a quick look that spares data rows the full test. */
+static int digits_first(const char *q, const char *le)
+{
+    while (q < le && jf_is_space(*q))
+        q++;
+    if (q < le && *q == '+')
+        q++;
+    while (q < le && *q >= '0' && *q <= '9')
+        q++;
+    return q == le || (jf_sep_class[(unsigned char)*q] & 3u);
+}
+
 /* The header-named columns other than x y z, carried as attributes:
  * read as doubles into v (row-major, grown by doubling), then packed in
  * the smallest exact type of each column (text_attrs_pack). */
@@ -40,6 +53,7 @@ typedef struct {
     int col[6];     /* column of x y z nx ny nz, -1 = not read */
     int maxcol;     /* largest column needed */
     text_attrs *ta; /* NULL: attributes not wanted */
+    int no_hash;    /* no '#' in the whole text */
 } tab;
 
 /* Next field of a row; csv fields are trimmed and may be empty. */
@@ -72,7 +86,7 @@ static int strip_comment(const tab *t, const char *ls, const char **le)
         q++;
     if (q == *le || *q == '#' || (*le - q >= 2 && q[0] == '/' && q[1] == '/'))
         return 0;
-    if (!t->csv) {
+    if (!t->csv && !t->no_hash) {
         const char *h = memchr(q, '#', (size_t)(*le - q));
         if (h)
             *le = h;
@@ -341,7 +355,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                          const char *name, const jf_read_opts *o, jf_cloud *c,
                          jf_error *err, text_attrs *ta)
 {
-    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta};
+    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, 0};
     int setx = 0, setn = 0;
     for (int k = 0; k < 6; k++) {
         if (o->columns[k] < -1 || o->columns[k] > 4095)
@@ -360,15 +374,18 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
     /* a UTF-8 byte order mark (spreadsheet exports) is not data */
     if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
         buf += 3, len -= 3;
-    size_t lines = 1;
+    size_t lines = 1, crs = 0;
     for (const char *q = buf, *e = buf + len;
          (q = memchr(q, '\n', (size_t)(e - q))) != NULL; q++)
         lines++;
     for (const char *q = buf, *e = buf + len; /* lone-CR line ends too */
          (q = memchr(q, '\r', (size_t)(e - q))) != NULL; q++)
-        lines++;
+        crs++;
+    lines += crs;
+    /* no '\r' or '#' anywhere: the per-line searches for them are skipped */
+    t.no_hash = !memchr(buf, '#', len);
     size_t cap = 0;
-    jf_text tx = {buf, buf + len, 0};
+    jf_text tx = {buf, buf + len, 0, crs == 0};
     const char *ls, *le;
     int started = 0, have_nrm = 0;
     size_t n = 0, since_count = 0, last_count = 0;
@@ -379,7 +396,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         if (!strip_comment(&t, ls, &le))
             continue;
         /* a point count line (PTS) */
-        if (!t.csv) {
+        if (!t.csv && digits_first(ls, le)) {
             const char *p = ls, *fs, *fe, *gs, *ge;
             uint64_t cnt;
             if (next_field(&t, &p, le, &fs, &fe) &&
@@ -435,7 +452,8 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         const char *p = ls, *fs, *fe;
         double v[6];
         int j = 0, bad = 0;
-        char why[160] = "";
+        char why[160];
+        why[0] = '\0';
         for (; j <= t.maxcol && next_field(&t, &p, le, &fs, &fe); j++) {
             for (int k = 0; k < 6 && !bad; k++) {
                 if (t.col[k] != j)
