@@ -195,13 +195,30 @@ static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *
  * coordinates, the products of monomials() in the same order, so the bits
  * are its; powers are built in the pure columns before they are weighted.
  * Column of x^a y^b: (a + b)(a + b + 1)/2 + b. */
+typedef double jet_v2d __attribute__((vector_size(16)));
+
 static void design(jf_fitter *f, size_t rows, int d, double ih)
 {
     double *m = f->m, *w = m, *x = m + rows, *y = m + 2 * rows;
-    for (size_t t = 0; t < rows; t++) {
+    /* two rows at a time, stored as pairs: the vector loops below (and
+     * the QR's) load these pairs back at once, and a pair loaded from two
+     * scalar stores just made cannot be forwarded (a stall per load) */
+    size_t t = 0;
+    for (; t + 2 <= rows; t += 2) {
+        const size_t i0 = f->order[t], i1 = f->order[t + 1];
+        const double *q0 = f->loc + 3 * i0, *q1 = f->loc + 3 * i1;
+        const jet_v2d wv = {f->w[i0], f->w[i1]}; /* w (1 * 1) */
+        const jet_v2d xv = (jet_v2d){q0[0], q1[0]} * ih, yv = (jet_v2d){q0[1], q1[1]} * ih;
+        const jet_v2d bv = wv * (jet_v2d){q0[2], q1[2]};
+        memcpy(w + t, &wv, sizeof wv);
+        memcpy(x + t, &xv, sizeof xv);
+        memcpy(y + t, &yv, sizeof yv);
+        memcpy(f->rhs + t, &bv, sizeof bv);
+    }
+    for (; t < rows; t++) {
         const size_t i = f->order[t];
         const double *q = f->loc + 3 * i;
-        w[t] = f->w[i]; /* w (1 * 1) */
+        w[t] = f->w[i];
         x[t] = q[0] * ih;
         y[t] = q[1] * ih;
         f->rhs[t] = f->w[i] * q[2];
