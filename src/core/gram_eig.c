@@ -174,6 +174,17 @@ static void put(jf_fitter *f, size_t cols, double hi, double lo)
     for (size_t j = 1; j < cols; j++) f->s[j] = lo;
 }
 
+/* The extremes of the Gram matrices g0 and g1 (cols x cols, cols <=
+ * GE_MAX), each in its lane. */
+static void gram_extremes(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo,
+                          int rc[2])
+{
+    v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX];
+    for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){g0[i], g1[i]};
+    tridiag_x2(a, cols, d, e);
+    extremes_x2(d, e, cols, hi, lo, rc);
+}
+
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
 {
     if (cols > GE_MAX || cols < 2) {
@@ -181,11 +192,9 @@ void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
         ok[1] = jf__eigvals(f1, cols);
         return;
     }
-    v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX], hi, lo;
-    for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){f0->x[i], f1->x[i]};
-    tridiag_x2(a, cols, d, e);
+    v2d hi, lo;
     int rc[2];
-    extremes_x2(d, e, cols, &hi, &lo, rc);
+    gram_extremes(f0->x, f1->x, cols, &hi, &lo, rc);
     put(f0, cols, hi[0], lo[0]);
     put(f1, cols, hi[1], lo[1]);
     ok[0] = rc[0] == 0;
@@ -196,11 +205,9 @@ int jf__eigvals(jf_fitter *f, size_t cols)
 {
     if (cols > GE_MAX || cols < 2) return jf__sym_eigvals(f->x, cols, f->s, f->work) == 0;
     /* both lanes on the same matrix: the bits of jf__eigvals_x2's lanes */
-    v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX], hi, lo;
-    for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){f->x[i], f->x[i]};
-    tridiag_x2(a, cols, d, e);
+    v2d hi, lo;
     int rc[2];
-    extremes_x2(d, e, cols, &hi, &lo, rc);
+    gram_extremes(f->x, f->x, cols, &hi, &lo, rc);
     put(f, cols, hi[0], lo[0]);
     return rc[0] == 0;
 }
