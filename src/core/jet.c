@@ -190,13 +190,13 @@ static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *
     return 1;
 }
 
+typedef double jet_v2d __attribute__((vector_size(16)));
+
 /* M' and B of degree d (§2.3) column by column, each column contiguous
  * over the rows (vector loops): column (a, b) = w (x^a y^b) of the scaled
  * coordinates, the products of monomials() in the same order, so the bits
  * are its; powers are built in the pure columns before they are weighted.
  * Column of x^a y^b: (a + b)(a + b + 1)/2 + b. */
-typedef double jet_v2d __attribute__((vector_size(16)));
-
 static void design(jf_fitter *f, size_t rows, int d, double ih)
 {
     double *m = f->m, *w = m, *x = m + rows, *y = m + 2 * rows;
