@@ -1,7 +1,8 @@
-/* planes.c -- tangent planes and denoised positions for natural
- * neighbourhoods on noisy clouds (issue 15.1, docs/natural.md).
+/* planes.c -- tangent planes for natural neighbourhoods: on a clean
+ * cloud the PCA of the 16 nearest points (below), on a noisy one the jet
+ * planes and denoised positions (issue 15.1, docs/natural.md).
  *
- * design:
+ * design (noisy clouds):
  *  - The natural neighbourhood of p is built in a plane H through p with
  *    power weights -h^2 (§5.1, natural.c): of the samples around p it
  *    prefers those nearest H.  On a noisy cloud that choice follows the
@@ -27,7 +28,10 @@
 
 #include "fitter_internal.h"
 #include "jetfit.h"
+#include "index_internal.h"
 #include "planes_internal.h"
+
+#define PCA_K 16 /* PCA of the 16 nearest points */
 
 jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, size_t k,
                              const jf_params *prm, int nt, double *nrm, double *proj,
@@ -75,4 +79,95 @@ jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, si
         free(d2);
     }
     return failed;
+}
+
+/* ---- PCA planes (clean clouds) ---------------------------------------- */
+
+/* Centred covariance a (3x3, row-major) of pts (m points), in scalar
+ * sums (an array of sums is stored and reloaded every point).  Returns 0
+ * for fewer than 3 points. */
+static int pca_cov(const double *pts, size_t m, double a[9])
+{
+    double c[3] = {0, 0, 0};
+    if (m < 3) return 0;
+    for (size_t i = 0; i < m; i++)
+        for (int j = 0; j < 3; j++) c[j] += pts[3 * i + j];
+    for (int j = 0; j < 3; j++) c[j] /= (double)m;
+    double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+    for (size_t i = 0; i < m; i++) { /* second pass: centred (no cancellation) */
+        const double dx = pts[3 * i] - c[0], dy = pts[3 * i + 1] - c[1], dz = pts[3 * i + 2] - c[2];
+        xx += dx * dx;
+        xy += dx * dy;
+        xz += dx * dz;
+        yy += dy * dy;
+        yz += dy * dz;
+        zz += dz * dz;
+    }
+    a[0] = xx, a[1] = a[3] = xy, a[2] = a[6] = xz;
+    a[4] = yy, a[5] = a[7] = yz, a[8] = zz;
+    return 1;
+}
+
+/* The normal from the eigen-decomposition of the covariance: its
+ * smallest eigenvalue's eigenvector.  0 if the points span less than a
+ * plane (no unique normal). */
+static int pca_pick(const double eval[3], const double evec[9], double nrm[3])
+{
+    if (!(eval[1] > 1e-24 * eval[2])) return 0; /* collinear */
+    memcpy(nrm, evec, sizeof(double[3]));
+    return 1;
+}
+
+static int pca_normal(const double *pts, size_t m, double nrm[3])
+{
+    double a[9], eval[3], evec[9];
+    if (!pca_cov(pts, m, a)) return 0;
+    jf__eig3(a, eval, evec);
+    return pca_pick(eval, evec, nrm);
+}
+
+int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3])
+{
+    uint32_t idx[PCA_K];
+    double d2[PCA_K], pts[3 * PCA_K];
+    size_t found = 0;
+    if (!isfinite(xyz[3 * i]) || !isfinite(xyz[3 * i + 1]) || !isfinite(xyz[3 * i + 2]) || jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) != JF_OK)
+        return 0;
+    for (size_t j = 0; j < found; j++) memcpy(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3]));
+    return pca_normal(pts, found, nrm);
+}
+
+void jf__planes_pca_knn(const jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags)
+{
+    const jf_index *ix = jf__natural_index(ntl);
+    const double *tp;
+    const uint32_t *id;
+    size_t m = jf__index_points(ix, &tp, &id);
+    for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
+#pragma omp parallel for schedule(static, 512) num_threads(nt)
+    for (size_t h = 0; h < (m + 1) / 2; h++) {
+        const size_t v0 = 2 * h, cnt = v0 + 1 < m ? 2 : 1;
+        double a[2][9], eval[2][3], evec[2][9];
+        int ok[2] = {0, 0};
+        for (size_t L = 0; L < cnt; L++) {
+            double pts[3 * PCA_K];
+            const uint32_t *c;
+            size_t k = jf__natural_candidates(ntl, v0 + L, &c);
+            if (k > PCA_K - 1) k = PCA_K - 1;
+            memcpy(pts, tp + 3 * (v0 + L), sizeof(double[3]));
+            for (size_t j = 0; j < k; j++)
+                memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[j], sizeof(double[3]));
+            ok[L] = pca_cov(pts, k + 1, a[L]);
+        }
+        if (ok[0] && ok[1])
+            jf__eig3_x2(a[0], a[1], eval[0], evec[0], eval[1], evec[1]);
+        else
+            for (size_t L = 0; L < cnt; L++)
+                if (ok[L]) jf__eig3(a[L], eval[L], evec[L]);
+        for (size_t L = 0; L < cnt; L++) {
+            const size_t i = id[v0 + L];
+            flags[i] |= ok[L] && pca_pick(eval[L], evec[L], nrm + 3 * i) ? JF_PT_NORMAL_PCA
+                                                                         : JF_PT_FAILED;
+        }
+    }
 }

@@ -17,4 +17,16 @@ jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, si
                              const jf_params *prm, int nt, double *nrm, double *proj,
                              unsigned *ok);
 
+/* PCA planes (the default on a clean cloud; --normal pca): the smallest
+ * eigenvector of the centred covariance of the 16 nearest points.
+ * jf__planes_pca_one: point i's from a k-NN query in ix (over xyz);
+ * returns 0 if there is none (non-finite point, fewer than 3 points, all
+ * collinear).  jf__planes_pca_knn: every point's, from the k-NN form's
+ * candidates of nt (the point and its 15 nearest others: no second
+ * query), two at a time with their 3x3 eigen-solvers in SIMD lanes
+ * (jf__eig3_x2: jf__eig3's bits); nrm[3i] = the normal or NaN, flags[i]
+ * |= JF_PT_NORMAL_PCA or JF_PT_FAILED.  OpenMP on nt threads. */
+int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3]);
+void jf__planes_pca_knn(const jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags);
+
 #endif

@@ -45,6 +45,10 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
  * was made from), nearest first: their count (at most 16) and *pos. */
 size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos);
 
+/* The k-d tree the k-NN form's vertices are positions of (NULL for the
+ * triangulation form). */
+const jf_index *jf__natural_index(const jf_natural *nt);
+
 /* After jf_natural_neighbors on ws (found points): their coordinates in
  * the structure's own copy (for the jet form, the points moved onto their
  * jets) to xyz[3 found]. */

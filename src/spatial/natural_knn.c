@@ -70,6 +70,8 @@ size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **p
     return c;
 }
 
+const jf_index *jf__natural_index(const jf_natural *nt) { return nt ? nt->ix : NULL; }
+
 void jf__natural_coords(const jf_natural_ws *ws, size_t found, double *xyz) {
     for (size_t k = 0; k < found; k++)
         memcpy(xyz + 3 * k, ws->nt->vxyz + 3 * (size_t)ws->list[k], sizeof(double[3]));

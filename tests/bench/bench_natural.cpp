@@ -60,6 +60,7 @@
 #include "jetfit.h"
 extern "C" {
 #include "fitter_internal.h"
+#include "planes_internal.h"
 #include "surfaces.h"
 }
 
@@ -135,8 +136,8 @@ static double cpu_self() {
 
 // the phases of natural:16's neighbourhoods (the k-NN form) on g_threads
 // threads, written to g_fd as wall[3] then cpu[3]: create (k-d tree and
-// candidates), the PCA planes of the 16 nearest (from a tree of the
-// bench's own, jf__eig3 as the pipeline), the neighbourhoods of every point
+// candidates), the PCA planes of the 16 nearest (the pipeline's
+// jf__planes_pca_knn, from the candidates), the neighbourhoods of every point
 static int g_fd = -1;
 static int run_profile() {
     size_t n = g_xyz.size() / 3;
@@ -146,36 +147,14 @@ static int run_profile() {
     if (jf_natural_create_knn(g_xyz.data(), n, g_threads, &nt) != JF_OK) return 1;
     double t1 = now(), c1 = cpu_self();
     w[0] = t1 - t0, c[0] = c1 - c0;
-    jf_index *ix;
-    if (jf_index_build(g_xyz.data(), n, &ix) != JF_OK) return 1;
     std::vector<double> nrm(3 * n, NAN);
+    std::vector<unsigned> flags(n, 0);
     std::vector<uint32_t> order(n);  // walked in space order, as the pipeline
     if (jf_spatial_order(g_xyz.data(), n, order.data()) != JF_OK) return 1;
     double t2 = now(), c2 = cpu_self();
-#pragma omp parallel for num_threads(g_threads) schedule(static)
-    for (long o = 0; o < (long)n; o++) {
-        long i = order[o];
-        uint32_t idx[16];
-        double d2[16], m[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0};
-        size_t f = 0;
-        jf_index_knn(ix, &g_xyz[3 * i], 16, idx, d2, &f);
-        for (size_t j = 0; j < f; j++)
-            for (int k = 0; k < 3; k++) m[k] += g_xyz[3 * idx[j] + k] / f;
-        for (size_t j = 0; j < f; j++) {
-            const double *q = &g_xyz[3 * idx[j]];
-            double d[3] = {q[0] - m[0], q[1] - m[1], q[2] - m[2]};
-            a[0] += d[0] * d[0], a[1] += d[0] * d[1], a[2] += d[0] * d[2];
-            a[3] += d[1] * d[1], a[4] += d[1] * d[2], a[5] += d[2] * d[2];
-        }
-        // smallest-eigenvalue eigenvector: the library's 3x3 solver
-        double cov[9] = {a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5]}, ev[3], evec[9];
-        jf__eig3(cov, ev, evec);
-        const double *v = evec;
-        for (int k = 0; k < 3; k++) nrm[3 * i + k] = v[k];
-    }
+    jf__planes_pca_knn(nt, n, g_threads, nrm.data(), flags.data());  // the pipeline's own
     double t3 = now(), c3 = cpu_self();
     w[1] = t3 - t2, c[1] = c3 - c2;
-    jf_index_free(ix);
     size_t total = 0;
     double t4 = now(), c4 = cpu_self();
 #pragma omp parallel num_threads(g_threads) reduction(+ : total)
