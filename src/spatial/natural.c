@@ -367,18 +367,24 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
         if (r > reach) reach = r;
     }
     reach = sqrt(reach);
-    double B = BOX_SCALE * reach;
-    size_t np = 4;
-    double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
-    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
-    for (size_t k = 0; k < m && np > 0; k++) {
-        if (ws->sx[k] == 0 && ws->sy[k] == 0) {
-            if (ws->sr[k] < 0) np = 0; /* s straight above u, nearer H */
-            continue;
-        }
-        jf__natural_clip(ws, &np, 2 * ws->sx[k], 2 * ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
-    }
+    size_t np = jf__natural_box(ws, BOX_SCALE * reach);
+    for (size_t k = 0; k < m && np > 0; k++)
+        jf__natural_cut(ws, &np, ws->sx[k], ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
     return jf__natural_labels(ws, h, np, reach, len);
+}
+
+size_t jf__natural_box(jf_natural_ws *ws, double B) {
+    const double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
+    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
+    return 4;
+}
+
+int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s) {
+    if (sx == 0 && sy == 0) {
+        if (sr < 0) *np = 0; /* s straight above u, nearer H: u has no cell */
+        return 0;
+    }
+    return jf__natural_clip(ws, np, 2 * sx, 2 * sy, sr, s);
 }
 
 /* Appends the labels of the clipped cell's edges (np vertices) not yet

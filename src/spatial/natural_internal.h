@@ -69,6 +69,16 @@ int jf__natural_threads(int threads);
  * edge labelled s; returns 0 when nothing was cut (no copy made). */
 int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s);
 
+/* Starts a cell as the box [-B, B]^2 about u' (edges labelled NONE);
+ * returns its vertex count, 4. */
+size_t jf__natural_box(jf_natural_ws *ws, double B);
+
+/* Cuts the cell by the half-plane of neighbour s, at (sx, sy) from u' in
+ * the plane with sr = |s' - u'|^2 + h_s^2 - h_u^2: jf__natural_clip's
+ * return; s straight above or below u' cuts nothing, or (nearer the
+ * plane) leaves u no cell (*np = 0). */
+int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s);
+
 /* Appends the labels of the clipped cell's edges (np vertices) not yet
  * collected; edges shorter than EDGE_EPS x reach are no adjacency.
  * Returns 0 when out of memory. */

@@ -103,16 +103,15 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *
     const jf_natural *nt = ws->nt;
     const double *U = nt->vxyz + 3 * (size_t)u;
     const uint32_t *c;
-    size_t cnt = jf__natural_candidates(nt, u, &c), K = CAND_K, np = 4, j = 0;
+    size_t cnt = jf__natural_candidates(nt, u, &c), K = CAND_K, np, j = 0;
     if (!cnt) return 1;
     double ux, uy, uz;
     project(h, U, &ux, &uy, &uz);
     const double *L = nt->vxyz + 3 * (size_t)c[cnt - 1];
     double reach = sqrt((L[0] - U[0]) * (L[0] - U[0]) + (L[1] - U[1]) * (L[1] - U[1]) +
                         (L[2] - U[2]) * (L[2] - U[2]));
-    double B = BOX_SCALE * reach;
-    double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
-    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
+    const double B = BOX_SCALE * reach;
+    np = jf__natural_box(ws, B);
     double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
     for (;;) {
         for (; j < cnt && np > 0; j++) {
@@ -122,11 +121,7 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *
             double x, y, z;
             project(h, S, &x, &y, &z);
             double sx = x - ux, sy = y - uy, sr = sx * sx + sy * sy + (z - uz) * (z + uz);
-            if (sx == 0 && sy == 0) {
-                if (sr < 0) np = 0; /* s straight above u, nearer H */
-                continue;
-            }
-            if (!jf__natural_clip(ws, &np, 2 * sx, 2 * sy, sr, c[j])) continue;
+            if (!jf__natural_cut(ws, &np, sx, sy, sr, c[j])) continue;
             r2 = 0;
             for (size_t k = 0; k < np; k++) {
                 double q = ws->px[k] * ws->px[k] + ws->py[k] * ws->py[k];
