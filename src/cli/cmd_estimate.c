@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include "cmd.h"
+#include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
 #include "jetfit.h"
 #include "opts.h"
 #include "rows.h"
@@ -134,31 +135,6 @@ static void progress(void *user, size_t done, size_t total)
     ps->shown = 1;
 }
 
-/* Moves the k-th smallest of a[0..n) (no NaN) to a[k], smaller ones
- * before it, larger after: quickselect with a three-way partition (many
- * equal values, as on grids, stay linear) and pivots from a fixed
- * xorshift sequence (no input order makes it quadratic by accident).
- * The summary's percentiles without sorting 10^8 values. */
-static void select_kth(double *a, size_t n, size_t k)
-{
-    uint64_t x = 0x9E3779B97F4A7C15ull;
-    size_t lo = 0, hi = n; /* a[k] lies in [lo, hi) */
-    while (hi - lo > 1) {
-        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
-        const double p = a[lo + (size_t)(x % (hi - lo))];
-        size_t lt = lo, i = lo, gt = hi; /* [lo,lt) < p, [lt,i) == p, [gt,hi) > p */
-        while (i < gt) {
-            double v = a[i];
-            if (v < p) a[i++] = a[lt], a[lt++] = v;
-            else if (v > p) a[i] = a[--gt], a[gt] = v;
-            else i++;
-        }
-        if (k < lt) hi = lt;
-        else if (k >= gt) lo = gt;
-        else return;
-    }
-}
-
 /* What the summary counts, per thread (the sink runs on the fit's
  * threads), padded so that threads do not share a cache line. */
 typedef struct {
@@ -207,7 +183,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
                        m - 1};
         for (int q = 0; q < 4; q++) {
             size_t from = q ? r[q - 1] : 0;
-            select_kth(cond + from, m - from, r[q] - from);
+            jf__select_kth(cond + from, m - from, r[q] - from);
         }
         fprintf(stderr, "  cond: p50 %.3g, p90 %.3g, p99 %.3g, max %.3g\n", cond[r[0]], cond[r[1]],
                 cond[r[2]], cond[r[3]]);

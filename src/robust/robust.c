@@ -20,6 +20,7 @@
 #include <string.h>
 #include <threads.h>
 
+#include "order_stat.h"
 #include "robust_internal.h"
 
 #define NORMAL_TOL 1e-6 /* rad: IRLS stops when the normal moves less... */
@@ -155,38 +156,14 @@ jf_fitter *jf__tl_fitter(const jf_params *pr, int d)
 }
 
 /* ---- median of |r| by quickselect on a scratch copy ---- */
-static double select_kth(double *a, size_t n, size_t k)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        double pivot = a[lo + (hi - lo) / 2];
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (a[i] < pivot) i++;
-            while (a[j] > pivot) j--;
-            if (i <= j) {
-                double t = a[i];
-                a[i] = a[j];
-                a[j] = t;
-                i++;
-                if (j == 0) break;
-                j--;
-            }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else return a[k];
-    }
-    return a[k];
-}
-
 static double mad_scale(const double *r, double *tmp, size_t nr)
 {
     size_t n = 0; /* non-finite input points have NaN residuals: left out */
     for (size_t i = 0; i < nr; i++)
         if (isfinite(r[i])) tmp[n++] = fabs(r[i]);
     if (n == 0) return 0.0;
-    double m = select_kth(tmp, n, n / 2);
+    jf__select_kth(tmp, n, n / 2);
+    double m = tmp[n / 2];
     if (n % 2 == 0) { /* the lower middle is the max of the lower half */
         double lo = tmp[0];
         for (size_t i = 1; i < n / 2; i++)
