@@ -2,7 +2,7 @@
  * jet fit (solve.c's fast path: kappa = sqrt(lambda_max / lambda_min)),
  * for two fits at once in the two lanes of SSE2 vectors.
  *
- * Householder tridiagonalisation T = H G H (as solve.c's sym_eigvals),
+ * Householder tridiagonalisation T = H G H (as solve.c's jf__sym_eigvals),
  * then Laguerre's iteration on det(T - x I), evaluated with its first two
  * derivatives by the three-term recurrence, from Gershgorin's bounds: for
  * a polynomial whose roots are all real, Laguerre's step from outside the
@@ -42,7 +42,7 @@ static inline v2d sqrt2(v2d x)
 
 /* T = H A H for the two n x n row-major matrices in the lanes of a
  * (destroyed): diagonal d, squared sub-diagonal e (e[n-1] = 0).  Each
- * lane does exactly sym_eigvals' operations; a lane with a zero column
+ * lane does exactly jf__sym_eigvals' operations; a lane with a zero column
  * keeps its values (mask). */
 static void tridiag_x2(v2d *a, size_t n, v2d *d, v2d *e)
 {

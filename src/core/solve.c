@@ -219,7 +219,7 @@ static int cond_of(const double *s, size_t rows, size_t cols, double *cond)
  * QL of Numerical Recipes' tqli, same eigenvalues to 2e-15 lambda_max).
  * e: n scratch (squared off-diagonals).  Returns 0, or -1 if an
  * eigenvalue took more than 30 iterations. */
-static int sym_eigvals(double *a, size_t n, double *d, double *e)
+int jf__sym_eigvals(double *a, size_t n, double *d, double *e)
 {
     /* 1. A <- H A H, H = I - beta v v^T zeroing column k below k+1;
      *    with p = beta A v, q = p - (v.p / v.v) v: A <- A - v q^T - q v^T */
@@ -364,8 +364,6 @@ int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, do
     if (have_eig && fast_finish(f, rows, cols, cond) == 0) return 0;
     return svd_rest(f, rows, cols, cond);
 }
-
-int jf__sym_eigvals(double *a, size_t n, double *d, double *e) { return sym_eigvals(a, n, d, e); }
 
 int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond)
 {
