@@ -92,6 +92,7 @@ typedef struct {
     const jf_index *ix;
     jf_mesh *mesh;        /* rings                                     */
     jf_natural *nt;       /* natural                                   */
+    int nt_own;           /* natural, k-NN form: rings from own-plane rows */
     double *nrm_own;      /* natural: normals we computed (3n)         */
     const double *nrm;    /* natural: the tangent-plane normals        */
     unsigned *nflags;     /* natural: JF_PT_NORMAL_* per point         */
@@ -159,6 +160,15 @@ static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const doub
     return st;
 }
 
+/* The k-NN form's own-plane rows from the normals nrm (by input index). */
+static jf_status own_rows(nbctx *x, const double *nrm, int nt, jf_error *err)
+{
+    jf_status st = jf__natural_own_rows(x->nt, nt, nrm);
+    if (st != JF_OK) set_err(err, "natural neighbours: the own-plane cells failed");
+    x->nt_own = st == JF_OK;
+    return st;
+}
+
 /* JF_NORMAL_JET (planes.c): the plane of point i is the jet normal of its
  * N nearest points, and the cells are made on the points moved to their
  * jets (the k-NN form, over a tree of its own); the fit later uses the
@@ -175,7 +185,7 @@ static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params 
         st = jf__planes_knn_jet(x->ix, c->xyz, n, x->want, prm, nt, x->nrm_own, proj, x->nflags);
     x->fit_moved = 1;
     if (st == JF_OK && (st = jf_natural_create_knn(proj, n, nt, &x->nt)) != JF_OK)
-        set_err(err, "natural neighbours: the k-NN candidates failed");
+        set_err(err, "natural neighbours: the k-d tree of the moved points failed");
     free(proj);
     for (size_t i = 0; st == JF_OK && i < n; i++) {
         if (x->nflags[i]) {
@@ -186,7 +196,7 @@ static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params 
             if (x->nflags[i] == JF_PT_FAILED) m[0] = m[1] = m[2] = NAN;
         }
     }
-    return st;
+    return st == JF_OK ? own_rows(x, x->nrm_own, nt, err) : st;
 }
 
 /* Step 1 for natural[:N]: the cells' structure and the tangent-plane
@@ -214,20 +224,24 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
                             : jf__natural_from_index(x->ix, nt, &x->nt);
     if (st != JF_OK) {
         set_err(err, delaunay ? "natural neighbours: building the Delaunay triangulation failed"
-                              : "natural neighbours: the k-NN candidates failed");
+                              : "natural neighbours: the k-NN form failed");
         return st;
     }
     if (src == JF_NORMAL_INPUT) {
         x->nrm = c->nrm;
         for (size_t i = 0; i < n; i++) x->nflags[i] = JF_PT_NORMAL_INPUT;
-        return JF_OK;
+        return own_rows(x, c->nrm, nt, err);
     }
     if (delaunay) {
         st = jf_natural_normals(x->nt, src, nt, x->nrm_own, x->nflags, NULL);
         if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
         return st;
     }
-    jf__planes_pca_knn(x->nt, n, nt, x->nrm_own, x->nflags);
+    if ((st = jf__planes_pca_knn(x->nt, n, nt, x->nrm_own, x->nflags)) != JF_OK) {
+        set_err(err, "natural neighbours: the PCA planes and own-plane cells failed");
+        return st;
+    }
+    x->nt_own = 1;
     int noisy = 0;
     if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy)) != JF_OK) {
         set_err(err, "natural neighbours: the noise test failed");
@@ -265,7 +279,8 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
             *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
             return JF_OK;
         }
-        st = jf_natural_neighbors(x->nt, ws, i, m, x->want, idx, x->cap, found);
+        st = x->nt_own ? jf__natural_neighbors_own(x->nt, ws, i, m, x->want, idx, x->cap, found)
+                       : jf_natural_neighbors(x->nt, ws, i, m, x->want, idx, x->cap, found);
         break;
     default:
         st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
@@ -400,9 +415,11 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
     /* fit_moved: the moved points are fitted, the raw ones kept for the
      * residual (raw_of: the buffer beside coords) */
     double *raw = x->fit_moved ? raw_of(w, coords) : coords;
-    for (size_t j = 0; !gathered && j < *found; j++)
-        memcpy(raw + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
-    if (x->fit_moved) jf__natural_coords(w->nws, *found, coords);
+    if (!gathered && (x->fit_moved || x->nb->kind != JF_NB_NATURAL))
+        for (size_t j = 0; j < *found; j++)
+            memcpy(raw + 3 * j, x->xyz + 3 * (size_t)w->idx[j], sizeof(double[3]));
+    /* natural: the structure's copy, in space order (moved: the jets') */
+    if (x->nb->kind == JF_NB_NATURAL) jf__natural_coords(w->nws, *found, coords);
     *fit = 1;
     return JF_OK;
 }
@@ -519,6 +536,17 @@ static jf_status deliver(const runctx *R, const uint32_t *idx, jf_result *res, s
     return R->sink(R->user, idx, res, m);
 }
 
+/* natural: what nb_query reads of point i by input index (its flags,
+ * normal, vertex), asked PREFETCH points of the walk ahead: in the
+ * tree's walk these are cache misses (the input is in any order). */
+#define PREFETCH 8
+static void prefetch_natural(const nbctx *x, size_t i)
+{
+    __builtin_prefetch(x->nflags + i);
+    __builtin_prefetch(x->nrm + 3 * i);
+    jf__natural_prefetch(x->nt, i);
+}
+
 /* Step 2 over walk[0..nwalk-1] (coordinates from walk_xyz, the tree's
  * copy, when not NULL): chunks of CHUNK points shared out dynamically. */
 static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *walk_xyz,
@@ -548,6 +576,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
             size_t m = 0; /* block modes: results in w.blk */
             for (size_t k = beg; k < end && wst == JF_OK;) {
                 const size_t i = walk[k];
+                if (x->nt && k + PREFETCH < nwalk) prefetch_natural(x, walk[k + PREFETCH]);
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : R->c->xyz + 3 * i;
                 if (fit && !fit[i]) { /* a halo point: a neighbour only */
                     if (!blocks) nan_result(&R->out[i], JF_PT_NONFINITE);

@@ -137,37 +137,53 @@ int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double n
     return pca_normal(pts, found, nrm);
 }
 
-void jf__planes_pca_knn(const jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags)
+jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags)
 {
-    const jf_index *ix = jf__natural_index(ntl);
     const double *tp;
     const uint32_t *id;
-    size_t m = jf__index_points(ix, &tp, &id);
+    size_t m = jf__index_points(jf__natural_index(ntl), &tp, &id);
     for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
-#pragma omp parallel for schedule(static, 512) num_threads(nt)
-    for (size_t h = 0; h < (m + 1) / 2; h++) {
-        const size_t v0 = 2 * h, cnt = v0 + 1 < m ? 2 : 1;
-        double a[2][9], eval[2][3], evec[2][9];
-        int ok[2] = {0, 0};
-        for (size_t L = 0; L < cnt; L++) {
-            double pts[3 * PCA_K];
-            const uint32_t *c;
-            size_t k = jf__natural_candidates(ntl, v0 + L, &c);
-            if (k > PCA_K - 1) k = PCA_K - 1;
-            memcpy(pts, tp + 3 * (v0 + L), sizeof(double[3]));
-            for (size_t j = 0; j < k; j++)
-                memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[j], sizeof(double[3]));
-            ok[L] = pca_cov(pts, k + 1, a[L]);
+    jf_status st = jf__natural_rows_alloc(ntl);
+    if (st != JF_OK) return st;
+    int bad = 0;
+#pragma omp parallel num_threads(nt) reduction(| : bad)
+    {
+        jf_natural_ws *ws = NULL;
+        bad |= jf_natural_ws_create(ntl, &ws) != JF_OK;
+#pragma omp for schedule(static, 512)
+        for (size_t h = 0; h < (m + 1) / 2; h++) {
+            const size_t v0 = 2 * h, cnt = v0 + 1 < m ? 2 : 1;
+            double a[2][9], eval[2][3], evec[2][9];
+            uint32_t c[2][JF_NATURAL_CAND];
+            size_t k[2] = {0, 0};
+            int ok[2] = {0, 0};
+            if (bad) continue;
+            for (size_t L = 0; L < cnt; L++) {
+                double pts[3 * PCA_K];
+                if ((k[L] = jf__natural_query(ntl, v0 + L, c[L])) == SIZE_MAX) {
+                    bad = 1;
+                    k[L] = 0;
+                }
+                size_t kp = k[L] < PCA_K - 1 ? k[L] : PCA_K - 1;
+                memcpy(pts, tp + 3 * (v0 + L), sizeof(double[3]));
+                for (size_t j = 0; j < kp; j++)
+                    memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[L][j], sizeof(double[3]));
+                ok[L] = pca_cov(pts, kp + 1, a[L]);
+            }
+            if (ok[0] && ok[1])
+                jf__eig3_x2(a[0], a[1], eval[0], evec[0], eval[1], evec[1]);
+            else
+                for (size_t L = 0; L < cnt; L++)
+                    if (ok[L]) jf__eig3(a[L], eval[L], evec[L]);
+            for (size_t L = 0; L < cnt; L++) {
+                const size_t i = id[v0 + L];
+                flags[i] |= ok[L] && pca_pick(eval[L], evec[L], nrm + 3 * i) ? JF_PT_NORMAL_PCA
+                                                                             : JF_PT_FAILED;
+                /* the cell in this plane, while its candidates are at hand */
+                bad |= !bad && !jf__natural_own_row(ws, v0 + L, nrm + 3 * i, c[L], k[L]);
+            }
         }
-        if (ok[0] && ok[1])
-            jf__eig3_x2(a[0], a[1], eval[0], evec[0], eval[1], evec[1]);
-        else
-            for (size_t L = 0; L < cnt; L++)
-                if (ok[L]) jf__eig3(a[L], eval[L], evec[L]);
-        for (size_t L = 0; L < cnt; L++) {
-            const size_t i = id[v0 + L];
-            flags[i] |= ok[L] && pca_pick(eval[L], evec[L], nrm + 3 * i) ? JF_PT_NORMAL_PCA
-                                                                         : JF_PT_FAILED;
-        }
+        jf_natural_ws_free(ws);
     }
+    return bad ? JF_ERR_NOMEM : JF_OK;
 }

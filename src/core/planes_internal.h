@@ -22,11 +22,13 @@ jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, si
  * jf__planes_pca_one: point i's from a k-NN query in ix (over xyz);
  * returns 0 if there is none (non-finite point, fewer than 3 points, all
  * collinear).  jf__planes_pca_knn: every point's, from the k-NN form's
- * candidates of nt (the point and its 15 nearest others: no second
- * query), two at a time with their 3x3 eigen-solvers in SIMD lanes
- * (jf__eig3_x2: jf__eig3's bits); nrm[3i] = the normal or NaN, flags[i]
- * |= JF_PT_NORMAL_PCA or JF_PT_FAILED.  OpenMP on nt threads. */
+ * candidates of nt (the point and its 15 nearest others), two at a time
+ * with their 3x3 eigen-solvers in SIMD lanes (jf__eig3_x2: jf__eig3's
+ * bits); nrm[3i] = the normal or NaN, flags[i] |= JF_PT_NORMAL_PCA or
+ * JF_PT_FAILED; and, from the same candidates, nt's own-plane rows
+ * (jf__natural_own_row).  OpenMP on nt threads; JF_ERR_NOMEM or
+ * JF_ERR_INTERNAL (a failed query) as jf__natural_own_rows. */
 int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3]);
-void jf__planes_pca_knn(const jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags);
+jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags);
 
 #endif

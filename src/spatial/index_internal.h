@@ -42,12 +42,39 @@ jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, dou
 jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out);
 
 /* The k-NN form's candidates of vertex v (tree position v of the tree it
- * was made from), nearest first: their count (at most 16) and *pos. */
-size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos);
+ * was made from): its JF_NATURAL_CAND nearest other vertices by
+ * (distance, input index) into pos; their count (fewer: the whole
+ * cloud), or SIZE_MAX if the query failed. */
+#define JF_NATURAL_CAND 20
+size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL_CAND]);
+
+/* Own-plane rows of the k-NN form (docs/natural.md, "Own-plane rings"):
+ * each vertex's planar cell in its own tangent plane, made once, so that
+ * a ring grows from stored rows instead of one clipped cell per ring
+ * vertex.  jf__natural_rows_alloc makes the table (every row LIVE);
+ * jf__natural_own_row fills vertex v's from its plane normal nrm (of its
+ * input point) and its candidates c[0..cnt) (jf__natural_query's; a
+ * zero or non-finite normal or more than the row's room leaves it LIVE:
+ * that cell is made when a ring asks for it); jf__natural_own_rows does
+ * both for every vertex, normals nrm[3n] by input index. */
+jf_status jf__natural_rows_alloc(jf_natural *nt);
+int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
+                        size_t cnt);
+jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);
+
+/* jf_natural_neighbors of input point i over the own-plane rows (every
+ * ring from its vertices' rows: the plane is each vertex's own, i's
+ * normal nrm for its own cell when its row is LIVE). */
+jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,
+                                    const double nrm[3], size_t N, uint32_t *idx, size_t cap,
+                                    size_t *found);
 
 /* The k-d tree the k-NN form's vertices are positions of (NULL for the
  * triangulation form). */
 const jf_index *jf__natural_index(const jf_natural *nt);
+
+/* Asks the cache for what jf_natural_neighbors first reads of point i. */
+void jf__natural_prefetch(const jf_natural *nt, size_t i);
 
 /* After jf_natural_neighbors on ws (found points): their coordinates in
  * the structure's own copy (for the jet form, the points moved onto their

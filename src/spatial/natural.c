@@ -116,6 +116,7 @@ void jf_natural_free(jf_natural *nt) {
     if (!nt->ix) free(nt->vxyz);
     free(nt->nn);
     jf_index_free(nt->ix_own);
+    free(nt->row);
     free(nt);
 }
 
@@ -280,7 +281,7 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws);
 }
 
-static int make_plane(const double *o, const double nrm[3], plane *h) {
+int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
     double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
     if (!(l > 0) || !isfinite(l)) return 0;
     for (int k = 0; k < 3; k++) h->n[k] = nrm[k] / l, h->o[k] = o[k];
@@ -433,16 +434,55 @@ static void sort_ring(jf_natural_ws *ws, size_t a, size_t b) {
     }
 }
 
+/* p's tangent plane, made when first needed (own rows need it only for
+ * a LIVE row). */
+typedef struct {
+    const double *o, *nrm;
+    plane h;
+    int made;
+} lazy_plane;
+
+static const plane *plane_of(lazy_plane *lp) {
+    if (!lp->made) lp->made = jf__natural_plane(lp->o, lp->nrm, &lp->h) ? 1 : -1;
+    return lp->made > 0 ? &lp->h : NULL;
+}
+
+/* Appends ring vertex u's neighbours: its own-plane row (own: the
+ * k-NN form's rows), else its cell in p's plane. */
+static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    const uint32_t *row = nt->row ? nt->row + (size_t)u * ROW_W : NULL;
+    if (!own || row[0] == ROW_LIVE) {
+        const plane *h = plane_of(lp);
+        if (!h) return 1; /* checked by grow: not reached */
+        return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, len) : cell_neighbors(ws, h, u, len);
+    }
+    const double *p = lp->o;
+    for (size_t k = 0; k < ROW_W && row[k] != NONE; k++) {
+        uint32_t s = row[k];
+        if (ws->stamp[s] == ws->gen) continue;
+        const double *q = nt->vxyz + 3 * (size_t)s;
+        double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                    (q[2] - p[2]) * (q[2] - p[2]);
+        ws->stamp[s] = ws->gen;
+        if (!push(ws, len, s, d2)) return 0;
+    }
+    return 1;
+}
+
 /* Grows rings from input point i until `want` vertices (with i) or
- * `maxrings` rings are collected.  ring_end[r] = end of ring r. */
+ * `maxrings` rings are collected.  ring_end[r] = end of ring r.  own:
+ * from the own-plane rows (jf__natural_neighbors_own). */
 static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const double nrm[3],
-                      size_t want, int maxrings, size_t *len, size_t *ring_end) {
+                      size_t want, int maxrings, int own, size_t *len, size_t *ring_end) {
     *len = 0;
     if (!nt || !ws || ws->nt != nt || !nrm || i >= nt->d.n) return JF_ERR_INVALID;
     uint32_t v0 = nt->d.vertex_of[i];
     if (v0 == NONE) return JF_OK;
-    plane h;
-    if (!make_plane(nt->vxyz + 3 * (size_t)v0, nrm, &h)) return JF_ERR_INVALID;
+    double l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
+    if (!(l2 > 0) || !isfinite(l2)) return JF_ERR_INVALID; /* as jf__natural_plane */
+    lazy_plane lp = {.o = nt->vxyz + 3 * (size_t)v0, .nrm = nrm};
+    if (!own && !plane_of(&lp)) return JF_ERR_INVALID;
     if (++ws->gen == 0) { /* wrapped: clear the stamps once */
         memset(ws->stamp, 0, nt->d.nv * sizeof *ws->stamp);
         ws->gen = 1;
@@ -453,9 +493,7 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (ring_end) ring_end[0] = 1;
     for (int r = 1; r <= maxrings && *len < want; r++) {
         for (size_t k = a; k < b; k++)
-            if (!(nt->ix ? jf__natural_knn_cell(ws, &h, ws->list[k], len)
-                         : cell_neighbors(ws, &h, ws->list[k], len)))
-                return JF_ERR_NOMEM;
+            if (!ring_step(ws, &lp, ws->list[k], own, len)) return JF_ERR_NOMEM;
         if (*len == b) break; /* the cloud ran out */
         sort_ring(ws, b, *len);
         a = b, b = *len;
@@ -464,19 +502,35 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     return JF_OK;
 }
 
-jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i,
-                               const double nrm[3], size_t N, uint32_t *idx, size_t cap,
-                               size_t *found) {
+static jf_status neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i, const double nrm[3],
+                           size_t N, int own, uint32_t *idx, size_t cap, size_t *found) {
     if (!found || !idx) return JF_ERR_INVALID;
     *found = 0;
     size_t len, want = N < cap ? N : cap;
-    jf_status st = grow(nt, ws, i, nrm, want, INT32_MAX, &len, NULL);
+    jf_status st = grow(nt, ws, i, nrm, want, INT32_MAX, own, &len, NULL);
     if (st != JF_OK || len == 0) return st;
     if (len > want) len = want;
     idx[0] = (uint32_t)i;
     for (size_t k = 1; k < len; k++) idx[k] = nt->d.rep[ws->list[k]];
     *found = len;
     return JF_OK;
+}
+
+void jf__natural_prefetch(const jf_natural *nt, size_t i) {
+    if (i < nt->d.n) __builtin_prefetch(nt->d.vertex_of + i);
+}
+
+jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,
+                                    const double nrm[3], size_t N, uint32_t *idx, size_t cap,
+                                    size_t *found) {
+    if (nt && !nt->row) return JF_ERR_INVALID;
+    return neighbors(nt, ws, i, nrm, N, 1, idx, cap, found);
+}
+
+jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i,
+                               const double nrm[3], size_t N, uint32_t *idx, size_t cap,
+                               size_t *found) {
+    return neighbors(nt, ws, i, nrm, N, 0, idx, cap, found);
 }
 
 jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws, size_t i,
@@ -487,7 +541,7 @@ jf_status jf_natural_rings(const jf_natural *nt, jf_natural_ws *ws, size_t i,
     size_t len;
     if (ring_end)
         for (int r = 0; r <= nrings; r++) ring_end[r] = 0;
-    jf_status st = grow(nt, ws, i, nrm, SIZE_MAX, nrings, &len, ring_end);
+    jf_status st = grow(nt, ws, i, nrm, SIZE_MAX, nrings, 0, &len, ring_end);
     if (st != JF_OK || len == 0) return st;
     if (ring_end) /* rings past the end of the cloud are empty */
         for (int r = 1; r <= nrings; r++)

@@ -7,22 +7,26 @@
 #include <stdint.h>
 
 #include "cgal_bridge.h"
+#include "index_internal.h"
 #include "jetfit.h"
 
 #define NONE UINT32_MAX
 #define BOX_SCALE 2.0      /* box half-size / farthest 3D neighbour     */
 #define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
 
-#define CAND_K 16          /* k-NN cells: candidates kept per vertex   */
+#define CAND_K JF_NATURAL_CAND /* k-NN cells: candidates queried first */
 #define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
 #define CAND_MAX 144       /* and at most                               */
 #define WCACHE 2048        /* slots of the per-thread CAND_MID cache    */
+#define ROW_W 10           /* own-plane rows: labels kept per vertex    */
+#define ROW_LIVE (NONE - 1) /* row[0]: no row, the cell made when asked */
 
 /* Two sources of the cells' cutting neighbours: the 3D Delaunay
  * neighbours (exact by construction), or the k-NN candidates of the k-d
  * tree, nearest first, with a certificate (knn_cell).  In the k-NN form
- * vertices are the tree's positions, d.adj holds CAND_K candidates per
- * vertex (NONE-padded), d.adj_off, d.pole, d.hull are NULL. */
+ * vertices are the tree's positions, the candidates are queried when a
+ * cell is made, d.adj, d.adj_off, d.pole, d.hull are NULL; row (when
+ * made) holds each vertex's cell labels in its own tangent plane. */
 struct jf_natural {
     jfb_delaunay d;
     double *vxyz; /* [3nv] coordinates of each vertex                  */
@@ -30,6 +34,8 @@ struct jf_natural {
     size_t max_deg;
     const jf_index *ix; /* k-NN form: the tree (owned if ix_own)        */
     jf_index *ix_own;
+    uint32_t *row; /* k-NN form: [nv * ROW_W] own-plane labels, NONE-
+                      padded; row[0] == ROW_LIVE: made when asked    */
 };
 
 struct jf_natural_ws {
@@ -62,6 +68,10 @@ static inline void project(const plane *h, const double *q, double *x, double *y
     *z = d[0] * h->n[0] + d[1] * h->n[1] + d[2] * h->n[2];
 }
 
+/* h through o with unit normal along nrm; 0 if nrm is zero or not
+ * finite. */
+int jf__natural_plane(const double *o, const double nrm[3], plane *h);
+
 /* OpenMP thread count of a call: threads, or every core when <= 0. */
 int jf__natural_threads(int threads);
 
@@ -85,7 +95,10 @@ int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double 
 int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len);
 
 /* natural_knn.c: vertex u's cell in the plane h from its k-NN candidates
- * (the certificate), its labels appended as jf__natural_labels does. */
-int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len);
+ * c[0..cnt) (nearest first, all of the CAND_K nearest; c NULL: queried
+ * here), made exact by the certificate; its labels appended as
+ * jf__natural_labels does.  Returns 0 on a failed query or no memory. */
+int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
+                         size_t cnt, size_t *len);
 
 #endif /* JF_NATURAL_INTERNAL_H */

@@ -15,11 +15,12 @@
 #include "natural_internal.h"
 
 /* The k-NN form over the tree ix: vertex v = tree position v; its
- * CAND_K nearest other vertices by (distance, input index). */
+ * candidates are queried when its cell is made (nothing per vertex is
+ * kept but the vertex maps). */
 jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out) {
     if (!ix || !out) return JF_ERR_INVALID;
     *out = NULL;
-    int nthr = jf__natural_threads(threads);
+    (void)threads;
     jf_natural *nt = calloc(1, sizeof *nt);
     if (!nt) return JF_ERR_NOMEM;
     const double *pts;
@@ -33,41 +34,82 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
     nt->d.nv = m;
     nt->d.vertex_of = malloc((n + 1) * sizeof *nt->d.vertex_of);
     nt->d.rep = malloc((m + 1) * sizeof *nt->d.rep);
-    nt->d.adj = malloc((m * CAND_K + 1) * sizeof *nt->d.adj);
-    if (!nt->d.vertex_of || !nt->d.rep || !nt->d.adj) {
+    if (!nt->d.vertex_of || !nt->d.rep) {
         jf_natural_free(nt);
         return JF_ERR_NOMEM;
     }
     for (size_t i = 0; i < n; i++) nt->d.vertex_of[i] = NONE;
     for (size_t v = 0; v < m; v++) nt->d.rep[v] = id[v], nt->d.vertex_of[id[v]] = (uint32_t)v;
-    long ml = (long)m;
-    int bad = 0;
-#ifdef _OPENMP
-#pragma omp parallel for schedule(static, 1024) num_threads(nthr) reduction(| : bad)
-#endif
-    for (long v = 0; v < ml; v++) {
-        uint32_t pos[CAND_K + 1], *a = nt->d.adj + (size_t)v * CAND_K;
-        double d2[CAND_K + 1];
-        size_t f = 0, c = 0;
-        bad |= jf__index_knn_pos(ix, pts + 3 * v, CAND_K + 1, INFINITY, pos, d2, &f) != JF_OK;
-        for (size_t j = 0; j < f && c < CAND_K; j++)
-            if (pos[j] != (uint32_t)v) a[c++] = pos[j];
-        while (c < CAND_K) a[c++] = NONE;
-    }
-    if (bad) {
-        jf_natural_free(nt);
-        return JF_ERR_INTERNAL;
-    }
     *out = nt;
     return JF_OK;
 }
 
-size_t jf__natural_candidates(const jf_natural *nt, size_t v, const uint32_t **pos) {
-    if (!nt || !nt->ix || v >= nt->d.nv) return 0;
-    size_t c = 0;
-    *pos = nt->d.adj + v * CAND_K;
-    while (c < CAND_K && (*pos)[c] != NONE) c++;
+size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[CAND_K]) {
+    uint32_t p[CAND_K + 1];
+    double d2[CAND_K + 1];
+    size_t f = 0, c = 0;
+    if (!nt || !nt->ix || v >= nt->d.nv) return SIZE_MAX;
+    if (jf__index_knn_pos(nt->ix, nt->vxyz + 3 * v, CAND_K + 1, INFINITY, p, d2, &f) != JF_OK)
+        return SIZE_MAX;
+    for (size_t j = 0; j < f && c < CAND_K; j++)
+        if (p[j] != (uint32_t)v) pos[c++] = p[j];
     return c;
+}
+
+jf_status jf__natural_rows_alloc(jf_natural *nt) {
+    if (!nt || !nt->ix) return JF_ERR_INVALID;
+    if (!nt->row && !(nt->row = malloc((nt->d.nv * ROW_W + 1) * sizeof *nt->row)))
+        return JF_ERR_NOMEM;
+    for (size_t v = 0; v < nt->d.nv; v++) nt->row[v * ROW_W] = ROW_LIVE;
+    return JF_OK;
+}
+
+int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
+                        size_t cnt) {
+    const jf_natural *nt = ws->nt;
+    uint32_t *row = nt->row + v * ROW_W;
+    plane h;
+    size_t len = 0;
+    row[0] = ROW_LIVE;
+    if (!jf__natural_plane(nt->vxyz + 3 * v, nrm, &h)) return 1;
+    if (++ws->gen == 0) { /* wrapped: clear the stamps once */
+        memset(ws->stamp, 0, nt->d.nv * sizeof *ws->stamp);
+        ws->gen = 1;
+    }
+    ws->stamp[v] = ws->gen;
+    if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, &len)) return 0;
+    if (len > ROW_W) return 1; /* rare: made again when asked */
+    for (size_t k = 0; k < ROW_W; k++) row[k] = k < len ? ws->list[k] : NONE;
+    return 1;
+}
+
+jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
+    if (!nt || !nt->ix || !nrm) return JF_ERR_INVALID;
+    jf_status st = jf__natural_rows_alloc(nt);
+    if (st != JF_OK) return st;
+    long nv = (long)nt->d.nv;
+    int bad = 0;
+#ifdef _OPENMP
+#pragma omp parallel num_threads(jf__natural_threads(threads)) reduction(| : bad)
+#endif
+    {
+        jf_natural_ws *ws = NULL;
+        bad |= jf_natural_ws_create(nt, &ws) != JF_OK;
+#ifdef _OPENMP
+#pragma omp for schedule(static, 1024)
+#endif
+        for (long v = 0; v < nv; v++) {
+            uint32_t c[CAND_K];
+            size_t cnt = bad ? SIZE_MAX : jf__natural_query(nt, (size_t)v, c);
+            if (cnt == SIZE_MAX) {
+                bad = 1;
+                continue;
+            }
+            bad |= !jf__natural_own_row(ws, (size_t)v, nrm + 3 * (size_t)nt->d.rep[v], c, cnt);
+        }
+        jf_natural_ws_free(ws);
+    }
+    return bad ? JF_ERR_NOMEM : JF_OK;
 }
 
 const jf_index *jf__natural_index(const jf_natural *nt) { return nt ? nt->ix : NULL; }
@@ -99,11 +141,16 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
  * exact.  The candidates run out before that only where the cell is
  * large (rim of an open scan, sparse or far-off-plane u): the query
  * widens to CAND_MAX, then the cell is taken as clipped by the box. */
-int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
+int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
+                         size_t cnt, size_t *len) {
     const jf_natural *nt = ws->nt;
     const double *U = nt->vxyz + 3 * (size_t)u;
-    const uint32_t *c;
-    size_t cnt = jf__natural_candidates(nt, u, &c), K = CAND_K, np, j = 0;
+    size_t K = CAND_K, np, j = 0;
+    if (!c) { /* widening below may overwrite cpos: it then reads its own list */
+        cnt = jf__natural_query(nt, u, ws->cpos);
+        if (cnt == SIZE_MAX) return 0;
+        c = ws->cpos;
+    }
     if (!cnt) return 1;
     double ux, uy, uz;
     project(h, U, &ux, &uy, &uz);

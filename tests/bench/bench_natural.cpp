@@ -60,6 +60,7 @@
 #include "jetfit.h"
 extern "C" {
 #include "fitter_internal.h"
+#include "index_internal.h"
 #include "planes_internal.h"
 #include "surfaces.h"
 }
@@ -135,9 +136,10 @@ static double cpu_self() {
 }
 
 // the phases of natural:16's neighbourhoods (the k-NN form) on g_threads
-// threads, written to g_fd as wall[3] then cpu[3]: create (k-d tree and
-// candidates), the PCA planes of the 16 nearest (the pipeline's
-// jf__planes_pca_knn, from the candidates), the neighbourhoods of every point
+// threads, written to g_fd as wall[3] then cpu[3]: create (the k-d tree),
+// the PCA planes of the 16 nearest with each point's own-plane cell (the
+// pipeline's jf__planes_pca_knn), the rings of every point from those rows
+// (jf__natural_neighbors_own, in the tree's order as the pipeline walks)
 static int g_fd = -1;
 static int run_profile() {
     size_t n = g_xyz.size() / 3;
@@ -149,10 +151,11 @@ static int run_profile() {
     w[0] = t1 - t0, c[0] = c1 - c0;
     std::vector<double> nrm(3 * n, NAN);
     std::vector<unsigned> flags(n, 0);
-    std::vector<uint32_t> order(n);  // walked in space order, as the pipeline
-    if (jf_spatial_order(g_xyz.data(), n, order.data()) != JF_OK) return 1;
+    const double *tp;
+    const uint32_t *order;  // the tree's order, as the pipeline walks
+    size_t nw = jf__index_points(jf__natural_index(nt), &tp, &order);
     double t2 = now(), c2 = cpu_self();
-    jf__planes_pca_knn(nt, n, g_threads, nrm.data(), flags.data());  // the pipeline's own
+    if (jf__planes_pca_knn(nt, n, g_threads, nrm.data(), flags.data()) != JF_OK) return 1;
     double t3 = now(), c3 = cpu_self();
     w[1] = t3 - t2, c[1] = c3 - c2;
     size_t total = 0;
@@ -163,10 +166,10 @@ static int run_profile() {
         std::vector<uint32_t> idx(64);
         if (jf_natural_ws_create(nt, &ws) == JF_OK) {
 #pragma omp for schedule(dynamic, 4096)
-            for (long o = 0; o < (long)n; o++) {
+            for (long o = 0; o < (long)nw; o++) {
                 size_t f = 0, i = order[o];
                 if (std::isfinite(nrm[3 * i]))
-                    jf_natural_neighbors(nt, ws, (size_t)i, &nrm[3 * i], 16, idx.data(), idx.size(), &f);
+                    jf__natural_neighbors_own(nt, ws, i, &nrm[3 * i], 16, idx.data(), idx.size(), &f);
                 total += f;
             }
             jf_natural_ws_free(ws);
@@ -314,7 +317,7 @@ static int bench_surface(jf_surface surf, size_t n, unsigned seed) {
     Meas prof = measure(run_profile);
     if (read(g_fd, w, sizeof w) != (ssize_t)sizeof w || read(g_fd, cp, sizeof cp) != (ssize_t)sizeof cp) prof.rc |= 4;
     close(g_fd);
-    const char *names[3] = {"create (tree, candidates)", "PCA planes", "neighbourhoods"};
+    const char *names[3] = {"create (tree)", "PCA planes + own cells", "rings from rows"};
     double csum = 0;
     std::printf("  profile of natural:16 (%dt), wall / CPU s:", g_threads);
     for (int k = 0; k < 3; k++) std::printf(" %s %.2f/%.2f,", names[k], w[k], cp[k]), csum += cp[k];
