@@ -576,7 +576,8 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
             size_t m = 0; /* block modes: results in w.blk */
             for (size_t k = beg; k < end && wst == JF_OK;) {
                 const size_t i = walk[k];
-                if (x->nt && k + PREFETCH < nwalk) prefetch_natural(x, walk[k + PREFETCH]);
+                if (x->nt && k + PREFETCH + 1 < nwalk) /* k steps by 2 for pairs */
+                    prefetch_natural(x, walk[k + PREFETCH]), prefetch_natural(x, walk[k + PREFETCH + 1]);
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : R->c->xyz + 3 * i;
                 if (fit && !fit[i]) { /* a halo point: a neighbour only */
                     if (!blocks) nan_result(&R->out[i], JF_PT_NONFINITE);

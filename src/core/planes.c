@@ -32,6 +32,7 @@
 #include "planes_internal.h"
 
 #define PCA_K 16 /* PCA of the 16 nearest points */
+#define PREFETCH 8 /* pairs ahead */
 
 jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, size_t k,
                              const jf_params *prm, int nt, double *nrm, double *proj,
@@ -158,6 +159,11 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
             size_t k[2] = {0, 0};
             int ok[2] = {0, 0};
             if (bad) continue;
+            if (v0 + 2 * PREFETCH < m) /* flags and nrm are in input order: misses */
+                for (size_t L = 0; L < 2; L++) {
+                    __builtin_prefetch(flags + id[v0 + 2 * PREFETCH + L], 1);
+                    __builtin_prefetch(nrm + 3 * (size_t)id[v0 + 2 * PREFETCH + L], 1);
+                }
             for (size_t L = 0; L < cnt; L++) {
                 double pts[3 * PCA_K];
                 if ((k[L] = jf__natural_query(ntl, v0 + L, c[L])) == SIZE_MAX) {

@@ -45,7 +45,7 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
  * was made from): its JF_NATURAL_CAND nearest other vertices by
  * (distance, input index) into pos; their count (fewer: the whole
  * cloud), or SIZE_MAX if the query failed. */
-#define JF_NATURAL_CAND 20
+#define JF_NATURAL_CAND 16
 size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL_CAND]);
 
 /* Own-plane rows of the k-NN form (docs/natural.md, "Own-plane rings"):

@@ -254,12 +254,6 @@ jf_status jf_natural_ws_create(const jf_natural *nt, jf_natural_ws **out) {
     ok &= (ws->ql = malloc(m * sizeof(uint32_t))) != NULL;
     ok &= (ws->cpos = malloc(m * sizeof(uint32_t))) != NULL;
     ok &= (ws->cd2 = malloc(m * sizeof(double))) != NULL;
-    if (ok && nt->ix) {
-        ok &= (ws->wkey = malloc(WCACHE * sizeof *ws->wkey)) != NULL;
-        ok &= (ws->wlist = malloc((size_t)WCACHE * CAND_MID * sizeof *ws->wlist)) != NULL;
-        ok &= (ws->wcnt = malloc(WCACHE)) != NULL;
-        for (size_t k = 0; ok && k < WCACHE; k++) ws->wkey[k] = NONE;
-    }
     if (!ok) {
         jf_natural_ws_free(ws);
         return JF_ERR_NOMEM;
@@ -277,7 +271,6 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws->sx), free(ws->sy), free(ws->sr);
     free(ws->pl), free(ws->ql);
     free(ws->cpos), free(ws->cd2);
-    free(ws->wkey), free(ws->wlist), free(ws->wcnt);
     free(ws);
 }
 
@@ -335,8 +328,10 @@ int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double 
     return 1;
 }
 
-static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
-    if (*len == ws->listcap) { /* rare: amortised growth, not per point */
+/* Room for `more` entries after len (rare: amortised growth, not per
+ * point); 0 when out of memory. */
+static int reserve(jf_natural_ws *ws, size_t len, size_t more) {
+    while (len + more > ws->listcap) {
         size_t c = 2 * ws->listcap;
         uint32_t *l = realloc(ws->list, c * sizeof *l);
         if (!l) return 0;
@@ -346,6 +341,11 @@ static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
         ws->dist = d;
         ws->listcap = c;
     }
+    return 1;
+}
+
+static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
+    if (*len == ws->listcap && !reserve(ws, *len, 1)) return 0;
     ws->list[*len] = v;
     ws->dist[(*len)++] = d2;
     return 1;
@@ -447,26 +447,44 @@ static const plane *plane_of(lazy_plane *lp) {
     return lp->made > 0 ? &lp->h : NULL;
 }
 
-/* Appends ring vertex u's neighbours: its own-plane row (own: the
- * k-NN form's rows), else its cell in p's plane. */
-static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, size_t *len) {
+/* Appends ring vertex u's neighbours: its cell in p's plane. */
+static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, size_t *len) {
     const jf_natural *nt = ws->nt;
-    const uint32_t *row = nt->row ? nt->row + (size_t)u * ROW_W : NULL;
-    if (!own || row[0] == ROW_LIVE) {
-        const plane *h = plane_of(lp);
-        if (!h) return 1; /* checked by grow: not reached */
-        return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, len) : cell_neighbors(ws, h, u, len);
+    const plane *h = plane_of(lp);
+    if (!h) return 1; /* checked by grow: not reached */
+    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, len) : cell_neighbors(ws, h, u, len);
+}
+
+/* The next ring from the own-plane rows of ring list[a..b) (a LIVE row:
+ * the vertex's cell in p's plane).  Locals: the stores to list and dist
+ * would otherwise reload every pointer. */
+static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    if (!reserve(ws, *len, (b - a) * ROW_W)) return 0;
+    const double *V = nt->vxyz, *p = lp->o;
+    const uint32_t gen = ws->gen;
+    uint32_t *restrict stamp = ws->stamp, *restrict list = ws->list;
+    double *restrict dist = ws->dist;
+    size_t n = *len;
+    for (size_t k = a; k < b; k++) {
+        const uint32_t *row = nt->row + (size_t)list[k] * ROW_W;
+        if (row[0] == ROW_LIVE) { /* rare: may grow the list */
+            *len = n;
+            if (!ring_step(ws, lp, list[k], len) || !reserve(ws, *len, (b - k) * ROW_W)) return 0;
+            n = *len, list = ws->list, dist = ws->dist;
+            continue;
+        }
+        for (size_t j = 0; j < ROW_W && row[j] != NONE; j++) {
+            const uint32_t s = row[j];
+            if (stamp[s] == gen) continue;
+            stamp[s] = gen;
+            const double *q = V + 3 * (size_t)s;
+            list[n] = s;
+            dist[n++] = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                        (q[2] - p[2]) * (q[2] - p[2]);
+        }
     }
-    const double *p = lp->o;
-    for (size_t k = 0; k < ROW_W && row[k] != NONE; k++) {
-        uint32_t s = row[k];
-        if (ws->stamp[s] == ws->gen) continue;
-        const double *q = nt->vxyz + 3 * (size_t)s;
-        double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
-                    (q[2] - p[2]) * (q[2] - p[2]);
-        ws->stamp[s] = ws->gen;
-        if (!push(ws, len, s, d2)) return 0;
-    }
+    *len = n;
     return 1;
 }
 
@@ -492,8 +510,12 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     size_t a = 0, b = 1;
     if (ring_end) ring_end[0] = 1;
     for (int r = 1; r <= maxrings && *len < want; r++) {
-        for (size_t k = a; k < b; k++)
-            if (!ring_step(ws, &lp, ws->list[k], own, len)) return JF_ERR_NOMEM;
+        if (own) {
+            if (!own_ring(ws, &lp, a, b, len)) return JF_ERR_NOMEM;
+        } else {
+            for (size_t k = a; k < b; k++)
+                if (!ring_step(ws, &lp, ws->list[k], len)) return JF_ERR_NOMEM;
+        }
         if (*len == b) break; /* the cloud ran out */
         sort_ring(ws, b, *len);
         a = b, b = *len;

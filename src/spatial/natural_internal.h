@@ -15,9 +15,9 @@
 #define EDGE_EPS 1e-9      /* edges shorter than this x reach: no edge */
 
 #define CAND_K JF_NATURAL_CAND /* k-NN cells: candidates queried first */
-#define CAND_MID 47        /* then (47 + itself: the tree's sorted path) */
-#define CAND_MAX 144       /* and at most                               */
-#define WCACHE 2048        /* slots of the per-thread CAND_MID cache    */
+#define CAND_MID 47        /* widened: at most (47 + itself: the tree's
+                              sorted path)                              */
+#define CAND_MAX 144       /* then at most                              */
 #define ROW_W 10           /* own-plane rows: labels kept per vertex    */
 #define ROW_LIVE (NONE - 1) /* row[0]: no row, the cell made when asked */
 
@@ -48,12 +48,8 @@ struct jf_natural_ws {
     double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
     uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
     double *sx, *sy, *sr;      /* projected neighbours of the cell     */
-    uint32_t *cpos;            /* k-NN form: a wider candidate query   */
+    uint32_t *cpos;            /* k-NN form: a candidate query         */
     double *cd2;
-    uint32_t *wkey;            /* k-NN form: cache of CAND_MID-nearest */
-    uint32_t *wlist;           /* lists, slot u % WCACHE: key, list,   */
-    uint8_t *wcnt;             /* count (a vertex's is needed again by
-                                  the neighbouring points' rings)      */
 };
 
 /* The tangent plane: orthonormal e1, e2 spanning it, n its unit normal. */

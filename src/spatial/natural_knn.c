@@ -140,7 +140,8 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
  * the polygon, no sample further out cuts it either and the cell is
  * exact.  The candidates run out before that only where the cell is
  * large (rim of an open scan, sparse or far-off-plane u): the query
- * widens to CAND_MAX, then the cell is taken as clipped by the box. */
+ * widens to the samples within twice the polygon's radius (at most
+ * CAND_MID, then CAND_MAX), then the cell is taken as clipped by the box. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
                          size_t cnt, size_t *len) {
     const jf_natural *nt = ws->nt;
@@ -180,28 +181,11 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
         const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
         double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
         if (dx * dx + dy * dy + dz * dz >= 4 * r2) break; /* the last cut shrank it enough */
-        /* widen: the first j of a wider list are the same candidates.
-         * First the CAND_MID nearest, from the thread's cache (fewer: the
-         * whole cloud); then the samples within 2 |x - u| (at most
-         * CAND_MAX; fewer found: all of them) */
+        /* widen: the samples within 2 |x - u| (the first j of them are
+         * the same candidates), at most CAND_MID, then CAND_MAX; fewer
+         * found: all of them */
         size_t f = 0, m = 0;
-        if (K == CAND_K) {
-            K = CAND_MID;
-            size_t slot = u & (WCACHE - 1);
-            uint32_t *w = ws->wlist + slot * CAND_MID;
-            if (ws->wkey[slot] != u) {
-                if (jf__index_knn_pos(nt->ix, U, CAND_MID + 1, INFINITY, ws->cpos, ws->cd2, &f) != JF_OK)
-                    return 0;
-                for (size_t k = 0; k < f && m < CAND_MID; k++)
-                    if (ws->cpos[k] != u) w[m++] = ws->cpos[k];
-                ws->wkey[slot] = u;
-                ws->wcnt[slot] = (uint8_t)m;
-            }
-            c = w;
-            cnt = ws->wcnt[slot];
-            continue;
-        }
-        K = CAND_MAX;
+        K = K < CAND_MID ? CAND_MID : CAND_MAX;
         if (jf__index_knn_pos(nt->ix, U, K + 1, 4 * r2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
         for (size_t k = 0; k < f; k++)
             if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
