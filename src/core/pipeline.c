@@ -115,8 +115,8 @@ static int cmp_double(const void *a, const void *b)
 
 /* JF_NORMAL_AUTO's test (jetfit.h): at up to NOISE_SAMPLES points spread
  * over the input order, the RMS residual of a plain degree-2 jet fitted to
- * the NOISE_N natural neighbours in the pole plane, relative to their RMS
- * distance to the point.  A clean surface leaves a residual of higher
+ * the NOISE_N natural neighbours (rings of the PCA planes' own-plane
+ * rows), relative to their RMS distance to the point.  A clean surface leaves a residual of higher
  * order (~ r^3 / R^2); noise leaves ~ sigma.  Noisy: the median ratio is
  * above JF_NATURAL_NOISY_RESIDUAL. */
 #define NOISE_SAMPLES 2000
@@ -140,7 +140,7 @@ static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const doub
         size_t found = 0;
         jf_result r;
         if (jf_natural_kept(nt, i) != i || !finite3(nrm + 3 * i)) continue;
-        if ((st = jf_natural_neighbors(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
+        if ((st = jf__natural_neighbors_own(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
             break;
         for (size_t j = 0; j < found; j++)
             for (int c = 0; c < 3; c++) {

@@ -119,10 +119,56 @@ static int pca_pick(const double eval[3], const double evec[9], double nrm[3])
     return 1;
 }
 
+/* The smallest eigenvector of a (3x3 symmetric, positive semi-definite)
+ * by power iteration on its adjugate, whose eigenvalues are l2 l3 >=
+ * l1 l3 >= l1 l2 on the same eigenvectors: each step divides the error
+ * by l2 / l1, large for a sample of a surface.  A tenth of the Jacobi
+ * solver's time.  Returns 0 (the caller uses jf__eig3) when a is zero
+ * or not finite, l2 is not clearly above 0 (collinear points: jf__eig3
+ * decides) or the iteration has not settled in PCA_ITER steps (l1 near
+ * l2: no clear plane). */
+#define PCA_ITER 64
+#define PCA_TOL 1e-14 /* step (x scaled to max 1): the error is about this */
+int jf__pca_smallest(const double a[9], double nrm[3])
+{
+    double s = 0;
+    for (int k = 0; k < 9; k++) s = fabs(a[k]) > s ? fabs(a[k]) : s;
+    if (!(s > 0) || !(s < INFINITY)) return 0;
+    const double r = 1 / s, a00 = a[0] * r, a01 = a[1] * r, a02 = a[2] * r, a11 = a[4] * r,
+                 a12 = a[5] * r, a22 = a[8] * r;
+    const double c[9] = {a11 * a22 - a12 * a12, a02 * a12 - a01 * a22, a01 * a12 - a02 * a11,
+                         a02 * a12 - a01 * a22, a00 * a22 - a02 * a02, a01 * a02 - a00 * a12,
+                         a01 * a12 - a02 * a11, a01 * a02 - a00 * a12, a00 * a11 - a01 * a01};
+    if (!(c[0] + c[4] + c[8] > 1e-12)) return 0; /* l2 l3 <= ~1e-12 l3^2 */
+    int k0 = c[0] >= c[4] ? (c[0] >= c[8] ? 0 : 2) : (c[4] >= c[8] ? 1 : 2);
+    double x[3] = {c[k0], c[3 + k0], c[6 + k0]}; /* column k0: nearly along v1 */
+    for (int it = 0; it < PCA_ITER; it++) {
+        double y[3], m = 0;
+        for (int i = 0; i < 3; i++) {
+            y[i] = c[3 * i] * x[0] + c[3 * i + 1] * x[1] + c[3 * i + 2] * x[2];
+            m = fabs(y[i]) > m ? fabs(y[i]) : m;
+        }
+        if (!(m > 0)) return 0;
+        double e = 0, im = 1 / m;
+        for (int i = 0; i < 3; i++) { /* x is scaled to max 1 as y now is */
+            y[i] *= im;
+            e = fabs(y[i] - x[i]) > e ? fabs(y[i] - x[i]) : e;
+            x[i] = y[i];
+        }
+        if (it > 0 && e <= PCA_TOL) {
+            double l = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            for (int i = 0; i < 3; i++) nrm[i] = x[i] / l;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static int pca_normal(const double *pts, size_t m, double nrm[3])
 {
     double a[9], eval[3], evec[9];
     if (!pca_cov(pts, m, a)) return 0;
+    if (jf__pca_smallest(a, nrm)) return 1;
     jf__eig3(a, eval, evec);
     return pca_pick(eval, evec, nrm);
 }
@@ -176,15 +222,19 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
                     memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[L][j], sizeof(double[3]));
                 ok[L] = pca_cov(pts, kp + 1, a[L]);
             }
-            if (ok[0] && ok[1])
+            int jac[2] = {0, 0}; /* the rare hard ones: Jacobi, paired in lanes */
+            for (size_t L = 0; L < cnt; L++)
+                jac[L] = ok[L] && !jf__pca_smallest(a[L], nrm + 3 * (size_t)id[v0 + L]);
+            if (jac[0] && jac[1])
                 jf__eig3_x2(a[0], a[1], eval[0], evec[0], eval[1], evec[1]);
             else
                 for (size_t L = 0; L < cnt; L++)
-                    if (ok[L]) jf__eig3(a[L], eval[L], evec[L]);
+                    if (jac[L]) jf__eig3(a[L], eval[L], evec[L]);
             for (size_t L = 0; L < cnt; L++) {
                 const size_t i = id[v0 + L];
-                flags[i] |= ok[L] && pca_pick(eval[L], evec[L], nrm + 3 * i) ? JF_PT_NORMAL_PCA
-                                                                             : JF_PT_FAILED;
+                flags[i] |= ok[L] && (!jac[L] || pca_pick(eval[L], evec[L], nrm + 3 * i))
+                                ? JF_PT_NORMAL_PCA
+                                : JF_PT_FAILED;
                 /* the cell in this plane, while its candidates are at hand */
                 bad |= !bad && !jf__natural_own_row(ws, v0 + L, nrm + 3 * i, c[L], k[L]);
             }

@@ -28,6 +28,12 @@ jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, si
  * JF_PT_FAILED; and, from the same candidates, nt's own-plane rows
  * (jf__natural_own_row).  OpenMP on nt threads; JF_ERR_NOMEM or
  * JF_ERR_INTERNAL (a failed query) as jf__natural_own_rows. */
+/* The unit eigenvector of the smallest eigenvalue of a (3x3 symmetric
+ * positive semi-definite, row-major) by power iteration on its
+ * adjugate; 0 when that is not settled (zero or non-finite a, collinear
+ * points, two smallest eigenvalues close): use jf__eig3 then. */
+int jf__pca_smallest(const double a[9], double nrm[3]);
+
 int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3]);
 jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags);
 

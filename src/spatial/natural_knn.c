@@ -132,6 +132,47 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
     return st;
 }
 
+/* The cell u' clipped by all samples of the candidate list (the last at
+ * squared distance dl2 from u): exact iff no vertex x has a sample
+ * strictly nearer than u (a half-plane that cuts a convex polygon holds
+ * one of its vertices).  Vertices with |x - u| <= dl / 2 are certified by
+ * the list; each other one asks the tree for its VERIFY_K nearest
+ * within |x - u| and clips by them (an edge's own label, on the circle
+ * by construction, is skipped), again from the start after a cut.
+ * Cheaper than the samples within 2 max |x - u| of u.  Returns 1 when
+ * exact, -1 when crowded or still cutting after VERIFY_ROUNDS (the
+ * caller widens), 0 on a failed query. */
+#define VERIFY_K 4
+#define VERIFY_ROUNDS 8
+static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, double uy, double uz,
+                  double dl2, size_t *np) {
+    const jf_natural *nt = ws->nt;
+    for (int round = 0; round < VERIFY_ROUNDS; round++) {
+        int cut = 0;
+        for (size_t k = 0; k < *np && !cut; k++) {
+            double px = ws->px[k], py = ws->py[k], rx2 = px * px + py * py + uz * uz;
+            if (4 * rx2 <= dl2) continue;
+            double X[3];
+            for (int d = 0; d < 3; d++) X[d] = h->o[d] + (ux + px) * h->e1[d] + (uy + py) * h->e2[d];
+            size_t f = 0;
+            if (jf__index_knn_pos(nt->ix, X, VERIFY_K, rx2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+            uint32_t e0 = ws->pl[k], e1 = ws->pl[k == 0 ? *np - 1 : k - 1];
+            for (size_t j = 0; j < f && !cut; j++) {
+                uint32_t s = ws->cpos[j];
+                if (s == u || s == e0 || s == e1) continue;
+                double x, y, z;
+                project(h, nt->vxyz + 3 * (size_t)s, &x, &y, &z);
+                double sx = x - ux, sy = y - uy;
+                cut = jf__natural_cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s) || *np == 0;
+            }
+            if (*np == 0) return 1;
+            if (!cut && f == VERIFY_K) return -1;
+        }
+        if (!cut) return 1;
+    }
+    return -1;
+}
+
 /* k-NN form of cell_neighbors: u's planar cell clipped by its
  * candidates, nearest first.  Certificate: a sample s at 3D distance
  * d_s from u cannot cut the cell at a vertex x (in H) with
@@ -180,7 +221,13 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
         if (np == 0 || cnt < K || K >= CAND_MAX) break;
         const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
         double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
-        if (dx * dx + dy * dy + dz * dz >= 4 * r2) break; /* the last cut shrank it enough */
+        double dl2 = dx * dx + dy * dy + dz * dz;
+        if (dl2 >= 4 * r2) break; /* the last cut shrank it enough */
+        if (K == CAND_K) {
+            int v = verify(ws, h, u, ux, uy, uz, dl2, &np);
+            if (v == 0) return 0;
+            if (v > 0) break;
+        }
         /* widen: the samples within 2 |x - u| (the first j of them are
          * the same candidates), at most CAND_MID, then CAND_MAX; fewer
          * found: all of them */
