@@ -189,6 +189,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
     const double *tp;
     const uint32_t *id;
     size_t m = jf__index_points(jf__natural_index(ntl), &tp, &id);
+#pragma omp parallel for schedule(static) num_threads(nt)
     for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
     jf_status st = jf__natural_rows_alloc(ntl);
     if (st != JF_OK) return st;

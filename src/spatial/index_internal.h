@@ -51,8 +51,8 @@ size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL
 /* Own-plane rows of the k-NN form (docs/natural.md, "Own-plane rings"):
  * each vertex's planar cell in its own tangent plane, made once, so that
  * a ring grows from stored rows instead of one clipped cell per ring
- * vertex.  jf__natural_rows_alloc makes the table (every row LIVE);
- * jf__natural_own_row fills vertex v's from its plane normal nrm (of its
+ * vertex.  jf__natural_rows_alloc makes the table (rows undefined: a
+ * pass must fill every one before a ring reads them); jf__natural_own_row fills vertex v's from its plane normal nrm (of its
  * input point) and its candidates c[0..cnt) (jf__natural_query's; a
  * zero or non-finite normal or more than the row's room leaves it LIVE:
  * that cell is made when a ring asks for it); jf__natural_own_rows does

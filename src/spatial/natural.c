@@ -418,19 +418,27 @@ static int lex_greater(const jf_natural *nt, uint32_t a, uint32_t b) {
     return p[2] > q[2];
 }
 
-/* Sorts list[a..b) by distance, then lexicographically (insertion sort:
- * rings are short). */
+/* Sorts list[a..b) by distance, then lexicographically: insertion sort
+ * on the distance alone (rings are short), then the rare runs of equal
+ * distances (grids) by coordinates. */
 static void sort_ring(jf_natural_ws *ws, size_t a, size_t b) {
+    uint32_t *restrict list = ws->list;
+    double *restrict dist = ws->dist;
+    int ties = 0;
     for (size_t k = a + 1; k < b; k++) {
-        uint32_t v = ws->list[k];
-        double d = ws->dist[k];
+        const uint32_t v = list[k];
+        const double d = dist[k];
         size_t j = k;
-        while (j > a && (ws->dist[j - 1] > d ||
-                         (ws->dist[j - 1] == d && lex_greater(ws->nt, ws->list[j - 1], v)))) {
-            ws->list[j] = ws->list[j - 1], ws->dist[j] = ws->dist[j - 1];
-            j--;
-        }
-        ws->list[j] = v, ws->dist[j] = d;
+        for (; j > a && dist[j - 1] > d; j--) list[j] = list[j - 1], dist[j] = dist[j - 1];
+        list[j] = v, dist[j] = d;
+        ties |= j > a && dist[j - 1] == d;
+    }
+    for (size_t k = a + 1; ties && k < b; k++) {
+        const uint32_t v = list[k];
+        size_t j = k;
+        for (; j > a && dist[j - 1] == dist[k] && lex_greater(ws->nt, list[j - 1], v); j--)
+            list[j] = list[j - 1];
+        list[j] = v;
     }
 }
 

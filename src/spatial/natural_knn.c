@@ -20,7 +20,6 @@
 jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out) {
     if (!ix || !out) return JF_ERR_INVALID;
     *out = NULL;
-    (void)threads;
     jf_natural *nt = calloc(1, sizeof *nt);
     if (!nt) return JF_ERR_NOMEM;
     const double *pts;
@@ -38,8 +37,20 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
         jf_natural_free(nt);
         return JF_ERR_NOMEM;
     }
-    for (size_t i = 0; i < n; i++) nt->d.vertex_of[i] = NONE;
-    for (size_t v = 0; v < m; v++) nt->d.rep[v] = id[v], nt->d.vertex_of[id[v]] = (uint32_t)v;
+    long nl = (long)n, ml = (long)m;
+#ifdef _OPENMP
+#pragma omp parallel num_threads(jf__natural_threads(threads))
+#endif
+    { /* first touch on every thread; the ids are distinct */
+#ifdef _OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (long i = 0; i < nl; i++) nt->d.vertex_of[i] = NONE;
+#ifdef _OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (long v = 0; v < ml; v++) nt->d.rep[v] = id[v], nt->d.vertex_of[id[v]] = (uint32_t)v;
+    }
     *out = nt;
     return JF_OK;
 }
@@ -60,8 +71,7 @@ jf_status jf__natural_rows_alloc(jf_natural *nt) {
     if (!nt || !nt->ix) return JF_ERR_INVALID;
     if (!nt->row && !(nt->row = malloc((nt->d.nv * ROW_W + 1) * sizeof *nt->row)))
         return JF_ERR_NOMEM;
-    for (size_t v = 0; v < nt->d.nv; v++) nt->row[v * ROW_W] = ROW_LIVE;
-    return JF_OK;
+    return JF_OK; /* filled (and first touched) by the threads' passes */
 }
 
 int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
