@@ -295,35 +295,44 @@ int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
 
 /* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
  * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
- * the clip line gets label s. */
+ * the clip line gets label s; ws->r2 = the largest px^2 + py^2 of the
+ * result (what the k-NN cells' certificate needs, without a second
+ * pass over vertices just stored). */
 int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
+    const double *restrict px = ws->px, *restrict py = ws->py;
+    const uint32_t *restrict pl = ws->pl;
+    double *restrict qx = ws->qx, *restrict qy = ws->qy;
+    uint32_t *restrict ql = ws->ql;
     size_t n = *m, o = 0, k0;
     for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
-        if (ax * ws->px[k0] + ay * ws->py[k0] > b) break;
+        if (ax * px[k0] + ay * py[k0] > b) break;
     if (k0 == n) return 0;
+    const double f0 = ax * px[0] + ay * py[0] - b;
+    double fu = f0, r2 = 0;
     for (size_t k = 0; k < n; k++) {
-        size_t k1 = k + 1 == n ? 0 : k + 1;
-        double fu = ax * ws->px[k] + ay * ws->py[k] - b;
-        double fw = ax * ws->px[k1] + ay * ws->py[k1] - b;
+        const size_t k1 = k + 1 == n ? 0 : k + 1;
+        const double fw = k1 ? ax * px[k1] + ay * py[k1] - b : f0;
         if (fu <= 0) {
-            ws->qx[o] = ws->px[k], ws->qy[o] = ws->py[k], ws->ql[o++] = ws->pl[k];
+            qx[o] = px[k], qy[o] = py[k], ql[o++] = pl[k];
+            const double q = px[k] * px[k] + py[k] * py[k];
+            r2 = q > r2 ? q : r2;
             if (fw > 0) {
-                double t = fu / (fu - fw);
-                ws->qx[o] = ws->px[k] + t * (ws->px[k1] - ws->px[k]);
-                ws->qy[o] = ws->py[k] + t * (ws->py[k1] - ws->py[k]);
-                ws->ql[o++] = s;
+                const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
+                             y = py[k] + t * (py[k1] - py[k]);
+                qx[o] = x, qy[o] = y, ql[o++] = s;
+                r2 = x * x + y * y > r2 ? x * x + y * y : r2;
             }
         } else if (fw <= 0) {
-            double t = fu / (fu - fw);
-            ws->qx[o] = ws->px[k] + t * (ws->px[k1] - ws->px[k]);
-            ws->qy[o] = ws->py[k] + t * (ws->py[k1] - ws->py[k]);
-            ws->ql[o++] = ws->pl[k];
+            const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
+                         y = py[k] + t * (py[k1] - py[k]);
+            qx[o] = x, qy[o] = y, ql[o++] = pl[k];
+            r2 = x * x + y * y > r2 ? x * x + y * y : r2;
         }
+        fu = fw;
     }
-    double *tx = ws->px, *ty = ws->py;
-    uint32_t *tl = ws->pl;
-    ws->px = ws->qx, ws->py = ws->qy, ws->pl = ws->ql;
-    ws->qx = tx, ws->qy = ty, ws->ql = tl;
+    ws->qx = ws->px, ws->qy = ws->py, ws->ql = ws->pl;
+    ws->px = qx, ws->py = qy, ws->pl = ql;
+    ws->r2 = r2;
     *m = o;
     return 1;
 }

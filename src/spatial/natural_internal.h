@@ -47,6 +47,7 @@ struct jf_natural_ws {
     size_t listcap;
     double *px, *py, *qx, *qy; /* polygon buffers (max_deg + 8)        */
     uint32_t *pl, *ql;         /* edge labels (vertex id, NONE = box)   */
+    double r2;                 /* after a clip: max px^2 + py^2         */
     double *sx, *sy, *sr;      /* projected neighbours of the cell     */
     uint32_t *cpos;            /* k-NN form: a candidate query         */
     double *cd2;

@@ -221,12 +221,7 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
             project(h, S, &x, &y, &z);
             double sx = x - ux, sy = y - uy, sr = sx * sx + sy * sy + (z - uz) * (z + uz);
             if (!jf__natural_cut(ws, &np, sx, sy, sr, c[j])) continue;
-            r2 = 0;
-            for (size_t k = 0; k < np; k++) {
-                double q = ws->px[k] * ws->px[k] + ws->py[k] * ws->py[k];
-                if (q > r2) r2 = q;
-            }
-            r2 += uz * uz;
+            r2 = ws->r2 + uz * uz;
         }
         if (np == 0 || cnt < K || K >= CAND_MAX) break;
         const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
