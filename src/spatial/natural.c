@@ -277,16 +277,18 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
 int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
     double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
     if (!(l > 0) || !isfinite(l)) return 0;
-    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] / l, h->o[k] = o[k];
-    /* e1: the world axis least aligned with n, made orthogonal */
-    int ax = fabs(h->n[0]) < fabs(h->n[1]) ? (fabs(h->n[0]) < fabs(h->n[2]) ? 0 : 2)
-                                            : (fabs(h->n[1]) < fabs(h->n[2]) ? 1 : 2);
-    double t[3] = {0, 0, 0};
-    t[ax] = 1;
-    double d = t[0] * h->n[0] + t[1] * h->n[1] + t[2] * h->n[2];
-    for (int k = 0; k < 3; k++) t[k] -= d * h->n[k];
-    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    for (int k = 0; k < 3; k++) h->e1[k] = t[k] / l;
+    /* the axis from nrm itself: it does not wait for the division */
+    int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
+                                          : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
+    double il = 1 / l;
+    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k];
+    /* e1: the world axis least aligned with n, made orthogonal:
+     * t = e_ax - n_ax n, |t|^2 = 1 - n_ax^2 (>= 2/3) */
+    double t[3];
+    for (int k = 0; k < 3; k++) t[k] = -h->n[ax] * h->n[k];
+    t[ax] += 1;
+    double it = 1 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int k = 0; k < 3; k++) h->e1[k] = t[k] * it;
     h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
     h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
     h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
