@@ -143,44 +143,49 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
 }
 
 /* The cell u' clipped by all samples of the candidate list (the last at
- * squared distance dl2 from u): exact iff no vertex x has a sample
+ * squared distance dl2 from u) is exact iff no vertex x has a sample
  * strictly nearer than u (a half-plane that cuts a convex polygon holds
  * one of its vertices).  Vertices with |x - u| <= dl / 2 are certified by
- * the list; each other one asks the tree for its VERIFY_K nearest
- * within |x - u| and clips by them (an edge's own label, on the circle
- * by construction, is skipped), again from the start after a cut.
+ * the list.  The balls B(x, |x - u|) of the others all pass through u,
+ * and z in B(c, |c - u|) is linear in c, so the ball of any point of the
+ * polygon lies in the union of its vertices' balls: one query for every
+ * sample in a ball enclosing the uncertified vertices' balls, and the
+ * cell clipped by them, is exact -- the clips only shrink the polygon.
  * Cheaper than the samples within 2 max |x - u| of u.  Returns 1 when
- * exact, -1 when crowded or still cutting after VERIFY_ROUNDS (the
- * caller widens), 0 on a failed query. */
-#define VERIFY_K 4
-#define VERIFY_ROUNDS 8
+ * exact, -1 when that ball holds CAND_MID samples or more (the caller
+ * widens), 0 on a failed query. */
 static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, double uy, double uz,
                   double dl2, size_t *np) {
     const jf_natural *nt = ws->nt;
-    for (int round = 0; round < VERIFY_ROUNDS; round++) {
-        int cut = 0;
-        for (size_t k = 0; k < *np && !cut; k++) {
-            double px = ws->px[k], py = ws->py[k], rx2 = px * px + py * py + uz * uz;
-            if (4 * rx2 <= dl2) continue;
-            double X[3];
-            for (int d = 0; d < 3; d++) X[d] = h->o[d] + (ux + px) * h->e1[d] + (uy + py) * h->e2[d];
-            size_t f = 0;
-            if (jf__index_knn_pos(nt->ix, X, VERIFY_K, rx2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
-            uint32_t e0 = ws->pl[k], e1 = ws->pl[k == 0 ? *np - 1 : k - 1];
-            for (size_t j = 0; j < f && !cut; j++) {
-                uint32_t s = ws->cpos[j];
-                if (s == u || s == e0 || s == e1) continue;
-                double x, y, z;
-                project(h, nt->vxyz + 3 * (size_t)s, &x, &y, &z);
-                double sx = x - ux, sy = y - uy;
-                cut = jf__natural_cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s) || *np == 0;
-            }
-            if (*np == 0) return 1;
-            if (!cut && f == VERIFY_K) return -1;
-        }
-        if (!cut) return 1;
+    double cx = 0, cy = 0, m = 0;
+    for (size_t k = 0; k < *np; k++) {
+        double px = ws->px[k], py = ws->py[k];
+        if (4 * (px * px + py * py + uz * uz) > dl2) cx += px, cy += py, m++;
     }
-    return -1;
+    if (m == 0) return 1;
+    cx /= m, cy /= m;
+    double rho = 0;
+    for (size_t k = 0; k < *np; k++) {
+        double px = ws->px[k], py = ws->py[k], rx2 = px * px + py * py + uz * uz;
+        if (4 * rx2 <= dl2) continue;
+        double e = sqrt((px - cx) * (px - cx) + (py - cy) * (py - cy)) + sqrt(rx2);
+        rho = e > rho ? e : rho;
+    }
+    rho *= 1 + 1e-12; /* the rounding of the sums above, outwards */
+    double X[3];
+    for (int d = 0; d < 3; d++) X[d] = h->o[d] + (ux + cx) * h->e1[d] + (uy + cy) * h->e2[d];
+    size_t f = 0;
+    if (jf__index_knn_pos(nt->ix, X, CAND_MID, rho * rho, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+    if (f == CAND_MID) return -1;
+    for (size_t j = 0; j < f && *np > 0; j++) {
+        uint32_t s = ws->cpos[j];
+        if (s == u) continue;
+        double x, y, z;
+        project(h, nt->vxyz + 3 * (size_t)s, &x, &y, &z);
+        double sx = x - ux, sy = y - uy;
+        jf__natural_cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s);
+    }
+    return 1;
 }
 
 /* k-NN form of cell_neighbors: u's planar cell clipped by its
