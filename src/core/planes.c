@@ -191,7 +191,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
     size_t m = jf__index_points(jf__natural_index(ntl), &tp, &id);
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
-    jf_status st = jf__natural_rows_alloc(ntl);
+    jf_status st = jf__natural_rows_alloc(ntl, nrm);
     if (st != JF_OK) return st;
     int bad = 0;
 #pragma omp parallel num_threads(nt) reduction(| : bad)

@@ -51,13 +51,16 @@ size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL
 /* Own-plane rows of the k-NN form (docs/natural.md, "Own-plane rings"):
  * each vertex's planar cell in its own tangent plane, made once, so that
  * a ring grows from stored rows instead of one clipped cell per ring
- * vertex.  jf__natural_rows_alloc makes the table (rows undefined: a
- * pass must fill every one before a ring reads them); jf__natural_own_row fills vertex v's from its plane normal nrm (of its
+ * vertex.  jf__natural_rows_alloc makes the table for the normals nrm
+ * (by input index, borrowed: they must outlive the rows' use; rows
+ * undefined: a pass must fill every one before a ring reads them);
+ * jf__natural_own_row fills vertex v's from its plane normal nrm (of its
  * input point) and its candidates c[0..cnt) (jf__natural_query's; a
  * zero or non-finite normal or more than the row's room leaves it LIVE:
- * that cell is made when a ring asks for it); jf__natural_own_rows does
- * both for every vertex, normals nrm[3n] by input index. */
-jf_status jf__natural_rows_alloc(jf_natural *nt);
+ * that cell is made when a ring asks for it, in its own plane, or in
+ * the asking point's if it has none); jf__natural_own_rows does both
+ * for every vertex, normals nrm[3n] by input index. */
+jf_status jf__natural_rows_alloc(jf_natural *nt, const double *nrm);
 int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
                         size_t cnt);
 jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);

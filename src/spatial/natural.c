@@ -382,7 +382,7 @@ static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t 
     size_t np = jf__natural_box(ws, BOX_SCALE * reach);
     for (size_t k = 0; k < m && np > 0; k++)
         jf__natural_cut(ws, &np, ws->sx[k], ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
-    return jf__natural_labels(ws, h, np, reach, len);
+    return jf__natural_labels(ws, h->o, np, reach, len);
 }
 
 size_t jf__natural_box(jf_natural_ws *ws, double B) {
@@ -401,9 +401,9 @@ int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double 
 
 /* Appends the labels of the clipped cell's edges (np vertices) not yet
  * collected; edges shorter than EDGE_EPS x reach are no adjacency. */
-int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len) {
+int jf__natural_labels(jf_natural_ws *ws, const double *p, size_t np, double reach,
+                       size_t *len) {
     const jf_natural *nt = ws->nt;
-    const double *p = h->o;
     for (size_t k = 0; k < np; k++) {
         uint32_t s = ws->pl[k];
         if (s == NONE || ws->stamp[s] == ws->gen) continue;
@@ -466,16 +466,20 @@ static const plane *plane_of(lazy_plane *lp) {
     return lp->made > 0 ? &lp->h : NULL;
 }
 
-/* Appends ring vertex u's neighbours: its cell in p's plane. */
-static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, size_t *len) {
+/* Appends ring vertex u's neighbours: its cell in p's plane; own (a LIVE
+ * row): in u's own plane when it has one. */
+static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, size_t *len) {
     const jf_natural *nt = ws->nt;
+    plane hu;
+    if (own && jf__natural_plane(nt->vxyz + 3 * (size_t)u, nt->row_nrm + 3 * (size_t)nt->d.rep[u], &hu))
+        return jf__natural_knn_cell(ws, &hu, u, NULL, 0, lp->o, len);
     const plane *h = plane_of(lp);
     if (!h) return 1; /* checked by grow: not reached */
-    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, len) : cell_neighbors(ws, h, u, len);
+    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, h->o, len) : cell_neighbors(ws, h, u, len);
 }
 
 /* The next ring from the own-plane rows of ring list[a..b) (a LIVE row:
- * the vertex's cell in p's plane).  Locals: the stores to list and dist
+ * ring_step's).  Locals: the stores to list and dist
  * would otherwise reload every pointer. */
 static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_t *len) {
     const jf_natural *nt = ws->nt;
@@ -489,7 +493,7 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
         const uint32_t *row = nt->row + (size_t)list[k] * ROW_W;
         if (row[0] == ROW_LIVE) { /* rare: may grow the list */
             *len = n;
-            if (!ring_step(ws, lp, list[k], len) || !reserve(ws, *len, (b - k) * ROW_W)) return 0;
+            if (!ring_step(ws, lp, list[k], 1, len) || !reserve(ws, *len, (b - k) * ROW_W)) return 0;
             n = *len, list = ws->list, dist = ws->dist;
             continue;
         }
@@ -533,7 +537,7 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
             if (!own_ring(ws, &lp, a, b, len)) return JF_ERR_NOMEM;
         } else {
             for (size_t k = a; k < b; k++)
-                if (!ring_step(ws, &lp, ws->list[k], len)) return JF_ERR_NOMEM;
+                if (!ring_step(ws, &lp, ws->list[k], 0, len)) return JF_ERR_NOMEM;
         }
         if (*len == b) break; /* the cloud ran out */
         sort_ring(ws, b, *len);

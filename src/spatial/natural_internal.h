@@ -36,6 +36,7 @@ struct jf_natural {
     jf_index *ix_own;
     uint32_t *row; /* k-NN form: [nv * ROW_W] own-plane labels, NONE-
                       padded; row[0] == ROW_LIVE: made when asked    */
+    const double *row_nrm; /* the rows' normals, by input index (borrowed) */
 };
 
 struct jf_natural_ws {
@@ -87,15 +88,17 @@ size_t jf__natural_box(jf_natural_ws *ws, double B);
 int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s);
 
 /* Appends the labels of the clipped cell's edges (np vertices) not yet
- * collected; edges shorter than EDGE_EPS x reach are no adjacency.
- * Returns 0 when out of memory. */
-int jf__natural_labels(jf_natural_ws *ws, const plane *h, size_t np, double reach, size_t *len);
+ * collected, with their squared distance to p; edges shorter than
+ * EDGE_EPS x reach are no adjacency.  Returns 0 when out of memory. */
+int jf__natural_labels(jf_natural_ws *ws, const double *p, size_t np, double reach,
+                       size_t *len);
 
 /* natural_knn.c: vertex u's cell in the plane h from its k-NN candidates
  * c[0..cnt) (nearest first, all of the CAND_K nearest; c NULL: queried
  * here), made exact by the certificate; its labels appended as
- * jf__natural_labels does.  Returns 0 on a failed query or no memory. */
+ * jf__natural_labels does (distances from `from`).  Returns 0 on a
+ * failed query or no memory. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
-                         size_t cnt, size_t *len);
+                         size_t cnt, const double *from, size_t *len);
 
 #endif /* JF_NATURAL_INTERNAL_H */

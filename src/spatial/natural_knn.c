@@ -67,8 +67,9 @@ size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[CAND_K]) {
     return c;
 }
 
-jf_status jf__natural_rows_alloc(jf_natural *nt) {
-    if (!nt || !nt->ix) return JF_ERR_INVALID;
+jf_status jf__natural_rows_alloc(jf_natural *nt, const double *nrm) {
+    if (!nt || !nt->ix || !nrm) return JF_ERR_INVALID;
+    nt->row_nrm = nrm;
     if (!nt->row && !(nt->row = malloc((nt->d.nv * ROW_W + 1) * sizeof *nt->row)))
         return JF_ERR_NOMEM;
     return JF_OK; /* filled (and first touched) by the threads' passes */
@@ -87,7 +88,7 @@ int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const 
         ws->gen = 1;
     }
     ws->stamp[v] = ws->gen;
-    if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, &len)) return 0;
+    if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, h.o, &len)) return 0;
     if (len > ROW_W) return 1; /* rare: made again when asked */
     for (size_t k = 0; k < ROW_W; k++) row[k] = k < len ? ws->list[k] : NONE;
     return 1;
@@ -95,7 +96,7 @@ int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const 
 
 jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
     if (!nt || !nt->ix || !nrm) return JF_ERR_INVALID;
-    jf_status st = jf__natural_rows_alloc(nt);
+    jf_status st = jf__natural_rows_alloc(nt, nrm);
     if (st != JF_OK) return st;
     long nv = (long)nt->d.nv;
     int bad = 0;
@@ -199,7 +200,7 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
  * widens to the samples within twice the polygon's radius (at most
  * CAND_MID, then CAND_MAX), then the cell is taken as clipped by the box. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
-                         size_t cnt, size_t *len) {
+                         size_t cnt, const double *from, size_t *len) {
     const jf_natural *nt = ws->nt;
     const double *U = nt->vxyz + 3 * (size_t)u;
     size_t K = CAND_K, np, j = 0;
@@ -250,5 +251,5 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
         cnt = m;
     }
 exact:
-    return jf__natural_labels(ws, h, np, reach, len);
+    return jf__natural_labels(ws, from, np, reach, len);
 }
