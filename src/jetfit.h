@@ -941,12 +941,13 @@ jf_status jf_natural_create_threads(const double *xyz, size_t n, int threads,
 void jf_natural_free(jf_natural *nt);
 
 /* The same neighbourhoods without a triangulation: each cell is clipped
- * by the point's nearest samples from a k-d tree (16 kept per point,
- * about 100 bytes per point with the tree), and is exact (the same as the
- * triangulation's up to rounding) once a certificate holds: every vertex
- * of the cell is within half the distance of the next candidate; the
- * query widens to 144 candidates before a cell is accepted as clipped
- * by the box (the rim of an open scan).  No vertex merging (identical
+ * by the point's 16 nearest samples from a k-d tree (queried when the
+ * cell is made; about 40 bytes per point with the tree), and is exact
+ * (the same as the triangulation's up to rounding) once a certificate
+ * holds: every vertex of the cell is within half the distance of the
+ * last candidate, or no sample lies in a ball enclosing the others'
+ * empty-circle balls; the query widens to 144 candidates before a cell
+ * is accepted as clipped by the box (the rim of an open scan).  No vertex merging (identical
  * points stay separate; only one of them is anyone's neighbour), no
  * poles: jf_natural_normals returns JF_ERR_INVALID on it, the caller
  * brings the normals (jf_estimate: PCA or jet).  jf_natural_get_stats

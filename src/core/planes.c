@@ -206,7 +206,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
             size_t k[2] = {0, 0};
             int ok[2] = {0, 0};
             if (bad) continue;
-            if (v0 + 2 * PREFETCH < m) /* flags and nrm are in input order: misses */
+            if (v0 + 2 * PREFETCH + 1 < m) /* flags and nrm are in input order: misses */
                 for (size_t L = 0; L < 2; L++) {
                     __builtin_prefetch(flags + id[v0 + 2 * PREFETCH + L], 1);
                     __builtin_prefetch(nrm + 3 * (size_t)id[v0 + 2 * PREFETCH + L], 1);

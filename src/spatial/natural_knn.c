@@ -3,9 +3,11 @@
  * 15.2): each planar power cell clipped by the sample's nearest samples
  * from the k-d tree, nearest first, until a certificate proves it exact
  * (knn_cell below; natural.c says why clipping by any superset of the
- * cutting samples gives the cell).  Vertices are the tree's positions;
- * d.adj holds CAND_K candidates per vertex (NONE-padded); no poles, no
- * merged duplicates.  docs/natural.md, "The k-NN cells".
+ * cutting samples gives the cell); and the own-plane rows: every
+ * sample's cell made once in its own tangent plane, the rings grown from
+ * them (natural.c own_ring).  Vertices are the tree's positions; no
+ * poles, no merged duplicates.  docs/natural.md, "Own-plane rings" and
+ * "The k-NN cells".
  */
 #include <math.h>
 #include <stdlib.h>
