@@ -432,22 +432,34 @@ static int lex_greater(const jf_natural *nt, uint32_t a, uint32_t b) {
     return p[2] > q[2];
 }
 
-/* Sorts list[a..b) by distance, then lexicographically: insertion sort
- * on the distance alone (rings are short), then the rare runs of equal
- * distances (grids) by coordinates. */
-static void sort_ring(jf_natural_ws *ws, size_t a, size_t b) {
+/* Puts the `keep` first of list[a..b) by (distance, coordinates) in
+ * order at its front (keep >= b - a: all of it): insertion on the
+ * distance alone (rings are short), an entry past a full front costing
+ * one comparison; then the rare runs of equal distances (grids) by
+ * coordinates.  The rest, beyond the front, in no order (the last ring
+ * is cut there). */
+static void sort_ring(jf_natural_ws *ws, size_t a, size_t b, size_t keep) {
     uint32_t *restrict list = ws->list;
     double *restrict dist = ws->dist;
+    const size_t m = keep < b - a ? keep : b - a;
     int ties = 0;
     for (size_t k = a + 1; k < b; k++) {
         const uint32_t v = list[k];
         const double d = dist[k];
         size_t j = k;
+        if (k - a >= m) { /* the front is full: v enters only before its last */
+            const size_t last = a + m - 1;
+            if (m == 0 || d > dist[last] ||
+                (d == dist[last] && !lex_greater(ws->nt, list[last], v)))
+                continue;
+            list[k] = list[last], dist[k] = dist[last];
+            j = last;
+        }
         for (; j > a && dist[j - 1] > d; j--) list[j] = list[j - 1], dist[j] = dist[j - 1];
         list[j] = v, dist[j] = d;
         ties |= j > a && dist[j - 1] == d;
     }
-    for (size_t k = a + 1; ties && k < b; k++) {
+    for (size_t k = a + 1; ties && k < a + m; k++) {
         const uint32_t v = list[k];
         size_t j = k;
         for (; j > a && dist[j - 1] == dist[k] && lex_greater(ws->nt, list[j - 1], v); j--)
@@ -543,7 +555,7 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
                 if (!ring_step(ws, &lp, ws->list[k], 0, len)) return JF_ERR_NOMEM;
         }
         if (*len == b) break; /* the cloud ran out */
-        sort_ring(ws, b, *len);
+        sort_ring(ws, b, *len, want - b); /* want > b: the loop goes on */
         a = b, b = *len;
         if (ring_end) ring_end[r] = b;
     }
