@@ -17,26 +17,8 @@
 
 #include "jetfit.h"
 
-static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
-static double urand(void) { /* xorshift64*, [0, 1) */
-    rng_state ^= rng_state >> 12, rng_state ^= rng_state << 25, rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 2685821657736338717ull) >> 11) / 9007199254740992.0;
-}
-static double gauss(void) {
-    double u = urand() + 1e-300, v = urand();
-    return sqrt(-2 * log(u)) * cos(2 * 3.14159265358979 * v);
-}
-
-/* n points of x^2 + (y/.75)^2 + (z/.5)^2 = 1 with Gaussian noise sigma
- * along each axis, and the exact normal of the noise-free point */
-static void ellipsoid(size_t n, double sigma, double *p, double *nrm) {
-    for (size_t i = 0; i < n; i++) {
-        double z = 2 * urand() - 1, t = 2 * 3.14159265358979 * urand(), r = sqrt(1 - z * z);
-        double x = r * cos(t), y = 0.75 * r * sin(t), w = 0.5 * z;
-        nrm[3 * i] = x, nrm[3 * i + 1] = y / 0.5625, nrm[3 * i + 2] = w / 0.25;
-        p[3 * i] = x + sigma * gauss(), p[3 * i + 1] = y + sigma * gauss(), p[3 * i + 2] = w + sigma * gauss();
-    }
-}
+#define JF_TEST_SEED 0x2545F4914F6CDD1Dull
+#include "test_rand.h"
 
 /* Neighbourhoods of every point in both forms; returns how many differ
  * among the points with keep[i] (NULL: all). */
