@@ -193,7 +193,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
     for (size_t i = 0; i < n; i++) nrm[3 * i] = nrm[3 * i + 1] = nrm[3 * i + 2] = NAN;
     jf_status st = jf__natural_rows_alloc(ntl, nrm);
     if (st != JF_OK) return st;
-    int bad = 0;
+    int bad = 0; /* 1: no memory, 2: a failed query */
 #pragma omp parallel num_threads(nt) reduction(| : bad)
     {
         jf_natural_ws *ws = NULL;
@@ -214,7 +214,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
             for (size_t L = 0; L < cnt; L++) {
                 double pts[3 * PCA_K];
                 if ((k[L] = jf__natural_query(ntl, v0 + L, c[L])) == SIZE_MAX) {
-                    bad = 1;
+                    bad |= 2;
                     k[L] = 0;
                 }
                 size_t kp = k[L] < PCA_K - 1 ? k[L] : PCA_K - 1;
@@ -242,5 +242,5 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
         }
         jf_natural_ws_free(ws);
     }
-    return bad ? JF_ERR_NOMEM : JF_OK;
+    return bad & 1 ? JF_ERR_NOMEM : bad ? JF_ERR_INTERNAL : JF_OK;
 }

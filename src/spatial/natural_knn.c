@@ -101,7 +101,7 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
     jf_status st = jf__natural_rows_alloc(nt, nrm);
     if (st != JF_OK) return st;
     long nv = (long)nt->d.nv;
-    int bad = 0;
+    int bad = 0; /* 1: no memory, 2: a failed query */
 #ifdef _OPENMP
 #pragma omp parallel num_threads(jf__natural_threads(threads)) reduction(| : bad)
 #endif
@@ -115,14 +115,14 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
             uint32_t c[CAND_K];
             size_t cnt = bad ? SIZE_MAX : jf__natural_query(nt, (size_t)v, c);
             if (cnt == SIZE_MAX) {
-                bad = 1;
+                bad |= 2;
                 continue;
             }
             bad |= !jf__natural_own_row(ws, (size_t)v, nrm + 3 * (size_t)nt->d.rep[v], c, cnt);
         }
         jf_natural_ws_free(ws);
     }
-    return bad ? JF_ERR_NOMEM : JF_OK;
+    return bad & 1 ? JF_ERR_NOMEM : bad ? JF_ERR_INTERNAL : JF_OK;
 }
 
 const jf_index *jf__natural_index(const jf_natural *nt) { return nt ? nt->ix : NULL; }
