@@ -92,7 +92,6 @@ typedef struct {
     const jf_index *ix;
     jf_mesh *mesh;        /* rings                                     */
     jf_natural *nt;       /* natural                                   */
-    int nt_own;           /* natural, k-NN form: rings from own-plane rows */
     double *nrm_own;      /* natural: normals we computed (3n)         */
     const double *nrm;    /* natural: the tangent-plane normals        */
     unsigned *nflags;     /* natural: JF_PT_NORMAL_* per point         */
@@ -165,7 +164,6 @@ static jf_status own_rows(nbctx *x, const double *nrm, int nt, jf_error *err)
 {
     jf_status st = jf__natural_own_rows(x->nt, nt, nrm);
     if (st != JF_OK) set_err(err, "natural neighbours: the own-plane cells failed");
-    x->nt_own = st == JF_OK;
     return st;
 }
 
@@ -241,7 +239,6 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         set_err(err, "natural neighbours: the PCA planes and own-plane cells failed");
         return st;
     }
-    x->nt_own = 1;
     int noisy = 0;
     if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy)) != JF_OK) {
         set_err(err, "natural neighbours: the noise test failed");
@@ -279,8 +276,8 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
             *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
             return JF_OK;
         }
-        st = x->nt_own ? jf__natural_neighbors_own(x->nt, ws, i, m, x->want, idx, x->cap, found)
-                       : jf_natural_neighbors(x->nt, ws, i, m, x->want, idx, x->cap, found);
+        /* the k-NN form's own-plane rows, or the triangulation's cells */
+        st = jf__natural_neighbors_own(x->nt, ws, i, m, x->want, idx, x->cap, found);
         break;
     default:
         st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);

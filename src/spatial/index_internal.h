@@ -65,9 +65,11 @@ int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const 
                         size_t cnt);
 jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);
 
-/* jf_natural_neighbors of input point i over the own-plane rows (every
- * ring from its vertices' rows: the plane is each vertex's own, i's
- * normal nrm for its own cell when its row is LIVE). */
+/* jf_natural_neighbors of input point i over the own-plane rows where
+ * they are made (every ring from its vertices' rows: the plane is each
+ * vertex's own, i's normal nrm for its own cell when its row is LIVE);
+ * without rows (the triangulation's form, no rows pass yet), the same as
+ * jf_natural_neighbors. */
 jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,
                                     const double nrm[3], size_t N, uint32_t *idx, size_t cap,
                                     size_t *found);

@@ -277,9 +277,16 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws);
 }
 
+/* |nrm|^2, 0 when nrm gives no plane (zero, or not finite) */
+static double plane_len2(const double nrm[3]) {
+    double l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
+    return l2 > 0 && isfinite(l2) ? l2 : 0;
+}
+
 int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
-    double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    if (!(l > 0) || !isfinite(l)) return 0;
+    double l2 = plane_len2(nrm);
+    if (!l2) return 0;
+    double l = sqrt(l2);
     /* the axis from nrm itself: it does not wait for the division */
     int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
                                           : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
@@ -340,6 +347,14 @@ int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double 
     ws->r2 = r2;
     *m = o;
     return 1;
+}
+
+void jf__natural_collect(jf_natural_ws *ws, uint32_t v) {
+    if (++ws->gen == 0) { /* wrapped: clear the stamps once */
+        memset(ws->stamp, 0, ws->nt->d.nv * sizeof *ws->stamp);
+        ws->gen = 1;
+    }
+    ws->stamp[v] = ws->gen;
 }
 
 /* Room for `more` entries after len (rare: amortised growth, not per
@@ -413,11 +428,8 @@ int jf__natural_labels(jf_natural_ws *ws, const double *p, size_t np, double rea
         size_t k1 = k + 1 == np ? 0 : k + 1;
         double ex = ws->px[k1] - ws->px[k], ey = ws->py[k1] - ws->py[k];
         if (ex * ex + ey * ey <= EDGE_EPS * EDGE_EPS * reach * reach) continue;
-        const double *q = nt->vxyz + 3 * (size_t)s;
-        double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
-                    (q[2] - p[2]) * (q[2] - p[2]);
         ws->stamp[s] = ws->gen;
-        if (!push(ws, len, s, d2)) return 0;
+        if (!push(ws, len, s, dist2(nt->vxyz + 3 * (size_t)s, p))) return 0;
     }
     return 1;
 }
@@ -516,10 +528,8 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
             const uint32_t s = row[j];
             if (stamp[s] == gen) continue;
             stamp[s] = gen;
-            const double *q = V + 3 * (size_t)s;
             list[n] = s;
-            dist[n++] = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
-                        (q[2] - p[2]) * (q[2] - p[2]);
+            dist[n++] = dist2(V + 3 * (size_t)s, p);
         }
     }
     *len = n;
@@ -535,15 +545,9 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (!nt || !ws || ws->nt != nt || !nrm || i >= nt->d.n) return JF_ERR_INVALID;
     uint32_t v0 = nt->d.vertex_of[i];
     if (v0 == NONE) return JF_OK;
-    double l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
-    if (!(l2 > 0) || !isfinite(l2)) return JF_ERR_INVALID; /* as jf__natural_plane */
+    if (!plane_len2(nrm)) return JF_ERR_INVALID; /* the plane itself: when needed */
     lazy_plane lp = {.o = nt->vxyz + 3 * (size_t)v0, .nrm = nrm};
-    if (!own && !plane_of(&lp)) return JF_ERR_INVALID;
-    if (++ws->gen == 0) { /* wrapped: clear the stamps once */
-        memset(ws->stamp, 0, nt->d.nv * sizeof *ws->stamp);
-        ws->gen = 1;
-    }
-    ws->stamp[v0] = ws->gen;
+    jf__natural_collect(ws, v0);
     push(ws, len, v0, 0.0);
     size_t a = 0, b = 1;
     if (ring_end) ring_end[0] = 1;
@@ -583,8 +587,7 @@ void jf__natural_prefetch(const jf_natural *nt, size_t i) {
 jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,
                                     const double nrm[3], size_t N, uint32_t *idx, size_t cap,
                                     size_t *found) {
-    if (nt && !nt->row) return JF_ERR_INVALID;
-    return neighbors(nt, ws, i, nrm, N, 1, idx, cap, found);
+    return neighbors(nt, ws, i, nrm, N, nt && nt->row, idx, cap, found);
 }
 
 jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i,

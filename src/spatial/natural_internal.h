@@ -66,9 +66,20 @@ static inline void project(const plane *h, const double *q, double *x, double *y
     *z = d[0] * h->n[0] + d[1] * h->n[1] + d[2] * h->n[2];
 }
 
+/* |a - b|^2 (the one expression: rings and cells compare these bit for
+ * bit). */
+static inline double dist2(const double *a, const double *b) {
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+           (a[2] - b[2]) * (a[2] - b[2]);
+}
+
 /* h through o with unit normal along nrm; 0 if nrm is zero or not
  * finite. */
 int jf__natural_plane(const double *o, const double nrm[3], plane *h);
+
+/* A new collection on ws: its stamp generation (stamps cleared when it
+ * wraps), v stamped as collected. */
+void jf__natural_collect(jf_natural_ws *ws, uint32_t v);
 
 /* OpenMP thread count of a call: threads, or every core when <= 0. */
 int jf__natural_threads(int threads);

@@ -85,11 +85,7 @@ int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const 
     size_t len = 0;
     row[0] = ROW_LIVE;
     if (!jf__natural_plane(nt->vxyz + 3 * v, nrm, &h)) return 1;
-    if (++ws->gen == 0) { /* wrapped: clear the stamps once */
-        memset(ws->stamp, 0, nt->d.nv * sizeof *ws->stamp);
-        ws->gen = 1;
-    }
-    ws->stamp[v] = ws->gen;
+    jf__natural_collect(ws, (uint32_t)v);
     if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, h.o, &len)) return 0;
     if (len > ROW_W) return 1; /* rare: made again when asked */
     for (size_t k = 0; k < ROW_W; k++) row[k] = k < len ? ws->list[k] : NONE;
@@ -113,7 +109,8 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
 #endif
         for (long v = 0; v < nv; v++) {
             uint32_t c[CAND_K];
-            size_t cnt = bad ? SIZE_MAX : jf__natural_query(nt, (size_t)v, c);
+            if (bad) continue;
+            size_t cnt = jf__natural_query(nt, (size_t)v, c);
             if (cnt == SIZE_MAX) {
                 bad |= 2;
                 continue;
@@ -143,6 +140,16 @@ jf_status jf_natural_create_knn(const double *xyz, size_t n, int threads, jf_nat
     else
         jf_index_free(ix);
     return st;
+}
+
+/* Cuts the cell (u' at (ux, uy) in h, u at height uz) by sample s:
+ * jf__natural_cut's return. */
+static int cut_by(jf_natural_ws *ws, const plane *h, double ux, double uy, double uz, uint32_t s,
+                  size_t *np) {
+    double x, y, z;
+    project(h, ws->nt->vxyz + 3 * (size_t)s, &x, &y, &z);
+    double sx = x - ux, sy = y - uy;
+    return jf__natural_cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s);
 }
 
 /* The cell u' clipped by all samples of the candidate list (the last at
@@ -181,12 +188,7 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
     if (jf__index_knn_pos(nt->ix, X, CAND_MID, rho * rho, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
     if (f == CAND_MID) return -1;
     for (size_t j = 0; j < f && *np > 0; j++) {
-        uint32_t s = ws->cpos[j];
-        if (s == u) continue;
-        double x, y, z;
-        project(h, nt->vxyz + 3 * (size_t)s, &x, &y, &z);
-        double sx = x - ux, sy = y - uy;
-        jf__natural_cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s);
+        if (ws->cpos[j] != u) cut_by(ws, h, ux, uy, uz, ws->cpos[j], np);
     }
     return 1;
 }
@@ -214,27 +216,17 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
     if (!cnt) return 1;
     double ux, uy, uz;
     project(h, U, &ux, &uy, &uz);
-    const double *L = nt->vxyz + 3 * (size_t)c[cnt - 1];
-    double reach = sqrt((L[0] - U[0]) * (L[0] - U[0]) + (L[1] - U[1]) * (L[1] - U[1]) +
-                        (L[2] - U[2]) * (L[2] - U[2]));
+    double reach = sqrt(dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U));
     const double B = BOX_SCALE * reach;
     np = jf__natural_box(ws, B);
     double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
     for (;;) {
         for (; j < cnt && np > 0; j++) {
-            const double *S = nt->vxyz + 3 * (size_t)c[j];
-            double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
-            if (dx * dx + dy * dy + dz * dz >= 4 * r2) goto exact;
-            double x, y, z;
-            project(h, S, &x, &y, &z);
-            double sx = x - ux, sy = y - uy, sr = sx * sx + sy * sy + (z - uz) * (z + uz);
-            if (!jf__natural_cut(ws, &np, sx, sy, sr, c[j])) continue;
-            r2 = ws->r2 + uz * uz;
+            if (dist2(nt->vxyz + 3 * (size_t)c[j], U) >= 4 * r2) goto exact;
+            if (cut_by(ws, h, ux, uy, uz, c[j], &np)) r2 = ws->r2 + uz * uz;
         }
         if (np == 0 || cnt < K || K >= CAND_MAX) break;
-        const double *S = nt->vxyz + 3 * (size_t)c[cnt - 1];
-        double dx = S[0] - U[0], dy = S[1] - U[1], dz = S[2] - U[2];
-        double dl2 = dx * dx + dy * dy + dz * dz;
+        double dl2 = dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U);
         if (dl2 >= 4 * r2) break; /* the last cut shrank it enough */
         if (K == CAND_K) {
             int v = verify(ws, h, u, ux, uy, uz, dl2, &np);
