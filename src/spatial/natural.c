@@ -277,78 +277,6 @@ void jf_natural_ws_free(jf_natural_ws *ws) {
     free(ws);
 }
 
-/* |nrm|^2, 0 when nrm gives no plane (zero, or not finite) */
-static double plane_len2(const double nrm[3]) {
-    double l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
-    return l2 > 0 && isfinite(l2) ? l2 : 0;
-}
-
-int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
-    double l2 = plane_len2(nrm);
-    if (!l2) return 0;
-    double l = sqrt(l2);
-    /* the axis from nrm itself: it does not wait for the division */
-    int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
-                                          : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
-    double il = 1 / l;
-    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k];
-    /* e1: the world axis least aligned with n, made orthogonal:
-     * t = e_ax - n_ax n, |t|^2 = 1 - n_ax^2 (>= 2/3) */
-    double t[3];
-    for (int k = 0; k < 3; k++) t[k] = -h->n[ax] * h->n[k];
-    t[ax] += 1;
-    double it = 1 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    for (int k = 0; k < 3; k++) h->e1[k] = t[k] * it;
-    h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
-    h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
-    h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
-    return 1;
-}
-
-/* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
- * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
- * the clip line gets label s; ws->r2 = the largest px^2 + py^2 of the
- * result (what the k-NN cells' certificate needs, without a second
- * pass over vertices just stored). */
-int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
-    const double *restrict px = ws->px, *restrict py = ws->py;
-    const uint32_t *restrict pl = ws->pl;
-    double *restrict qx = ws->qx, *restrict qy = ws->qy;
-    uint32_t *restrict ql = ws->ql;
-    size_t n = *m, o = 0, k0;
-    for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
-        if (ax * px[k0] + ay * py[k0] > b) break;
-    if (k0 == n) return 0;
-    const double f0 = ax * px[0] + ay * py[0] - b;
-    double fu = f0, r2 = 0;
-    for (size_t k = 0; k < n; k++) {
-        const size_t k1 = k + 1 == n ? 0 : k + 1;
-        const double fw = k1 ? ax * px[k1] + ay * py[k1] - b : f0;
-        if (fu <= 0) {
-            qx[o] = px[k], qy[o] = py[k], ql[o++] = pl[k];
-            const double q = px[k] * px[k] + py[k] * py[k];
-            r2 = q > r2 ? q : r2;
-            if (fw > 0) {
-                const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
-                             y = py[k] + t * (py[k1] - py[k]);
-                qx[o] = x, qy[o] = y, ql[o++] = s;
-                r2 = x * x + y * y > r2 ? x * x + y * y : r2;
-            }
-        } else if (fw <= 0) {
-            const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
-                         y = py[k] + t * (py[k1] - py[k]);
-            qx[o] = x, qy[o] = y, ql[o++] = pl[k];
-            r2 = x * x + y * y > r2 ? x * x + y * y : r2;
-        }
-        fu = fw;
-    }
-    ws->qx = ws->px, ws->qy = ws->py, ws->ql = ws->pl;
-    ws->px = qx, ws->py = qy, ws->pl = ql;
-    ws->r2 = r2;
-    *m = o;
-    return 1;
-}
-
 void jf__natural_collect(jf_natural_ws *ws, uint32_t v) {
     if (++ws->gen == 0) { /* wrapped: clear the stamps once */
         memset(ws->stamp, 0, ws->nt->d.nv * sizeof *ws->stamp);
@@ -357,9 +285,7 @@ void jf__natural_collect(jf_natural_ws *ws, uint32_t v) {
     ws->stamp[v] = ws->gen;
 }
 
-/* Room for `more` entries after len (rare: amortised growth, not per
- * point); 0 when out of memory. */
-static int reserve(jf_natural_ws *ws, size_t len, size_t more) {
+int jf__natural_reserve(jf_natural_ws *ws, size_t len, size_t more) {
     while (len + more > ws->listcap) {
         size_t c = 2 * ws->listcap;
         uint32_t *l = realloc(ws->list, c * sizeof *l);
@@ -369,67 +295,6 @@ static int reserve(jf_natural_ws *ws, size_t len, size_t more) {
         if (!d) return 0;
         ws->dist = d;
         ws->listcap = c;
-    }
-    return 1;
-}
-
-static int push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
-    if (*len == ws->listcap && !reserve(ws, *len, 1)) return 0;
-    ws->list[*len] = v;
-    ws->dist[(*len)++] = d2;
-    return 1;
-}
-
-/* Appends to the list the planar natural neighbours of vertex u not yet
- * collected (the edge labels of u's clipped power cell). */
-static int cell_neighbors(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
-    const jf_natural *nt = ws->nt;
-    size_t b = nt->d.adj_off[u], e = nt->d.adj_off[u + 1], m = 0;
-    double ux, uy, uz, reach = 0;
-    project(h, nt->vxyz + 3 * (size_t)u, &ux, &uy, &uz);
-    for (size_t k = b; k < e; k++, m++) {
-        double x, y, z;
-        project(h, nt->vxyz + 3 * (size_t)nt->d.adj[k], &x, &y, &z);
-        /* relative to u': the half-plane 2 d.X <= |d|^2 + h_s^2 - h_u^2 */
-        ws->sx[m] = x - ux, ws->sy[m] = y - uy;
-        ws->sr[m] = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z + uz);
-        double r = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z - uz);
-        if (r > reach) reach = r;
-    }
-    reach = sqrt(reach);
-    size_t np = jf__natural_box(ws, BOX_SCALE * reach);
-    for (size_t k = 0; k < m && np > 0; k++)
-        jf__natural_cut(ws, &np, ws->sx[k], ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
-    return jf__natural_labels(ws, h->o, np, reach, len);
-}
-
-size_t jf__natural_box(jf_natural_ws *ws, double B) {
-    const double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
-    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
-    return 4;
-}
-
-int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s) {
-    if (sx == 0 && sy == 0) {
-        if (sr < 0) *np = 0; /* s straight above u, nearer H: u has no cell */
-        return 0;
-    }
-    return jf__natural_clip(ws, np, 2 * sx, 2 * sy, sr, s);
-}
-
-/* Appends the labels of the clipped cell's edges (np vertices) not yet
- * collected; edges shorter than EDGE_EPS x reach are no adjacency. */
-int jf__natural_labels(jf_natural_ws *ws, const double *p, size_t np, double reach,
-                       size_t *len) {
-    const jf_natural *nt = ws->nt;
-    for (size_t k = 0; k < np; k++) {
-        uint32_t s = ws->pl[k];
-        if (s == NONE || ws->stamp[s] == ws->gen) continue;
-        size_t k1 = k + 1 == np ? 0 : k + 1;
-        double ex = ws->px[k1] - ws->px[k], ey = ws->py[k1] - ws->py[k];
-        if (ex * ex + ey * ey <= EDGE_EPS * EDGE_EPS * reach * reach) continue;
-        ws->stamp[s] = ws->gen;
-        if (!push(ws, len, s, dist2(nt->vxyz + 3 * (size_t)s, p))) return 0;
     }
     return 1;
 }
@@ -502,7 +367,7 @@ static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, siz
         return jf__natural_knn_cell(ws, &hu, u, NULL, 0, lp->o, len);
     const plane *h = plane_of(lp);
     if (!h) return 1; /* checked by grow: not reached */
-    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, h->o, len) : cell_neighbors(ws, h, u, len);
+    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, h->o, len) : jf__natural_tri_cell(ws, h, u, len);
 }
 
 /* The next ring from the own-plane rows of ring list[a..b) (a LIVE row:
@@ -510,7 +375,7 @@ static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, siz
  * would otherwise reload every pointer. */
 static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_t *len) {
     const jf_natural *nt = ws->nt;
-    if (!reserve(ws, *len, (b - a) * ROW_W)) return 0;
+    if (!jf__natural_reserve(ws, *len, (b - a) * ROW_W)) return 0;
     const double *V = nt->vxyz, *p = lp->o;
     const uint32_t gen = ws->gen;
     uint32_t *restrict stamp = ws->stamp, *restrict list = ws->list;
@@ -520,7 +385,7 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
         const uint32_t *row = nt->row + (size_t)list[k] * ROW_W;
         if (row[0] == ROW_LIVE) { /* rare: may grow the list */
             *len = n;
-            if (!ring_step(ws, lp, list[k], 1, len) || !reserve(ws, *len, (b - k) * ROW_W)) return 0;
+            if (!ring_step(ws, lp, list[k], 1, len) || !jf__natural_reserve(ws, *len, (b - k) * ROW_W)) return 0;
             n = *len, list = ws->list, dist = ws->dist;
             continue;
         }
@@ -548,7 +413,7 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (!plane_len2(nrm)) return JF_ERR_INVALID; /* the plane itself: when needed */
     lazy_plane lp = {.o = nt->vxyz + 3 * (size_t)v0, .nrm = nrm};
     jf__natural_collect(ws, v0);
-    push(ws, len, v0, 0.0);
+    jf__natural_push(ws, len, v0, 0.0);
     size_t a = 0, b = 1;
     if (ring_end) ring_end[0] = 1;
     for (int r = 1; r <= maxrings && *len < want; r++) {

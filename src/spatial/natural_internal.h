@@ -73,6 +73,12 @@ static inline double dist2(const double *a, const double *b) {
            (a[2] - b[2]) * (a[2] - b[2]);
 }
 
+/* |nrm|^2, 0 when nrm gives no plane (zero, or not finite) */
+static inline double plane_len2(const double nrm[3]) {
+    double l2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
+    return l2 > 0 && isfinite(l2) ? l2 : 0;
+}
+
 /* h through o with unit normal along nrm; 0 if nrm is zero or not
  * finite. */
 int jf__natural_plane(const double *o, const double nrm[3], plane *h);
@@ -84,31 +90,31 @@ void jf__natural_collect(jf_natural_ws *ws, uint32_t v);
 /* OpenMP thread count of a call: threads, or every core when <= 0. */
 int jf__natural_threads(int threads);
 
-/* Clips the convex polygon (ws->px, py, pl)[0..*m) by a.x <= b, the new
- * edge labelled s; returns 0 when nothing was cut (no copy made). */
-int jf__natural_clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s);
+/* Room for `more` list entries after len (amortised growth, not per
+ * point); 0 when out of memory. */
+int jf__natural_reserve(jf_natural_ws *ws, size_t len, size_t more);
 
-/* Starts a cell as the box [-B, B]^2 about u' (edges labelled NONE);
- * returns its vertex count, 4. */
-size_t jf__natural_box(jf_natural_ws *ws, double B);
+/* Appends v (squared distance d2 to p) to the list; 0 when out of memory. */
+static inline int jf__natural_push(jf_natural_ws *ws, size_t *len, uint32_t v, double d2) {
+    if (*len == ws->listcap && !jf__natural_reserve(ws, *len, 1)) return 0;
+    ws->list[*len] = v;
+    ws->dist[(*len)++] = d2;
+    return 1;
+}
 
-/* Cuts the cell by the half-plane of neighbour s, at (sx, sy) from u' in
- * the plane with sr = |s' - u'|^2 + h_s^2 - h_u^2: jf__natural_clip's
- * return; s straight above or below u' cuts nothing, or (nearer the
- * plane) leaves u no cell (*np = 0). */
-int jf__natural_cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s);
+/* natural_cell.c: vertex u's cell in the plane h clipped by its 3D
+ * Delaunay neighbours (the triangulation's form): the labels of its
+ * edges not yet collected appended to the list with their squared
+ * distance to h->o (edges shorter than EDGE_EPS x reach: no adjacency).
+ * 0: no memory. */
+int jf__natural_tri_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len);
 
-/* Appends the labels of the clipped cell's edges (np vertices) not yet
- * collected, with their squared distance to p; edges shorter than
- * EDGE_EPS x reach are no adjacency.  Returns 0 when out of memory. */
-int jf__natural_labels(jf_natural_ws *ws, const double *p, size_t np, double reach,
-                       size_t *len);
-
-/* natural_knn.c: vertex u's cell in the plane h from its k-NN candidates
+/* natural_cell.c: vertex u's cell in the plane h from its k-NN candidates
  * c[0..cnt) (nearest first, all of the CAND_K nearest; c NULL: queried
  * here), made exact by the certificate; its labels appended as
- * jf__natural_labels does (distances from `from`).  Returns 0 on a
- * failed query or no memory. */
+ * jf__natural_tri_cell does (distances from `from`; from NULL: every
+ * label, no stamps or distances -- a row).  Returns 0 on a failed query
+ * or no memory. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
                          size_t cnt, const double *from, size_t *len);
 

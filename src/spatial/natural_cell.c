@@ -1,0 +1,245 @@
+/*
+ * natural_cell.c -- one planar power cell (§5.1; natural.c says why the
+ * clipped cell is exact): the tangent plane, the convex clip, and the
+ * cell from either source of cutting samples -- the 3D Delaunay
+ * neighbours (the triangulation's form) or the k-d tree's nearest
+ * samples with a certificate (the k-NN form).  One file so the clip is
+ * inlined where the cells are made (docs/natural.md, "Speed").
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "index_internal.h"
+#include "natural_internal.h"
+
+int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
+    double l2 = plane_len2(nrm);
+    if (!l2) return 0;
+    double l = sqrt(l2);
+    /* the axis from nrm itself: it does not wait for the division */
+    int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
+                                          : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
+    double il = 1 / l;
+    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k];
+    /* e1: the world axis least aligned with n, made orthogonal:
+     * t = e_ax - n_ax n, |t|^2 = 1 - n_ax^2 (>= 2/3) */
+    double t[3];
+    for (int k = 0; k < 3; k++) t[k] = -h->n[ax] * h->n[k];
+    t[ax] += 1;
+    double it = 1 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int k = 0; k < 3; k++) h->e1[k] = t[k] * it;
+    h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
+    h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
+    h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
+    return 1;
+}
+
+/* Clips the convex polygon (px, py, pl)[0..*m) by a.x <= b; pl[k] labels
+ * the edge from vertex k to k+1.  Sutherland-Hodgman; the new edge along
+ * the clip line gets label s; ws->r2 = the largest px^2 + py^2 of the
+ * result (what the k-NN cells' certificate needs, without a second
+ * pass over vertices just stored). */
+static int clip(jf_natural_ws *ws, size_t *m, double ax, double ay, double b, uint32_t s) {
+    const double *restrict px = ws->px, *restrict py = ws->py;
+    const uint32_t *restrict pl = ws->pl;
+    double *restrict qx = ws->qx, *restrict qy = ws->qy;
+    uint32_t *restrict ql = ws->ql;
+    size_t n = *m, o = 0, k0;
+    for (k0 = 0; k0 < n; k0++) /* most 3D neighbours cut nothing: no copy */
+        if (ax * px[k0] + ay * py[k0] > b) break;
+    if (k0 == n) return 0;
+    const double f0 = ax * px[0] + ay * py[0] - b;
+    double fu = f0, r2 = 0;
+    for (size_t k = 0; k < n; k++) {
+        const size_t k1 = k + 1 == n ? 0 : k + 1;
+        const double fw = k1 ? ax * px[k1] + ay * py[k1] - b : f0;
+        if (fu <= 0) {
+            qx[o] = px[k], qy[o] = py[k], ql[o++] = pl[k];
+            const double q = px[k] * px[k] + py[k] * py[k];
+            r2 = q > r2 ? q : r2;
+            if (fw > 0) {
+                const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
+                             y = py[k] + t * (py[k1] - py[k]);
+                qx[o] = x, qy[o] = y, ql[o++] = s;
+                r2 = x * x + y * y > r2 ? x * x + y * y : r2;
+            }
+        } else if (fw <= 0) {
+            const double t = fu / (fu - fw), x = px[k] + t * (px[k1] - px[k]),
+                         y = py[k] + t * (py[k1] - py[k]);
+            qx[o] = x, qy[o] = y, ql[o++] = pl[k];
+            r2 = x * x + y * y > r2 ? x * x + y * y : r2;
+        }
+        fu = fw;
+    }
+    ws->qx = ws->px, ws->qy = ws->py, ws->ql = ws->pl;
+    ws->px = qx, ws->py = qy, ws->pl = ql;
+    ws->r2 = r2;
+    *m = o;
+    return 1;
+}
+
+static size_t box(jf_natural_ws *ws, double B) {
+    const double bx[4] = {-B, B, B, -B}, by[4] = {-B, -B, B, B};
+    for (int k = 0; k < 4; k++) ws->px[k] = bx[k], ws->py[k] = by[k], ws->pl[k] = NONE;
+    return 4;
+}
+
+static int cut(jf_natural_ws *ws, size_t *np, double sx, double sy, double sr, uint32_t s) {
+    if (sx == 0 && sy == 0) {
+        if (sr < 0) *np = 0; /* s straight above u, nearer H: u has no cell */
+        return 0;
+    }
+    return clip(ws, np, 2 * sx, 2 * sy, sr, s);
+}
+
+/* Appends the labels of the clipped cell's edges (np vertices) not yet
+ * collected, with their squared distance to p; edges shorter than
+ * EDGE_EPS x reach are no adjacency.  p NULL (a row): every label, no
+ * stamps or distances (a convex cell's labels are distinct; the rings
+ * check them again anyway).  Returns 0 when out of memory. */
+static int labels(jf_natural_ws *ws, const double *p, size_t np, double reach, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    for (size_t k = 0; k < np; k++) {
+        uint32_t s = ws->pl[k];
+        if (s == NONE || (p && ws->stamp[s] == ws->gen)) continue;
+        size_t k1 = k + 1 == np ? 0 : k + 1;
+        double ex = ws->px[k1] - ws->px[k], ey = ws->py[k1] - ws->py[k];
+        if (ex * ex + ey * ey <= EDGE_EPS * EDGE_EPS * reach * reach) continue;
+        if (p) ws->stamp[s] = ws->gen;
+        if (!jf__natural_push(ws, len, s, p ? dist2(nt->vxyz + 3 * (size_t)s, p) : 0)) return 0;
+    }
+    return 1;
+}
+
+/* Appends to the list the planar natural neighbours of vertex u not yet
+ * collected (the edge labels of u's clipped power cell). */
+int jf__natural_tri_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    size_t b = nt->d.adj_off[u], e = nt->d.adj_off[u + 1], m = 0;
+    double ux, uy, uz, reach = 0;
+    project(h, nt->vxyz + 3 * (size_t)u, &ux, &uy, &uz);
+    for (size_t k = b; k < e; k++, m++) {
+        double x, y, z;
+        project(h, nt->vxyz + 3 * (size_t)nt->d.adj[k], &x, &y, &z);
+        /* relative to u': the half-plane 2 d.X <= |d|^2 + h_s^2 - h_u^2 */
+        ws->sx[m] = x - ux, ws->sy[m] = y - uy;
+        ws->sr[m] = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z + uz);
+        double r = ws->sx[m] * ws->sx[m] + ws->sy[m] * ws->sy[m] + (z - uz) * (z - uz);
+        if (r > reach) reach = r;
+    }
+    reach = sqrt(reach);
+    size_t np = box(ws, BOX_SCALE * reach);
+    for (size_t k = 0; k < m && np > 0; k++)
+        cut(ws, &np, ws->sx[k], ws->sy[k], ws->sr[k], nt->d.adj[b + k]);
+    return labels(ws, h->o, np, reach, len);
+}
+
+/* Cuts the cell (u' at (ux, uy) in h, u at height uz) by sample s:
+ * cut's return. */
+static int cut_by(jf_natural_ws *ws, const plane *h, double ux, double uy, double uz, uint32_t s,
+                  size_t *np) {
+    double x, y, z;
+    project(h, ws->nt->vxyz + 3 * (size_t)s, &x, &y, &z);
+    double sx = x - ux, sy = y - uy;
+    return cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s);
+}
+
+/* The cell u' clipped by all samples of the candidate list (the last at
+ * squared distance dl2 from u) is exact iff no vertex x has a sample
+ * strictly nearer than u (a half-plane that cuts a convex polygon holds
+ * one of its vertices).  Vertices with |x - u| <= dl / 2 are certified by
+ * the list.  The balls B(x, |x - u|) of the others all pass through u,
+ * and z in B(c, |c - u|) is linear in c, so the ball of any point of the
+ * polygon lies in the union of its vertices' balls: one query for every
+ * sample in a ball enclosing the uncertified vertices' balls, and the
+ * cell clipped by them, is exact -- the clips only shrink the polygon.
+ * Cheaper than the samples within 2 max |x - u| of u.  Returns 1 when
+ * exact, -1 when that ball holds CAND_MID samples or more (the caller
+ * widens), 0 on a failed query. */
+static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, double uy, double uz,
+                  double dl2, size_t *np) {
+    const jf_natural *nt = ws->nt;
+    double cx = 0, cy = 0, m = 0;
+    for (size_t k = 0; k < *np; k++) {
+        double px = ws->px[k], py = ws->py[k];
+        if (4 * (px * px + py * py + uz * uz) > dl2) cx += px, cy += py, m++;
+    }
+    if (m == 0) return 1;
+    cx /= m, cy /= m;
+    double rho = 0;
+    for (size_t k = 0; k < *np; k++) {
+        double px = ws->px[k], py = ws->py[k], rx2 = px * px + py * py + uz * uz;
+        if (4 * rx2 <= dl2) continue;
+        double e = sqrt((px - cx) * (px - cx) + (py - cy) * (py - cy)) + sqrt(rx2);
+        rho = e > rho ? e : rho;
+    }
+    rho *= 1 + 1e-12; /* the rounding of the sums above, outwards */
+    double X[3];
+    for (int d = 0; d < 3; d++) X[d] = h->o[d] + (ux + cx) * h->e1[d] + (uy + cy) * h->e2[d];
+    size_t f = 0;
+    if (jf__index_knn_pos(nt->ix, X, CAND_MID, rho * rho, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+    if (f == CAND_MID) return -1;
+    /* those nearer u than the last candidate are candidates: cut already */
+    const double *U = nt->vxyz + 3 * (size_t)u;
+    for (size_t j = 0; j < f && *np > 0; j++) {
+        const uint32_t s = ws->cpos[j];
+        if (s != u && !(dist2(nt->vxyz + 3 * (size_t)s, U) < dl2)) cut_by(ws, h, ux, uy, uz, s, np);
+    }
+    return 1;
+}
+
+/* k-NN form of cell_neighbors: u's planar cell clipped by its
+ * candidates, nearest first.  Certificate: a sample s at 3D distance
+ * d_s from u cannot cut the cell at a vertex x (in H) with
+ * |x - u| <= d_s / 2, since |x - s| >= d_s - |x - u| >= |x - u|.  So
+ * once the next candidate is at least twice as far as every vertex of
+ * the polygon, no sample further out cuts it either and the cell is
+ * exact.  The candidates run out before that only where the cell is
+ * large (rim of an open scan, sparse or far-off-plane u): the query
+ * widens to the samples within twice the polygon's radius (at most
+ * CAND_MID, then CAND_MAX), then the cell is taken as clipped by the box. */
+int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
+                         size_t cnt, const double *from, size_t *len) {
+    const jf_natural *nt = ws->nt;
+    const double *U = nt->vxyz + 3 * (size_t)u;
+    size_t K = CAND_K, np, j = 0;
+    if (!c) { /* widening below may overwrite cpos: it then reads its own list */
+        cnt = jf__natural_query(nt, u, ws->cpos);
+        if (cnt == SIZE_MAX) return 0;
+        c = ws->cpos;
+    }
+    if (!cnt) return 1;
+    double ux, uy, uz;
+    project(h, U, &ux, &uy, &uz);
+    double reach = sqrt(dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U));
+    const double B = BOX_SCALE * reach;
+    np = box(ws, B);
+    double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
+    for (;;) {
+        for (; j < cnt && np > 0; j++) {
+            if (dist2(nt->vxyz + 3 * (size_t)c[j], U) >= 4 * r2) goto exact;
+            if (cut_by(ws, h, ux, uy, uz, c[j], &np)) r2 = ws->r2 + uz * uz;
+        }
+        if (np == 0 || cnt < K || K >= CAND_MAX) break;
+        double dl2 = dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U);
+        if (dl2 >= 4 * r2) break; /* the last cut shrank it enough */
+        if (K == CAND_K) {
+            int v = verify(ws, h, u, ux, uy, uz, dl2, &np);
+            if (v == 0) return 0;
+            if (v > 0) break;
+        }
+        /* widen: the samples within 2 |x - u| (the first j of them are
+         * the same candidates), at most CAND_MID, then CAND_MAX; fewer
+         * found: all of them */
+        size_t f = 0, m = 0;
+        K = K < CAND_MID ? CAND_MID : CAND_MAX;
+        if (jf__index_knn_pos(nt->ix, U, K + 1, 4 * r2, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
+        for (size_t k = 0; k < f; k++)
+            if (ws->cpos[k] != u) ws->cpos[m++] = ws->cpos[k];
+        c = ws->cpos;
+        cnt = m;
+    }
+exact:
+    return labels(ws, from, np, reach, len);
+}
