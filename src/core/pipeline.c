@@ -276,8 +276,10 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
             *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
             return JF_OK;
         }
-        /* the k-NN form's own-plane rows, or the triangulation's cells */
-        st = jf__natural_neighbors_own(x->nt, ws, i, m, x->want, idx, x->cap, found);
+        /* the k-NN form's own-plane rows, or the triangulation's cells;
+         * input indices only for the graph and the raw points */
+        st = jf__natural_neighbors_own(x->nt, ws, i, m, x->want,
+                                       x->graph || x->fit_moved ? idx : NULL, x->cap, found);
         break;
     default:
         st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);

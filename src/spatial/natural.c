@@ -433,12 +433,14 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
 
 static jf_status neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i, const double nrm[3],
                            size_t N, int own, uint32_t *idx, size_t cap, size_t *found) {
-    if (!found || !idx) return JF_ERR_INVALID;
+    if (!found) return JF_ERR_INVALID;
     *found = 0;
     size_t len, want = N < cap ? N : cap;
     jf_status st = grow(nt, ws, i, nrm, want, INT32_MAX, own, &len, NULL);
     if (st != JF_OK || len == 0) return st;
     if (len > want) len = want;
+    *found = len;
+    if (!idx) return JF_OK; /* the caller reads ws->list only */
     idx[0] = (uint32_t)i;
     for (size_t k = 1; k < len; k++) idx[k] = nt->d.rep[ws->list[k]];
     *found = len;
@@ -458,6 +460,7 @@ jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, siz
 jf_status jf_natural_neighbors(const jf_natural *nt, jf_natural_ws *ws, size_t i,
                                const double nrm[3], size_t N, uint32_t *idx, size_t cap,
                                size_t *found) {
+    if (!idx) return JF_ERR_INVALID;
     return neighbors(nt, ws, i, nrm, N, 0, idx, cap, found);
 }
 

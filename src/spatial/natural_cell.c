@@ -14,20 +14,18 @@
 #include "natural_internal.h"
 
 int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
-    double l2 = plane_len2(nrm);
+    const double l2 = plane_len2(nrm);
     if (!l2) return 0;
-    double l = sqrt(l2);
-    /* the axis from nrm itself: it does not wait for the division */
-    int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
-                                          : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
-    double il = 1 / l;
-    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k];
-    /* e1: the world axis least aligned with n, made orthogonal:
-     * t = e_ax - n_ax n, |t|^2 = 1 - n_ax^2 (>= 2/3) */
+    /* e1: the world axis least aligned with nrm, made orthogonal:
+     * t = l2 e_ax - a nrm (a = nrm_ax), |t|^2 = l2 (l2 - a^2) with
+     * a^2 <= l2 / 3 -- both square roots at once, not one waiting on the
+     * other (the plane is on the path of every cell) */
+    const int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
+                                                : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
+    const double a = nrm[ax], l = sqrt(l2), s = sqrt(l2 - a * a), il = 1 / l, it = 1 / (l * s);
     double t[3];
-    for (int k = 0; k < 3; k++) t[k] = -h->n[ax] * h->n[k];
-    t[ax] += 1;
-    double it = 1 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k], t[k] = -a * nrm[k];
+    t[ax] += l2;
     for (int k = 0; k < 3; k++) h->e1[k] = t[k] * it;
     h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
     h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
