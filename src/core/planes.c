@@ -109,6 +109,29 @@ static int pca_cov(const double *pts, size_t m, double a[9])
     return 1;
 }
 
+/* The same scatter matrix of tree vertex v (coordinates tp) and its k
+ * candidates c in one pass, about v itself: sum d d^T - s s^T / m over
+ * d = q - v (v's own d is 0).  The neighbours' mean is within their
+ * spread of v, so the subtraction loses nothing to speak of; no copy of
+ * the points is made. */
+static int pca_cov_about(const double *tp, size_t v, const uint32_t *c, size_t k, double a[9])
+{
+    if (k < 2) return 0;
+    const double *u = tp + 3 * v;
+    double sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+    for (size_t j = 0; j < k; j++) {
+        const double *q = tp + 3 * (size_t)c[j];
+        const double dx = q[0] - u[0], dy = q[1] - u[1], dz = q[2] - u[2];
+        sx += dx, sy += dy, sz += dz;
+        xx += dx * dx, xy += dx * dy, xz += dx * dz;
+        yy += dy * dy, yz += dy * dz, zz += dz * dz;
+    }
+    const double im = 1 / (double)(k + 1);
+    a[0] = xx - sx * sx * im, a[1] = a[3] = xy - sx * sy * im, a[2] = a[6] = xz - sx * sz * im;
+    a[4] = yy - sy * sy * im, a[5] = a[7] = yz - sy * sz * im, a[8] = zz - sz * sz * im;
+    return 1;
+}
+
 /* The normal from the eigen-decomposition of the covariance: its
  * smallest eigenvalue's eigenvector.  0 if the points span less than a
  * plane (no unique normal). */
@@ -212,16 +235,11 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
                     __builtin_prefetch(nrm + 3 * (size_t)id[v0 + 2 * PREFETCH + L], 1);
                 }
             for (size_t L = 0; L < cnt; L++) {
-                double pts[3 * PCA_K];
                 if ((k[L] = jf__natural_query(ntl, v0 + L, c[L])) == SIZE_MAX) {
                     bad |= 2;
                     k[L] = 0;
                 }
-                size_t kp = k[L] < PCA_K - 1 ? k[L] : PCA_K - 1;
-                memcpy(pts, tp + 3 * (v0 + L), sizeof(double[3]));
-                for (size_t j = 0; j < kp; j++)
-                    memcpy(pts + 3 * (j + 1), tp + 3 * (size_t)c[L][j], sizeof(double[3]));
-                ok[L] = pca_cov(pts, kp + 1, a[L]);
+                ok[L] = pca_cov_about(tp, v0 + L, c[L], k[L] < PCA_K - 1 ? k[L] : PCA_K - 1, a[L]);
             }
             int jac[2] = {0, 0}; /* the rare hard ones: Jacobi, paired in lanes */
             for (size_t L = 0; L < cnt; L++)

@@ -216,8 +216,13 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
     double r2 = 2 * B * B + uz * uz; /* largest |x - u|^2 over the polygon */
     for (;;) {
         for (; j < cnt && np > 0; j++) {
-            if (dist2(nt->vxyz + 3 * (size_t)c[j], U) >= 4 * r2) goto exact;
-            if (cut_by(ws, h, ux, uy, uz, c[j], &np)) r2 = ws->r2 + uz * uz;
+            /* s - u in the plane's frame: its length is the certificate's,
+             * its half-plane the cut (one read of s) */
+            double x, y, z;
+            project(h, nt->vxyz + 3 * (size_t)c[j], &x, &y, &z);
+            const double sx = x - ux, sy = y - uy, dz = z - uz, s2 = sx * sx + sy * sy;
+            if (s2 + dz * dz >= 4 * r2) goto exact;
+            if (cut(ws, &np, sx, sy, s2 + dz * (z + uz), c[j])) r2 = ws->r2 + uz * uz;
         }
         if (np == 0 || cnt < K || K >= CAND_MAX) break;
         double dl2 = dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U);
