@@ -23,13 +23,13 @@ int jf__natural_plane(const double *o, const double nrm[3], plane *h) {
     const int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2)
                                                 : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
     const double a = nrm[ax], l = sqrt(l2), s = sqrt(l2 - a * a), il = 1 / l, it = 1 / (l * s);
-    double t[3];
-    for (int k = 0; k < 3; k++) h->n[k] = nrm[k] * il, h->o[k] = o[k], t[k] = -a * nrm[k];
-    t[ax] += l2;
-    for (int k = 0; k < 3; k++) h->e1[k] = t[k] * it;
-    h->e2[0] = h->n[1] * h->e1[2] - h->n[2] * h->e1[1];
-    h->e2[1] = h->n[2] * h->e1[0] - h->n[0] * h->e1[2];
-    h->e2[2] = h->n[0] * h->e1[1] - h->n[1] * h->e1[0];
+    /* in locals, no indexed store (read back as a vector, it stalls) */
+    double n[3], e[3];
+    for (int k = 0; k < 3; k++) n[k] = nrm[k] * il, e[k] = ((k == ax ? l2 : 0) - a * nrm[k]) * it;
+    for (int k = 0; k < 3; k++) h->o[k] = o[k], h->n[k] = n[k], h->e1[k] = e[k];
+    h->e2[0] = n[1] * e[2] - n[2] * e[1];
+    h->e2[1] = n[2] * e[0] - n[0] * e[2];
+    h->e2[2] = n[0] * e[1] - n[1] * e[0];
     return 1;
 }
 
