@@ -272,7 +272,10 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
     case JF_NB_NATURAL:
         *flags = x->nflags[i];
         const double *m = x->nrm + 3 * i;
-        if (!finite3(m) || (m[0] == 0 && m[1] == 0 && m[2] == 0)) {
+        /* a PCA or jet plane is a unit normal: not read here (input order,
+         * a cache miss per point); the others are checked */
+        if (!(*flags & (JF_PT_NORMAL_PCA | JF_PT_NORMAL_JET)) &&
+            (!finite3(m) || (m[0] == 0 && m[1] == 0 && m[2] == 0))) {
             *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
             return JF_OK;
         }
@@ -535,14 +538,13 @@ static jf_status deliver(const runctx *R, const uint32_t *idx, jf_result *res, s
     return R->sink(R->user, idx, res, m);
 }
 
-/* natural: what nb_query reads of point i by input index (its flags,
- * normal, vertex), asked PREFETCH points of the walk ahead: in the
- * tree's walk these are cache misses (the input is in any order). */
+/* natural: what nb_query reads of point i by input index (its flags and
+ * vertex), asked PREFETCH points of the walk ahead: in the tree's walk
+ * these are cache misses (the input is in any order). */
 #define PREFETCH 8
 static void prefetch_natural(const nbctx *x, size_t i)
 {
     __builtin_prefetch(x->nflags + i);
-    __builtin_prefetch(x->nrm + 3 * i);
     jf__natural_prefetch(x->nt, i);
 }
 

@@ -69,8 +69,10 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);
  * they are made (every ring from its vertices' rows: the plane is each
  * vertex's own, i's normal nrm for its own cell when its row is LIVE);
  * without rows (the triangulation's form, no rows pass yet), the same as
- * jf_natural_neighbors.  idx may be NULL: the neighbours are then only
- * ws's list (vertices; jf__natural_coords reads them). */
+ * jf_natural_neighbors.  With rows nrm is not checked (the caller's
+ * planes are valid; a LIVE row of i without one gets no neighbours).
+ * idx may be NULL: the neighbours are then only ws's list (vertices;
+ * jf__natural_coords reads them). */
 jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,
                                     const double nrm[3], size_t N, uint32_t *idx, size_t cap,
                                     size_t *found);

@@ -410,7 +410,9 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
     if (!nt || !ws || ws->nt != nt || !nrm || i >= nt->d.n) return JF_ERR_INVALID;
     uint32_t v0 = nt->d.vertex_of[i];
     if (v0 == NONE) return JF_OK;
-    if (!plane_len2(nrm)) return JF_ERR_INVALID; /* the plane itself: when needed */
+    /* the plane itself: when needed; own: nrm is the caller's to check
+     * (not read unless i's row is LIVE) */
+    if (!own && !plane_len2(nrm)) return JF_ERR_INVALID;
     lazy_plane lp = {.o = nt->vxyz + 3 * (size_t)v0, .nrm = nrm};
     jf__natural_collect(ws, v0);
     jf__natural_push(ws, len, v0, 0.0);
