@@ -226,6 +226,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
             const size_t v0 = 2 * h, cnt = v0 + 1 < m ? 2 : 1;
             double a[2][9], eval[2][3], evec[2][9];
             uint32_t c[2][JF_NATURAL_CAND];
+            jf__kd_scan scan[2];
             size_t k[2] = {0, 0};
             int ok[2] = {0, 0};
             if (bad) continue;
@@ -235,7 +236,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
                     __builtin_prefetch(nrm + 3 * (size_t)id[v0 + 2 * PREFETCH + L], 1);
                 }
             for (size_t L = 0; L < cnt; L++) {
-                if ((k[L] = jf__natural_query(ntl, v0 + L, c[L])) == SIZE_MAX) {
+                if ((k[L] = jf__natural_query(ntl, v0 + L, c[L], &scan[L])) == SIZE_MAX) {
                     bad |= 2;
                     k[L] = 0;
                 }
@@ -255,7 +256,7 @@ jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, uns
                                 ? JF_PT_NORMAL_PCA
                                 : JF_PT_FAILED;
                 /* the cell in this plane, while its candidates are at hand */
-                bad |= !bad && !jf__natural_own_row(ws, v0 + L, nrm + 3 * i, c[L], k[L]);
+                bad |= !bad && !jf__natural_own_row(ws, v0 + L, nrm + 3 * i, c[L], k[L], &scan[L]);
             }
         }
         jf_natural_ws_free(ws);

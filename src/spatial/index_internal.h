@@ -37,6 +37,22 @@ size_t jf__index_input_size(const jf_index *ix);
 jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, double bound,
                             uint32_t *pos, double *d2, size_t *found);
 
+/* What a k-NN search read: the leaves it scanned (tree positions
+ * first[j] .. first[j] + cnt[j] - 1) and rc2, the least squared distance
+ * a point it did not read can have (every point nearer is in those
+ * leaves; 0 when more than JF_KD_SCAN_LEAVES leaves were read).  The
+ * k-NN cells use it to certify their rim without a second query. */
+#define JF_KD_SCAN_LEAVES 16
+typedef struct {
+    uint32_t first[JF_KD_SCAN_LEAVES], cnt[JF_KD_SCAN_LEAVES];
+    size_t n;
+    double rc2;
+} jf__kd_scan;
+
+/* jf__index_knn_pos (no bound) recording what it read in *scan. */
+jf_status jf__index_knn_scan(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
+                             double *d2, size_t *found, jf__kd_scan *scan);
+
 /* natural.c: natural neighbourhoods over k-NN candidates of the tree's
  * points (borrowed: ix must outlive *out); see jf_natural_create_knn. */
 jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **out);
@@ -44,9 +60,11 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
 /* The k-NN form's candidates of vertex v (tree position v of the tree it
  * was made from): its JF_NATURAL_CAND nearest other vertices by
  * (distance, input index) into pos; their count (fewer: the whole
- * cloud), or SIZE_MAX if the query failed. */
+ * cloud), or SIZE_MAX if the query failed.  scan (may be NULL): what
+ * the search read, for the cell's rim. */
 #define JF_NATURAL_CAND 16
-size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL_CAND]);
+size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL_CAND],
+                         jf__kd_scan *scan);
 
 /* Own-plane rows of the k-NN form (docs/natural.md, "Own-plane rings"):
  * each vertex's planar cell in its own tangent plane, made once, so that
@@ -55,14 +73,15 @@ size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL
  * (by input index, borrowed: they must outlive the rows' use; rows
  * undefined: a pass must fill every one before a ring reads them);
  * jf__natural_own_row fills vertex v's from its plane normal nrm (of its
- * input point) and its candidates c[0..cnt) (jf__natural_query's; a
+ * input point) and its candidates c[0..cnt) (jf__natural_query's, with
+ * its scan or NULL; a
  * zero or non-finite normal or more than the row's room leaves it LIVE:
  * that cell is made when a ring asks for it, in its own plane, or in
  * the asking point's if it has none); jf__natural_own_rows does both
  * for every vertex, normals nrm[3n] by input index. */
 jf_status jf__natural_rows_alloc(jf_natural *nt, const double *nrm);
 int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
-                        size_t cnt);
+                        size_t cnt, const jf__kd_scan *scan);
 jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);
 
 /* jf_natural_neighbors of input point i over the own-plane rows where

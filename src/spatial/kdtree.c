@@ -256,6 +256,7 @@ typedef struct {
     int sorted;       /* small k: a sorted array instead of the heap     */
     double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
     uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
+    jf__kd_scan *scan; /* when not NULL: the leaves read, the cells passed */
 } kd_query;
 
 /* (d, position p) < (da, position pa) in the (distance, index) order */
@@ -324,6 +325,11 @@ static void sorted_push(kd_query *s, double d, uint32_t pos)
 static void scan_leaf(kd_query *s, const kd_node *nd)
 {
     const uint32_t first = nd->first, cnt = nd->dim >> 2;
+    if (s->scan) {
+        jf__kd_scan *r = s->scan;
+        if (r->n < JF_KD_SCAN_LEAVES) r->first[r->n] = first, r->cnt[r->n] = cnt;
+        r->n++;
+    }
     const double *p = s->ix->pts + 3 * (size_t)first;
     const uint32_t *id = s->ix->id;
     double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2];
@@ -394,6 +400,7 @@ static void search(kd_query *s, const double g0[3])
                 ni = f->node;
                 break;
             }
+            if (s->scan && bound < s->scan->rc2) s->scan->rc2 = bound;
         }
     }
 }
@@ -410,6 +417,7 @@ static void run_query(kd_query *s)
     }
     double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (bound <= s->worst_d) search(s, g);
+    else if (s->scan) s->scan->rc2 = bound;
     if (s->sorted) return;
     /* heap sort: repeatedly move the worst to the end */
     for (size_t end = s->cnt; end > 1; end--) {
@@ -423,9 +431,11 @@ static void run_query(kd_query *s)
     }
 }
 
-/* The query proper; ids = 0 leaves tree positions in idx. */
+/* The query proper; ids = 0 leaves tree positions in idx; scan (may be
+ * NULL) records what the search read. */
 static jf_status query(const jf_index *ix, const double q[3], size_t k, double bound,
-                       uint32_t *idx, double *d2, double *xyz, size_t *found, int ids)
+                       uint32_t *idx, double *d2, double *xyz, size_t *found, int ids,
+                       jf__kd_scan *scan)
 {
     if (found) *found = 0;
     if (!ix || !q || !found || (k && !idx)) return JF_ERR_INVALID;
@@ -439,8 +449,10 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     }
     /* idx holds positions during the search, indices after */
     kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  idx,
-                  k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX};
+                  k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX, scan};
+    if (scan) scan->n = 0, scan->rc2 = INFINITY;
     run_query(&s);
+    if (scan && scan->n > JF_KD_SCAN_LEAVES) scan->rc2 = 0; /* not all kept */
     if (keys != d2 && keys != stack_keys) free(keys);
     for (size_t j = 0; ids && j < s.cnt; j++) {
         const uint32_t pos = idx[j];
@@ -454,13 +466,19 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
 jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
                           uint32_t *idx, double *d2, double *xyz, size_t *found)
 {
-    return query(ix, q, k, bound, idx, d2, xyz, found, 1);
+    return query(ix, q, k, bound, idx, d2, xyz, found, 1, NULL);
 }
 
 jf_status jf__index_knn_pos(const jf_index *ix, const double q[3], size_t k, double bound,
                             uint32_t *pos, double *d2, size_t *found)
 {
-    return query(ix, q, k, bound, pos, d2, NULL, found, 0);
+    return query(ix, q, k, bound, pos, d2, NULL, found, 0, NULL);
+}
+
+jf_status jf__index_knn_scan(const jf_index *ix, const double q[3], size_t k, uint32_t *pos,
+                             double *d2, size_t *found, jf__kd_scan *scan)
+{
+    return query(ix, q, k, INFINITY, pos, d2, NULL, found, 0, scan);
 }
 
 jf_status jf_index_knn(const jf_index *ix, const double q[3], size_t k,

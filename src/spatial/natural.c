@@ -364,10 +364,11 @@ static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, siz
     const jf_natural *nt = ws->nt;
     plane hu;
     if (own && jf__natural_plane(nt->vxyz + 3 * (size_t)u, nt->row_nrm + 3 * (size_t)nt->d.rep[u], &hu))
-        return jf__natural_knn_cell(ws, &hu, u, NULL, 0, lp->o, len);
+        return jf__natural_knn_cell(ws, &hu, u, NULL, 0, NULL, lp->o, len);
     const plane *h = plane_of(lp);
     if (!h) return 1; /* checked by grow: not reached */
-    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, h->o, len) : jf__natural_tri_cell(ws, h, u, len);
+    return nt->ix ? jf__natural_knn_cell(ws, h, u, NULL, 0, NULL, h->o, len)
+                  : jf__natural_tri_cell(ws, h, u, len);
 }
 
 /* The next ring from the own-plane rows of ring list[a..b) (a LIVE row:

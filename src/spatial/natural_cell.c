@@ -9,6 +9,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "index_internal.h"
 #include "natural_internal.h"
@@ -187,6 +190,53 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
     return 1;
 }
 
+/* Before a second query: the candidates' search read every sample
+ * nearer u than sqrt(scan->rc2) (usually 1.2 times the last candidate's
+ * distance), in at most JF_KD_SCAN_LEAVES leaves.  The cell cut by those
+ * of them beyond the candidates (d2 >= dl2) that can still cut (d2 < 4
+ * r2) is exact out to |x - u| <= sqrt(rc2) / 2.  Returns the new r2. */
+static double from_leaves(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, double uy,
+                          double uz, double dl2, double r2, const jf__kd_scan *scan,
+                          size_t *np) {
+    const double *V = ws->nt->vxyz, *U = V + 3 * (size_t)u;
+    double *restrict d = ws->cd2; /* >= KD_LEAF entries */
+    for (size_t l = 0; l < scan->n && *np > 0; l++) {
+        const uint32_t s0 = scan->first[l], m = scan->cnt[l];
+        const double *restrict P = V + 3 * (size_t)s0;
+        uint32_t k = 0, in = 0; /* bit k: point k may cut (most: a candidate, or too far) */
+#ifdef __SSE2__
+        /* two points a step (the scalar dist2's operations, in lanes) */
+        const __m128d u0 = _mm_set1_pd(U[0]), u1 = _mm_set1_pd(U[1]), u2 = _mm_set1_pd(U[2]),
+                      lo = _mm_set1_pd(dl2), hi = _mm_set1_pd(4 * r2);
+        for (; k + 1 < m; k += 2) {
+            const __m128d a = _mm_loadu_pd(P + 3 * k), b = _mm_loadu_pd(P + 3 * k + 2),
+                          c = _mm_loadu_pd(P + 3 * k + 4);
+            const __m128d dx = _mm_sub_pd(_mm_shuffle_pd(a, b, 2), u0),
+                          dy = _mm_sub_pd(_mm_shuffle_pd(a, c, 1), u1),
+                          dz = _mm_sub_pd(_mm_shuffle_pd(b, c, 2), u2);
+            const __m128d e = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)),
+                                         _mm_mul_pd(dz, dz));
+            _mm_storeu_pd(d + k, e);
+            in |= (uint32_t)_mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(e, lo), _mm_cmplt_pd(e, hi))) << k;
+        }
+#endif
+        for (; k < m; k++) {
+            d[k] = dist2(P + 3 * k, U);
+            in |= (uint32_t)(d[k] >= dl2 && d[k] < 4 * r2) << k;
+        }
+        for (; in && *np > 0; in &= in - 1) {
+            k = (uint32_t)__builtin_ctz(in);
+            const uint32_t s = s0 + k;
+            if (d[k] >= 4 * r2) continue; /* r2 shrinks as it is cut */
+            double x, y, z;
+            project(h, V + 3 * (size_t)s, &x, &y, &z);
+            const double sx = x - ux, sy = y - uy;
+            if (cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s)) r2 = ws->r2 + uz * uz;
+        }
+    }
+    return r2;
+}
+
 /* k-NN form of cell_neighbors: u's planar cell clipped by its
  * candidates, nearest first.  Certificate: a sample s at 3D distance
  * d_s from u cannot cut the cell at a vertex x (in H) with
@@ -198,14 +248,16 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
  * widens to the samples within twice the polygon's radius (at most
  * CAND_MID, then CAND_MAX), then the cell is taken as clipped by the box. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
-                         size_t cnt, const double *from, size_t *len) {
+                         size_t cnt, const jf__kd_scan *scan, const double *from, size_t *len) {
     const jf_natural *nt = ws->nt;
     const double *U = nt->vxyz + 3 * (size_t)u;
     size_t K = CAND_K, np, j = 0;
+    jf__kd_scan own;
     if (!c) { /* widening below may overwrite cpos: it then reads its own list */
-        cnt = jf__natural_query(nt, u, ws->cpos);
+        cnt = jf__natural_query(nt, u, ws->cpos, &own);
         if (cnt == SIZE_MAX) return 0;
         c = ws->cpos;
+        scan = &own;
     }
     if (!cnt) return 1;
     double ux, uy, uz;
@@ -228,6 +280,11 @@ int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const ui
         double dl2 = dist2(nt->vxyz + 3 * (size_t)c[cnt - 1], U);
         if (dl2 >= 4 * r2) break; /* the last cut shrank it enough */
         if (K == CAND_K) {
+            if (scan && scan->rc2 > dl2) { /* the leaves already read */
+                r2 = from_leaves(ws, h, u, ux, uy, uz, dl2, r2, scan, &np);
+                dl2 = scan->rc2;
+                if (np == 0 || dl2 >= 4 * r2) break;
+            }
             int v = verify(ws, h, u, ux, uy, uz, dl2, &np);
             if (v == 0) return 0;
             if (v > 0) break;

@@ -110,12 +110,13 @@ static inline int jf__natural_push(jf_natural_ws *ws, size_t *len, uint32_t v, d
 int jf__natural_tri_cell(jf_natural_ws *ws, const plane *h, uint32_t u, size_t *len);
 
 /* natural_cell.c: vertex u's cell in the plane h from its k-NN candidates
- * c[0..cnt) (nearest first, all of the CAND_K nearest; c NULL: queried
- * here), made exact by the certificate; its labels appended as
+ * c[0..cnt) (nearest first, all of the CAND_K nearest, scan what their
+ * search read or NULL; c NULL: queried here), made exact by the
+ * certificate; its labels appended as
  * jf__natural_tri_cell does (distances from `from`; from NULL: every
  * label, no stamps or distances -- a row).  Returns 0 on a failed query
  * or no memory. */
 int jf__natural_knn_cell(jf_natural_ws *ws, const plane *h, uint32_t u, const uint32_t *c,
-                         size_t cnt, const double *from, size_t *len);
+                         size_t cnt, const jf__kd_scan *scan, const double *from, size_t *len);
 
 #endif /* JF_NATURAL_INTERNAL_H */

@@ -57,12 +57,13 @@ jf_status jf__natural_from_index(const jf_index *ix, int threads, jf_natural **o
     return JF_OK;
 }
 
-size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[CAND_K]) {
+size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[CAND_K], jf__kd_scan *scan) {
     uint32_t p[CAND_K + 1];
     double d2[CAND_K + 1];
     size_t f = 0, c = 0;
     if (!nt || !nt->ix || v >= nt->d.nv) return SIZE_MAX;
-    if (jf__index_knn_pos(nt->ix, nt->vxyz + 3 * v, CAND_K + 1, INFINITY, p, d2, &f) != JF_OK)
+    if ((scan ? jf__index_knn_scan(nt->ix, nt->vxyz + 3 * v, CAND_K + 1, p, d2, &f, scan)
+              : jf__index_knn_pos(nt->ix, nt->vxyz + 3 * v, CAND_K + 1, INFINITY, p, d2, &f)) != JF_OK)
         return SIZE_MAX;
     for (size_t j = 0; j < f && c < CAND_K; j++)
         if (p[j] != (uint32_t)v) pos[c++] = p[j];
@@ -78,14 +79,14 @@ jf_status jf__natural_rows_alloc(jf_natural *nt, const double *nrm) {
 }
 
 int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
-                        size_t cnt) {
+                        size_t cnt, const jf__kd_scan *scan) {
     const jf_natural *nt = ws->nt;
     uint32_t *row = nt->row + v * ROW_W;
     plane h;
     size_t len = 0;
     row[0] = ROW_LIVE;
     if (!jf__natural_plane(nt->vxyz + 3 * v, nrm, &h)) return 1;
-    if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, NULL, &len)) return 0;
+    if (!jf__natural_knn_cell(ws, &h, (uint32_t)v, c, cnt, scan, NULL, &len)) return 0;
     if (len > ROW_W) return 1; /* rare: made again when asked */
     for (size_t k = 0; k < ROW_W; k++) row[k] = k < len ? ws->list[k] : NONE;
     return 1;
@@ -108,13 +109,14 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm) {
 #endif
         for (long v = 0; v < nv; v++) {
             uint32_t c[CAND_K];
+            jf__kd_scan scan;
             if (bad) continue;
-            size_t cnt = jf__natural_query(nt, (size_t)v, c);
+            size_t cnt = jf__natural_query(nt, (size_t)v, c, &scan);
             if (cnt == SIZE_MAX) {
                 bad |= 2;
                 continue;
             }
-            bad |= !jf__natural_own_row(ws, (size_t)v, nrm + 3 * (size_t)nt->d.rep[v], c, cnt);
+            bad |= !jf__natural_own_row(ws, (size_t)v, nrm + 3 * (size_t)nt->d.rep[v], c, cnt, &scan);
         }
         jf_natural_ws_free(ws);
     }
