@@ -389,6 +389,60 @@ START_TEST(build_threads_same_tree)
 }
 END_TEST
 
+/* jf__index_knn_scan: the same points as jf__index_knn_pos, and its
+ * record holds every point nearer than sqrt(rc2) (brute force), with
+ * rc2 at least the k-th distance -- on a surface sample (the k-NN
+ * cells' case), a clustered cloud, and a query outside the box. */
+START_TEST(knn_scan_record)
+{
+    size_t n = 20000, k = 17;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < n; i++) {
+        double u = urand(), v = urand();
+        xyz[3 * i] = u, xyz[3 * i + 1] = v, xyz[3 * i + 2] = 0.1 * exp(2 * u + v - v * v);
+        if (i % 3 == 0) xyz[3 * i + 2] += 0.5 * urand(); /* a thick part too */
+    }
+    jf_index *ix;
+    ck_assert_int_eq(jf__index_build_threads(xyz, n, 2, &ix), JF_OK);
+    const double *pts;
+    const uint32_t *id;
+    size_t m = jf__index_points(ix, &pts, &id);
+    uint32_t a[32], b[32];
+    double da[32], db[32];
+    size_t gained = 0, tried = 0;
+    for (size_t t = 0; t < 400; t++) {
+        double q[3];
+        if (t < 399) memcpy(q, pts + 3 * (t * 37 % m), sizeof q);
+        else q[0] = 5, q[1] = -3, q[2] = 2; /* outside the box */
+        size_t fa = 0, fb = 0;
+        jf__kd_scan sc;
+        ck_assert_int_eq(jf__index_knn_pos(ix, q, k, INFINITY, a, da, &fa), JF_OK);
+        ck_assert_int_eq(jf__index_knn_scan(ix, q, k, b, db, &fb, &sc), JF_OK);
+        ck_assert_uint_eq(fa, fb);
+        ck_assert(memcmp(a, b, fa * sizeof *a) == 0 && memcmp(da, db, fa * sizeof *da) == 0);
+        if (sc.rc2 == 0) { /* too many leaves: nothing promised */
+            ck_assert_uint_gt(sc.n, JF_KD_SCAN_LEAVES);
+            continue;
+        }
+        ck_assert_uint_le(sc.n, JF_KD_SCAN_LEAVES);
+        ck_assert(sc.rc2 >= db[fb - 1]);
+        tried++, gained += sc.rc2 > 1.1 * db[fb - 1];
+        for (size_t p = 0; p < m; p++) {
+            double dx = q[0] - pts[3 * p], dy = q[1] - pts[3 * p + 1], dz = q[2] - pts[3 * p + 2];
+            if (!(dx * dx + dy * dy + dz * dz < sc.rc2)) continue;
+            int in = 0;
+            for (size_t l = 0; l < sc.n && !in; l++) in = p >= sc.first[l] && p < sc.first[l] + sc.cnt[l];
+            ck_assert_msg(in, "query %zu: point %zu nearer than rc2 not in the leaves read", t, p);
+        }
+    }
+    /* the record is worth having: rc2 well past the k-th distance often */
+    ck_assert_uint_gt(tried, 300);
+    ck_assert_uint_gt(2 * gained, tried);
+    jf_index_free(ix);
+    free(xyz);
+}
+END_TEST
+
 /* ---------------------------------------------------------------- order */
 
 START_TEST(order_is_permutation)
@@ -468,6 +522,7 @@ static Suite *kdtree_suite(void)
     tcase_add_test(tc, knn_edge_cases);
     tcase_add_test(tc, knn_large_k_without_d2);
     tcase_add_test(tc, knn_threads_agree);
+    tcase_add_test(tc, knn_scan_record);
     tcase_add_test(tc, build_threads_same_tree);
     tcase_add_test(tc, index_memory_small);
     suite_add_tcase(s, tc);
