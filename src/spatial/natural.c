@@ -378,7 +378,7 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
     const jf_natural *nt = ws->nt;
     if (!jf__natural_reserve(ws, *len, (b - a) * ROW_W)) return 0;
     const double *V = nt->vxyz, *p = lp->o;
-    const uint32_t gen = ws->gen;
+    const uint32_t gen = ws->gen, v0 = ws->list[0]; /* p: always collected */
     uint32_t *restrict stamp = ws->stamp, *restrict list = ws->list;
     double *restrict dist = ws->dist;
     size_t n = *len;
@@ -390,12 +390,16 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
             n = *len, list = ws->list, dist = ws->dist;
             continue;
         }
-        for (size_t j = 0; j < ROW_W && row[j] != NONE; j++) {
-            const uint32_t s = row[j];
-            if (stamp[s] == gen) continue;
+        /* every slot, no branch: whether a label is new, or the row has
+         * ended (NONE: p itself, collected), is a coin toss for the
+         * branch predictor; an old one is written and not counted */
+        for (size_t j = 0; j < ROW_W; j++) {
+            const uint32_t s = row[j] == NONE ? v0 : row[j];
+            const size_t fresh = stamp[s] != gen;
             stamp[s] = gen;
             list[n] = s;
-            dist[n++] = dist2(V + 3 * (size_t)s, p);
+            dist[n] = dist2(V + 3 * (size_t)s, p);
+            n += fresh;
         }
     }
     *len = n;
