@@ -121,42 +121,61 @@ static int cmp_double(const void *a, const void *b)
 #define NOISE_SAMPLES 2000
 #define NOISE_N 20
 static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const double *nrm,
-                             size_t n, int *noisy)
+                             size_t n, int threads, int *noisy)
 {
     *noisy = 0;
     jf_params p;
     jf_params_init(&p);
     p.degree = 2;
-    jf_fitter *f = NULL;
-    jf_natural_ws *ws = NULL;
-    double *ratio = malloc(NOISE_SAMPLES * sizeof *ratio);
-    jf_status st = ratio ? jf_fitter_create(&p, &f) : JF_ERR_NOMEM;
-    if (st == JF_OK) st = jf_natural_ws_create(nt, &ws);
-    size_t m = 0, step = n > NOISE_SAMPLES ? n / NOISE_SAMPLES : 1;
-    for (size_t i = 0; st == JF_OK && i < n && m < NOISE_SAMPLES; i += step) {
-        uint32_t idx[NOISE_N];
-        double pts[3 * NOISE_N], d2 = 0;
-        size_t found = 0;
-        jf_result r;
-        if (jf_natural_kept(nt, i) != i || !finite3(nrm + 3 * i)) continue;
-        if ((st = jf__natural_neighbors_own(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
-            break;
-        for (size_t j = 0; j < found; j++)
-            for (int c = 0; c < 3; c++) {
-                pts[3 * j + c] = xyz[3 * (size_t)idx[j] + c];
-                d2 += (pts[3 * j + c] - xyz[3 * i + c]) * (pts[3 * j + c] - xyz[3 * i + c]);
-            }
-        if (found < NOISE_N || (st = jf_fit_point(f, xyz + 3 * i, pts, found, &r)) != JF_OK) continue;
-        if (r.degree == 2 && d2 > 0) ratio[m++] = r.residual / sqrt(d2 / (double)found);
+    /* every n / NOISE_SAMPLES-th point (fewer than 4000 points: each),
+     * side by side, one slot each; the first NOISE_SAMPLES that give a
+     * ratio are the test's, whatever the thread count */
+    const size_t step = n > NOISE_SAMPLES ? n / NOISE_SAMPLES : 1;
+    const long ns = (long)((n + step - 1) / step);
+    double *ratio = malloc((size_t)ns * sizeof *ratio);
+    if (!ratio) return JF_ERR_NOMEM;
+    jf_status failed = JF_OK;
+#pragma omp parallel num_threads(threads)
+    {
+        jf_fitter *f = NULL;
+        jf_natural_ws *ws = NULL;
+        jf_status st = jf_fitter_create(&p, &f);
+        if (st == JF_OK) st = jf_natural_ws_create(nt, &ws);
+#pragma omp for schedule(static)
+        for (long k = 0; k < ns; k++) {
+            const size_t i = (size_t)k * step;
+            uint32_t idx[NOISE_N];
+            double pts[3 * NOISE_N], d2 = 0;
+            size_t found = 0;
+            jf_result r;
+            ratio[k] = NAN;
+            if (st != JF_OK || jf_natural_kept(nt, i) != i || !finite3(nrm + 3 * i)) continue;
+            if ((st = jf__natural_neighbors_own(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
+                continue;
+            for (size_t j = 0; j < found; j++)
+                for (int c = 0; c < 3; c++) {
+                    pts[3 * j + c] = xyz[3 * (size_t)idx[j] + c];
+                    d2 += (pts[3 * j + c] - xyz[3 * i + c]) * (pts[3 * j + c] - xyz[3 * i + c]);
+                }
+            if (found < NOISE_N || (st = jf_fit_point(f, xyz + 3 * i, pts, found, &r)) != JF_OK) continue;
+            if (r.degree == 2 && d2 > 0) ratio[k] = r.residual / sqrt(d2 / (double)found);
+        }
+        if (st != JF_OK) {
+#pragma omp atomic write
+            failed = st;
+        }
+        jf_natural_ws_free(ws);
+        jf_fitter_free(f);
     }
-    if (st == JF_OK && m > 0) {
+    size_t m = 0;
+    for (long k = 0; k < ns && m < NOISE_SAMPLES; k++)
+        if (!isnan(ratio[k])) ratio[m++] = ratio[k];
+    if (failed == JF_OK && m > 0) {
         qsort(ratio, m, sizeof *ratio, cmp_double);
         *noisy = ratio[m / 2] > JF_NATURAL_NOISY_RESIDUAL;
     }
-    jf_natural_ws_free(ws);
-    jf_fitter_free(f);
     free(ratio);
-    return st;
+    return failed;
 }
 
 /* The k-NN form's own-plane rows from the normals nrm (by input index). */
@@ -240,7 +259,7 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
         return st;
     }
     int noisy = 0;
-    if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, &noisy)) != JF_OK) {
+    if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, nt, &noisy)) != JF_OK) {
         set_err(err, "natural neighbours: the noise test failed");
         return st;
     }

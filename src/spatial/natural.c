@@ -372,8 +372,8 @@ static int ring_step(jf_natural_ws *ws, lazy_plane *lp, uint32_t u, int own, siz
 }
 
 /* The next ring from the own-plane rows of ring list[a..b) (a LIVE row:
- * ring_step's).  Locals: the stores to list and dist
- * would otherwise reload every pointer. */
+ * ring_step's).  Locals: the stores to list and dist would otherwise
+ * reload every pointer. */
 static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_t *len) {
     const jf_natural *nt = ws->nt;
     if (!jf__natural_reserve(ws, *len, (b - a) * ROW_W)) return 0;
@@ -381,7 +381,8 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
     const uint32_t gen = ws->gen, v0 = ws->list[0]; /* p: always collected */
     uint32_t *restrict stamp = ws->stamp, *restrict list = ws->list;
     double *restrict dist = ws->dist;
-    size_t n = *len;
+    const size_t n0 = *len;
+    size_t n = n0;
     for (size_t k = a; k < b; k++) {
         const uint32_t *row = nt->row + (size_t)list[k] * ROW_W;
         if (row[0] == ROW_LIVE) { /* rare: may grow the list */
@@ -398,10 +399,11 @@ static int own_ring(jf_natural_ws *ws, lazy_plane *lp, size_t a, size_t b, size_
             const size_t fresh = stamp[s] != gen;
             stamp[s] = gen;
             list[n] = s;
-            dist[n] = dist2(V + 3 * (size_t)s, p);
             n += fresh;
         }
     }
+    /* the distances of the new ones only (a LIVE row's: the same again) */
+    for (size_t k = n0; k < n; k++) dist[k] = dist2(V + 3 * (size_t)list[k], p);
     *len = n;
     return 1;
 }
