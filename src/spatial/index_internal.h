@@ -86,10 +86,12 @@ jf_status jf__natural_own_rows(jf_natural *nt, int threads, const double *nrm);
 
 /* jf_natural_neighbors of input point i over the own-plane rows where
  * they are made (every ring from its vertices' rows: the plane is each
- * vertex's own, i's normal nrm for its own cell when its row is LIVE);
- * without rows (the triangulation's form, no rows pass yet), the same as
- * jf_natural_neighbors.  With rows nrm is not checked (the caller's
- * planes are valid; a LIVE row of i without one gets no neighbours).
+ * vertex's own, i's normal nrm for its own cell when its row is LIVE;
+ * a ring kept whole comes in row order -- a fit does not care -- the cut
+ * one by (distance, coordinates); nrm is not checked: the caller's
+ * planes are valid, and a LIVE row of i without one gets no
+ * neighbours); without rows (the triangulation's form, no rows pass
+ * yet), the same as jf_natural_neighbors.
  * idx may be NULL: the neighbours are then only ws's list (vertices;
  * jf__natural_coords reads them). */
 jf_status jf__natural_neighbors_own(const jf_natural *nt, jf_natural_ws *ws, size_t i,

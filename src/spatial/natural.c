@@ -433,7 +433,9 @@ static jf_status grow(const jf_natural *nt, jf_natural_ws *ws, size_t i, const d
                 if (!ring_step(ws, &lp, ws->list[k], 0, len)) return JF_ERR_NOMEM;
         }
         if (*len == b) break; /* the cloud ran out */
-        sort_ring(ws, b, *len, want - b); /* want > b: the loop goes on */
+        /* want > b: the loop goes on.  own: a ring kept whole stays in
+         * row order (a fit does not care; the cut one is sorted) */
+        if (!own || *len > want) sort_ring(ws, b, *len, want - b);
         a = b, b = *len;
         if (ring_end) ring_end[r] = b;
     }
