@@ -25,7 +25,8 @@
  *    clean §6.1 patch were 9.75 deg off at the rim (0.10 with 2x; knn:128
  *    0.02; docs/natural.md).
  *  - The same cells without a triangulation (the k-NN form, the default
- *    of jf_estimate): natural_knn.c; the rings below serve both.  With
+ *    of jf_estimate): natural_knn.c; the cells of both forms and their
+ *    clip: natural_cell.c; the rings below serve both.  With
  *    the k-NN form's own-plane rows (jf_estimate), ring r+1 is the union
  *    of ring r's rows: each vertex's cell in its own plane, made once,
  *    instead of again in every p's plane that reaches it.

@@ -1,11 +1,11 @@
 /*
  * natural_knn.c -- natural neighbourhoods without a triangulation (issue
- * 15.2): each planar power cell clipped by the sample's nearest samples
- * from the k-d tree, nearest first, until a certificate proves it exact
- * (knn_cell below; natural.c says why clipping by any superset of the
- * cutting samples gives the cell); and the own-plane rows: every
- * sample's cell made once in its own tangent plane, the rings grown from
- * them (natural.c own_ring).  Vertices are the tree's positions; no
+ * 15.2): the form's vertices and candidates (each planar power cell is
+ * clipped by the sample's nearest samples from the k-d tree until a
+ * certificate proves it exact: natural_cell.c; natural.c says why
+ * clipping by any superset of the cutting samples gives the cell); and
+ * the own-plane rows: every sample's cell made once in its own tangent
+ * plane, the rings grown from them (natural.c own_ring).  Vertices are the tree's positions; no
  * poles, no merged duplicates.  docs/natural.md, "Own-plane rings" and
  * "The k-NN cells".
  */
