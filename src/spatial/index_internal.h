@@ -74,11 +74,11 @@ size_t jf__natural_query(const jf_natural *nt, size_t v, uint32_t pos[JF_NATURAL
  * undefined: a pass must fill every one before a ring reads them);
  * jf__natural_own_row fills vertex v's from its plane normal nrm (of its
  * input point) and its candidates c[0..cnt) (jf__natural_query's, with
- * its scan or NULL; a
- * zero or non-finite normal or more than the row's room leaves it LIVE:
- * that cell is made when a ring asks for it, in its own plane, or in
- * the asking point's if it has none); jf__natural_own_rows does both
- * for every vertex, normals nrm[3n] by input index. */
+ * its scan or NULL; a zero or non-finite normal or more than the row's
+ * room leaves it LIVE: that cell is made when a ring asks for it, in its
+ * own plane, or in the asking point's if it has none);
+ * jf__natural_own_rows does both for every vertex, normals nrm[3n] by
+ * input index. */
 jf_status jf__natural_rows_alloc(jf_natural *nt, const double *nrm);
 int jf__natural_own_row(jf_natural_ws *ws, size_t v, const double nrm[3], const uint32_t *c,
                         size_t cnt, const jf__kd_scan *scan);

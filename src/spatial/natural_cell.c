@@ -146,11 +146,11 @@ static int cut_by(jf_natural_ws *ws, const plane *h, double ux, double uy, doubl
     return cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s);
 }
 
-/* The cell u' clipped by all samples of the candidate list (the last at
- * squared distance dl2 from u) is exact iff no vertex x has a sample
- * strictly nearer than u (a half-plane that cuts a convex polygon holds
- * one of its vertices).  Vertices with |x - u| <= dl / 2 are certified by
- * the list.  The balls B(x, |x - u|) of the others all pass through u,
+/* The cell u' clipped by every sample nearer u than dl = sqrt(dl2) (the
+ * candidates, the last at dl; or those of the leaves their search read)
+ * is exact iff no vertex x has a sample strictly nearer than u (a
+ * half-plane that cuts a convex polygon holds one of its vertices).
+ * Vertices with |x - u| <= dl / 2 are certified by those samples.  The balls B(x, |x - u|) of the others all pass through u,
  * and z in B(c, |c - u|) is linear in c, so the ball of any point of the
  * polygon lies in the union of its vertices' balls: one query for every
  * sample in a ball enclosing the uncertified vertices' balls, and the
@@ -181,7 +181,7 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
     size_t f = 0;
     if (jf__index_knn_pos(nt->ix, X, CAND_MID, rho * rho, ws->cpos, ws->cd2, &f) != JF_OK) return 0;
     if (f == CAND_MID) return -1;
-    /* those nearer u than the last candidate are candidates: cut already */
+    /* those nearer u than dl have cut it already */
     const double *U = nt->vxyz + 3 * (size_t)u;
     for (size_t j = 0; j < f && *np > 0; j++) {
         const uint32_t s = ws->cpos[j];
@@ -191,7 +191,7 @@ static int verify(jf_natural_ws *ws, const plane *h, uint32_t u, double ux, doub
 }
 
 /* Before a second query: the candidates' search read every sample
- * nearer u than sqrt(scan->rc2) (usually 1.2 times the last candidate's
+ * nearer u than sqrt(scan->rc2) (median 1.22 times the last candidate's
  * distance), in at most JF_KD_SCAN_LEAVES leaves.  The cell cut by those
  * of them beyond the candidates (d2 >= dl2) that can still cut (d2 < 4
  * r2) is exact out to |x - u| <= sqrt(rc2) / 2.  Returns the new r2. */
@@ -199,41 +199,46 @@ static double from_leaves(jf_natural_ws *ws, const plane *h, uint32_t u, double 
                           double uz, double dl2, double r2, const jf__kd_scan *scan,
                           size_t *np) {
     const double *V = ws->nt->vxyz, *U = V + 3 * (size_t)u;
-    double *restrict d = ws->cd2; /* >= KD_LEAF entries */
-    for (size_t l = 0; l < scan->n && *np > 0; l++) {
-        const uint32_t s0 = scan->first[l], m = scan->cnt[l];
-        const double *restrict P = V + 3 * (size_t)s0;
-        uint32_t k = 0, in = 0; /* bit k: point k may cut (most: a candidate, or too far) */
+    double *restrict d = ws->cd2; /* >= 32 entries (CAND_MAX) */
+    for (size_t l = 0; l < scan->n; l++)
+        for (uint32_t off = 0; off < scan->cnt[l] && *np > 0; off += 32) {
+            /* a run of up to 32 points of the leaf (12..24): one bit each,
+             * set where the point may cut (most: a candidate, or too far) */
+            const uint32_t s0 = scan->first[l] + off,
+                           m = scan->cnt[l] - off < 32 ? scan->cnt[l] - off : 32;
+            const double *restrict P = V + 3 * (size_t)s0;
+            uint32_t k = 0, in = 0;
 #ifdef __SSE2__
-        /* two points a step (the scalar dist2's operations, in lanes) */
-        const __m128d u0 = _mm_set1_pd(U[0]), u1 = _mm_set1_pd(U[1]), u2 = _mm_set1_pd(U[2]),
-                      lo = _mm_set1_pd(dl2), hi = _mm_set1_pd(4 * r2);
-        for (; k + 1 < m; k += 2) {
-            const __m128d a = _mm_loadu_pd(P + 3 * k), b = _mm_loadu_pd(P + 3 * k + 2),
-                          c = _mm_loadu_pd(P + 3 * k + 4);
-            const __m128d dx = _mm_sub_pd(_mm_shuffle_pd(a, b, 2), u0),
-                          dy = _mm_sub_pd(_mm_shuffle_pd(a, c, 1), u1),
-                          dz = _mm_sub_pd(_mm_shuffle_pd(b, c, 2), u2);
-            const __m128d e = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)),
-                                         _mm_mul_pd(dz, dz));
-            _mm_storeu_pd(d + k, e);
-            in |= (uint32_t)_mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(e, lo), _mm_cmplt_pd(e, hi))) << k;
-        }
+            /* two points a step (the scalar dist2's operations, in lanes) */
+            const __m128d u0 = _mm_set1_pd(U[0]), u1 = _mm_set1_pd(U[1]), u2 = _mm_set1_pd(U[2]),
+                          lo = _mm_set1_pd(dl2), hi = _mm_set1_pd(4 * r2);
+            for (; k + 1 < m; k += 2) {
+                const __m128d a = _mm_loadu_pd(P + 3 * k), b = _mm_loadu_pd(P + 3 * k + 2),
+                              c = _mm_loadu_pd(P + 3 * k + 4);
+                const __m128d dx = _mm_sub_pd(_mm_shuffle_pd(a, b, 2), u0),
+                              dy = _mm_sub_pd(_mm_shuffle_pd(a, c, 1), u1),
+                              dz = _mm_sub_pd(_mm_shuffle_pd(b, c, 2), u2);
+                const __m128d e = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)),
+                                             _mm_mul_pd(dz, dz));
+                _mm_storeu_pd(d + k, e);
+                in |= (uint32_t)_mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(e, lo), _mm_cmplt_pd(e, hi)))
+                      << k;
+            }
 #endif
-        for (; k < m; k++) {
-            d[k] = dist2(P + 3 * k, U);
-            in |= (uint32_t)(d[k] >= dl2 && d[k] < 4 * r2) << k;
+            for (; k < m; k++) {
+                d[k] = dist2(P + 3 * k, U);
+                in |= (uint32_t)(d[k] >= dl2 && d[k] < 4 * r2) << k;
+            }
+            for (; in && *np > 0; in &= in - 1) {
+                k = (uint32_t)__builtin_ctz(in);
+                if (d[k] >= 4 * r2) continue; /* r2 shrinks as it is cut */
+                double x, y, z;
+                project(h, P + 3 * k, &x, &y, &z);
+                const double sx = x - ux, sy = y - uy;
+                if (cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s0 + k))
+                    r2 = ws->r2 + uz * uz;
+            }
         }
-        for (; in && *np > 0; in &= in - 1) {
-            k = (uint32_t)__builtin_ctz(in);
-            const uint32_t s = s0 + k;
-            if (d[k] >= 4 * r2) continue; /* r2 shrinks as it is cut */
-            double x, y, z;
-            project(h, V + 3 * (size_t)s, &x, &y, &z);
-            const double sx = x - ux, sy = y - uy;
-            if (cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s)) r2 = ws->r2 + uz * uz;
-        }
-    }
     return r2;
 }
 
