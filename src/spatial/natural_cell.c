@@ -231,7 +231,7 @@ static double from_leaves(jf_natural_ws *ws, const plane *h, uint32_t u, double 
             }
             for (; in && *np > 0; in &= in - 1) {
                 k = (uint32_t)__builtin_ctz(in);
-                if (d[k] >= 4 * r2) continue; /* r2 shrinks as it is cut */
+                if (d[k] >= 4 * r2 || s0 + k == u) continue; /* r2 shrinks as it is cut */
                 double x, y, z;
                 project(h, P + 3 * k, &x, &y, &z);
                 const double sx = x - ux, sy = y - uy;
