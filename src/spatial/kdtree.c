@@ -19,7 +19,9 @@
  *    g_i <= |q_i - p_i| computed by the same rounded operations as a point's
  *    distance, so (rounding being monotonic) it never exceeds the distance of
  *    any point inside; a cell is skipped only if its bound is strictly
- *    larger than the current worst, so ties are never lost.
+ *    larger than the current worst, or equal to it and its smallest original
+ *    index above the worst's, so ties are never lost -- and a cloud of
+ *    identical points (every bound a tie) is not read whole per query.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -50,6 +52,7 @@ struct jf_index {
     double *pts;       /* 3m coordinates, in tree order                   */
     uint32_t *id;      /* m original indices, in tree order               */
     kd_node *nodes;
+    uint32_t *minid;   /* nnodes: the smallest original index under a node */
     size_t nnodes;
     double bbox[6];    /* lo x,y,z then hi x,y,z of the finite points     */
 };
@@ -76,22 +79,34 @@ static void swap_pt(double *pts, uint32_t *id, size_t a, size_t b)
     id[b] = ti;
 }
 
-/* Quickselect (median of three, Hoare partition: equal keys split evenly,
- * so grids with many equal coordinates stay O(n)): afterwards every point
- * in [lo, nth) has coordinate d <= that of nth <= those in (nth, hi). */
+/* (coordinate d, original index) order of positions a, b: ties on the
+ * axis go by index, so a run of equal coordinates (a grid's rows, or a
+ * hostile cloud of one repeated point) is laid out by index and a query's
+ * ties prune whole subtrees (minid). */
+static int key_less(const double *pts, const uint32_t *id, size_t a, size_t b, int d)
+{
+    const double x = pts[3 * a + d], y = pts[3 * b + d];
+    return x < y || (x == y && id[a] < id[b]);
+}
+
+/* Quickselect (median of three, Hoare partition) on (coordinate d, index):
+ * afterwards every point in [lo, nth) is before nth and every one in
+ * (nth, hi) after it in that order, so coordinates in [lo, nth) <= that
+ * of nth <= those in (nth, hi).  The keys are distinct: O(n) expected. */
 static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
                        size_t nth, int d)
 {
     while (hi - lo > 2) {
         size_t mid = lo + (hi - lo) / 2, last = hi - 1;
-        if (pts[3 * mid + d] < pts[3 * lo + d]) swap_pt(pts, id, mid, lo);
-        if (pts[3 * last + d] < pts[3 * lo + d]) swap_pt(pts, id, last, lo);
-        if (pts[3 * last + d] < pts[3 * mid + d]) swap_pt(pts, id, last, mid);
-        double pivot = pts[3 * mid + d];
+        if (key_less(pts, id, mid, lo, d)) swap_pt(pts, id, mid, lo);
+        if (key_less(pts, id, last, lo, d)) swap_pt(pts, id, last, lo);
+        if (key_less(pts, id, last, mid, d)) swap_pt(pts, id, last, mid);
+        const double pc = pts[3 * mid + d];
+        const uint32_t pi = id[mid];
         size_t i = lo, j = last;
         for (;;) {
-            while (pts[3 * i + d] < pivot) i++;
-            while (pts[3 * j + d] > pivot) j--;
+            while (pts[3 * i + d] < pc || (pts[3 * i + d] == pc && id[i] < pi)) i++;
+            while (pts[3 * j + d] > pc || (pts[3 * j + d] == pc && id[j] > pi)) j--;
             if (i >= j) break;
             swap_pt(pts, id, i, j);
             i++;
@@ -101,7 +116,7 @@ static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
         if (nth <= j) hi = j + 1;
         else lo = j + 1;
     }
-    if (hi - lo == 2 && pts[3 * (lo + 1) + d] < pts[3 * lo + d])
+    if (hi - lo == 2 && key_less(pts, id, lo + 1, lo, d))
         swap_pt(pts, id, lo, lo + 1);
 }
 
@@ -183,7 +198,8 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     ix->pts = malloc((m ? m : 1) * 3 * sizeof *ix->pts);
     ix->id = malloc((m ? m : 1) * sizeof *ix->id);
     ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);
-    if (!ix->pts || !ix->id || !ix->nodes) {
+    ix->minid = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->minid);
+    if (!ix->pts || !ix->id || !ix->nodes || !ix->minid) {
         jf_index_free(ix);
         return JF_ERR_NOMEM;
     }
@@ -210,6 +226,18 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
 #pragma omp parallel if (m >= 2 * KD_TASK_MIN) num_threads(nt) default(none) shared(bp, m)
 #pragma omp single
         build_node(bp, 0, 0, m, 1);
+        /* children come after their parent: one pass from the last node */
+        for (size_t ni = ix->nnodes; ni-- > 0;) {
+            const kd_node *nd = &ix->nodes[ni];
+            uint32_t mn = UINT32_MAX;
+            if ((nd->dim & 3u) == KD_IS_LEAF)
+                for (uint32_t j = nd->first, e = nd->first + (nd->dim >> 2); j < e; j++)
+                    mn = ix->id[j] < mn ? ix->id[j] : mn;
+            else
+                mn = ix->minid[nd->first] < ix->minid[nd->first + 1] ? ix->minid[nd->first]
+                                                                     : ix->minid[nd->first + 1];
+            ix->minid[ni] = mn;
+        }
     }
     *out = ix;
     return JF_OK;
@@ -221,6 +249,7 @@ void jf_index_free(jf_index *ix)
     free(ix->pts);
     free(ix->id);
     free(ix->nodes);
+    free(ix->minid);
     free(ix);
 }
 
@@ -232,7 +261,7 @@ size_t jf_index_memory(const jf_index *ix)
 {
     if (!ix) return 0;
     return sizeof *ix + ix->m * (3 * sizeof(double) + sizeof(uint32_t)) +
-           ix->nnodes * sizeof(kd_node);
+           ix->nnodes * (sizeof(kd_node) + sizeof(uint32_t));
 }
 
 /* ---------------------------------------------------------------- query */
@@ -367,7 +396,7 @@ static void search(kd_query *s, const double g0[3])
             int dim = (int)nd->dim;
             double v = s->q[dim], gap;
             uint32_t far;
-            if ((v - nd->lo) + (v - nd->hi) < 0) {
+            if ((v - nd->lo) + (v - nd->hi) <= 0) { /* a tie: left, the smaller indices */
                 ni = nd->first;
                 far = nd->first + 1;
                 gap = nd->hi - v; /* far (right) points: coordinate >= hi */
@@ -393,7 +422,10 @@ static void search(kd_query *s, const double g0[3])
             kd_frame *f = &stack[--top];
             double bound = f->g[0] * f->g[0] + f->g[1] * f->g[1] +
                            f->g[2] * f->g[2];
-            if (bound <= s->worst_d) {
+            /* a tie reads the cell only if it may hold a smaller index */
+            if (bound < s->worst_d ||
+                (bound == s->worst_d && (s->worst_p == UINT32_MAX ||
+                                         s->ix->minid[f->node] < s->ix->id[s->worst_p]))) {
                 g[0] = f->g[0];
                 g[1] = f->g[1];
                 g[2] = f->g[2];
