@@ -944,10 +944,12 @@ void jf_natural_free(jf_natural *nt);
  * by the point's 16 nearest samples from a k-d tree (queried when the
  * cell is made; about 40 bytes per point with the tree), and is exact
  * (the same as the triangulation's up to rounding) once a certificate
- * holds: every vertex of the cell is within half the distance of the
- * last candidate, or no sample lies in a ball enclosing the others'
- * empty-circle balls; the query widens to 144 candidates before a cell
- * is accepted as clipped by the box (the rim of an open scan).  No vertex merging (identical
+ * holds: every vertex of the cell is within half the distance inside
+ * which every sample has cut it (the last candidate's, or the reach of
+ * the leaves their search read), or no sample lies in a ball enclosing
+ * the others' empty-circle balls; the query widens to 144 candidates
+ * before a cell is accepted as clipped by the box (the rim of an open
+ * scan).  No vertex merging (identical
  * points stay separate; only one of them is anyone's neighbour), no
  * poles: jf_natural_normals returns JF_ERR_INVALID on it, the caller
  * brings the normals (jf_estimate: PCA or jet).  jf_natural_get_stats

@@ -84,36 +84,12 @@ jf_status jf__planes_knn_jet(const jf_index *ix, const double *xyz, size_t n, si
 
 /* ---- PCA planes (clean clouds) ---------------------------------------- */
 
-/* Centred covariance a (3x3, row-major) of pts (m points), in scalar
- * sums (an array of sums is stored and reloaded every point).  Returns 0
- * for fewer than 3 points. */
-static int pca_cov(const double *pts, size_t m, double a[9])
-{
-    double c[3] = {0, 0, 0};
-    if (m < 3) return 0;
-    for (size_t i = 0; i < m; i++)
-        for (int j = 0; j < 3; j++) c[j] += pts[3 * i + j];
-    for (int j = 0; j < 3; j++) c[j] /= (double)m;
-    double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-    for (size_t i = 0; i < m; i++) { /* second pass: centred (no cancellation) */
-        const double dx = pts[3 * i] - c[0], dy = pts[3 * i + 1] - c[1], dz = pts[3 * i + 2] - c[2];
-        xx += dx * dx;
-        xy += dx * dy;
-        xz += dx * dz;
-        yy += dy * dy;
-        yz += dy * dz;
-        zz += dz * dz;
-    }
-    a[0] = xx, a[1] = a[3] = xy, a[2] = a[6] = xz;
-    a[4] = yy, a[5] = a[7] = yz, a[8] = zz;
-    return 1;
-}
-
-/* The same scatter matrix of tree vertex v (coordinates tp) and its k
- * candidates c in one pass, about v itself: sum d d^T - s s^T / m over
- * d = q - v (v's own d is 0).  The neighbours' mean is within their
- * spread of v, so the subtraction loses nothing to speak of; no copy of
- * the points is made. */
+/* The centred scatter matrix a (3x3, row-major) of point v of tp and its
+ * k neighbours c (indices into tp, v not among them), in one pass about
+ * v itself: sum d d^T - s s^T / m over d = q - v (v's own d is 0), m =
+ * k + 1.  The neighbours' mean is within their spread of v, so the
+ * subtraction loses nothing to speak of; no copy of the points is made.
+ * Returns 0 for fewer than 3 points. */
 static int pca_cov_about(const double *tp, size_t v, const uint32_t *c, size_t k, double a[9])
 {
     if (k < 2) return 0;
@@ -187,24 +163,21 @@ int jf__pca_smallest(const double a[9], double nrm[3])
     return 0;
 }
 
-static int pca_normal(const double *pts, size_t m, double nrm[3])
+int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3])
 {
-    double a[9], eval[3], evec[9];
-    if (!pca_cov(pts, m, a)) return 0;
+    uint32_t idx[PCA_K], c[PCA_K];
+    double d2[PCA_K], a[9], eval[3], evec[9];
+    size_t found = 0, k = 0;
+    if (!isfinite(xyz[3 * i]) || !isfinite(xyz[3 * i + 1]) || !isfinite(xyz[3 * i + 2]) ||
+        jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) != JF_OK)
+        return 0;
+    /* the point and its nearest others (16 in all: as the PCA pass) */
+    for (size_t j = 0; j < found && k + 1 < PCA_K; j++)
+        if (idx[j] != i) c[k++] = idx[j];
+    if (!pca_cov_about(xyz, i, c, k, a)) return 0;
     if (jf__pca_smallest(a, nrm)) return 1;
     jf__eig3(a, eval, evec);
     return pca_pick(eval, evec, nrm);
-}
-
-int jf__planes_pca_one(const jf_index *ix, const double *xyz, size_t i, double nrm[3])
-{
-    uint32_t idx[PCA_K];
-    double d2[PCA_K], pts[3 * PCA_K];
-    size_t found = 0;
-    if (!isfinite(xyz[3 * i]) || !isfinite(xyz[3 * i + 1]) || !isfinite(xyz[3 * i + 2]) || jf_index_knn(ix, xyz + 3 * i, PCA_K, idx, d2, &found) != JF_OK)
-        return 0;
-    for (size_t j = 0; j < found; j++) memcpy(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3]));
-    return pca_normal(pts, found, nrm);
 }
 
 jf_status jf__planes_pca_knn(jf_natural *ntl, size_t n, int nt, double *nrm, unsigned *flags)

@@ -232,11 +232,7 @@ static double from_leaves(jf_natural_ws *ws, const plane *h, uint32_t u, double 
             for (; in && *np > 0; in &= in - 1) {
                 k = (uint32_t)__builtin_ctz(in);
                 if (d[k] >= 4 * r2 || s0 + k == u) continue; /* r2 shrinks as it is cut */
-                double x, y, z;
-                project(h, P + 3 * k, &x, &y, &z);
-                const double sx = x - ux, sy = y - uy;
-                if (cut(ws, np, sx, sy, sx * sx + sy * sy + (z - uz) * (z + uz), s0 + k))
-                    r2 = ws->r2 + uz * uz;
+                if (cut_by(ws, h, ux, uy, uz, s0 + k, np)) r2 = ws->r2 + uz * uz;
             }
         }
     return r2;
