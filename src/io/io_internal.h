@@ -184,6 +184,11 @@ jf_status jf_io_fail(jf_error *err, jf_status st, const char *name,
  * exact 128-bit integers; everything else goes to strtod. */
 int jf_parse_double(const char *s, const char *e, double *out);
 
+/* The number at the start of [s, e) in jf_parse_double's exact fast
+ * ranges: its end (the token is [s, end) if a separator follows), or NULL
+ * where jf_parse_double would ask strtod. */
+const char *jf_scan_double(const char *s, const char *e, double *out);
+
 /* m 10^q (m != 0) correctly rounded, by Eisel-Lemire (io_lemire.c): 1 and
  * *out, or 0 when it cannot tell (subnormal or overflowing results, |q| >
  * 64, the rare ambiguous products): the caller's exact path decides. */

@@ -156,42 +156,79 @@ static int wide_double(uint64_t m, int e10, double *out)
     return 1;
 }
 
-int jf_parse_double(const char *s, const char *e, double *out)
+/* Eight ASCII digits at p as their value, or -1 (fast_float's SWAR test
+ * and three multiplies; little-endian loads). */
+static inline int64_t eight_digits(const char *p)
+{
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    uint64_t x;
+    memcpy(&x, p, sizeof x);
+    if (((x & 0xF0F0F0F0F0F0F0F0ULL) |
+         (((x + 0x0606060606060606ULL) & 0xF0F0F0F0F0F0F0F0ULL) >> 4)) != 0x3333333333333333ULL)
+        return -1;
+    x -= 0x3030303030303030ULL;
+    x = x * 10 + (x >> 8);
+    x = (((x & 0x000000FF000000FFULL) * (100 + (1000000ULL << 32))) +
+         (((x >> 16) & 0x000000FF000000FFULL) * (1 + (10000ULL << 32)))) >> 32;
+    return (int64_t)(uint32_t)x;
+#else
+    (void)p;
+    return -1;
+#endif
+}
+
+/* Digits at *pp into m (at most 19 significant: *nd counts them), eight
+ * at a time once m is non-zero; *cnt counts every digit, *shift those
+ * taken (fraction: the exponent's decrement).  0 if strtod must decide
+ * (a 20th significant digit, or more than 400 digits). */
+static inline int digit_run(const char **pp, const char *e, uint64_t *m, int *nd, int *cnt,
+                            int *taken)
+{
+    const char *p = *pp;
+    for (;;) {
+        int64_t v8;
+        if (*m != 0 && *nd <= 11 && e - p >= 8 && (v8 = eight_digits(p)) >= 0) {
+            *m = *m * 100000000u + (uint64_t)v8;
+            *nd += 8, *taken += 8, p += 8;
+            if ((*cnt += 8) > 400)
+                return 0;
+            continue;
+        }
+        if (p >= e || (unsigned)(*p - '0') >= 10)
+            break;
+        if (*nd >= 19)
+            return 0;
+        *m = *m * 10 + (uint64_t)(*p - '0');
+        *nd += (*m != 0);
+        (*taken)++, p++;
+        if (++*cnt > 400) /* bounds the exponent; strtod decides */
+            return 0;
+    }
+    *pp = p;
+    return 1;
+}
+
+/* The decimal number at the start of [s, e) in the one-rounding and
+ * Eisel-Lemire ranges: its end, or NULL (nan, inf, hex, 20+ digits, no
+ * digits, a malformed exponent, subnormal results: strtod's cases). */
+const char *jf_scan_double(const char *s, const char *e, double *out)
 {
     const char *p = s;
     int neg = 0;
     if (p < e && (*p == '-' || *p == '+'))
         neg = (*p++ == '-');
     uint64_t m = 0;
-    int nd = 0, exp10 = 0, digits = 0;
-    while (p < e && (unsigned)(*p - '0') < 10) {
-        if (nd < 19) {
-            m = m * 10 + (uint64_t)(*p - '0');
-            nd += (m != 0);
-        } else {
-            return slow_double(s, e, out);
-        }
-        p++;
-        if (++digits > 400)
-            return slow_double(s, e, out);
-    }
+    int nd = 0, exp10 = 0, digits = 0, ip = 0, fp = 0;
+    if (!digit_run(&p, e, &m, &nd, &digits, &ip))
+        return NULL;
     if (p < e && *p == '.') {
         p++;
-        while (p < e && (unsigned)(*p - '0') < 10) {
-            if (nd < 19) {
-                m = m * 10 + (uint64_t)(*p - '0');
-                nd += (m != 0);
-                exp10--;
-            } else {
-                return slow_double(s, e, out);
-            }
-            p++;
-            if (++digits > 400) /* bounds exp10; strtod decides */
-                return slow_double(s, e, out);
-        }
+        if (!digit_run(&p, e, &m, &nd, &digits, &fp))
+            return NULL;
+        exp10 = -fp;
     }
     if (!digits)
-        return slow_double(s, e, out); /* nan, inf, or not a number */
+        return NULL;
     if (p < e && (*p == 'e' || *p == 'E')) {
         p++;
         int eneg = 0, ev = 0, ed = 0;
@@ -202,23 +239,32 @@ int jf_parse_double(const char *s, const char *e, double *out)
             ed++;
         }
         if (!ed || (p < e && (unsigned)(*p - '0') < 10))
-            return slow_double(s, e, out);
+            return NULL;
         exp10 += eneg ? -ev : ev;
     }
-    if (p != e)
-        return slow_double(s, e, out); /* hex float, or not a number */
     if (m > ((uint64_t)1 << 53) || exp10 > 22 || exp10 < -22) {
         double v;
         if (!jf__lemire(m, exp10, &v) &&
             (exp10 < -27 || exp10 > 27 || !wide_double(m, exp10, &v)))
-            return slow_double(s, e, out);
+            return NULL;
         *out = neg ? -v : v;
-        return 1;
+        return p;
     }
     double v = (double)m;
     v = exp10 >= 0 ? v * jf_pow10[exp10] : v / jf_pow10[-exp10];
     *out = neg ? -v : v;
-    return 1;
+    return p;
+}
+
+int jf_parse_double(const char *s, const char *e, double *out)
+{
+    /* the whole token or strtod (hex floats, nan, inf, long mantissas) */
+    double v;
+    if (jf_scan_double(s, e, &v) == e) {
+        *out = v;
+        return 1;
+    }
+    return slow_double(s, e, out);
 }
 
 int jf_parse_size(const char *s, const char *e, uint64_t max, uint64_t *out)

@@ -372,6 +372,54 @@ START_TEST(exact_decimal_parse)
 }
 END_TEST
 
+/* After the first row, rows of exactly the first row's numbers are read
+ * in one pass (jf_scan_double); every other row goes field by field.
+ * Both must give strtod's values, and a bad row after good ones its own
+ * error, with its line. */
+START_TEST(xyz_one_pass_rows)
+{
+    const char *s = "1 2 3\n"
+                    "  -0.5\t+2.25;3e-2  \n"        /* blanks, tab, ';' */
+                    "4,5,6,\n"                       /* trailing comma */
+                    ".5 5. 0x1p3\n"                  /* hex: strtod */
+                    "inf -nan 1\n"                   /* words: strtod */
+                    "12345678901234567890123 1e-400 7\n"
+                    "0.000000000000000012345678901234567 1.2345678901234567e+300 9\n";
+    jf_cloud c;
+    read_ok(text("onepass.xyz", s), NULL, &c);
+    ck_assert_uint_eq(c.n, 7);
+    const char *nums[] = {"1", "2", "3", "-0.5", "2.25", "3e-2", "4", "5", "6", ".5", "5.",
+                          "0x1p3", "inf", "-nan", "1", "12345678901234567890123", "1e-400",
+                          "7", "0.000000000000000012345678901234567",
+                          "1.2345678901234567e+300", "9"};
+    for (size_t i = 0; i < 21; i++) {
+        double want = strtod(nums[i], NULL);
+        ck_assert_msg(memcmp(&want, &c.xyz[i], 8) == 0 || (isnan(want) && isnan(c.xyz[i])),
+                      "value %zu (%s): %.17g", i, nums[i], c.xyz[i]);
+    }
+    ck_assert(signbit(c.xyz[3]));
+    jf_cloud_free(&c);
+    /* six columns: normals; a short, a long and a broken row fail with
+     * their line */
+    read_ok(text("six.xyz", "0 0 0 0 0 1\n1 1 1 0.6 0.8 0\n"), NULL, &c);
+    ck_assert_ptr_nonnull(c.nrm);
+    ck_assert(c.nrm[3] == 0.6 && c.nrm[4] == 0.8 && c.xyz[5] == 1);
+    jf_cloud_free(&c);
+    static const char *const bad[][2] = {
+        {"1 2 3\n4 5 6\n7 8\n", ":3:"},
+        {"1 2 3\n4 5 6\n7 8 9 10\n", ":3:"},
+        {"1 2 3\n4 5 6x\n", ":2:"},
+        {"1 2 3\n4 5 1e\n", ":2:"},
+        {"1 2 3\n4 5 --6\n", ":2:"}};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        jf_error e;
+        const char *path = text("bad.xyz", bad[i][0]);
+        ck_assert_int_eq(jf_cloud_read(path, NULL, &c, &e), JF_ERR_FORMAT);
+        ck_assert_msg(strstr(e.msg, bad[i][1]) != NULL, "case %zu: %s", i, e.msg);
+    }
+}
+END_TEST
+
 START_TEST(parse_vs_strtod)
 {
     /* 19-, 18-, 17- and short-digit mantissas, exponents -40..40, and
@@ -447,6 +495,7 @@ int main(void)
     tcase_add_test(tc, off_variants);
     tcase_add_test(tc, exact_decimal_parse);
     tcase_add_test(tc, parse_vs_strtod);
+    tcase_add_test(tc, xyz_one_pass_rows);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
