@@ -11,10 +11,13 @@
  *     thread, to run Python's signal handlers: Ctrl-C raises
  *     KeyboardInterrupt in the handler, the hook says stop, every OpenMP
  *     thread leaves after its current block of 256 points.
- *  3. The per-point results are copied into the Result's arrays.
- * Memory: the library's own (k-d tree ~40 B/point, 216 B/point of
- * jf_result) plus the Result's arrays (148-220 B/point); no copy of the
- * points when they are float64 C-contiguous. */
+ *  3. The results go into the Result's arrays block by block as they are
+ *     fitted (jf_estimate_blocks' sink, on the estimate's threads), except
+ *     with orient='mst', which needs every normal first: then n results
+ *     are kept and copied (jf_estimate_blocks would fit twice).
+ * Memory: the library's own (k-d tree ~40 B/point; with mst 216 B/point
+ * of jf_result) plus the Result's arrays (116-188 B/point); no copy of
+ * the points when they are float64 C-contiguous. */
 #include <time.h>
 
 #include <omp.h>
@@ -61,8 +64,11 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
     }
     PyObject *result = jf_py_result_new(c->n, po->e.monge, points, faces);
     if (!result) return NULL;
-    jf_result *res = PyMem_RawMalloc((c->n ? c->n : 1) * sizeof *res);
-    if (!res) {
+    /* mst orients after every normal is known: jf_estimate_blocks would
+     * fit twice, so that one keeps the n results and copies them */
+    const int whole = o->orient == JF_ORIENT_MST;
+    jf_result *res = whole ? PyMem_RawMalloc((c->n ? c->n : 1) * sizeof *res) : NULL;
+    if (whole && !res) {
         Py_DECREF(result);
         return PyErr_NoMemory();
     }
@@ -71,9 +77,14 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
     o->cancel = check_signals;
     o->cancel_user = &cx;
     cx.ts = PyEval_SaveThread();
-    jf_status st = jf_estimate(c, o, res, &err);
-    if (st == JF_OK)
-        jf_py_result_fill(result, res, c->n, o->threads > 0 ? o->threads : omp_get_max_threads());
+    jf_status st;
+    if (whole) {
+        st = jf_estimate(c, o, res, &err);
+        if (st == JF_OK)
+            jf_py_result_fill(result, res, c->n, o->threads > 0 ? o->threads : omp_get_max_threads());
+    } else {
+        st = jf_estimate_blocks(c, o, jf_py_result_block, result, &err);
+    }
     PyEval_RestoreThread(cx.ts);
     PyMem_RawFree(res);
     if (st != JF_OK) {

@@ -75,6 +75,10 @@ PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *face
 /* Copies res[0..n-1] into the Result's arrays on `threads` OpenMP threads
  * (<= 0: all cores); no Python calls. */
 void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads);
+/* jf_block_fn writing a block of results into the Result `result`
+ * (jf_estimate_blocks' sink: straight into the arrays, no n results in
+ * between; thread-safe, blocks are disjoint). */
+jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, size_t m);
 /* The output file's columns and rows, as the command writes them. */
 size_t jf_py_result_columns(PyObject *result, jf_column *cols);
 int jf_py_result_monge(PyObject *result);

@@ -67,35 +67,55 @@ PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *face
     return (PyObject *)r;
 }
 
+/* Where each column of a Result is written. */
+typedef struct {
+    double *nrm, *k1, *k2, *d1, *d2, *cond, *resid, *b, *c;
+    int32_t *deg, *nb, *st;
+} outp;
+
+static outp out_ptrs(Result *r)
+{
+    return (outp){PyArray_DATA(ARR(r->normal)), PyArray_DATA(ARR(r->k1)),
+                  PyArray_DATA(ARR(r->k2)),     PyArray_DATA(ARR(r->d1)),
+                  PyArray_DATA(ARR(r->d2)),     PyArray_DATA(ARR(r->cond)),
+                  PyArray_DATA(ARR(r->residual)),
+                  r->monge >= 3 ? PyArray_DATA(ARR(r->b)) : NULL,
+                  r->monge >= 4 ? PyArray_DATA(ARR(r->c)) : NULL,
+                  PyArray_DATA(ARR(r->degree)), PyArray_DATA(ARR(r->neighbors)),
+                  PyArray_DATA(ARR(r->status))};
+}
+
+static void put(const outp *o, size_t i, const jf_result *p)
+{
+    memcpy(o->nrm + 3 * i, p->normal, sizeof p->normal);
+    memcpy(o->d1 + 3 * i, p->d1, sizeof p->d1);
+    memcpy(o->d2 + 3 * i, p->d2, sizeof p->d2);
+    o->k1[i] = p->k1;
+    o->k2[i] = p->k2;
+    if (o->b) memcpy(o->b + 4 * i, p->b, sizeof p->b);
+    if (o->c) memcpy(o->c + 5 * i, p->c, sizeof p->c);
+    o->deg[i] = p->degree;
+    o->nb[i] = p->n_used;
+    o->st[i] = (int32_t)p->status;
+    o->cond[i] = p->cond;
+    o->resid[i] = p->residual;
+}
+
 void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads)
 {
-    Result *r = (Result *)result;
-    double *nrm = PyArray_DATA(ARR(r->normal)), *k1 = PyArray_DATA(ARR(r->k1)),
-           *k2 = PyArray_DATA(ARR(r->k2)), *d1 = PyArray_DATA(ARR(r->d1)),
-           *d2 = PyArray_DATA(ARR(r->d2)), *cond = PyArray_DATA(ARR(r->cond)),
-           *resid = PyArray_DATA(ARR(r->residual));
-    double *b = r->monge >= 3 ? PyArray_DATA(ARR(r->b)) : NULL;
-    double *c = r->monge >= 4 ? PyArray_DATA(ARR(r->c)) : NULL;
-    int32_t *deg = PyArray_DATA(ARR(r->degree)), *nb = PyArray_DATA(ARR(r->neighbors)),
-            *st = PyArray_DATA(ARR(r->status));
+    const outp o = out_ptrs((Result *)result);
     /* on the estimate's threads: the first touch of fresh output pages
      * costs as much as the copy (10^6 points: 0.2 s on one thread) */
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (size_t i = 0; i < n; i++) {
-        const jf_result *p = &res[i];
-        memcpy(nrm + 3 * i, p->normal, sizeof p->normal);
-        memcpy(d1 + 3 * i, p->d1, sizeof p->d1);
-        memcpy(d2 + 3 * i, p->d2, sizeof p->d2);
-        k1[i] = p->k1;
-        k2[i] = p->k2;
-        if (b) memcpy(b + 4 * i, p->b, sizeof p->b);
-        if (c) memcpy(c + 5 * i, p->c, sizeof p->c);
-        deg[i] = p->degree;
-        nb[i] = p->n_used;
-        st[i] = (int32_t)p->status;
-        cond[i] = p->cond;
-        resid[i] = p->residual;
-    }
+    for (size_t i = 0; i < n; i++) put(&o, i, &res[i]);
+}
+
+jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, size_t m)
+{
+    /* reads the arrays' data pointers only: no GIL needed */
+    const outp o = out_ptrs(result);
+    for (size_t j = 0; j < m; j++) put(&o, idx[j], &res[j]);
+    return JF_OK;
 }
 
 int jf_py_result_monge(PyObject *result) { return ((Result *)result)->monge; }
