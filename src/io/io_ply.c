@@ -265,6 +265,16 @@ static int read_value(ply *h, int t, int swap, const char **q, const char *le,
         h->p += type_size[t];
         return VAL_OK;
     }
+    /* the usual token, a number ending at a blank: one pass (the same
+     * value as jf_parse_double of the token); anything else, by token */
+    const char *p = *q;
+    while (p < le && jf_is_space(*p)) p++;
+    const char *e = p < le ? jf_scan_double(p, le, v) : NULL;
+    if (e && (e == le || jf_is_space(*e))) {
+        *ts = p, *te = *q = e;
+        (*found)++;
+        return VAL_OK;
+    }
     if (!jf_next_token(q, le, 0, ts, te)) return VAL_SHORT_ROW;
     (*found)++;
     return jf_parse_double(*ts, *te, v) ? VAL_OK : VAL_NOT_NUMBER;

@@ -204,6 +204,37 @@ START_TEST(ply_ascii_nan)
 }
 END_TEST
 
+/* ascii PLY values: a number ending at a blank is read in one pass,
+ * anything else token by token; both give strtod's double, and a token
+ * with a tail is named. */
+START_TEST(ply_ascii_one_pass)
+{
+    const char *s = "ply\nformat ascii 1.0\nelement vertex 3\n"
+                    "property float x\nproperty float y\nproperty double z\nend_header\n"
+                    "  0.1000000000000000055511151231257827\t-2.5e-3 7\n"
+                    "12345678901234567890123 .5 5.\n"
+                    "1.7976931348623157e308 4.9406564584124654e-324 -1e-5\n";
+    jf_cloud c;
+    read_ok(text("onepass.ply", s), NULL, &c);
+    ck_assert_uint_eq(c.n, 3);
+    const char *nums[] = {"0.1000000000000000055511151231257827", "-2.5e-3", "7",
+                          "12345678901234567890123", ".5", "5.", "1.7976931348623157e308",
+                          "4.9406564584124654e-324", "-1e-5"};
+    for (size_t i = 0; i < 9; i++) {
+        double want = strtod(nums[i], NULL);
+        ck_assert_msg(memcmp(&want, &c.xyz[i], 8) == 0, "value %zu (%s): %.17g", i, nums[i],
+                      c.xyz[i]);
+    }
+    jf_cloud_free(&c);
+    jf_error e;
+    const char *path = text("tail.ply", "ply\nformat ascii 1.0\nelement vertex 2\n"
+                                        "property double x\nproperty double y\n"
+                                        "property double z\nend_header\n1 2 3\n4 5 6x\n");
+    ck_assert_int_eq(jf_cloud_read(path, NULL, &c, &e), JF_ERR_FORMAT);
+    ck_assert_msg(strstr(e.msg, ":9:") && strstr(e.msg, "'6x' is not a number"), "%s", e.msg);
+}
+END_TEST
+
 /* ---- XYZ / PTS / CSV ------------------------------------------------------ */
 
 START_TEST(xyz_columns)
@@ -487,6 +518,7 @@ int main(void)
     tcase_add_test(tc, ply_binary_be);
     tcase_add_test(tc, ply_binary_le_faces);
     tcase_add_test(tc, ply_ascii_nan);
+    tcase_add_test(tc, ply_ascii_one_pass);
     tcase_add_test(tc, xyz_columns);
     tcase_add_test(tc, xyz_default_normals);
     tcase_add_test(tc, xyz_nan_rows_kept);
