@@ -326,8 +326,8 @@ static jf_status read_elem(ply *h, const ply_elem *el, const ply_plan *pl,
                                       (unsigned long long)r,
                                       (unsigned long long)el->count);
                 q = ls;
-            } while (!jf_next_token(&q, le, 0, &ts, &te));
-            q = ls;
+                while (q < le && jf_is_space(*q)) q++; /* a blank line: skipped */
+            } while (q == le);
             line = h->tx.line;
         }
         for (int k = 0; k < el->nprops; k++) {
