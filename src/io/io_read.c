@@ -178,7 +178,7 @@ static inline int64_t eight_digits(const char *p)
 }
 
 /* Digits at *pp into m (at most 19 significant: *nd counts them), eight
- * at a time once m is non-zero; *cnt counts every digit, *shift those
+ * at a time once m is non-zero; *cnt counts every digit, *taken those
  * taken (fraction: the exponent's decrement).  0 if strtod must decide
  * (a 20th significant digit, or more than 400 digits). */
 static inline int digit_run(const char **pp, const char *e, uint64_t *m, int *nd, int *cnt,
