@@ -9,8 +9,11 @@
  *  2. For part a: index its own points; each own point turns its
  *     neighbourhood into at most two requests "the k nearest within
  *     squared distance <= bound", bound its own k-th distance
- *     (jf__halo_requests).  Every other part b whose box is within a
- *     request's bound is indexed in turn (one at a time) and answers with
+ *     (jf__halo_requests; in space order, knn points whose own k-th
+ *     distance is bounded below every other box's distance by the
+ *     previous query's skip theirs: jf__halo_requests_near).  Every
+ *     other part b whose box is within a request's bound is indexed in
+ *     turn (one at a time) and answers with
  *     its k nearest within the bound; the answers' union is the halo: it
  *     holds every remote point of every own point's neighbourhood over the
  *     whole cloud (a point of b in that neighbourhood is among b's k
@@ -96,12 +99,16 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const size_t *c
     uint32_t *idx = malloc(scratch * sizeof *idx), *bids = NULL, *h = NULL;
     double *d2 = malloc(scratch * sizeof *d2), *bxyz = NULL;
     size_t nh = 0, caph = 0, bmax = 0;
-    jf_status st = idx && d2 ? JF_OK : JF_ERR_NOMEM;
-    /* requests that reach another part's box (serial: cheap beside the
-     * fits; kept compact, 32 bytes each) */
-    for (size_t j = 0; st == JF_OK && j < m; j++) {
+    uint32_t *ord = malloc((m ? m : 1) * sizeof *ord);
+    jf_status st = idx && d2 && ord ? JF_OK : JF_ERR_NOMEM;
+    if (st == JF_OK) st = jf_spatial_order(xyz, m, ord);
+    /* requests that reach another part's box (serial: in space order only
+     * the points near the part's rim query; kept compact, 32 bytes each) */
+    double last[4] = {0, 0, 0, INFINITY};
+    for (size_t jj = 0; st == JF_OK && jj < m; jj++) {
+        const size_t j = ord[jj];
         jf_halo_req r[2];
-        int nr = jf__halo_requests(own, q, xyz + 3 * j, idx, d2, r);
+        int nr = jf__halo_requests_near(own, q, box, P, a, xyz + 3 * j, last, idx, d2, r);
         for (int t = 0; t < nr; t++) {
             int reach = 0;
             for (int b = 0; b < P && !reach; b++)
@@ -158,6 +165,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const size_t *c
         }
     }
     free(rq);
+    free(ord);
     free(idx);
     free(d2);
     free(bids);

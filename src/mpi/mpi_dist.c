@@ -384,36 +384,6 @@ static int cmp_hpt(const void *a, const void *b)
     return (x->gid > y->gid) - (x->gid < y->gid);
 }
 
-/* Point p's requests (jf__halo_requests), or none when, for knn, no
- * other part can hold one of its k nearest: its own k-th distance is at
- * most last[3] + |p - last| (the triangle inequality, last = the point
- * queried before it on this thread, last[3] its own k-th distance), and
- * every other part's box lies farther than that (a margin of 1e-9 for
- * the roundings; ties cannot occur beyond it).  Walked in space order,
- * an interior point skips its query.  last is updated on a query. */
-static int requests_of(const jf_index *ix, const jf_part_query *q, const double *boxes, int P,
-                       int rank, const double p[3], double last[4], uint32_t *ti, double *td,
-                       jf_halo_req rq[2])
-{
-    const int knn = q->nb.kind == JF_NB_KNN;
-    if (knn && last[3] < INFINITY) {
-        double d2 = 0, near2 = INFINITY;
-        for (int k = 0; k < 3; k++) d2 += (p[k] - last[k]) * (p[k] - last[k]);
-        const double u = sqrt(d2) + last[3];
-        for (int b = 0; b < P; b++) {
-            const double bd = b == rank ? INFINITY : jf__box_dist2(boxes + 6 * b, p);
-            if (bd < near2) near2 = bd; /* NaN: an empty part's box */
-        }
-        if (u * u * (1 + 1e-9) < near2) return 0;
-    }
-    const int nr = jf__halo_requests(ix, q, p, ti, td, rq);
-    if (knn && nr == 1) {
-        memcpy(last, p, sizeof(double[3]));
-        last[3] = sqrt(rq[0].bound);
-    }
-    return nr;
-}
-
 /* The halo of this rank's part (own: its points, by input index). */
 static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_query *q,
                        int threads, hpt **halo, size_t *nhalo, size_t *fetched)
@@ -458,8 +428,8 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
 #pragma omp for schedule(dynamic, 1024)
         for (size_t j = 0; j < nown; j++) {
             const size_t i = ord[j];
-            nrq[i] = ok ? (uint8_t)requests_of(ix, q, boxes, P, m->rank, own[i].xyz, last, ti, td,
-                                               rq + 2 * i)
+            nrq[i] = ok ? (uint8_t)jf__halo_requests_near(ix, q, boxes, P, m->rank, own[i].xyz,
+                                                          last, ti, td, rq + 2 * i)
                         : 0;
         }
         free(ti);

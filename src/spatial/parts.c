@@ -196,6 +196,31 @@ int jf__halo_requests(const jf_index *own, const jf_part_query *q, const double 
     }
 }
 
+int jf__halo_requests_near(const jf_index *own, const jf_part_query *q, const double *boxes,
+                           int nboxes, int self, const double p[3], double last[4],
+                           uint32_t *idx, double *d2, jf_halo_req req[2])
+{
+    const int knn = q->nb.kind == JF_NB_KNN;
+    if (knn && last[3] < INFINITY && finite3(p)) {
+        double dd = 0, near2 = INFINITY;
+        for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
+        /* own k-th distance <= last's + |p - last| (triangle inequality) */
+        const double u = sqrt(dd) + last[3];
+        for (int b = 0; b < nboxes; b++) {
+            const double bd = b == self ? INFINITY : jf__box_dist2(boxes + 6 * b, p);
+            if (bd < near2) near2 = bd;
+        }
+        /* strictly beyond, with room for the roundings: no tie either */
+        if (u * u * (1 + 1e-9) < near2) return 0;
+    }
+    const int nr = jf__halo_requests(own, q, p, idx, d2, req);
+    if (knn && nr == 1) {
+        memcpy(last, p, sizeof(double[3]));
+        last[3] = sqrt(req[0].bound);
+    }
+    return nr;
+}
+
 /* Growable list of input indices (one per thread). */
 typedef struct {
     uint32_t *v;

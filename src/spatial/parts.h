@@ -83,6 +83,17 @@ typedef struct {
 int jf__halo_requests(const jf_index *own, const jf_part_query *q, const double p[3],
                       uint32_t *idx, double *d2, jf_halo_req req[2]);
 
+/* jf__halo_requests, or 0 requests when (knn only) no other part can
+ * hold one of p's k nearest: p's own k-th distance is at most last[3] +
+ * |p - last| (last: the point queried before on this thread, last[3] its
+ * own k-th distance; start with last[3] = inf), and every box but
+ * boxes[self] (nboxes of them, 6 doubles each) lies strictly farther
+ * (a 1e-9 margin for the roundings).  Walked in space order, interior
+ * points skip their query.  last is updated when p is queried. */
+int jf__halo_requests_near(const jf_index *own, const jf_part_query *q, const double *boxes,
+                           int nboxes, int self, const double p[3], double last[4],
+                           uint32_t *idx, double *d2, jf_halo_req req[2]);
+
 /* A candidate of a request: squared distance, input index, and whether
  * it came from another part.  jf__halo_cmp orders by (d2, index), the
  * k-d tree's order: a request's neighbourhood is the first k of its
