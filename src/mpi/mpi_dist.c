@@ -136,17 +136,64 @@ typedef struct { /* one point of an answer */
     double xyz[3];
 } arec;
 
-static int cmp_key(const void *a, const void *b)
+/* Sorts *pp[0..n) by (key, gid), or by gid alone: a stable LSD radix
+ * sort of 11-bit digits (few enough buckets to stay in cache) over (key,
+ * gid, position) triples (a digit every item shares is skipped), then one
+ * gather into a new array, its loads independent of each other (qsort
+ * moved the 64-byte records log n times; following the permutation's
+ * cycles in place chains two cache misses per record).  0: no memory
+ * (*pp unchanged). */
+typedef struct {
+    uint64_t key;
+    uint32_t gid, at;
+} skey;
+
+enum { RBITS = 11, RSIZE = 1 << RBITS };
+
+static unsigned digit_of(const skey *e, int d)
 {
-    const prec *x = a, *y = b;
-    if (x->key != y->key) return x->key < y->key ? -1 : 1;
-    return (x->gid > y->gid) - (x->gid < y->gid);
+    /* digits 0-2: gid; 3-8: key */
+    const uint64_t v = d < 3 ? (uint64_t)e->gid >> (RBITS * d) : e->key >> (RBITS * (d - 3));
+    return (unsigned)(v & (RSIZE - 1));
 }
 
-static int cmp_gid(const void *a, const void *b)
+static int sort_precs(prec **pp, size_t n, int by_key)
 {
-    const prec *x = a, *y = b;
-    return (x->gid > y->gid) - (x->gid < y->gid);
+    if (n < 2) return 1;
+    prec *p = *pp;
+    skey *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    size_t *cnt = malloc(RSIZE * sizeof *cnt);
+    if (!a || !b || !cnt) {
+        free(a), free(b), free(cnt);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) a[i] = (skey){by_key ? p[i].key : 0, p[i].gid, (uint32_t)i};
+    for (int d = 0; d < (by_key ? 9 : 3); d++) {
+        memset(cnt, 0, RSIZE * sizeof *cnt);
+        for (size_t i = 0; i < n; i++) cnt[digit_of(&a[i], d)]++;
+        if (cnt[digit_of(&a[0], d)] == n) continue;
+        size_t sum = 0;
+        for (size_t v = 0; v < RSIZE; v++) {
+            const size_t c = cnt[v];
+            cnt[v] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) b[cnt[digit_of(&a[i], d)]++] = a[i];
+        skey *t = a;
+        a = b, b = t;
+    }
+    free(b);
+    free(cnt);
+    prec *out = malloc(n * sizeof *out);
+    if (!out) {
+        free(a);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) out[i] = p[a[i].at];
+    free(a);
+    free(p);
+    *pp = out;
+    return 1;
 }
 
 static int cmp_pair(const void *a, const void *b)
@@ -304,7 +351,7 @@ static void partition(jf_mpi *m, prec **pts, size_t *npts)
     const double scale = jf__morton_scale(box);
     for (size_t i = 0; i < *npts; i++)
         (*pts)[i].key = jf__morton_key((*pts)[i].xyz, box, scale);
-    qsort(*pts, *npts, sizeof **pts, cmp_key);
+    if (!sort_precs(pts, *npts, 1)) jf_mpi_fail(m, "out of memory (sort)");
 
     /* regular samples -> P-1 splitters */
     int ns = (int)(*npts < (size_t)(16 * P) ? *npts : (size_t)(16 * P)), tot = 0;
@@ -350,7 +397,8 @@ static void partition(jf_mpi *m, prec **pts, size_t *npts)
         free(*pts);
         *pts = got;
         *npts = ngot;
-        qsort(*pts, *npts, sizeof **pts, cmp_key);
+        if (!sort_precs(pts, *npts, 1)) jf_mpi_fail(m, "out of memory (sort)");
+        if (jf_mpi_check(m)) goto out;
 
         /* rebalance: global position in the (key, index) order -> part */
         uint64_t mine = *npts, off = 0;
@@ -363,7 +411,7 @@ static void partition(jf_mpi *m, prec **pts, size_t *npts)
         *pts = got;
         *npts = ngot;
     }
-    qsort(*pts, *npts, sizeof **pts, cmp_gid);
+    if (!sort_precs(pts, *npts, 0)) jf_mpi_fail(m, "out of memory (sort)");
 out:
     free(cnt);
     free(dsp);
