@@ -6,12 +6,13 @@
  *     (pread at their offsets: no rank reads the whole file);
  *  2. partition (parts.h's, distributed): the global bounding box of the
  *     finite points (allreduce), Morton keys, a sample sort on (key, input
- *     index) -- local sort, regular samples allgathered, P-1 splitters,
+ *     index) -- local radix sort, regular samples allgathered, P-1 splitters,
  *     all-to-all -- then a second all-to-all by global rank in that order,
  *     so part r holds exactly the ranks [nf r / P, nf (r+1) / P) (balanced
  *     within one point, whatever the splitters were);
- *  3. halo: each own point's requests (jf__halo_requests over the own
- *     k-d tree) go to the ranks whose part's box is within their bound;
+ *  3. halo: each own point's requests (jf__halo_requests_near over the
+ *     own k-d tree, in space order: interior knn points need none) go to
+ *     the ranks whose part's box is within their bound;
  *     each rank answers with its top k within the bound; the requester
  *     merges each request's answers with its own candidates in the
  *     (d2, index) order and keeps the first k: the remote points kept are
@@ -136,62 +137,34 @@ typedef struct { /* one point of an answer */
     double xyz[3];
 } arec;
 
-/* Sorts *pp[0..n) by (key, gid), or by gid alone: a stable LSD radix
- * sort of 11-bit digits (few enough buckets to stay in cache) over (key,
- * gid, position) triples (a digit every item shares is skipped), then one
- * gather into a new array, its loads independent of each other (qsort
- * moved the 64-byte records log n times; following the permutation's
- * cycles in place chains two cache misses per record).  0: no memory
- * (*pp unchanged). */
-typedef struct {
-    uint64_t key;
-    uint32_t gid, at;
-} skey;
-
-enum { RBITS = 11, RSIZE = 1 << RBITS };
-
-static unsigned digit_of(const skey *e, int d)
-{
-    /* digits 0-2: gid; 3-8: key */
-    const uint64_t v = d < 3 ? (uint64_t)e->gid >> (RBITS * d) : e->key >> (RBITS * (d - 3));
-    return (unsigned)(v & (RSIZE - 1));
-}
-
+/* Sorts *pp[0..n) by (key, gid), or by gid alone: jf__radix_sort of the
+ * positions by gid, then (stable) by key, and one gather into a new
+ * array, its loads independent of each other (qsort moved the 64-byte
+ * records log n times).  0: no memory (*pp unchanged). */
 static int sort_precs(prec **pp, size_t n, int by_key)
 {
     if (n < 2) return 1;
     prec *p = *pp;
-    skey *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
-    size_t *cnt = malloc(RSIZE * sizeof *cnt);
-    if (!a || !b || !cnt) {
-        free(a), free(b), free(cnt);
+    uint64_t *key = malloc(2 * n * sizeof *key);
+    uint32_t *ord = malloc(2 * n * sizeof *ord);
+    if (!key || !ord) {
+        free(key), free(ord);
         return 0;
     }
-    for (size_t i = 0; i < n; i++) a[i] = (skey){by_key ? p[i].key : 0, p[i].gid, (uint32_t)i};
-    for (int d = 0; d < (by_key ? 9 : 3); d++) {
-        memset(cnt, 0, RSIZE * sizeof *cnt);
-        for (size_t i = 0; i < n; i++) cnt[digit_of(&a[i], d)]++;
-        if (cnt[digit_of(&a[0], d)] == n) continue;
-        size_t sum = 0;
-        for (size_t v = 0; v < RSIZE; v++) {
-            const size_t c = cnt[v];
-            cnt[v] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++) b[cnt[digit_of(&a[i], d)]++] = a[i];
-        skey *t = a;
-        a = b, b = t;
+    for (size_t i = 0; i < n; i++) key[i] = p[i].gid, ord[i] = (uint32_t)i;
+    jf__radix_sort(key, ord, n, 32, key + n, ord + n);
+    if (by_key) {
+        for (size_t i = 0; i < n; i++) key[i] = p[ord[i]].key;
+        jf__radix_sort(key, ord, n, 64, key + n, ord + n);
     }
-    free(b);
-    free(cnt);
+    free(key);
     prec *out = malloc(n * sizeof *out);
     if (!out) {
-        free(a);
+        free(ord);
         return 0;
     }
-    for (size_t i = 0; i < n; i++) out[i] = p[a[i].at];
-    free(a);
-    free(p);
+    for (size_t i = 0; i < n; i++) out[i] = p[ord[i]];
+    free(ord), free(p);
     *pp = out;
     return 1;
 }

@@ -18,6 +18,41 @@
 #define ORD_BITS 21
 #define ORD_DIGIT 11
 
+void jf__radix_sort(uint64_t *key, uint32_t *order, size_t n, int nbits, uint64_t *key_tmp,
+                    uint32_t *order_tmp)
+{
+    uint32_t *src_o = order, *dst_o = order_tmp;
+    uint64_t *src_k = key, *dst_k = key_tmp;
+    size_t count[1u << ORD_DIGIT];
+    for (int shift = 0; shift < nbits; shift += ORD_DIGIT) {
+        const uint64_t mask = (1u << ORD_DIGIT) - 1;
+        for (size_t b = 0; b <= mask; b++) count[b] = 0;
+        for (size_t i = 0; i < n; i++) count[(src_k[i] >> shift) & mask]++;
+        if (count[(src_k[0] >> shift) & mask] == n) continue; /* one digit */
+        size_t sum = 0;
+        for (size_t b = 0; b <= mask; b++) {
+            size_t c = count[b];
+            count[b] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) {
+            size_t at = count[(src_k[i] >> shift) & mask]++;
+            dst_k[at] = src_k[i];
+            dst_o[at] = src_o[i];
+        }
+        uint64_t *tk = src_k;
+        src_k = dst_k;
+        dst_k = tk;
+        uint32_t *to = src_o;
+        src_o = dst_o;
+        dst_o = to;
+    }
+    if (src_o != order) {
+        for (size_t i = 0; i < n; i++) order[i] = src_o[i];
+        for (size_t i = 0; i < n; i++) key[i] = src_k[i];
+    }
+}
+
 jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order)
 {
     if ((!xyz || !order) && n) return JF_ERR_INVALID;
@@ -48,35 +83,7 @@ jf_status jf_spatial_order(const double *xyz, size_t n, uint32_t *order)
         key[i] = jf__morton_key(p, box, scale);
     }
     /* LSD radix sort on 63 bits (64 if a UINT64_MAX key is present) */
-    int nbits = any_bad ? 64 : 3 * ORD_BITS;
-    uint32_t *src_o = order, *dst_o = tmp;
-    uint64_t *src_k = key, *dst_k = key2;
-    size_t count[1u << ORD_DIGIT];
-    for (int shift = 0; shift < nbits; shift += ORD_DIGIT) {
-        const uint64_t mask = (1u << ORD_DIGIT) - 1;
-        for (size_t b = 0; b <= mask; b++) count[b] = 0;
-        for (size_t i = 0; i < n; i++) count[(src_k[i] >> shift) & mask]++;
-        if (count[(src_k[0] >> shift) & mask] == n) continue; /* one digit */
-        size_t sum = 0;
-        for (size_t b = 0; b <= mask; b++) {
-            size_t c = count[b];
-            count[b] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++) {
-            size_t at = count[(src_k[i] >> shift) & mask]++;
-            dst_k[at] = src_k[i];
-            dst_o[at] = src_o[i];
-        }
-        uint64_t *tk = src_k;
-        src_k = dst_k;
-        dst_k = tk;
-        uint32_t *to = src_o;
-        src_o = dst_o;
-        dst_o = to;
-    }
-    if (src_o != order)
-        for (size_t i = 0; i < n; i++) order[i] = src_o[i];
+    jf__radix_sort(key, order, n, any_bad ? 64 : 3 * ORD_BITS, key2, tmp);
     free(key);
     free(tmp);
     return JF_OK;

@@ -39,6 +39,13 @@ typedef struct {
  * JF_ERR_INVALID (bad parameters). */
 jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q);
 
+/* Stable LSD radix sort (11-bit digits; a digit all keys share is
+ * skipped) of the pairs (key[i], order[i]) by the low nbits of key; the
+ * result is left in key and order.  key_tmp, order_tmp: n entries of
+ * scratch.  jf_spatial_order's sort; jetfit-mpi's record sorts. */
+void jf__radix_sort(uint64_t *key, uint32_t *order, size_t n, int nbits, uint64_t *key_tmp,
+                    uint32_t *order_tmp);
+
 /* Morton keys as jf_spatial_order makes them: 21 bits per axis over the
  * cube of side max extent from lo (box = lo xyz, hi xyz of the finite
  * points).  *scale for jf__morton_key. */
