@@ -1,4 +1,4 @@
-/* bench_parts.c -- halo figures of the partition (src/spatial/parts.c) for
+/* bench_parts.c -- halo figures of the partition (src/estimate/parts.c) for
  * docs/scale.md "Distributed runs": P parts simulated in one process.
  *
  * For knn:16 and knn:64 at P = 2, 8, 64, 512 it prints the halo fraction

@@ -1,6 +1,6 @@
 /* parts.h -- space cut into parts, and the exact halo each part needs to
  * compute its points' k-NN / radius neighbourhoods as one index over the
- * whole cloud would (src/spatial/parts.c; not part of the public API).
+ * whole cloud would (src/estimate/parts.c; not part of the public API).
  *
  * Used by `jetfit-mpi` (one part per rank, src/mpi/) and by the bounded-
  * memory estimate (parts processed one at a time).  Both follow the same
@@ -134,13 +134,13 @@ jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int 
 
 /* jf_estimate on c fitting only the points with fit[i] != 0 (fit NULL:
  * all); the others get a NONFINITE row (NaN, left alone by the
- * orientation) and are still neighbours.  Defined in core/pipeline.c. */
+ * orientation) and are still neighbours.  Defined in estimate/pipeline.c. */
 jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o,
                               const uint8_t *fit, jf_result *out, jf_error *err);
 
 /* jf_estimate_blocks with the same mask: only the points with fit[i] != 0
  * are fitted and handed to the sink (the halo points are neighbours
- * only).  Defined in core/pipeline.c; used by core/parts_run.c. */
+ * only).  Defined in estimate/pipeline.c; used by estimate/parts_run.c. */
 jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
                                      const uint8_t *fit, jf_block_fn sink, void *user,
                                      jf_error *err);

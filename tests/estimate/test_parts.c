@@ -1,4 +1,4 @@
-/* test_parts.c -- partition into parts and exact halos (src/spatial/parts.c):
+/* test_parts.c -- partition into parts and exact halos (src/estimate/parts.c):
  * for clouds whose part boundaries cut dense regions (lattices with points
  * exactly on the cuts and equidistant ties, duplicates straddling a cut,
  * K larger than some parts' count, empty parts, non-finite points), every
