@@ -4,15 +4,18 @@
  * design: the points arrive already translated to p (so coordinates of
  * 1e6 lose nothing); the covariance is accumulated in two passes about the
  * weighted centroid (CGAL 5.5.1 sums in one pass in world coordinates and
- * loses all precision at large offsets, see CGAL_NOTES.md); a cyclic Jacobi
+ * loses all precision at large offsets, docs/design.md "CGAL 5.5.1"); a cyclic Jacobi
  * eigen-solver gives orthonormal eigenvectors whose signs are pinned so the
  * frame, hence every result, is reproducible. */
-#include <emmintrin.h>
 #include <float.h>
 #include <math.h>
 #include <string.h>
 
 #include "fitter_internal.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* Pins the sign of v: its largest-|component| (first on ties) positive. */
 static void pin_sign(double *v)
@@ -179,7 +182,11 @@ typedef long long v2l __attribute__((vector_size(16)));
 
 static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
 static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
+#if defined(__SSE2__)
 static inline v2d sqrt2(v2d x) { return (v2d)_mm_sqrt_pd((__m128d)x); }
+#else /* IEEE sqrt is correctly rounded: the same bits lane by lane */
+static inline v2d sqrt2(v2d x) { return (v2d){sqrt(x[0]), sqrt(x[1])}; }
+#endif
 
 void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
                  double eval1[3], double evec1[9])

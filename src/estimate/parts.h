@@ -25,6 +25,7 @@
 #include <stdint.h>
 
 #include "jetfit.h"
+#include "order_internal.h"
 
 /* The neighbourhood query jf_estimate makes for a kind the k-d tree
  * answers (knn, radius, knn+radius), with the pipeline's sizes. */
@@ -38,23 +39,6 @@ typedef struct {
  * JF_ERR_UNSUPPORTED (rings, natural: not a k-d tree query),
  * JF_ERR_INVALID (bad parameters). */
 jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q);
-
-/* Stable LSD radix sort (11-bit digits; a digit all keys share is
- * skipped) of the pairs (key[i], order[i]) by the low nbits of key; the
- * result is left in key and order.  key_tmp, order_tmp: n entries of
- * scratch.  jf_spatial_order's sort; jetfit-mpi's record sorts. */
-void jf__radix_sort(uint64_t *key, uint32_t *order, size_t n, int nbits, uint64_t *key_tmp,
-                    uint32_t *order_tmp);
-
-/* Morton keys as jf_spatial_order makes them: 21 bits per axis over the
- * cube of side max extent from lo (box = lo xyz, hi xyz of the finite
- * points).  *scale for jf__morton_key. */
-double jf__morton_scale(const double box[6]);
-uint64_t jf__morton_key(const double p[3], const double box[6], double scale);
-
-/* Bounding box of the finite points of xyz[3n] (lo xyz, hi xyz); with no
- * finite point lo = +inf, hi = -inf.  Returns the number of finite points. */
-size_t jf__parts_bbox(const double *xyz, size_t n, double box[6]);
 
 /* Step 1 in one process: part[i] in 0..nparts-1 for each finite point,
  * -1 for the others.  Part r holds the finite points of ranks

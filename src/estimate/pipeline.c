@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <emmintrin.h>
 #include <omp.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -30,8 +29,9 @@
 #define _mm_sfence() ((void)0)
 #endif
 
-#include "fitter_internal.h"
 #include <stdint.h>
+
+#include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
 #include "orient_internal.h"

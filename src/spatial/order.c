@@ -13,10 +13,71 @@
 #include <stdlib.h>
 
 #include "jetfit.h"
-#include "parts.h"
+#include "order_internal.h"
 
 #define ORD_BITS 21
 #define ORD_DIGIT 11
+
+static int finite3(const double *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+/* Morton keys: 21 bits per axis, interleaved (x in bit 0) */
+
+/* Spreads the low 21 bits of v so that bit i moves to bit 3i. */
+static uint64_t spread3(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
+static uint64_t quantise(double v, double lo, double scale)
+{
+    double t = (v - lo) * scale;
+    if (!(t > 0)) return 0;
+    if (t >= (double)((1u << ORD_BITS) - 1)) return (1u << ORD_BITS) - 1;
+    return (uint64_t)t;
+}
+
+double jf__morton_scale(const double box[6])
+{
+    double ext = 0;
+    for (int d = 0; d < 3; d++)
+        if (box[3 + d] - box[d] > ext) ext = box[3 + d] - box[d];
+    return ext > 0 && isfinite(ext) ? (double)((1u << ORD_BITS) - 1) / ext : 0.0;
+}
+
+uint64_t jf__morton_key(const double p[3], const double box[6], double scale)
+{
+    return spread3(quantise(p[0], box[0], scale)) | spread3(quantise(p[1], box[1], scale)) << 1 |
+           spread3(quantise(p[2], box[2], scale)) << 2;
+}
+
+size_t jf__parts_bbox(const double *xyz, size_t n, double box[6])
+{
+    size_t m = 0;
+    for (int d = 0; d < 3; d++) {
+        box[d] = INFINITY;
+        box[3 + d] = -INFINITY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        if (!finite3(p)) continue;
+        m++;
+        for (int d = 0; d < 3; d++) {
+            if (p[d] < box[d]) box[d] = p[d];
+            if (p[d] > box[3 + d]) box[3 + d] = p[d];
+        }
+    }
+    return m;
+}
+
 
 void jf__radix_sort(uint64_t *key, uint32_t *order, size_t n, int nbits, uint64_t *key_tmp,
                     uint32_t *order_tmp)

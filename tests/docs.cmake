@@ -1,0 +1,11 @@
+# The repository's own consistency (issue 24): every path or section a
+# comment or document names exists (check_refs.py), and the library's
+# folders call only down (check_layers.py, over the built objects).
+find_program(JF_PY3 NAMES python3)
+if(JF_PY3)
+  add_test(NAME check_refs COMMAND ${JF_PY3} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_refs.py
+           ${PROJECT_SOURCE_DIR})
+  add_test(NAME check_layers COMMAND ${JF_PY3} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_layers.py
+           ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/CMakeFiles/jetfit_obj.dir/src)
+  set_tests_properties(check_refs check_layers PROPERTIES LABELS docs)
+endif()
