@@ -13,7 +13,7 @@ extern "C" {
 const char *jfb_cgal_version(void);
 
 /* ---- 3D Delaunay triangulation of a cloud, flattened to plain arrays ----
- * (delaunay.cpp, poles.cpp).  The bridge builds CGAL's
+ * (delaunay.cpp, star.cpp).  The bridge builds CGAL's
  * Delaunay_triangulation_3 (spatially sorted range insertion), copies out
  * what the C core needs and destroys the triangulation before returning,
  * so nothing C++ outlives the call.  Every array is malloc'd by the bridge

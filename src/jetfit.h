@@ -132,7 +132,7 @@ typedef struct {
     double max_cond;         /* adaptive degree: lower the degree while
                                 kappa(M') > max_cond; >= 1, +INFINITY
                                 disables the test (default 1e3, measured:
-                                README "Choosing --max-cond")             */
+                                docs/numerics.md "Per point")             */
     size_t max_neighbors;    /* largest N a fitter accepts (default 256)   */
     jf_robust_mode robust;   /* IRLS weights on residuals (default none)   */
     int robust_iters;        /* IRLS iteration cap (default 10)            */
@@ -198,7 +198,7 @@ typedef struct {
 
 /* Flips the orientation of a result in place: normal -> -normal, every
  * Monge coefficient negated, k1<->k2, d1<->d2, b0<->b3, b1<->b2,
- * c0<->c4, c1<->c3 (DESIGN.md; the convention of CGAL's
+ * c0<->c4, c1<->c3 (docs/design.md; the convention of CGAL's
  * Monge_via_jet_fitting).  d1 x d2 = n is kept. */
 void jf_result_flip(jf_result *r);
 
@@ -254,7 +254,7 @@ jf_status jf_fitter_residuals(const jf_fitter *f, double *res, size_t n);
 /* The parameters the fitter was created with. */
 const jf_params *jf_fitter_params(const jf_fitter *f);
 
-/* The full per-point fit used by the command (src/scale.c, robust.c,
+/* The full per-point fit used by the command (src/robust/scale.c, robust.c,
  * select.c).
  *  - params.robust: iteratively reweighted least squares on the height
  *    residuals; scale s = 1.4826 median|r|; Huber (c = 1.345 s) or Tukey
@@ -285,10 +285,10 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *    unless the unweighted normal agrees within the intervals).  Lowers
  *    truncation error on clean data, costs variance under noise.  The
  *    command's --robust-normals is degree_select 1 with dist_weight 0.55
- *    (README: below CGAL's jet in every PCPNet cell on the same points).
+ *    (docs/robustness.md: below CGAL's jet in every PCPNet cell on the same points).
  * The degree-selection fitters of lower degrees are created once per thread
  * (on first use; recreated only when the parameters change) and freed at
- * thread exit.  Defaults (off) and constants: README, bench_pcpnet.
+ * thread exit.  Defaults (off) and constants: docs/robustness.md, bench_pcpnet.
  * With none set it is exactly jf_fit_point.  Returns what jf_fit_point
  * returns, or JF_ERR_NOMEM (n > 512 with robust or dist_weight: a
  * per-thread buffer is allocated once, grown when a larger n is first
@@ -782,7 +782,7 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
                          jf_error *err);
 
 /* ------------------------------------------------------------------ */
-/* Evaluation (src/eval.c): error measures against ground truth        */
+/* Evaluation (src/eval/eval.c): error measures against ground truth        */
 /* ------------------------------------------------------------------ */
 
 /* Unoriented angle between two directions in degrees, in [0, 90]:
@@ -839,7 +839,7 @@ int jf_eval_table_col(const jf_eval_table *t, const char *name);
 void jf_eval_table_free(jf_eval_table *t); /* NULL or zeroed: no-op */
 
 /* ------------------------------------------------------------------ */
-/* Orientation (src/orient.c)                                          */
+/* Orientation (src/spatial/orient.c)                                          */
 /* ------------------------------------------------------------------ */
 /* Each call flips whole results (jf_result_flip: curvature signs, k1/k2,
  * d1/d2 and Monge coefficients follow the normal).  Results with
@@ -885,7 +885,7 @@ jf_status jf_orient_mst_graph(jf_result *res, const double *xyz, size_t n,
                               const uint32_t *nbr, size_t k);
 
 /* ------------------------------------------------------------------ */
-/* Natural neighbourhoods (§5.1, point clouds; src/natural.c over the  */
+/* Natural neighbourhoods (§5.1, point clouds; src/spatial/natural.c over */
 /* CGAL bridge)                                                        */
 /* ------------------------------------------------------------------ */
 typedef enum {
@@ -924,7 +924,7 @@ typedef enum {
  * after create.  About 170 bytes per point (mean Delaunay degree ~18);
  * create peaks at ~750 bytes per point while CGAL's triangulation exists
  * (1M points of the §6.1 surface: 751 MiB vs 645 MiB for a plain CGAL
- * Delaunay_triangulation_3; tests/bench_natural). */
+ * Delaunay_triangulation_3; tests/bench/bench_natural.cpp). */
 typedef struct jf_natural jf_natural;
 
 /* Builds it over the finite points of xyz[3n] (non-finite points are left
@@ -1057,7 +1057,7 @@ void jf_tmpfiles_remove_all(void);
 int jf_same_file(const char *a, const char *b);
 
 /* ------------------------------------------------------------------ */
-/* Estimation pipeline (src/pipeline.c): a whole cloud, with OpenMP    */
+/* Estimation pipeline (src/estimate/): a whole cloud, with OpenMP    */
 /* ------------------------------------------------------------------ */
 #define JF_ESTIMATE_DEFAULT_K 32   /* knn:32, the command's default    */
 

@@ -1,5 +1,5 @@
 /* cmd_convergence.c -- `jetfit convergence --out DIR [--quick]`: the §6.1
- * experiment end to end (src/convergence.c), its tables and the plots of
+ * experiment end to end (src/synth/convergence.c), its tables and the plots of
  * Figures 5-12 made with gnuplot (optional: without it the CSVs are still
  * written and a note goes to stderr). */
 #include <errno.h>

@@ -58,7 +58,7 @@ static void usage(FILE *f)
         "                        0.3-0.4; default off)\n"
         "  --robust-normals      preset for normals on data of unknown noise:\n"
         "                        --degree-select 1 --dist-weight 0.55 (later flags\n"
-        "                        override; measured on PCPNet, see README)\n"
+        "                        override; measured on PCPNet: docs/robustness.md)\n"
         "  --columns X,Y,Z[,NX,NY,NZ]\n"
         "                        .xyz/.txt/.pts/.csv: 0-based columns of x y z [nx ny nz]\n"
         "                        (default: x y z first, normals in 3..5 if 6 columns)\n"

@@ -1,5 +1,5 @@
 /* cmd_generate.c -- `jetfit generate SURFACE -o FILE ...`: the paper's
- * surfaces (src/surfaces.c) as clouds or triangulated meshes, with exact
+ * surfaces (src/synth/surfaces.c) as clouds or triangulated meshes, with exact
  * ground truth and the noise models of issue 6.  Deterministic: the same
  * arguments and --seed give the same bytes. */
 #include <errno.h>

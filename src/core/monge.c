@@ -1,6 +1,6 @@
 /* monge.c -- differential quantities of a fitted jet (§3, §5.3, Table 1):
  * normal, principal curvatures and directions, Monge coefficients b0..b3,
- * c0..c4, and the orientation flip of DESIGN.md.
+ * c0..c4, and the orientation flip of docs/design.md.
  *
  * design: the jet z = J(u,v) lives in the fitting frame.  Its point above
  * p is P0 = (0,0,A00), with normal n ~ (-A10, -A01, 1) (the fitting frame's

@@ -4,8 +4,8 @@
 
 #include "jetfit.h"
 
-/* Default kappa threshold of the adaptive degree (§5.2), measured (README,
- * "Choosing --max-cond"): on exact §6.1 data kappa stays below ~3e4 and
+/* Default kappa threshold of the adaptive degree (§5.2), measured (docs/numerics.md
+ * "Per point"): on exact §6.1 data kappa stays below ~3e4 and
  * errors grow ~ kappa; on a raw bunny scan (bun000) fits with kappa > 1e3
  * have normals 38-57 degrees off a K64 2-jet on average, and lowering
  * them brings that to 11-18 degrees. */

@@ -1,7 +1,7 @@
 /* pipeline.c -- jf_estimate: index -> per point {neighbourhood, fit} ->
  * orientation, over a whole cloud, with OpenMP.
  *
- * design (DESIGN.md "The per-point computation", "Performance rules"):
+ * design (docs/design.md "Data flow of an estimate", "Performance rules"):
  *  1. Build what the neighbourhood needs once: the k-d tree (non-finite
  *     points are left out of it: nobody's neighbour), the mesh adjacency
  *     (rings), or the Delaunay triangulation and a tangent-plane normal

@@ -41,7 +41,7 @@ void jf_curv_compare(const double n[3], double k1, double k2,
                      double err_abs[2], double err_rel[2])
 {
     /* Orient the estimate along the truth first: flipping the normal
-     * negates the curvatures and swaps them (DESIGN.md, CGAL's rule). */
+     * negates the curvatures and swaps them (docs/design.md, CGAL's rule). */
     if (n[0] * n_true[0] + n[1] * n_true[1] + n[2] * n_true[2] < 0.0) {
         double t = k1;
         k1 = -k2;

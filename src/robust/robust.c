@@ -30,7 +30,7 @@
 /* Tuning constants of the selection rules (select.c, scale.c), one place
  * so that the bench-only setter below reaches them all. */
 /* Scale selection's weight of the variance in its MSE estimate (scale.c:
- * 2, by measurement on the §6.1 surface; README). */
+ * 2, by measurement on the §6.1 surface; docs/robustness.md). */
 #ifndef JF_SCALE_VARW
 #define JF_SCALE_VARW 2.0
 #endif
@@ -44,7 +44,7 @@
  * (0.55) on PCPNet's armadillo, the one set of the sweep below CGAL's jet
  * in all 24 cells with the widest margin (1.5 / 0.2 / 50; the earlier
  * 1 / 0.15 / no shrink lost 2 cells by up to 0.44 deg; bench_pcpnet
- * --same-points --dtau --dsdmin --dfloorn, README). */
+ * --same-points --dtau --dsdmin --dfloorn, docs/robustness.md). */
 #ifndef JF_DEGREE_TAU
 #define JF_DEGREE_TAU 1.5
 #endif
@@ -58,7 +58,7 @@
 jf__knobs jf__knob = {JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN,
                       JF_DEGREE_FLOOR_N};
 
-/* Bench-only setter of the knobs (tests/bench_pcpnet.cpp measures them);
+/* Bench-only setter of the knobs (tests/bench/bench_pcpnet.cpp measures them);
  * not in jetfit.h, not thread-safe: call before fitting.  name: a field
  * of jf__knobs.  Returns 0, or -1 for an unknown name. */
 int jf__robust_tune(const char *name, double v)

@@ -7,7 +7,7 @@
  * the permutation is deterministic and non-finite points come last, in
  * index order.  Neighbours in the order are mostly neighbours in space,
  * which keeps the k-d tree's and the fitter's working set in cache
- * (CGAL_NOTES.md: 2.5x-4.4x for PCL/Open3D on Z-ordered files).
+ * (docs/design.md "CGAL 5.5.1": 2.5x-4.4x for PCL/Open3D on Z-ordered files).
  */
 #include <math.h>
 #include <stdlib.h>

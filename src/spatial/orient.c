@@ -1,6 +1,6 @@
 /* orient.c -- a consistent side for the normals of a cloud of results.
  *
- * Three rules (DESIGN.md §7 "Orientation"), each flipping whole results with
+ * Three rules (docs/design.md "Data flow of an estimate"), each flipping whole results with
  * jf_result_flip so that curvature signs, k1/k2, d1/d2 and the Monge
  * coefficients follow the normal:
  *  - input:     agree with the normals read from the file;

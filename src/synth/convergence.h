@@ -1,6 +1,6 @@
 /* convergence.h -- the §6.1 convergence experiment as a library call
- * (internal header: src/convergence.c; used by cmd_convergence.c and
- * tests/test_convergence_mesh.c).
+ * (internal header: src/synth/convergence.c; used by cmd_convergence.c and
+ * tests/synth/test_convergence_mesh.c).
  *
  * Setup (§6.1): the graph f(u,v) = 0.1 exp(2u + v - v^2) sampled on a
  * triangulated square grid of side h, each vertex moved by (d h, d' h),
@@ -13,7 +13,7 @@
  * beyond them, so no neighbourhood meets the border.  The adaptive degree
  * is off (max_cond = DBL_MAX): every fit is at the requested degree
  * unless the system is rank deficient (counted in `lowered`).
- * Errors per point against the exact values of src/surfaces.c, the
+ * Errors per point against the exact values of src/synth/surfaces.c, the
  * estimate oriented along the exact normal: sin of the normal angle and
  * the relative errors |k - k_true| / |k_true| of kmin (k2) and kmax (k1);
  * the exp graph is hyperbolic everywhere (K < 0), so k_true != 0. */

@@ -1,9 +1,9 @@
 /* surfaces.h -- the paper's test surfaces with exact differential truth,
  * their samplings (random clouds, perturbed triangulated grids) and the
- * noise models of `jetfit generate` (internal header: src/surfaces.c,
- * src/surf_sample.c; used by cmd_generate.c, cmd_convergence.c and tests).
+ * noise models of `jetfit generate` (internal header: src/synth/surfaces.c,
+ * src/synth/surf_sample.c; used by cmd_generate.c, cmd_convergence.c and tests).
  *
- * Conventions (DESIGN.md): the normal is unit; k1 >= k2 are signed w.r.t.
+ * Conventions (docs/design.md): the normal is unit; k1 >= k2 are signed w.r.t.
  * it, i.e. near the point the surface is z = (k1 x^2 + k2 y^2)/2 along the
  * normal with x along d1, y along d2, and d1 x d2 = n.  Graphs z = f(x,y)
  * use the upward normal (-f_x, -f_y, 1)/W; closed surfaces (sphere,
@@ -85,7 +85,7 @@ uint64_t jf_rng_next(jf_rng *r);
 double jf_rng_uniform(jf_rng *r);   /* [0, 1), 53 bits              */
 double jf_rng_gauss(jf_rng *r);     /* N(0,1), Box-Muller (polar)    */
 
-/* ---------------- samplings (src/surf_sample.c) ---------------- */
+/* ---------------- samplings (src/synth/surf_sample.c) ---------------- */
 typedef enum {
     JF_DENSITY_UNIFORM = 0,
     JF_DENSITY_GRADIENT,   /* keep probability 0.05 + 0.95 t, t in [0,1]
@@ -138,7 +138,7 @@ double jf_sample_grid_h_for(jf_surface s, size_t n);
 jf_status jf_sample_graph_grid(jf_surface s, double h, int m, double perturb,
                                jf_rng *rng, jf_sample *out);
 
-/* ---------------- noise models (src/surf_sample.c) ---------------- */
+/* ---------------- noise models (src/synth/surf_sample.c) ---------------- */
 /* Diagonal and largest side of the bounding box of the n points. */
 void jf_bbox_measure(const double *xyz, size_t n, double *diag,
                      double *largest_side);

@@ -1,4 +1,4 @@
-/* bench_index.cpp -- jf_index (src/kdtree.c) against CGAL's kd-tree
+/* bench_index.cpp -- jf_index (src/spatial/kdtree.c) against CGAL's kd-tree
  * (Orthogonal_k_neighbor_search, Search_traits_3) and nanoflann
  * (KDTreeSingleIndexAdaptor), in the same run, one thread each.
  *

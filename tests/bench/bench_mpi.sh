@@ -5,7 +5,7 @@
 # measured in the same run.  Prints wall seconds, points/s, peak RSS of the
 # largest rank (GNU time), the slowest rank's exchange / fit / write
 # seconds and the halo, and checks that every output is byte-identical.
-# A benchmark, not a test (docs/scale.md "Distributed runs").
+# A benchmark, not a test (docs/scale.md "How it works").
 # Usage: sh tests/bench/bench_mpi.sh [BUILD_DIR] [N] [WORK_DIR]
 set -u
 top=$(cd "$(dirname "$0")/../.." && pwd)

@@ -1,5 +1,5 @@
 /* bench_parts.c -- halo figures of the partition (src/estimate/parts.c) for
- * docs/scale.md "Distributed runs": P parts simulated in one process.
+ * docs/scale.md "Halo fraction": P parts simulated in one process.
  *
  * For knn:16 and knn:64 at P = 2, 8, 64, 512 it prints the halo fraction
  * (points fetched from other parts / points owned, summed over the parts),

@@ -46,7 +46,7 @@
 
 #include "jetfit.h"
 
-// src/robust.c's bench-only setter of its tuning constants (scale_varw,
+// src/robust/robust.c's bench-only setter of its tuning constants (scale_varw,
 // scale_target, scale_floor, degree_tau, degree_sdmin, degree_floor_n).
 extern "C" int jf__robust_tune(const char *name, double v);
 

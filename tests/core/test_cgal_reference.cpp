@@ -11,11 +11,11 @@
 // fitted surface -- hence normal, k1, k2, d1, d2, b0..b3, c0..c4 -- is the same
 // up to rounding; only the preconditioning (§2.3: jetfit h^(i+j); CGAL one h
 // and factorials) and the SVD differ.  So we compare to 1e-8 relative after
-// orientation agreement (jf_result_flip, DESIGN.md's rule = CGAL's
+// orientation agreement (jf_result_flip, docs/design.md's rule = CGAL's
 // comply_wrt_given_normal) and after agreeing on the sign of d1 (both pick it
 // by convention only; (d1, d2) -> (-d1, -d2) negates b0..b3, keeps c0..c4).
 //
-// We compare only where CGAL is valid (CGAL_NOTES.md): near the origin,
+// We compare only where CGAL is valid (docs/design.md "CGAL 5.5.1"): near the origin,
 // well conditioned, N >= N_n.  Where the two differ by design (jetfit's
 // adaptive degree for N < N_n, its translated covariance at 1e6 offsets, the
 // world-axis frame) the difference itself is asserted.
@@ -272,7 +272,7 @@ static int check_case(const std::string &ctx0, const std::vector<double> &xyz,
                       " N" + std::to_string(xyz.size() / 3);
     int cm = d < 2 ? 1 : monge_of(d);  // CGAL: dprime <= d
     Cgal_fit c = cgal_fit(xyz, d, cm);
-    // CGAL is valid here: full rank and well conditioned (CGAL_NOTES.md).
+    // CGAL is valid here: full rank and well conditioned (docs/design.md "CGAL 5.5.1").
     ck_assert_msg(c.cond < 1e8, "%s: CGAL cond %.3g", ctx.c_str(), c.cond);
     jf_result r = jet_fit(xyz, d, monge_of(d), mode, JF_FRAME_PCA);
     ck_assert_msg(r.degree == d && !(r.status & JF_PT_FAILED),
@@ -499,7 +499,7 @@ END_TEST
 // un-offset CGAL run sees exactly the same geometry: jetfit, which
 // translates to p before its covariance, matches it to the usual 1e-8.
 // CGAL's one-pass world-coordinate covariance cancels catastrophically at
-// 1e6 (CGAL_NOTES.md), so its own offset result is off by far more.
+// 1e6 (docs/design.md "CGAL 5.5.1"), so its own offset result is off by far more.
 START_TEST(test_offset_1e6)
 {
     const double off[3] = {1e6, -1e6, 5e5};
@@ -531,7 +531,7 @@ START_TEST(test_offset_1e6)
 END_TEST
 
 // N < N_n: CGAL's precondition is not checked under NDEBUG and it returns
-// wrong curvatures (CGAL_NOTES.md), so we never call it there.  jetfit
+// wrong curvatures (docs/design.md "CGAL 5.5.1"), so we never call it there.  jetfit
 // lowers the degree (JF_PT_LOWERED_FEW) and must then equal CGAL at that
 // lower degree on the same points.
 START_TEST(test_too_few_points_lowers)

@@ -252,7 +252,7 @@ END_TEST
  * offsets; the offset coordinates round to ~1e-10), gives the same result
  * to 1e-7 in both frames, and in the axis frame the analytic curvatures of
  * the graph (its 2-jet is exact); one-pass world-coordinate covariance
- * sums lose everything here (CGAL_NOTES.md). */
+ * sums lose everything here (docs/design.md "CGAL 5.5.1"). */
 START_TEST(test_offset_1e6)
 {
     const double off[3] = {1e6, -2e6, 5e5};

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """check_layers.py -- the library's folders call only down (src/README.md):
-every symbol an object file of src/F uses from another folder G of the
-library must come from a lower layer, and every internal header a source of
-src/F includes must live in F or a lower layer.  Reads the object files of
+every symbol an object file of a library folder uses from another folder
+must come from a lower layer, and every internal header a source includes
+must live in its own folder or a lower layer.  Reads the object files of
 the build (nm).  Prints each upward call or include; exits 1 if any.
 Usage: check_layers.py SRC_DIR OBJ_DIR"""
 import os

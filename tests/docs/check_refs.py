@@ -53,9 +53,11 @@ for f in FILES:
         DIRS.add(d)
         d = os.path.dirname(d)
 
-PATH_RE = re.compile(r'(?<![\w./-])((?:%s)/[\w./-]*[\w])' % '|'.join(re.escape(t) for t in TOPS))
-BARE_RE = re.compile(r'(?<![\w./-])([A-Za-z_][\w-]*\.(?:c|h|cpp|hpp|md))\b(?![\w/-])')
+PATH_RE = re.compile(r'(?<![\w./$-])((?:%s)/[\w./-]*[\w])' % '|'.join(re.escape(t) for t in TOPS))
+BARE_RE = re.compile(r'(?<![\w./*$-])([A-Za-z_][\w-]*\.(?:c|h|cpp|hpp|md))\b(?![\w/-])')
 LINK_RE = re.compile(r'\]\(([^)\s]+)\)')
+# a document and a quoted section of it: docs/design.md "CGAL 5.5.1"
+SECTION_RE = re.compile(r'([\w./-]+\.md|README)(?:\)|\]\([^)]*\))?,? "([^"]+)"')
 
 
 def anchors(path):
@@ -74,6 +76,18 @@ def anchors(path):
     return out
 
 
+def headings(path):
+    """The lower-cased heading texts of a Markdown file."""
+    out = []
+    try:
+        with open(os.path.join(ROOT, path), encoding='utf-8') as fh:
+            out = [m.group(1).strip().lower() for m in
+                   (re.match(r'#+\s+(.*)', line) for line in fh) if m]
+    except OSError:
+        pass
+    return out
+
+
 def exists(p):
     p = os.path.normpath(p.rstrip('.'))
     return p in FILESET or p in DIRS or os.path.basename(p) in GENERATED
@@ -86,7 +100,11 @@ def check_file(rel, bad):
     except (OSError, UnicodeDecodeError):
         return
     here = os.path.dirname(rel)
+    fenced = False
     for no, line in enumerate(lines, 1):
+        if rel.endswith('.md') and line.lstrip().startswith('```'):
+            fenced = not fenced
+            continue
         if line.lstrip().startswith('#include <'):
             continue
         for m in PATH_RE.finditer(line):
@@ -95,7 +113,18 @@ def check_file(rel, bad):
                 continue
             if not exists(p):
                 bad.append('%s:%d: names %s, which is not in the repository' % (rel, no, p))
+        for m in SECTION_RE.finditer(line):
+            doc = m.group(1) if m.group(1) != 'README' else 'README.md'
+            cand = [f for f in FILES if f == doc or f.endswith(os.sep + doc)]
+            for title in re.findall(r'"([^"]+)"', line[m.start():]):
+                for f in cand:
+                    if not any(h.startswith(title.lower()) for h in headings(f)):
+                        bad.append('%s:%d: names section "%s" of %s, which it does not have'
+                                   % (rel, no, title, f))
+                break
         for m in BARE_RE.finditer(line):
+            if fenced:
+                continue
             b = m.group(1)
             stem = b.rsplit('.', 1)[0]
             if len(stem) < 3 or b in SYSTEM or line[:m.start()].endswith(('->', '.')):

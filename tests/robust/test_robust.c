@@ -10,7 +10,7 @@
 
 #include "jetfit.h"
 
-/* src/robust.c's bench-only setter of the selection constants */
+/* src/robust/robust.c's bench-only setter of the selection constants */
 int jf__robust_tune(const char *name, double v);
 
 /* ---- the surface and its exact quantities ---- */

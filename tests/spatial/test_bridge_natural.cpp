@@ -254,7 +254,7 @@ START_TEST(flat_grid_fallback) {
 END_TEST
 
 // Dense sphere: ring 1 equals CGAL's surface_neighbors_certified_3 given
-// the 64 nearest samples of p as candidates, p left out (CGAL_NOTES.md:
+// the 64 nearest samples of p as candidates, p left out (docs/design.md "CGAL 5.5.1":
 // the uncertified version is broken in 5.5.1, fewer than 32 candidates can
 // miss neighbours, and p among the candidates returns only p).
 START_TEST(sphere_vs_surface_neighbors) {

@@ -1,4 +1,4 @@
-/* test_surfaces.c -- the exact truth of src/surfaces.c against central
+/* test_surfaces.c -- the exact truth of src/synth/surfaces.c against central
  * finite differences of each parametrisation (an independent route: the
  * truth uses analytic derivatives or the implicit equation), known
  * closed-form values, and the samplings' invariants. */

@@ -3,7 +3,7 @@
  * umbilics (never NaN), the sphere in both orientations and the cylinder
  * at points where the fitting frame is tilted from the normal (this
  * exercises the re-expansion over the tangent plane; the error is the
- * jet's truncation, O(h^(n-k+1)) by Theorem 3), the flip rule of DESIGN.md
+ * jet's truncation, O(h^(n-k+1)) by Theorem 3), the flip rule of docs/design.md
  * and jf_fit_cloud (1 thread == 2 threads, bit for bit). */
 #include <check.h>
 #include <math.h>
