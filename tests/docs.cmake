@@ -9,3 +9,8 @@ if(JF_PY3)
            ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/CMakeFiles/jetfit_obj.dir/src)
   set_tests_properties(check_refs check_layers PROPERTIES LABELS docs)
 endif()
+if(JF_PY3 AND TARGET jetfit_shared)
+  add_test(NAME check_abi COMMAND ${JF_PY3} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_abi.py
+           ${PROJECT_SOURCE_DIR}/src/jetfit.h $<TARGET_FILE:jetfit_shared>)
+  set_tests_properties(check_abi PROPERTIES LABELS docs)
+endif()
