@@ -1,7 +1,7 @@
 # exports.cmake -- libjetfit.so exports exactly the functions jetfit.h
 # declares (issue 24.3): the version script is generated from the header at
 # configure time, so a function added to the header is exported and an
-# internal helper (jf__*, io helpers) never is.  tests/abi.cmake compares
+# internal helper (jf__*, io helpers) never is.  ctest check_abi compares
 # `nm -D` of the built library with the header.
 file(READ ${PROJECT_SOURCE_DIR}/src/jetfit.h JF_HDR)
 # comments out (they name functions in prose), then "name(" at a declaration

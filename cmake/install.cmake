@@ -17,7 +17,11 @@ if(JF_STATIC_LIB)
   set_target_properties(jetfit_static PROPERTIES OUTPUT_NAME jetfit EXPORT_NAME jetfit_static)
   target_include_directories(jetfit_static PUBLIC
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
-  target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+  if(JF_CGAL)
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+  else()
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp m)
+  endif()
   install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
 install(FILES ${PROJECT_SOURCE_DIR}/docs/jetfit.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
@@ -32,6 +36,11 @@ install(FILES ${PROJECT_BINARY_DIR}/jetfitConfig.cmake ${PROJECT_BINARY_DIR}/jet
 
 # pkg-config: paths relative to the .pc file, so `--prefix P` at install
 # time (not the configure-time prefix) is what the file describes
+if(JF_CGAL)
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lstdc++ -lgmp -lmpfr -lm")
+else()
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lm")
+endif()
 file(RELATIVE_PATH JF_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit.pc.in ${PROJECT_BINARY_DIR}/jetfit.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/jetfit.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

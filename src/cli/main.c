@@ -79,8 +79,12 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "--version")) {
         printf("jetfit %s\n", jf_version());
-        printf("built with CGAL %s, GSL %s, OpenMP %s\n", jfb_cgal_version(), GSL_VERSION,
-               openmp_version());
+        const char *cgal = jfb_cgal_version(); /* NULL: built with -DJF_CGAL=OFF */
+        if (cgal)
+            printf("built with CGAL %s, GSL %s, OpenMP %s\n", cgal, GSL_VERSION, openmp_version());
+        else
+            printf("built without CGAL (natural with --normal poles|mincirc unavailable), "
+                   "GSL %s, OpenMP %s\n", GSL_VERSION, openmp_version());
         return 0;
     }
     for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)

@@ -240,8 +240,11 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     jf_status st = delaunay ? jf_natural_create_threads(c->xyz, n, nt, &x->nt)
                             : jf__natural_from_index(x->ix, nt, &x->nt);
     if (st != JF_OK) {
-        set_err(err, delaunay ? "natural neighbours: building the Delaunay triangulation failed"
-                              : "natural neighbours: the k-NN form failed");
+        set_err(err, st == JF_ERR_UNSUPPORTED
+                         ? "natural neighbours: the poles and mincirc normals need a 3D Delaunay "
+                           "triangulation (CGAL), which this build leaves out (JF_CGAL=OFF)"
+                     : delaunay ? "natural neighbours: building the Delaunay triangulation failed"
+                                : "natural neighbours: the k-NN form failed");
         return st;
     }
     if (src == JF_NORMAL_INPUT) {

@@ -58,6 +58,7 @@ static jf_status from_bridge(int rc) {
     case 1: return JF_ERR_INVALID;
     case 2: return JF_ERR_NOMEM;
     case 5: return JF_ERR_TOO_LARGE;
+    case 7: return JF_ERR_UNSUPPORTED; /* built without CGAL */
     default: return JF_ERR_INTERNAL;
     }
 }

@@ -17,10 +17,6 @@
 
 START_TEST(random_strings_round_trip)
 {
-    if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        fprintf(stderr, "skipped: gnuplot not installed\n");
-        return;
-    }
     char dir[] = "/tmp/jf_gpq_XXXXXX";
     ck_assert_ptr_nonnull(mkdtemp(dir));
     char script[64], out[64], cmd[256];
@@ -72,6 +68,10 @@ END_TEST
 
 int main(void)
 {
+    if (system("command -v gnuplot >/dev/null 2>&1") != 0) { /* a reported skip (ctest: 77) */
+        printf("SKIP: gnuplot is not installed (Debian package gnuplot-nox)\n");
+        return 77;
+    }
     Suite *s = suite_create("gnuplot_quote");
     TCase *tc = tcase_create("quote");
     tcase_add_test(tc, random_strings_round_trip);
