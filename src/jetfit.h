@@ -852,9 +852,20 @@ typedef enum {
     JF_ORIENT_VIEWPOINT = 2, /* point towards a scanner position          */
     JF_ORIENT_MST = 3,       /* propagate along a k-NN minimum spanning
                                 tree (Hoppe et al. 1992)                 */
-    JF_ORIENT_SCANNER = 4    /* towards the scanner that measured each
+    JF_ORIENT_SCANNER = 4,   /* towards the scanner that measured each
                                 point (jf_cloud.scan / scanner: PTX)     */
+    JF_ORIENT_AUTO = 5       /* the estimate's default: scanner when the
+                                cloud has scanner positions, else input
+                                when it has normals, else none
+                                (jf_orient_resolve)                      */
 } jf_orient_mode;
+
+/* The mode JF_ORIENT_AUTO stands for on a cloud that has (non-zero) or
+ * has not normals and scanner positions: JF_ORIENT_SCANNER, else
+ * JF_ORIENT_INPUT, else JF_ORIENT_NONE; any other mode is returned as it
+ * is.  The one place of the rule, for callers that hold no jf_cloud
+ * (jetfit-mpi); jf_estimate* apply it themselves.  Thread-safe. */
+jf_orient_mode jf_orient_resolve(jf_orient_mode m, int has_normals, int has_scanners);
 
 /* res[i] agrees with nrm[3i..3i+2] (n_i . nrm_i >= 0).  nrm is caller-owned. */
 jf_status jf_orient_input(jf_result *res, size_t n, const double *nrm);
@@ -1090,7 +1101,7 @@ typedef struct {
                                 16 nearest points), jet (jet normal of
                                 the N nearest, rings on the cloud
                                 projected on those jets) or input       */
-    jf_orient_mode orient;   /* default none                            */
+    jf_orient_mode orient;   /* default JF_ORIENT_AUTO (jf_orient_resolve) */
     double viewpoint[3];     /* JF_ORIENT_VIEWPOINT                     */
     size_t orient_k;         /* JF_ORIENT_MST: k of the k-NN graph (8)  */
     int threads;             /* <= 0: all cores (OpenMP default)        */

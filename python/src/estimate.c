@@ -53,8 +53,6 @@ static int check_signals(void *user)
 static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *faces)
 {
     jf_estimate_opts *o = &po->e.o;
-    if (!po->e.orient_set && c->nrm) o->orient = JF_ORIENT_INPUT; /* as the command */
-    if (!po->e.orient_set && c->scanner) o->orient = JF_ORIENT_SCANNER; /* as for PTX */
     if (o->orient == JF_ORIENT_SCANNER && !c->scanner) {
         PyErr_SetString(PyExc_ValueError,
                         "orient='scanner' needs scanners=: the (N, 3) position of the scanner "

@@ -274,8 +274,6 @@ int jf_cmd_estimate(int argc, char **argv)
         fprintf(stderr, "jetfit: %s: %zu unparsable rows kept as NaN rows (status nonfinite), "
                         "lines %s%s\n", in, c.nbad, lines, c.nbad > shown ? ", ..." : "");
     }
-    if (!e.orient_set && c.nrm) o.orient = JF_ORIENT_INPUT;
-    if (!e.orient_set && c.scanner) o.orient = JF_ORIENT_SCANNER; /* PTX */
     if (o.orient == JF_ORIENT_SCANNER && !c.scanner) {
         fprintf(stderr, "jetfit: %s: --orient scanner needs the scanner positions of a PTX "
                         "file; this input has none\n", in);

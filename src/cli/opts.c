@@ -120,7 +120,6 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
             return bad_(bad, name, val, "expected a number >= 1");
         o->params.max_cond = dv;
     } else if (!strcmp(name, "--orient")) {
-        e->orient_set = 1;
         if (!strcmp(val, "none")) o->orient = JF_ORIENT_NONE;
         else if (!strcmp(val, "input")) o->orient = JF_ORIENT_INPUT;
         else if (!strncmp(val, "viewpoint:", 10)) {

@@ -23,7 +23,6 @@ typedef struct {
     const char *nbspec;    /* --neighbors text (parsed by _finish)       */
     int monge;             /* --monge-degree, -1 = from the degree       */
     const char *monge_s;
-    int orient_set;        /* --orient given (else: input if normals)    */
 } jf_cli_est;
 
 /* What was wrong: option, its value, why (static or argv strings). */

@@ -269,9 +269,9 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     jf_row_layout lay;
     jf_mpi_probe(m, in, &lay);
     if (jf_mpi_check(m)) return 1;
-    if (!cmd.e.orient_set && lay.has_normals) o.orient = JF_ORIENT_INPUT;
+    o.orient = jf_orient_resolve(o.orient, lay.has_normals, 0); /* the library's rule */
     if (o.orient == JF_ORIENT_INPUT && !lay.has_normals)
-        return refuse(m, "%s: --orient input: the input file has no normals", in);
+        return refuse(m, "%s: orient input: the cloud has no normals", in);
     jf_part_query q;
     if (jf__part_query_init(&o, &q) != JF_OK)
         return refuse(m, "%s: invalid parameters", in);
