@@ -1097,7 +1097,7 @@ typedef struct {
                                 n = 0: max(2 N_n, 12) points            */
     jf_normal_source normal; /* natural only: tangent planes from auto
                                 (default: jet on a noisy cloud, else
-                                poles), poles, mincirc, pca (PCA of the
+                                pca), poles, mincirc, pca (PCA of the
                                 16 nearest points), jet (jet normal of
                                 the N nearest, rings on the cloud
                                 projected on those jets) or input       */
