@@ -676,6 +676,18 @@ typedef struct {
 
 typedef struct jf_writer jf_writer;
 
+/* The estimate's output table: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z,
+ * then b0..b3 when monge >= 3 and c0..c4 when monge >= 4 (the Monge degree
+ * of the fit), then degree neighbors cond residual status (I32 for
+ * degree, neighbors and status).  jf_result_columns fills cols (at least
+ * JF_RESULT_MAX_COLS entries; names are static) and returns their number;
+ * jf_result_row writes point p's row of r into v in that order and
+ * returns the number of values.  The command, jetfit-mpi and the Python
+ * module write this one list.  Thread-safe. */
+#define JF_RESULT_MAX_COLS 32
+size_t jf_result_columns(int monge, jf_column *cols);
+size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v);
+
 /* Opens a table of ncols columns and exactly nrows rows (the PLY header
  * needs the count; commit fails if a different number was written).
  * ascii != 0 asks for ascii PLY (ignored for text formats).  Names must

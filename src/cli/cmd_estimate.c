@@ -14,7 +14,6 @@
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
 #include "jetfit.h"
 #include "opts.h"
-#include "rows.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -221,7 +220,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
     double *v = s->rows + (size_t)t * 256 * s->ncols;
     for (size_t j = 0; j < m; j++) {
-        jf_cli_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;
     }
@@ -282,8 +281,8 @@ int jf_cmd_estimate(int argc, char **argv)
     }
 
     /* open the output first: a missing folder fails before the work */
-    jf_column cols[32];
-    size_t ncols = jf_cli_columns(monge, cols);
+    jf_column cols[JF_RESULT_MAX_COLS];
+    size_t ncols = jf_result_columns(monge, cols);
     jf_writer *w = NULL;
     st = jf_writer_open(out, cols, ncols, c.n, ascii, &w, &err);
     if (st != JF_OK) {
