@@ -1151,11 +1151,12 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
                       jf_result *out, jf_error *err);
 
 /* A block of results from jf_estimate_blocks: res[j] belongs to input
- * point idx[j], j < m (m <= 256); the results are final (oriented).
+ * point idx[j], j < m (m <= JF_BLOCK_MAX); the results are final (oriented).
  * Return JF_OK to go on; any other status stops the estimate, which
  * returns it.  Called concurrently from the OpenMP threads of the fit
  * (blocks are disjoint): it must be thread-safe.  res and idx are the
  * library's, valid during the call only (res may be changed). */
+#define JF_BLOCK_MAX 256
 typedef jf_status (*jf_block_fn)(void *user, const uint32_t *idx, jf_result *res, size_t m);
 
 /* jf_estimate without the n results in memory: the same results, bit for

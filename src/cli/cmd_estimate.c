@@ -197,7 +197,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
 /* ---- rows straight to the output ------------------------------------- */
 
 /* design (docs/scale.md): results are never held for the whole cloud.
- * jf_estimate_blocks hands over blocks of <= 256 results from the fit's
+ * jf_estimate_blocks hands over blocks of <= JF_BLOCK_MAX results from the fit's
  * threads; each block becomes rows written at their input index
  * (jf_writer_put: in place for binary PLY and LAS, through a binary spool
  * for text).  What stays per point: the coordinates, the index, and the
@@ -207,7 +207,7 @@ typedef struct {
     const double *xyz;
     int monge, nt;
     size_t ncols;
-    double *rows;    /* nt x 256 x ncols: one block per thread          */
+    double *rows;    /* nt x JF_BLOCK_MAX x ncols: a block per thread    */
     tally *tl;       /* nt                                              */
     double *cond;    /* n, or NULL (--quiet)                            */
     int wfail;       /* a jf_writer_put failed (atomic)                 */
@@ -218,7 +218,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     sinkctx *s = user;
     int t = omp_get_thread_num();
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
-    double *v = s->rows + (size_t)t * 256 * s->ncols;
+    double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
     for (size_t j = 0; j < m; j++) {
         jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
@@ -308,7 +308,7 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
-    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
+    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
     if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
         /* a failed begin is reported by commit's message below */
