@@ -5,6 +5,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 #define N 700
 
@@ -326,9 +327,5 @@ int main(void)
     tcase_add_test(tc, progress_on_terminal);
     tcase_add_test(tc, summary_percentiles);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }
