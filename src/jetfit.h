@@ -693,6 +693,28 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
  * no-op for other formats.  JF_ERR_INVALID after the first row. */
 jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
 
+/* jf_writer_las_frame with the scale and offset of each axis given
+ * (scale[a] > 0; either array may be NULL: that one by the rule, the
+ * offset being the minimum).  Without a scale given, a warning
+ * (jf_writer_warnings) names each axis the rule's scale rounds by more than
+ * 1e-6 of the cloud's bulk size (the largest range of the middle 99% of
+ * the points over the axes: an outlier widening the extent).  Coordinates
+ * that cannot be stored as int32 counts (an extent beyond the largest
+ * double, a scale too small for them) are refused here: JF_ERR_TOO_LARGE,
+ * the writer failed (commit says which axis and extent, no file is made).
+ * JF_ERR_INVALID for a scale <= 0 or not finite, after the first row. */
+jf_status jf_writer_las_frame_given(jf_writer *w, const double *xyz, size_t n,
+                                    const double scale[3], const double offset[3]);
+
+/* The writer's warnings so far, lines "FILE: reason" each ending in a
+ * newline ("" if none), for the caller to show: LAS, an Extra Bytes name
+ * over 32 bytes shortened (to its first bytes and "~N", the first N giving
+ * a name no other holds), the
+ * rule's scale rounding coordinates (above), input VLRs that run past the
+ * point data and are not copied.  Owned by w; valid until the next call on
+ * w.  Never NULL. */
+const char *jf_writer_warnings(jf_writer *w);
+
 /* Carries a cloud's attributes (jf_cloud.attrs) into the table: their
  * columns go after x y z (columns 0-2) and before the others, each named
  * as in the input with `in_` put before the name while it clashes with a
