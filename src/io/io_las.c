@@ -296,19 +296,22 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
     for (size_t i = 0; i < c->n; i++, r += rec_len)
         for (int a = 0; a < 3; a++)
             c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
-    if (o->no_attrs)
-        return JF_OK;
-    /* the records whole, the header and VLRs, the EVLRs (1.4: the count
-     * and start in the header; 1.3: the waveform data record) */
+    /* the header and VLRs, even without attributes: a LAS output keeps
+     * the CRS (a CRS is not an attribute; docs/formats.md) */
     jf_attrs *at = &c->attrs;
-    at->stride = rec_len;
-    at->rec = malloc(c->n * rec_len);
-    at->las_head = malloc(data_off);
-    if (!at->rec || !at->las_head)
-        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
-    memcpy(at->rec, b + data_off, c->n * rec_len);
+    if (!(at->las_head = malloc(data_off)))
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the header");
     memcpy(at->las_head, b, data_off);
     at->las_head_len = data_off;
+    if (o->no_attrs)
+        return JF_OK;
+    /* the records whole, the EVLRs (1.4: the count and start in the
+     * header; 1.3: the waveform data record) */
+    at->stride = rec_len;
+    at->rec = malloc(c->n * rec_len);
+    if (!at->rec)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
+    memcpy(at->rec, b + data_off, c->n * rec_len);
     size_t end = data_off + c->n * rec_len;
     uint64_t evlr = 0;
     if (minor >= 4 && u32(b + 243))

@@ -179,7 +179,9 @@ const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS] = {
 static const unsigned char eb_code[10] = {2, 1, 4, 3, 6, 5, 8, 7, 9, 10};
 static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
 
-static int keep(const jf_las_out *L) { return L->a && L->a->las_head; }
+static int keep(const jf_las_out *L) { return L->a && L->a->las_head && L->a->rec; }
+/* A LAS input read without its records (no_attrs): its CRS VLRs only. */
+static int crs_only(const jf_las_out *L) { return L->a && L->a->las_head && !L->a->rec; }
 
 static uint16_t g16(const unsigned char *p) { return (uint16_t)(p[0] | p[1] << 8); }
 static uint32_t g32(const unsigned char *p)
@@ -227,6 +229,9 @@ static int is_eb(const unsigned char *v)
     return !memcmp(v + 2, "LASF_Spec\0", 10) && g16(v + 18) == 4;
 }
 
+/* GeoTIFF keys, OGC WKT (LAS 1.4 R15 §2.5.1): the "LASF_Projection" VLRs */
+static int is_crs(const unsigned char *v) { return !memcmp(v + 2, "LASF_Projection\0", 16); }
+
 /* The Extra Bytes VLR of the input (NULL if none) and its descriptions
  * that fit the record (the reader's rule). */
 typedef struct { const unsigned char *eb; size_t len; } eb_find;
@@ -272,6 +277,10 @@ static void sum_vlr(void *u, const unsigned char *v, size_t len)
     vlr_sum *s = u;
     if (!is_eb(v)) s->bytes += len, s->n++;
 }
+static void sum_crs(void *u, const unsigned char *v, size_t len)
+{
+    if (is_crs(v)) sum_vlr(u, v, len);
+}
 
 int jf__las_fits(const jf_las_out *L)
 {
@@ -282,7 +291,7 @@ int jf__las_fits(const jf_las_out *L)
 size_t jf__las_prefix_size(const jf_las_out *L)
 {
     vlr_sum s = {0, 0};
-    if (keep(L)) walk_vlrs(L, sum_vlr, &s);
+    if (keep(L) || crs_only(L)) walk_vlrs(L, keep(L) ? sum_vlr : sum_crs, &s);
     return LAS_HEADER + s.bytes + VLR_HEADER + EB_DESC * out_descs(L);
 }
 
@@ -339,6 +348,10 @@ static void copy_vlr(void *u, const unsigned char *v, size_t len)
     if (is_eb(v)) return;
     memcpy(c->o, v, len);
     c->o += len;
+}
+static void copy_crs(void *u, const unsigned char *v, size_t len)
+{
+    if (is_crs(v)) copy_vlr(u, v, len);
 }
 
 /* One description: type, name (all 32 bytes of the field: LAS 1.4 R15
@@ -397,7 +410,7 @@ int jf__las_names(jf_las_out *L, const char *file)
     free(full);
     free(used);
     L->ebn = e;
-    if (keep(L)) {
+    if (keep(L) || crs_only(L)) {
         uint32_t seen = walk_vlrs(L, no_vlr, NULL), decl = g32(L->a->las_head + 100);
         if (seen < decl)
             warn_add(&L->warn_names, file, "the input's VLR %u of %u runs past its point data: "
@@ -489,6 +502,16 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
         walk_vlrs(L, copy_vlr, &c);
         v = c.o;
         nvlr += s.n;
+    } else if (crs_only(L)) {
+        /* new records, the input's CRS: its VLRs and the WKT bit (4) of
+         * the global encoding */
+        vlr_copy c = {v};
+        vlr_sum s = {0, 0};
+        walk_vlrs(L, sum_crs, &s);
+        walk_vlrs(L, copy_crs, &c);
+        v = c.o;
+        nvlr += s.n;
+        b[6] = (unsigned char)(L->a->las_head[6] & 0x10);
     }
     put32(b + 100, nvlr); /* the input's VLRs, then the Extra Bytes one */
     size_t nd = out_descs(L);

@@ -70,7 +70,7 @@ static jf_status write_header(jf_writer *w)
     if (w->fmt == FMT_LAS) {
         /* a placeholder of the header's size: the real one, with the
          * count and bounds, is written over it at commit */
-        if (!w->las_framed && !(w->attrs && w->attrs->las_head))
+        if (!w->las_framed && !(w->attrs && w->attrs->las_head && w->attrs->rec))
             return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
                                                  "(jf_writer_las_frame) before the rows");
         size_t n = jf__las_prefix_size(&w->las);
@@ -243,7 +243,7 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
         return JF_ERR_INVALID;
     if (!a || (!a->nattrs && !(a->las_head && w->fmt == FMT_LAS)))
         return JF_OK; /* nothing to carry */
-    if (w->ncols < 3 || (a->nattrs && !a->rec) || (a->las_head && !a->rec))
+    if (w->ncols < 3 || (a->nattrs && !a->rec))
         return JF_ERR_INVALID;
     char (*nm)[64] = calloc(a->nattrs ? a->nattrs : 1, sizeof *nm);
     if (!nm)
@@ -251,7 +251,7 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
     /* a format 0 LAS output also has its own dimensions: an Extra Byte
      * named as one (intensity, classification, ...) would be a second
      * dimension of that name to LAS readers */
-    int fmt0 = w->fmt == FMT_LAS && !a->las_head;
+    int fmt0 = w->fmt == FMT_LAS && !(a->las_head && a->rec);
     size_t nn = w->ncols + (fmt0 ? JF__LAS_FMT0_NDIMS : 0);
     char **taken = malloc(nn * sizeof *taken);
     if (!taken) {
@@ -635,7 +635,7 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
         write_faces(w);
     /* LAS: the input's EVLRs after the records, then the header */
     if (f->st == JF_OK && w->fmt == FMT_LAS && w->attrs && w->attrs->las_head &&
-        w->attrs->las_evlr)
+        w->attrs->rec && w->attrs->las_evlr)
         jf_wf_write(f, (const char *)w->attrs->las_evlr, w->attrs->las_evlr_len);
     if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
         jf__las_write_prefix(f->fd, &w->las) != 0)
