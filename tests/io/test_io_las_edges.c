@@ -207,7 +207,7 @@ START_TEST(extra_bytes_names)
     ck_assert_int_eq(jf_writer_open(path, cols, 6, n, 0, &w, &e), JF_OK);
     ck_assert_int_eq(jf_writer_las_frame(w, xyz, n), JF_OK);
     const char *warn = jf_writer_warnings(w);
-    char want[256];
+    char want[512];
     snprintf(want, sizeof want, "%s: Extra Bytes name '%s' is longer than LAS's 32 bytes: "
              "written as 'the_same_first_thirty_one_byte~1'\n", path, la);
     ck_assert_msg(strstr(warn, want) == warn, "'%s'", warn);
