@@ -12,10 +12,13 @@
  * dimension by dimension (laspy's names, bit fields included), the Extra
  * Bytes by the "LASF_Spec" record 4 VLR's descriptions (so a file jetfit
  * wrote reads back with its columns); the header, VLRs and EVLRs are kept
- * verbatim for a LAS output.  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
+ * verbatim for a LAS output (the header block even without attributes:
+ * the output keeps the CRS).  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
  * sets it) is refused with how to convert it.  Every header field that
  * points into the file is checked against its size before use, so a lying
- * header is a one-line error, never a read past the end.
+ * header is a one-line error, never a read past the end; a format byte
+ * outside 0-10, two disagreeing point counts and whole records past the
+ * count are refused too (issue 30.1, 33.7), never read as something else.
  */
 #include <stdint.h>
 #include <stdlib.h>

@@ -7,7 +7,10 @@
  *
  * design: X Y Z are int32 counts of a scale per axis, the smallest power
  * of ten >= max(1e-7, extent / 2e9): 0.1 µm wherever the extent allows
- * (below about 200 m), never an overflow; the offset is the minimum.  The
+ * (below about 200 m), never an overflow; the offset is the minimum (or
+ * both as the caller gives them; counts beyond int32, an extent beyond the
+ * largest double: refused, issue 30.4).  A warning names an axis the rule
+ * rounds by more than 1e-6 of the cloud's bulk size (issue 30.3).  The
  * frame comes from the whole cloud (jf_writer_las_frame) before the first
  * row; the header, which holds the point count and the bounds, is written
  * over the placeholder at offset 0 when the table is committed.  A non-finite
@@ -21,7 +24,10 @@
  * input's own (whose descriptions are copied, renamed when they clash:
  * `nx` -> `in_nx`; undescribed bytes get an "undocumented" description so
  * the offsets stay right).  From any other input, format 0 as above with
- * the attributes as Extra Bytes of their own type ahead of jetfit's.
+ * the attributes as Extra Bytes of their own type ahead of jetfit's (and
+ * a LAS input's CRS VLRs under --keep none).  Extra Bytes names fill the
+ * 32-byte field whole; longer ones become distinct "first bytes~N" with a
+ * warning (jf__las_names, issue 30.2).
  */
 #include <math.h>
 #include <stdarg.h>
