@@ -268,6 +268,72 @@ START_TEST(extra_bytes_names_distinct)
 }
 END_TEST
 
+/* A LAS input kept whole (keep mode): two Extra Bytes of the same 32-byte
+ * name; the second becomes `in_` + the name (35 bytes), shortened with a
+ * warning; the first and jetfit's k1 kept. */
+START_TEST(extra_bytes_names_keep_mode)
+{
+    static const char n32[] = "abcdefghijklmnopqrstuvwxyz012345";
+    const size_t n = 5, hs = 227, vl = 54 + 2 * 192, rl = 22;
+    size_t len = hs + vl + n * rl;
+    unsigned char *b = calloc(1, len);
+    memcpy(b, "LASF", 4);
+    b[24] = 1, b[25] = 2;
+    put16(b + 94, (unsigned)hs);
+    put32(b + 96, (uint32_t)(hs + vl));
+    put32(b + 100, 1);
+    put16(b + 105, (unsigned)rl);
+    put32(b + 107, (uint32_t)n);
+    for (int a = 0; a < 3; a++) putd(b + 131 + 8 * a, 0.01);
+    unsigned char *v = b + hs;
+    memcpy(v + 2, "LASF_Spec", 9);
+    put16(v + 18, 4);
+    put16(v + 20, 2 * 192);
+    for (int d = 0; d < 2; d++) {
+        v[54 + 192 * d + 2] = 1; /* unsigned char */
+        memcpy(v + 54 + 192 * d + 4, n32, 32);
+    }
+    for (size_t i = 0; i < n; i++) {
+        unsigned char *r = b + hs + vl + i * rl;
+        put32(r, (uint32_t)i);
+        r[20] = (unsigned char)i, r[21] = (unsigned char)(100 + i);
+    }
+    const char *in = fixture("kin.las", b, len);
+    jf_cloud c;
+    jf_error e = {{0}};
+    ck_assert_msg(jf_cloud_read(in, NULL, &c, &e) == JF_OK, "%s", e.msg);
+    jf_column cols[4] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
+                         {"k1", JF_COL_F64}};
+    char path[128];
+    snprintf(path, sizeof path, "%s/kout.las", tmpdir);
+    jf_writer *w;
+    ck_assert_int_eq(jf_writer_open(path, cols, 4, n, 0, &w, &e), JF_OK);
+    ck_assert_int_eq(jf_writer_attrs(w, &c.attrs), JF_OK);
+    char want[512];
+    snprintf(want, sizeof want, "%s: Extra Bytes name 'in_%s' is longer than LAS's 32 bytes: "
+             "written as 'in_abcdefghijklmnopqrstuvwxyz0~1'\n", path, n32);
+    ck_assert_str_eq(jf_writer_warnings(w), want);
+    for (size_t i = 0; i < n; i++) {
+        double r[4] = {0, 0, 0, (double)i};
+        ck_assert_int_eq(jf_writer_row(w, r), JF_OK);
+    }
+    ck_assert_int_eq(jf_writer_commit(w, &e), JF_OK);
+    char nm[8][33];
+    ck_assert_uint_eq(eb_names(path, nm, 8), 3);
+    ck_assert(!memcmp(nm[0], n32, 32));
+    ck_assert_str_eq(nm[1], "in_abcdefghijklmnopqrstuvwxyz0~1");
+    ck_assert_str_eq(nm[2], "k1");
+    jf_cloud r;
+    ck_assert_msg(jf_cloud_read(path, NULL, &r, &e) == JF_OK, "%s", e.msg);
+    int k = jf_attr_find(&r.attrs, "in_abcdefghijklmnopqrstuvwxyz0~1");
+    ck_assert_int_ge(k, 0);
+    ck_assert(jf_attr_get(&r.attrs, (size_t)k, 3) == 103);
+    jf_cloud_free(&r);
+    jf_cloud_free(&c);
+    free(b);
+}
+END_TEST
+
 /* Writes xyz (n points) as LAS with the rule's frame (or the one given);
  * returns the frame's status, *warn a copy of the warnings. */
 static jf_status las_out(const char *path, const double *xyz, size_t n, const double *scale,
@@ -434,6 +500,7 @@ static Suite *suite(void)
     tcase_add_test(tc, point_counts);
     tcase_add_test(tc, extra_bytes_names);
     tcase_add_test(tc, extra_bytes_names_distinct);
+    tcase_add_test(tc, extra_bytes_names_keep_mode);
     tcase_add_test(tc, scale_warning);
     tcase_add_test(tc, huge_extent);
     tcase_add_test(tc, vlr_past_data);
