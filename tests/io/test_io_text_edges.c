@@ -74,6 +74,32 @@ START_TEST(bom_skipped)
 }
 END_TEST
 
+/* The table reader of eval and render (jf_eval_table_read): the same
+ * names and values with a BOM before a CSV or a PLY. */
+START_TEST(bom_eval_tables)
+{
+    static const char csv[] = "x,y,z,k1\n1,2,3,0.5\n";
+    static const char ply[] = "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\n"
+                              "property double y\nproperty double z\nproperty double k1\n"
+                              "end_header\n1 2 3 0.5\n";
+    const char *t[2][2] = {{"t.csv", csv}, {"t.ply", ply}};
+    for (int k = 0; k < 2; k++) {
+        char b[512];
+        memcpy(b, BOM, 3);
+        memcpy(b + 3, t[k][1], strlen(t[k][1]));
+        jf_eval_table a;
+        jf_error e = {{0}};
+        ck_assert_msg(jf_eval_table_read(fixture(t[k][0], b, 3 + strlen(t[k][1])), &a, &e) == JF_OK,
+                      "%s: %s", t[k][0], e.msg);
+        ck_assert_uint_eq(a.nrows, 1);
+        ck_assert_uint_eq(a.ncols, 4);
+        ck_assert_str_eq(a.names[0], "x");
+        ck_assert(a.v[3] == 0.5);
+        jf_eval_table_free(&a);
+    }
+}
+END_TEST
+
 /* A one-scan PTX whose rotation rows are r (3 lines of text). */
 static jf_status ptx_rot(const char *rows, jf_cloud *c, jf_error *e)
 {
@@ -120,6 +146,7 @@ int main(void)
     tcase_add_checked_fixture(tc, setup, teardown);
     tcase_add_test(tc, bom_skipped);
     tcase_add_test(tc, ptx_rotation);
+    tcase_add_test(tc, bom_eval_tables);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
