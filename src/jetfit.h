@@ -542,14 +542,16 @@ typedef struct {
 } jf_attr;
 
 typedef struct {
-    size_t nattrs;       /* 0: no attributes (and the rest NULL/0)      */
+    size_t nattrs;       /* 0: no attributes (and the rest NULL/0 but
+                            las_head)                                   */
     jf_attr *attr;       /* nattrs descriptions                         */
     size_t stride;       /* bytes per point record                      */
     unsigned char *rec;  /* n * stride bytes, point i at rec + i*stride */
     unsigned char *las_head; /* LAS input only: the header block and
                             VLRs verbatim (las_head_len bytes, up to the
                             offset to point data); rec holds the point
-                            records; else NULL                          */
+                            records (NULL under no_attrs: las_head is
+                            then kept for the CRS VLRs); else NULL      */
     size_t las_head_len;
     unsigned char *las_evlr; /* LAS 1.3/1.4 input: its EVLRs verbatim,
                             or NULL                                     */
