@@ -724,12 +724,13 @@ const char *jf_writer_warnings(jf_writer *w);
  * `in_nx`).  PLY: each property in its input type (64-bit integers as
  * double); text: integers exact, floats and doubles %.17g (the exact
  * value, so a reader gets the same number back); LAS: from a
- * LAS input (a->las_head) the input's point records are written unchanged
+ * LAS input (a->las_head and a->rec) the input's point records are written unchanged
  * -- same point format, scale, offset, header fields, VLRs and EVLRs --
  * with the table's columns 3.. appended as Extra Bytes after the input's
  * own (x y z of the rows are then not used, and jf_writer_las_frame is
  * not needed); from another input, format 0 with the attributes as Extra
- * Bytes of their type ahead of the table's.  Row r of the table carries
+ * Bytes of their type ahead of the table's (a LAS input read without its
+ * records, no_attrs: format 0 with the input's CRS VLRs copied).  Row r of the table carries
  * the attributes of point r (rows are in input order): `a` is read while
  * rows are written and must stay valid until commit.  Call before the
  * first row.  A table with no attribute (nattrs 0, not LAS) is a no-op.
