@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -76,6 +77,11 @@ static void usage(FILE *f)
         "                        a LAS output keeps the LAS records) go to the output\n"
         "                        after x y z, a name that clashes renamed in_NAME;\n"
         "                        none: jetfit's columns only\n"
+        "  --las-scale X,Y,Z     a LAS output's scale per axis (or one value), and\n"
+        "  --las-offset X,Y,Z    its offset (default: the minimum); without them\n"
+        "                        the scale is the smallest power of ten >= 1e-7\n"
+        "                        keeping counts in int32, with a warning when an\n"
+        "                        outlier makes it coarse (docs/formats.md)\n"
         "  --quiet               no progress line, no summary\n"
         "  -h, --help            this text\n"
         "\n"
@@ -293,7 +299,28 @@ int jf_cmd_estimate(int argc, char **argv)
     /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
-    (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
+    /* .las: the scale and offset (--las-scale, --las-offset, else the
+     * rule); a cloud LAS cannot hold is refused here, before the work and
+     * with no file made.  Kept LAS records keep their own. */
+    size_t olen = strlen(out);
+    int las_out = olen >= 4 && !strcasecmp(out + olen - 4, ".las");
+    if ((cmd.las_scale_set || cmd.las_offset_set) && (!las_out || (keep && c.attrs.las_head))) {
+        fprintf(stderr, "jetfit: %s: --las-scale and --las-offset %s\n", out,
+                !las_out ? "apply to a .las output"
+                         : "do not apply: the LAS input's records are kept with their own scale "
+                           "and offset (add --keep none for new ones)");
+        jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    if (!(keep && c.attrs.las_head) &&
+        jf_writer_las_frame_given(w, c.xyz, c.n, cmd.las_scale_set ? cmd.las_scale : NULL,
+                                  cmd.las_offset_set ? cmd.las_offset : NULL) != JF_OK) {
+        st = jf_writer_commit(w, &err); /* removes the temporary, says why */
+        fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        jf_cloud_free(&c);
+        return 1;
+    }
     /* the input's attributes after x y z (a LAS output from a LAS input
      * keeps its records) */
     st = jf_writer_attrs(w, &c.attrs);
@@ -306,6 +333,12 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_writer_abort(w);
         jf_cloud_free(&c);
         return 1;
+    }
+    /* the writer's warnings (a name shortened, coordinates rounded): also
+     * under --quiet, since they say the output differs from the input */
+    for (const char *wl = jf_writer_warnings(w), *nl; *wl; wl = nl + 1) {
+        if (!(nl = strchr(wl, '\n'))) break;
+        fprintf(stderr, "jetfit: %.*s\n", (int)(nl - wl), wl);
     }
     const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
     sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
