@@ -7,6 +7,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 /* n points of a paraboloid patch at (4123456.789012, 5e6, 100) +- 50. */
 static void patch(const char *path, size_t n, const char *extra)
@@ -186,9 +187,5 @@ int main(void)
     tcase_add_test(tc, long_names);
     tcase_add_test(tc, keep_none_keeps_crs);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -18,6 +18,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_lase_XXXXXX"); }
 
@@ -510,9 +511,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *r = srunner_create(suite());
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return jf_test_run(suite());
 }
