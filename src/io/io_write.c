@@ -230,11 +230,11 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
     }
     memcpy(taken, w->names, w->ncols * sizeof *taken);
     for (size_t k = w->ncols; k < nn; k++) taken[k] = (char *)jf__las_fmt0_dims[k - w->ncols];
-    int bad = jf__attrs_names(a, taken, nn, nm) != 0;
+    int bad = jf__attrs_names(a, taken, nn, nm);
     free(taken);
     if (bad) {
         free(nm);
-        return JF_ERR_INVALID;
+        return bad == -2 ? JF_ERR_NOMEM : JF_ERR_INVALID;
     }
     size_t need = w->row_max + a->nattrs * 32;
     w->las.a = a;
@@ -408,7 +408,12 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
     const int nt = threads > 0 ? threads : omp_get_max_threads();
-    const size_t row_max = w->row_max, slot = ROWS_BLOCK * row_max;
+    /* wide rows (a CSV of 100,000 named columns: 3 MB a row) take fewer
+     * rows a block, so the scratch stays near 8 MB a thread */
+    const size_t row_max = w->row_max,
+                 blk = row_max * ROWS_BLOCK <= ((size_t)8 << 20) ? ROWS_BLOCK
+                       : row_max >= ((size_t)8 << 20) ? 1 : ((size_t)8 << 20) / row_max,
+                 slot = blk * row_max;
     char *scratch = malloc((size_t)nt * slot);
     size_t *len = malloc((size_t)nt * sizeof *len);
     if (!scratch || !len) {
@@ -416,13 +421,13 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
         free(len);
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
     }
-    /* each round: thread t formats the t-th block of ROWS_BLOCK rows into
+    /* each round: thread t formats the t-th block of blk rows into
      * its slot, then the slots go out in order, unbuffered */
     for (size_t r0 = 0; r0 < nrows && f->st == JF_OK;
-         r0 += (size_t)nt * ROWS_BLOCK) {
+         r0 += (size_t)nt * blk) {
 #pragma omp parallel for num_threads(nt) schedule(static, 1)
         for (int t = 0; t < nt; t++) {
-            size_t a = r0 + (size_t)t * ROWS_BLOCK, b = a + ROWS_BLOCK;
+            size_t a = r0 + (size_t)t * blk, b = a + blk;
             char *o = scratch + (size_t)t * slot;
             len[t] = 0;
             for (size_t r = a; r < b && r < nrows; r++)
