@@ -45,8 +45,7 @@ static volatile sig_atomic_t stop_asked;
 
 static void on_signal(int sig)
 {
-    (void)sig;
-    stop_asked = 1;
+    stop_asked = sig; /* the exit status is 128 + sig, as main.c's */
 }
 
 static int cancel_hook(void *user)
@@ -429,7 +428,7 @@ int jf_cmd_study(int argc, char **argv)
         fprintf(stderr, "jetfit study: interrupted: %zu of %zu cells in %s/study.csv; the same "
                         "command with --resume goes on\n", done, s->ncells, c.dir);
         jf_study_args_free(&c);
-        return 130;
+        return 128 + (int)stop_asked;
     }
     if (werr || jf_study_write_best(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
@@ -437,6 +436,9 @@ int jf_cmd_study(int argc, char **argv)
     }
     int nplots = jf_study_plots(s, c.dir, msg, sizeof msg);
     if (nplots < 0) fprintf(stderr, "jetfit study: no plots: %s\n", msg);
+    /* gnuplot missing is a note (the plots are optional); gnuplot failing,
+     * or a picture cut short, is an error once the report is written */
+    int plot_err = nplots == -1;
     if (jf_study_report(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;
@@ -445,7 +447,7 @@ int jf_cmd_study(int argc, char **argv)
         fprintf(stderr, "jetfit study: %zu cells (%zu run, %zu failed) in %.1f s: %s/report.html\n",
                 s->ncells, pg.cell_no, nfailed, now_s() - pg.t0, c.dir);
     jf_study_args_free(&c);
-    return 0;
+    return plot_err ? 1 : 0;
 fail:
     jf_study_args_free(&c);
     return 1;

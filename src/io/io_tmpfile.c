@@ -175,6 +175,17 @@ jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err)
 {
     const char *name = final ? final : "(output)";
     jf_status st = JF_OK;
+    /* the name must still be our file: another process with write access
+     * to the folder may have put a link there (issue 33.2), and the
+     * rename would make that link the output */
+    struct stat a, b;
+    if (t->fd >= 0 && (fstat(t->fd, &a) != 0 || lstat(t->tmp, &b) != 0 ||
+                       a.st_dev != b.st_dev || a.st_ino != b.st_ino)) {
+        st = jf_io_fail(err, JF_ERR_IO, name, 0,
+                        "its temporary %s was replaced by another process", t->tmp);
+        close(t->fd);
+        t->fd = -1;
+    }
     if (t->fd >= 0 && close(t->fd) != 0)
         st = jf_io_fail(err, JF_ERR_IO, name, 0, "close failed: %s", strerror(errno));
     t->fd = -1;

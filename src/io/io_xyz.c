@@ -503,6 +503,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                 continue;
         }
         double v[6];
+        int room;
         if (fast && fast_row(ls, le, nf0, v))
             goto store;
         const char *p = ls, *fs, *fe;
@@ -559,8 +560,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         /* rows that parse fit the byte bound; bad rows kept as NaN under
          * --bad-rows skip can be shorter ("4 5"): only the line count
          * bounds them, so the arrays grow up to it */
-        int room = n < cap ? 1 : grow_rows(c, &cap, lines, have_nrm);
-        if (room <= 0)
+        if (n == cap && (room = grow_rows(c, &cap, lines, have_nrm)) <= 0)
             return room < 0 ? jf_io_fail(err, JF_ERR_NOMEM, name, tx.line,
                                          "out of memory for %zu points", n + 1)
                             : jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
