@@ -716,11 +716,12 @@ jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
 jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a);
 
 /* PLY only (ignored by text formats): also write a `face` element
- * (list uchar int vertex_indices) from nfaces polygons
- * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the
- * first row; the arrays are read at commit and must stay valid until
- * then.  JF_ERR_INVALID if rows were already written, a face has more
- * than 255 vertices or an index >= nrows. */
+ * (list uchar int vertex_indices; list uint int when a polygon has more
+ * than 255 vertices) from nfaces polygons idx[off[f] .. off[f+1]-1], so
+ * a mesh keeps its faces.  Call before the first row; the arrays are read
+ * at commit and must stay valid until then.  JF_ERR_INVALID if rows were
+ * already written, the offsets decrease or an index is >= nrows (or
+ * over INT32_MAX). */
 jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
                           const uint32_t *idx);
 

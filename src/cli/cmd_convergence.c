@@ -257,6 +257,12 @@ int jf_cmd_convergence(int argc, char **argv)
         fprintf(stderr, "jetfit convergence: --out DIR is required (jetfit convergence --help)\n");
         return 2;
     }
+    struct stat sb;
+    if (stat(dir, &sb) != 0 && lstat(dir, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+        fprintf(stderr, "jetfit convergence: %s: a symbolic link to a folder that does not "
+                        "exist\n", dir);
+        return 1;
+    }
     if (mkdir(dir, 0777) && errno != EEXIST) {
         fprintf(stderr, "jetfit convergence: cannot create %s: %s\n", dir, strerror(errno));
         return 1;

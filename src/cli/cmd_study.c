@@ -275,6 +275,10 @@ static int prepare_dir(const char *dir)
             fprintf(stderr, "jetfit: %s: not a folder\n", dir);
             return 1;
         }
+    } else if (lstat(dir, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+        /* mkdir would say "File exists" (issue 33.12) */
+        fprintf(stderr, "jetfit: %s: a symbolic link to a folder that does not exist\n", dir);
+        return 1;
     } else if (mkdir(dir, 0777)) {
         fprintf(stderr, "jetfit: %s: %s\n", dir, strerror(errno));
         return 1;

@@ -23,6 +23,7 @@ typedef struct {
     const char *nbspec;    /* --neighbors text (parsed by _finish)       */
     int monge;             /* --monge-degree, -1 = from the degree       */
     const char *monge_s;
+    const char *dsel_s;    /* --degree-select text, for _finish's message */
     int orient_set;        /* --orient given (else: input if normals)    */
 } jf_cli_est;
 

@@ -11,7 +11,9 @@
  * the target is replaced.  The new file keeps the mode of the file it
  * replaces, or gets 0666 less the umask.  Every open temporary is listed in
  * a fixed table so that a signal handler can remove them
- * (jf_tmpfiles_remove_all: unlink(2) only, async-signal-safe).
+ * (jf_tmpfiles_remove_all: unlink(2) only, async-signal-safe).  An
+ * existing output that is not a regular file (a FIFO, a device) is
+ * refused; at commit the temporary's name must still be our file.
  */
 #define _GNU_SOURCE /* getrandom, O_NOFOLLOW */
 #include <errno.h>
@@ -126,6 +128,16 @@ jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err)
     if (replacing && S_ISDIR(old.st_mode)) {
         jf_tmpfile_discard(t);
         return jf_io_fail(err, JF_ERR_IO, name, 0, "is a directory");
+    }
+    /* a FIFO, device or socket would be replaced by a plain file (issue
+     * 33.12): refused, since the output is written whole then renamed */
+    if (replacing && !S_ISREG(old.st_mode)) {
+        const char *what = S_ISFIFO(old.st_mode) ? "a FIFO" : S_ISSOCK(old.st_mode) ? "a socket"
+                                                                                 : "a device";
+        jf_tmpfile_discard(t);
+        return jf_io_fail(err, JF_ERR_IO, name, 0,
+                          "is %s, not a regular file: jetfit writes a whole file and renames it "
+                          "into place", what);
     }
     size_t blen = strlen(base) > 200 ? 200 : strlen(base);
     size_t cap = dirlen + blen + 32;

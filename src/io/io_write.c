@@ -30,6 +30,7 @@ struct jf_writer {
     char **names;
     int header_done;
     size_t nfaces;
+    int face_count4;                 /* a face over 255 vertices: uint counts */
     const size_t *foff;
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
@@ -108,7 +109,11 @@ static jf_status write_header(jf_writer *w)
         if (w->foff) {
             snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
             jf_wf_puts(f, line);
-            jf_wf_puts(f, "property list uchar int vertex_indices\n");
+            /* uchar counts, as every PLY mesh tool writes them; a polygon
+             * over 255 vertices needs uint counts (PLY allows any integer
+             * type for a list count) */
+            jf_wf_puts(f, w->face_count4 ? "property list uint int vertex_indices\n"
+                                         : "property list uchar int vertex_indices\n");
         }
         return jf_wf_puts(f, "end_header\n");
     }
@@ -271,13 +276,16 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
 {
     if (!w || w->header_done || (nfaces && (!off || !idx)))
         return JF_ERR_INVALID;
+    int wide = 0;
     for (size_t f = 0; f < nfaces; f++) {
-        if (off[f + 1] < off[f] || off[f + 1] - off[f] > 255)
+        if (off[f + 1] < off[f] || off[f + 1] - off[f] > UINT32_MAX)
             return JF_ERR_INVALID;
+        wide |= off[f + 1] - off[f] > 255;
         for (size_t k = off[f]; k < off[f + 1]; k++)
-            if (idx[k] >= w->nrows)
+            if (idx[k] >= w->nrows || idx[k] > INT32_MAX) /* written as PLY int */
                 return JF_ERR_INVALID;
     }
+    w->face_count4 = wide;
     w->nfaces = nfaces;
     w->foff = off;
     w->fidx = idx;
@@ -514,7 +522,13 @@ static jf_status write_faces(jf_writer *w)
             }
             *o++ = '\n';
         } else {
-            *o++ = (char)(unsigned char)k;
+            if (w->face_count4) {
+                uint32_t c = (uint32_t)k;
+                for (int t = 0; t < 4; t++)
+                    *o++ = (char)(unsigned char)(c >> (8 * t)); /* the file is little-endian */
+            } else {
+                *o++ = (char)(unsigned char)k;
+            }
             for (size_t j = 0; j < k; j++) {
                 int32_t x = (int32_t)ix[j];
                 unsigned char b[4];
@@ -691,8 +705,8 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
     if (c->nfaces && (st = jf_writer_faces(w, c->nfaces, c->face_off,
                                            c->face_idx)) != JF_OK) {
         jf_writer_abort(w);
-        return jf_io_fail(err, st, nm, 0, "a face has more than 255 "
-                                          "vertices or bad offsets");
+        return jf_io_fail(err, st, nm, 0, "a face has bad offsets or a vertex "
+                                          "index out of range");
     }
     for (size_t i = 0; i < c->n && st == JF_OK; i++) {
         double v[6];
