@@ -390,7 +390,9 @@ int jf_cmd_estimate(int argc, char **argv)
                         "nothing written\n", in, nonfin, c.n - nonfin,
                 big > 1e150 ? ": coordinates near 1e150 or beyond overflow the fit (rescale "
                               "the cloud)"
-                : nonfin < c.n ? ": too few or collinear neighbours (K must be at least 3)" : "");
+                : nonfin < c.n ? ": too few or collinear neighbours (K must be at least 3)"
+                               : ": every point is NaN or infinite (a scale or transform that "
+                                 "overflows?)");
         free(sk.tl);
         free(sk.cond);
         jf_cloud_free(&c);
