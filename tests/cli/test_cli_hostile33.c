@@ -96,7 +96,8 @@ START_TEST(mesh_faces_kept)
 END_TEST
 
 /* 3. The writer: a face naming a row the file does not have is refused
- * (JF_ERR_INVALID), and a triangle mesh keeps its uchar counts. */
+ * (JF_ERR_INVALID: the return the command and Python now act on; this
+ * check passed before too), and a triangle mesh keeps its uchar counts. */
 START_TEST(writer_faces_checked)
 {
     jf_column cols[3] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64}};
