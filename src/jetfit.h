@@ -1042,10 +1042,14 @@ typedef struct {
 } jf_tmpfile;
 
 /* Creates the temporary for `final`.  JF_OK, or JF_ERR_IO / _INVALID /
- * _NOMEM with err "FINAL: reason" and *t holding nothing.  Thread-safe. */
+ * _NOMEM with err "FINAL: reason" and *t holding nothing (an existing
+ * final that is a folder, FIFO, device or socket: JF_ERR_IO).
+ * Thread-safe. */
 jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err);
 /* Closes the temporary and renames it onto its target; on failure removes
- * it.  Either way *t holds nothing afterwards. */
+ * it.  JF_ERR_IO when the temporary's name no longer holds the file t->fd
+ * is open on (another process replaced it).  Either way *t holds nothing
+ * afterwards. */
 jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err);
 /* Closes and removes the temporary (t may be NULL or empty). */
 void jf_tmpfile_discard(jf_tmpfile *t);
