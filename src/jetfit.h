@@ -753,11 +753,12 @@ const char *jf_writer_warnings(jf_writer *w);
 jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a);
 
 /* PLY only (ignored by text formats): also write a `face` element
- * (list uchar int vertex_indices) from nfaces polygons
- * idx[off[f] .. off[f+1]-1], so a mesh keeps its faces.  Call before the
- * first row; the arrays are read at commit and must stay valid until
- * then.  JF_ERR_INVALID if rows were already written, a face has more
- * than 255 vertices or an index >= nrows. */
+ * (list uchar int vertex_indices; list uint int when a polygon has more
+ * than 255 vertices) from nfaces polygons idx[off[f] .. off[f+1]-1], so
+ * a mesh keeps its faces.  Call before the first row; the arrays are read
+ * at commit and must stay valid until then.  JF_ERR_INVALID if rows were
+ * already written, the offsets decrease or an index is >= nrows (or
+ * over INT32_MAX). */
 jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
                           const uint32_t *idx);
 
@@ -1089,10 +1090,14 @@ typedef struct {
 } jf_tmpfile;
 
 /* Creates the temporary for `final`.  JF_OK, or JF_ERR_IO / _INVALID /
- * _NOMEM with err "FINAL: reason" and *t holding nothing.  Thread-safe. */
+ * _NOMEM with err "FINAL: reason" and *t holding nothing (an existing
+ * final that is a folder, FIFO, device or socket: JF_ERR_IO).
+ * Thread-safe. */
 jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err);
 /* Closes the temporary and renames it onto its target; on failure removes
- * it.  Either way *t holds nothing afterwards. */
+ * it.  JF_ERR_IO when the temporary's name no longer holds the file t->fd
+ * is open on (another process replaced it).  Either way *t holds nothing
+ * afterwards. */
 jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err);
 /* Closes and removes the temporary (t may be NULL or empty). */
 void jf_tmpfile_discard(jf_tmpfile *t);

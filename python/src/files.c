@@ -247,6 +247,15 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
     int fbad = fobj != Py_None && jf_py_faces(fobj, n, &fc) < 0;
     Py_DECREF(fobj);
     if (fbad) goto out;
+    /* a face naming a point the file does not have is an error, never
+     * dropped (issue 33.3) */
+    for (size_t f = 0; f < fc.nfaces; f++)
+        for (size_t k = fc.face_off[f]; k < fc.face_off[f + 1]; k++)
+            if (fc.face_idx[k] >= n) {
+                PyErr_Format(PyExc_ValueError, "faces: face %zu has vertex index %lu, the "
+                             "points have %zu rows", f, (unsigned long)fc.face_idx[k], n);
+                goto out;
+            }
 
     int monge = jf_py_result_monge(result);
     cols_src s = {PyArray_DATA(pa), data_of(result, "normal"), data_of(result, "k1"),
@@ -271,13 +280,18 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
     st = jf_writer_open(path, cols, ncols, n, ascii, &w, &err);
     if (st == JF_OK) {
         /* a mesh keeps its faces in a PLY output, as the command does */
-        if (fc.nfaces) (void)jf_writer_faces(w, fc.nfaces, fc.face_off, fc.face_idx);
-        for (size_t b0 = 0; b0 < n; b0 += BLOCK) {
+        if (fc.nfaces && (st = jf_writer_faces(w, fc.nfaces, fc.face_off, fc.face_idx)) != JF_OK)
+            jf_writer_abort(w);
+        for (size_t b0 = 0; st == JF_OK && b0 < n; b0 += BLOCK) {
             size_t nb = n - b0 < BLOCK ? n - b0 : BLOCK;
             for (size_t k = 0; k < nb; k++) make_row(&s, b0 + k, monge, rows + k * ncols);
             if (jf_writer_rows(w, rows, nb, nthreads) != JF_OK) break;
         }
-        st = jf_writer_commit(w, &err); /* reports a failed row too */
+        if (st == JF_OK)
+            st = jf_writer_commit(w, &err); /* reports a failed row too */
+        else
+            snprintf(err.msg, sizeof err.msg, "%s: cannot write its %zu faces: %s", path,
+                     fc.nfaces, jf_strerror(st));
     }
     Py_END_ALLOW_THREADS
     PyMem_RawFree(rows);

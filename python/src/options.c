@@ -63,8 +63,20 @@ int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int
             PyErr_Format(PyExc_TypeError, "%s: expected a str, got %s", kw, Py_TYPE(v)->tp_name);
             return -1;
         }
-        const char *s = PyUnicode_AsUTF8(v);
+        Py_ssize_t n;
+        const char *s = PyUnicode_AsUTF8AndSize(v, &n);
         if (!s) return -1;
+        /* the C parser would stop at a NUL: 'knn:16\0junk' must not run
+         * knn:16 (issue 33.10), as a path with a NUL is refused */
+        if (strlen(s) != (size_t)n) {
+            PyErr_Format(PyExc_ValueError, "%s: embedded null character", kw);
+            return -1;
+        }
+        if ((size_t)n >= sizeof text) { /* never cut short either */
+            PyErr_Format(PyExc_ValueError, "%s: value too long (%zd characters, at most %zu)", kw,
+                         n, sizeof text - 1);
+            return -1;
+        }
         snprintf(text, sizeof text, "%s", s);
     } else if (kind == JF_PY_LIST) {
         /* scales: a sequence of ints, or one int */

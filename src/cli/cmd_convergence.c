@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "cmd.h"
+#include "gnuplot.h"
 #include "convergence.h"
 #include "jetfit.h"
 
@@ -63,21 +64,49 @@ static int close_checked(FILE *f, const char *path)
     return 0;
 }
 
+static const char *const qn[3] = {"normal", "kmin", "kmax"};
+
+/* The PNG names, in the order the script draws them: per mode drawn,
+ * normal/kmin/kmax against h, then degree.  Returns how many (<= 8). */
+static int png_names(const jf_conv_config *c, char name[8][32])
+{
+    int n = 0;
+    for (int m = 0; m < 2; m++) {
+        const char *mn = m ? "approx" : "interp";
+        if ((m == 0 && !c->interp) || (m == 1 && !c->approx))
+            continue;
+        for (int q = 0; q < 3; q++)
+            snprintf(name[n++], 32, "%s_%s.png", qn[q], mn);
+        snprintf(name[n++], 32, "degree_%s.png", mn);
+    }
+    return n;
+}
+
 /* The gnuplot script: Figs. 5-10 (log(1/delta) vs log(1/h) per degree,
  * read from convergence.csv) and Figs. 11-12 (log(1/delta)/log(1/h) vs
- * degree at h = c->h[kfix], inline data blocks so the lines join). */
-static int write_script(const char *dir, const jf_conv_config *c,
-                        const jf_conv_row *rows, int kfix)
+ * degree at h = c->h[kfix], inline data blocks so the lines join).
+ * fd NULL: the script users run in DIR (file names); else the one jetfit
+ * runs: convergence.csv's rows inline and each picture to descriptor
+ * fd[i] (gnuplot opens no name in DIR, issue 33.2). */
+static void emit_script(FILE *f, const jf_conv_config *c, const jf_conv_row *rows, int kfix,
+                        const int *fd)
 {
-    char path[4096];
-    FILE *f = open_in(dir, "convergence.gp", path, sizeof path);
-    if (!f)
-        return -1;
-    static const char *qn[3] = {"normal", "kmin", "kmax"};
-    int nd = c->deg_hi - c->deg_lo + 1;
+    int nd = c->deg_hi - c->deg_lo + 1, np = 0;
+    char pn[8][32];
+    png_names(c, pn);
     fprintf(f, "# made by jetfit convergence; run in this folder: gnuplot convergence.gp\n"
                "set terminal pngcairo size 640,480 font ',10' noenhanced\n"
                "set datafile separator ','\nset key outside right\nset grid\n");
+    if (fd) {
+        fprintf(f, "$csv << EOD\n");
+        for (size_t k = 0, nr = jf_conv_row_count(c); k < nr; k++) {
+            fprintf(f, "%s,%d,%.17g", mode_name(rows[k].mode), rows[k].degree, rows[k].h);
+            for (int q = 0; q < 3; q++)
+                fprintf(f, ",%.17g,%.17g", rows[k].avg[q], rows[k].max[q]);
+            fprintf(f, "\n");
+        }
+        fprintf(f, "EOD\n");
+    }
     for (int m = 0, g = 0; m < 2; m++) {
         const char *mn = m ? "approx" : "interp";
         if ((m == 0 && !c->interp) || (m == 1 && !c->approx))
@@ -94,25 +123,97 @@ static int write_script(const char *dir, const jf_conv_config *c,
         fprintf(f, "EOD\n");
         g++;
         fprintf(f, "set xlabel 'log(1/h)'\nset ylabel 'log(1/delta)'\n");
-        for (int q = 0; q < 3; q++)
-            fprintf(f, "set output '%s_%s.png'\n"
-                       "set title 'exp graph: %s error (average) vs h, %s'\n"
-                       "plot for [d=%d:%d] 'convergence.csv' skip 1 using "
+        for (int q = 0; q < 3; q++) {
+            if (fd)
+                jf_gp_output(f, fd[np++]);
+            else
+                fprintf(f, "set output '%s'\n", pn[np++]);
+            fprintf(f, "set title 'exp graph: %s error (average) vs h, %s'\n"
+                       "plot for [d=%d:%d] %s using "
                        "(strcol(1) eq '%s' && $2 == d ? log(1/$3) : 1/0):"
                        "(log(1/$%d)) with linespoints title sprintf('deg %%d', d)\n",
-                    qn[q], mn, qn[q], mn, q && c->deg_lo < 2 ? 2 : c->deg_lo,
-                    c->deg_hi, mn, 4 + 2 * q);
-        fprintf(f, "set output 'degree_%s.png'\nset xlabel 'degree'\n"
+                    qn[q], mn, q && c->deg_lo < 2 ? 2 : c->deg_lo,
+                    c->deg_hi, fd ? "$csv" : "'convergence.csv' skip 1", mn, 4 + 2 * q);
+        }
+        if (fd)
+            jf_gp_output(f, fd[np++]);
+        else
+            fprintf(f, "set output '%s'\n", pn[np++]);
+        fprintf(f, "set xlabel 'degree'\n"
                    "set ylabel 'log(1/delta)/log(1/h)'\n"
                    "set title 'exp graph: errors vs degree at h = %g, %s'\nplot ",
-                mn, c->h[kfix], mn);
+                c->h[kfix], mn);
         for (int q = 0; q < 3; q++)
             for (int a = 0; a < 2; a++)
                 fprintf(f, "%s$deg_%s using 1:%d with linespoints title '%s_%s'",
                         q + a ? ", " : "", mn, 2 + 2 * q + a, qn[q], a ? "max" : "av");
         fprintf(f, "\n");
     }
+    if (fd)
+        fprintf(f, "unset output\n");
+}
+
+static int write_script(const char *dir, const jf_conv_config *c,
+                        const jf_conv_row *rows, int kfix)
+{
+    char path[4096];
+    FILE *f = open_in(dir, "convergence.gp", path, sizeof path);
+    if (!f)
+        return -1;
+    emit_script(f, c, rows, kfix, NULL);
     return close_checked(f, path);
+}
+
+/* gnuplot draws each picture into a temporary beside its final name
+ * (jf_tmpfile) through an inherited descriptor; all are checked whole
+ * (gnuplot says nothing of a full disk) before any is renamed.  0, or -1
+ * after one line; *missing set when gnuplot is not installed. */
+static int run_plots(const char *dir, const jf_conv_config *c, const jf_conv_row *rows,
+                     int kfix, int *missing)
+{
+    char pn[8][32], path[8][4096], why[600];
+    int np = png_names(c, pn), fd[8], ok = 0, bad = 0;
+    jf_tmpfile tf[8];
+    jf_error e = {{0}};
+    *missing = 0;
+    for (; ok < np; ok++) {
+        snprintf(path[ok], sizeof path[ok], "%s/%s", dir, pn[ok]);
+        if (jf_tmpfile_open(path[ok], &tf[ok], &e) != JF_OK)
+            break;
+        fd[ok] = tf[ok].fd;
+    }
+    if (ok < np) {
+        fprintf(stderr, "jetfit convergence: %s\n", e.msg);
+        bad = 1;
+    }
+    jf_gp g;
+    if (!bad && jf_gp_open(&g, fd, np, why, sizeof why) != 0) {
+        *missing = g.missing;
+        if (!g.missing)
+            fprintf(stderr, "jetfit convergence: %s\n", why);
+        bad = 1;
+    }
+    if (!bad) {
+        emit_script(g.in, c, rows, kfix, fd);
+        if (jf_gp_close(&g, why, sizeof why) != 0) {
+            fprintf(stderr, "jetfit convergence: %s; CSVs are written\n", why);
+            bad = 1;
+        }
+    }
+    for (int p = 0; p < np && !bad; p++)
+        if (jf_gp_png_whole(fd[p], why, sizeof why)) {
+            fprintf(stderr, "jetfit convergence: %s: %s\n", path[p], why);
+            bad = 1;
+        }
+    for (int p = 0; p < ok; p++) {
+        if (bad)
+            jf_tmpfile_discard(&tf[p]);
+        else if (jf_tmpfile_commit(&tf[p], path[p], &e) != JF_OK) {
+            fprintf(stderr, "jetfit convergence: %s\n", e.msg);
+            bad = 1;
+        }
+    }
+    return bad ? -1 : 0;
 }
 
 int jf_cmd_convergence(int argc, char **argv)
@@ -155,6 +256,12 @@ int jf_cmd_convergence(int argc, char **argv)
     if (!dir) {
         fprintf(stderr, "jetfit convergence: --out DIR is required (jetfit convergence --help)\n");
         return 2;
+    }
+    struct stat sb;
+    if (stat(dir, &sb) != 0 && lstat(dir, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+        fprintf(stderr, "jetfit convergence: %s: a symbolic link to a folder that does not "
+                        "exist\n", dir);
+        return 1;
     }
     if (mkdir(dir, 0777) && errno != EEXIST) {
         fprintf(stderr, "jetfit convergence: cannot create %s: %s\n", dir, strerror(errno));
@@ -216,24 +323,24 @@ int jf_cmd_convergence(int argc, char **argv)
         free(rows);
         return 1;
     }
-    free(rows);
+    jf_conv_row *rows_kept = rows; /* the plots' data */
     if (lowered || failed)
         fprintf(stderr, "jetfit convergence: note: %zu fits were rank deficient "
                         "(lower degree), %zu failed\n", lowered, failed);
-    if (!plots)
+    if (!plots) {
+        free(rows_kept);
         return 0;
-    if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    }
+    int missing = 0;
+    if (run_plots(dir, &c, rows_kept, c.nh > 2 ? 2 : c.nh - 1, &missing) == 0) {
+        free(rows_kept);
+        return 0;
+    }
+    free(rows_kept);
+    if (missing) { /* the plots are optional */
         fprintf(stderr, "jetfit convergence: gnuplot not found: CSVs written, no plots "
                         "(install gnuplot-nox, then run gnuplot convergence.gp in %s)\n", dir);
         return 0;
     }
-    if (strchr(dir, '\'')) {
-        fprintf(stderr, "jetfit convergence: folder name has a quote; run gnuplot convergence.gp in it yourself\n");
-        return 0;
-    }
-    char cmd[4200];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot convergence.gp", dir);
-    if (system(cmd) != 0)
-        fprintf(stderr, "jetfit convergence: gnuplot failed; CSVs are written\n");
-    return 0;
+    return 1;
 }

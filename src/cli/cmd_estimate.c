@@ -144,12 +144,14 @@ static void progress(void *user, size_t done, size_t total)
  * threads), padded so that threads do not share a cache line. */
 typedef struct {
     size_t flags[32], ok, deg[JF_MAX_DEGREE + 1];
+    size_t unfit; /* failed or nonfinite: no fit at all */
     char pad[64];
 } tally;
 
 static void tally_add(tally *t, const jf_result *r)
 {
     if (!r->status) t->ok++;
+    if (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) t->unfit++;
     for (int b = 0; b < 32; b++)
         if (r->status & (1u << b)) t->flags[b]++;
     if (r->degree >= 0 && r->degree <= JF_MAX_DEGREE) t->deg[r->degree]++;
@@ -159,7 +161,7 @@ static void tally_add(tally *t, const jf_result *r)
 static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
                     const char *out)
 {
-    tally t = {{0}, 0, {0}, {0}};
+    tally t = {{0}, 0, {0}, 0, {0}};
     for (int k = 0; k < nt; k++) {
         t.ok += tl[k].ok;
         for (int b = 0; b < 32; b++) t.flags[b] += tl[k].flags[b];
@@ -297,8 +299,14 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
-     * the surface); polygons over 255 vertices: vertices only */
-    if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
+     * the surface); never dropped silently (issue 33.3) */
+    if (c.nfaces && (st = jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx)) != JF_OK) {
+        fprintf(stderr, "jetfit: %s: cannot write its %zu faces to %s: %s\n", in, c.nfaces, out,
+                jf_strerror(st));
+        jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
     /* .las: the scale and offset (--las-scale, --las-offset, else the
      * rule); a cloud LAS cannot hold is refused here, before the work and
      * with no file made.  Kept LAS records keep their own. */
@@ -395,6 +403,34 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
+    /* no point fitted (coordinates near 1e160 overflow every fit, K below
+     * 3, a PTX transform or LAS scale of 1e300): an error, nothing written
+     * (issues 31, 33.12); most points unfitted: a warning */
+    size_t unfit = 0, nonfin = 0;
+    for (int k = 0; k < nt; k++) {
+        unfit += sk.tl[k].unfit;
+        nonfin += sk.tl[k].flags[5]; /* JF_PT_NONFINITE */
+    }
+    if (c.n && unfit == c.n) {
+        jf_writer_abort(w);
+        double big = 0;
+        for (size_t i = 0; i < 3 * c.n; i++)
+            if (isfinite(c.xyz[i]) && fabs(c.xyz[i]) > big) big = fabs(c.xyz[i]);
+        fprintf(stderr, "jetfit: %s: no point could be fitted (%zu non-finite, %zu failed)%s; "
+                        "nothing written\n", in, nonfin, c.n - nonfin,
+                big > 1e150 ? ": coordinates near 1e150 or beyond overflow the fit (rescale "
+                              "the cloud)"
+                : nonfin < c.n ? ": too few or collinear neighbours (K must be at least 3)"
+                               : ": every point is NaN or infinite (a scale or transform that "
+                                 "overflows?)");
+        free(sk.tl);
+        free(sk.cond);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    if (unfit > c.n / 2)
+        fprintf(stderr, "jetfit: %s: warning: %zu of %zu points could not be fitted (status "
+                        "failed or nonfinite)\n", in, unfit, c.n);
     /* commit reports a failed row too, and removes the temporary */
     st = jf_writer_commit(w, &err);
     if (st != JF_OK) {

@@ -315,7 +315,7 @@ int jf_cmd_render(int argc, char **argv)
         jf_eval_table_free(&t);
         return 1;
     }
-    if (jf_gp_open(&gpr, why, sizeof why) != 0) {
+    if (jf_gp_open(&gpr, &tf.fd, 1, why, sizeof why) != 0) {
         fprintf(stderr, "jetfit render: %s\n", why);
         jf_tmpfile_discard(&tf);
         free(val), free(tmp), free(take), free(ord);
@@ -327,9 +327,7 @@ int jf_cmd_render(int argc, char **argv)
         fprintf(gp, "set terminal png size %d,%d noenhanced\n", w, hgt);
     else
         fprintf(gp, "set terminal pngcairo size %d,%d font ',10' noenhanced\n", w, hgt);
-    fprintf(gp, "set output ");
-    jf_gp_quote(gp, tf.tmp);
-    fputc('\n', gp);
+    jf_gp_output(gp, tf.fd);
     char def_title[600];
     const char *base = strrchr(in, '/') ? strrchr(in, '/') + 1 : in;
     snprintf(def_title, sizeof def_title, "%s: %s%s", base,
@@ -383,6 +381,8 @@ int jf_cmd_render(int argc, char **argv)
     }
     fprintf(gp, "\nset output\n"); /* closes the picture before gnuplot exits */
     int rc = jf_gp_close(&gpr, why, sizeof why);
+    if (rc == 0)
+        rc = jf_gp_png_whole(tf.fd, why, sizeof why);
     free(val), free(tmp), free(take), free(ord);
     jf_eval_table_free(&t);
     if (rc != 0) {

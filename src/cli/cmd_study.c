@@ -45,8 +45,7 @@ static volatile sig_atomic_t stop_asked;
 
 static void on_signal(int sig)
 {
-    (void)sig;
-    stop_asked = 1;
+    stop_asked = sig; /* the exit status is 128 + sig, as main.c's */
 }
 
 static int cancel_hook(void *user)
@@ -271,6 +270,10 @@ static int prepare_dir(const char *dir)
             fprintf(stderr, "jetfit: %s: not a folder\n", dir);
             return 1;
         }
+    } else if (lstat(dir, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+        /* mkdir would say "File exists" (issue 33.12) */
+        fprintf(stderr, "jetfit: %s: a symbolic link to a folder that does not exist\n", dir);
+        return 1;
     } else if (mkdir(dir, 0777)) {
         fprintf(stderr, "jetfit: %s: %s\n", dir, strerror(errno));
         return 1;
@@ -424,7 +427,7 @@ int jf_cmd_study(int argc, char **argv)
         fprintf(stderr, "jetfit study: interrupted: %zu of %zu cells in %s/study.csv; the same "
                         "command with --resume goes on\n", done, s->ncells, c.dir);
         jf_study_args_free(&c);
-        return 130;
+        return 128 + (int)stop_asked;
     }
     if (werr || jf_study_write_best(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
@@ -432,6 +435,9 @@ int jf_cmd_study(int argc, char **argv)
     }
     int nplots = jf_study_plots(s, c.dir, msg, sizeof msg);
     if (nplots < 0) fprintf(stderr, "jetfit study: no plots: %s\n", msg);
+    /* gnuplot missing is a note (the plots are optional); gnuplot failing,
+     * or a picture cut short, is an error once the report is written */
+    int plot_err = nplots == -1;
     if (jf_study_report(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;
@@ -440,7 +446,7 @@ int jf_cmd_study(int argc, char **argv)
         fprintf(stderr, "jetfit study: %zu cells (%zu run, %zu failed) in %.1f s: %s/report.html\n",
                 s->ncells, pg.cell_no, nfailed, now_s() - pg.t0, c.dir);
     jf_study_args_free(&c);
-    return 0;
+    return plot_err ? 1 : 0;
 fail:
     jf_study_args_free(&c);
     return 1;

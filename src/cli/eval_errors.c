@@ -126,6 +126,11 @@ int jf_cli_subset_load(const char *path, size_t nrows, size_t **sel, size_t *nse
     jf_eval_table sub;
     *sel = NULL;
     if (load(path, &sub, msg, len)) return -1;
+    if (!sub.nrows) { /* no rows: every metric would be NaN (issue 33.12) */
+        snprintf(msg, len, "%s: no indices (an empty subset has no metrics)", path);
+        jf_eval_table_free(&sub);
+        return -1;
+    }
     size_t *s = malloc((sub.nrows ? sub.nrows : 1) * sizeof *s);
     if (!s) {
         snprintf(msg, len, "%s: out of memory", path);

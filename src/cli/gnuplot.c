@@ -1,14 +1,20 @@
 /* gnuplot.c -- gnuplot as a child process without a shell (fork + execlp),
  * its script on a pipe, its output in an anonymous temporary file, so that
  * neither its messages nor a PNG ever reach the user's terminal; the
- * command prints one line of its own instead (issue 11). */
-#define _POSIX_C_SOURCE 200809L /* fdopen, fileno */
+ * command prints one line of its own instead (issue 11).  Pictures go to
+ * descriptors jetfit opened and gnuplot inherits ("/dev/fd/N"): gnuplot
+ * never opens a name in the output folder, where another process could
+ * swap the temporary for a link (issue 33.2).  gnuplot reports no failed
+ * write (a full disk): jf_gp_png_whole checks the picture itself. */
+#define _POSIX_C_SOURCE 200809L /* fdopen, fileno, pread */
 #include "gnuplot.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,12 +39,40 @@ void jf_gp_quote(FILE *gp, const char *s)
         fputc(')', gp);
 }
 
-int jf_gp_open(jf_gp *g, char *msg, size_t len)
+void jf_gp_output(FILE *gp, int fd)
+{
+    fprintf(gp, "set output '/dev/fd/%d'\n", fd);
+}
+
+int jf_gp_png_whole(int fd, char *msg, size_t len)
+{
+    /* PNG (ISO/IEC 15948 §5.2, §11.2.5): an 8-byte signature first, the
+     * empty IEND chunk (length 0, "IEND", its CRC) last */
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+    unsigned char a[8], b[12];
+    struct stat sb;
+    /* a write the disk refused late (delayed allocation) shows up here */
+    if (fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+        snprintf(msg, len, "the picture could not be written: %s", strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, &sb) != 0 || sb.st_size < 20 || pread(fd, a, 8, 0) != 8 ||
+        pread(fd, b, 12, sb.st_size - 12) != 12 || memcmp(a, sig, 8) || memcmp(b, iend, 12)) {
+        snprintf(msg, len, "gnuplot wrote an incomplete picture (%lld bytes, no PNG end); "
+                           "is the disk full?", (long long)(fstat(fd, &sb) ? -1 : sb.st_size));
+        return -1;
+    }
+    return 0;
+}
+
+int jf_gp_open(jf_gp *g, const int *keep, int nkeep, char *msg, size_t len)
 {
     memset(g, 0, sizeof *g);
     g->pid = -1;
     if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
         snprintf(msg, len, "gnuplot not found (Debian package gnuplot-nox)");
+        g->missing = 1;
         return -1;
     }
     int fd[2];
@@ -53,6 +87,11 @@ int jf_gp_open(jf_gp *g, char *msg, size_t len)
     fflush(NULL);
     g->pid = fork();
     if (g->pid == 0) {
+        /* the picture descriptors stay open across exec (they are O_CLOEXEC
+         * in jetfit); every other descriptor of ours closes */
+        for (int k = 0; k < nkeep; k++)
+            if (keep[k] > 2)
+                fcntl(keep[k], F_SETFD, 0);
         dup2(fd[0], 0);
         dup2(fileno(g->log), 1);
         dup2(fileno(g->log), 2);

@@ -59,6 +59,7 @@ void jf_cli_est_init(jf_cli_est *e)
     e->nbspec = JF_CLI_DEFAULT_NEIGHBORS;
     e->monge = -1;
     e->monge_s = "";
+    e->dsel_s = "";
 }
 
 static const char *const valued[] = {
@@ -163,6 +164,7 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
         if (jf_cli_parse_int(val, 1, JF_MAX_DEGREE, &iv))
             return bad_(bad, name, val, "expected a degree 1..9");
         o->params.degree_select = iv;
+        e->dsel_s = val;
     } else if (!strcmp(name, "--dist-weight")) {
         if (jf_cli_parse_double(val, &dv) || !(dv > 0) || !isfinite(dv))
             return bad_(bad, name, val, "expected a positive number");
@@ -209,7 +211,7 @@ int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad)
     }
     if (need > o->params.max_neighbors) o->params.max_neighbors = need;
     if (o->params.degree_select > o->params.degree)
-        return bad_(bad, "--degree-select", "", "must not exceed --degree");
+        return bad_(bad, "--degree-select", e->dsel_s, "must not exceed --degree");
     const char *bf = NULL;
     if (jf_params_validate(&o->params, &bf) != JF_OK)
         return bad_(bad, "parameters", bf ? bf : "?", "invalid combination");

@@ -19,6 +19,7 @@ int jf_cli_parse_list(const char *s, double *v, int max);
 /* One set of estimation options as the command line gives them. */
 typedef struct {
     jf_estimate_opts o;
+    const char *dsel_s;    /* --degree-select text, for _finish's message */
     jf_read_opts ro;       /* --columns                                  */
     const char *nbspec;    /* --neighbors text (parsed by _finish)       */
     int monge;             /* --monge-degree, -1 = from the degree       */

@@ -96,7 +96,8 @@ int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len);
 
 /* The plots: DIR/normal.png, DIR/curvature.png, DIR/k.png (the last only
  * when two strategies differ by K alone).  Returns how many were made,
- * or -1 with msg (gnuplot missing or failing). */
+ * -2 with msg when gnuplot is missing (the plots are optional), or -1
+ * with msg (gnuplot failed, a picture was cut short, a rename failed). */
 int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len);
 
 /* DIR/report.html from the cells, best.csv's choice and the PNGs found

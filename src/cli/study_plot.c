@@ -181,9 +181,7 @@ static int k_lines(FILE *gp, const jf_study *s, int mode)
 
 static void set_output(FILE *gp, const jf_tmpfile *t)
 {
-    fprintf(gp, "set output ");
-    jf_gp_quote(gp, t->tmp);
-    fputc('\n', gp);
+    jf_gp_output(gp, t->fd); /* a descriptor: no name to swap, none to quote */
 }
 
 int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
@@ -207,9 +205,10 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
             return -1;
         }
     jf_gp g;
-    if (jf_gp_open(&g, msg, len)) {
+    int fds[3] = {tf[0].fd, tf[1].fd, tf[2].fd};
+    if (jf_gp_open(&g, fds, 3, msg, len)) {
         for (int p = 0; p < 3; p++) jf_tmpfile_discard(&tf[p]);
-        return -1;
+        return g.missing ? -2 : -1;
     }
     FILE *gp = g.in;
     int ax = jf_study_noise_axis(s);
@@ -251,9 +250,21 @@ int jf_study_plots(const jf_study *s, const char *dir, char *msg, size_t len)
         made[2] = 1;
     }
     int bad = jf_gp_close(&g, msg, len) != 0, n = 0;
+    /* gnuplot does not report a failed write: every picture is checked
+     * before any is renamed, so a full disk leaves the old ones */
+    for (int p = 0; p < 3 && !bad; p++)
+        if (made[p] && jf_gp_png_whole(tf[p].fd, msg, len)) {
+            char m2[600];
+            snprintf(m2, sizeof m2, "%s: %s", path[p], msg);
+            snprintf(msg, len, "%s", m2);
+            bad = 1;
+        }
     for (int p = 0; p < 3; p++) {
         if (!bad && made[p] && jf_tmpfile_commit(&tf[p], path[p], &e) == JF_OK) n++;
-        else jf_tmpfile_discard(&tf[p]);
+        else if (!bad && made[p]) {
+            snprintf(msg, len, "%s", e.msg);
+            bad = 1;
+        } else jf_tmpfile_discard(&tf[p]);
     }
     return bad ? -1 : n;
 }

@@ -133,27 +133,62 @@ int jf__attrs_add(jf_attrs *a, const char *name, size_t len, jf_attr_type t,
 
 /* ---- output --------------------------------------------------------------- */
 
+/* A set of names for jf__attrs_names: open addressing over FNV-1a
+ * hashes, so a CSV with 100,000 named columns costs linear time (a
+ * search per pair of names took minutes). */
+typedef struct {
+    const char **slot;
+    size_t mask;
+} name_set;
+
+static size_t name_hash(const char *s)
+{
+    uint64_t h = 14695981039346656037ULL;
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+    return (size_t)h;
+}
+
+/* 1 if s is in the set; else adds it when add is set (s must outlive the set) */
+static int name_seen(name_set *ns, const char *s, int add)
+{
+    size_t i = name_hash(s) & ns->mask;
+    for (; ns->slot[i]; i = (i + 1) & ns->mask)
+        if (!strcmp(ns->slot[i], s))
+            return 1;
+    if (add)
+        ns->slot[i] = s;
+    return 0;
+}
+
 int jf__attrs_names(const jf_attrs *a, char *const *cols, size_t ncols, char (*out)[64])
 {
+    name_set ns;
+    size_t want = 2 * (ncols + a->nattrs) + 2, cap = 16;
+    while (cap < want)
+        cap *= 2;
+    ns.mask = cap - 1;
+    ns.slot = calloc(cap, sizeof *ns.slot);
+    if (!ns.slot)
+        return -2;
+    for (size_t k = 0; k < ncols; k++)
+        name_seen(&ns, cols[k], 1);
     for (size_t j = 0; j < a->nattrs; j++) {
         char nm[64];
         snprintf(nm, sizeof nm, "%s", a->attr[j].name);
-        for (;;) {
-            int clash = 0;
-            for (size_t k = 0; k < ncols && !clash; k++)
-                clash = !strcmp(cols[k], nm);
-            for (size_t k = 0; k < j && !clash; k++)
-                clash = !strcmp(out[k], nm);
-            if (!clash)
-                break;
+        while (name_seen(&ns, nm, 0)) {
             char t[64];
-            if (strlen(nm) + 3 >= sizeof t)
+            if (strlen(nm) + 3 >= sizeof t) {
+                free(ns.slot);
                 return -1; /* cannot be made unique within 63 bytes */
+            }
             snprintf(t, sizeof t, "in_%s", nm);
             memcpy(nm, t, sizeof nm);
         }
         memcpy(out[j], nm, sizeof nm);
+        name_seen(&ns, out[j], 1);
     }
+    free(ns.slot);
     return 0;
 }
 

@@ -166,7 +166,7 @@ int jf__attrs_add(jf_attrs *a, const char *name, size_t len, jf_attr_type t,
                   uint32_t offset, unsigned shift, unsigned bits);
 /* The output names: each attribute's, with `in_` put before it while it
  * clashes with one of cols[0..ncols-1] or an earlier attribute.  -1 if a
- * name cannot be made unique in 63 bytes. */
+ * name cannot be made unique in 63 bytes, -2 out of memory.  Linear time. */
 int jf__attrs_names(const jf_attrs *a, char *const *cols, size_t ncols, char (*out)[64]);
 /* The type a value is written as (a bit field: U8), its PLY type name
  * (64-bit integers: double). */

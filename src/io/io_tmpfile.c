@@ -11,7 +11,9 @@
  * the target is replaced.  The new file keeps the mode of the file it
  * replaces, or gets 0666 less the umask.  Every open temporary is listed in
  * a fixed table so that a signal handler can remove them
- * (jf_tmpfiles_remove_all: unlink(2) only, async-signal-safe).
+ * (jf_tmpfiles_remove_all: unlink(2) only, async-signal-safe).  An
+ * existing output that is not a regular file (a FIFO, a device) is
+ * refused; at commit the temporary's name must still be our file.
  */
 #define _GNU_SOURCE /* getrandom, O_NOFOLLOW */
 #include <errno.h>
@@ -127,6 +129,16 @@ jf_status jf_tmpfile_open(const char *final, jf_tmpfile *t, jf_error *err)
         jf_tmpfile_discard(t);
         return jf_io_fail(err, JF_ERR_IO, name, 0, "is a directory");
     }
+    /* a FIFO, device or socket would be replaced by a plain file (issue
+     * 33.12): refused, since the output is written whole then renamed */
+    if (replacing && !S_ISREG(old.st_mode)) {
+        const char *what = S_ISFIFO(old.st_mode) ? "a FIFO" : S_ISSOCK(old.st_mode) ? "a socket"
+                                                                                 : "a device";
+        jf_tmpfile_discard(t);
+        return jf_io_fail(err, JF_ERR_IO, name, 0,
+                          "is %s, not a regular file: jetfit writes a whole file and renames it "
+                          "into place", what);
+    }
     size_t blen = strlen(base) > 200 ? 200 : strlen(base);
     size_t cap = dirlen + blen + 32;
     t->tmp = malloc(cap);
@@ -175,6 +187,17 @@ jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err)
 {
     const char *name = final ? final : "(output)";
     jf_status st = JF_OK;
+    /* the name must still be our file: another process with write access
+     * to the folder may have put a link there (issue 33.2), and the
+     * rename would make that link the output */
+    struct stat a, b;
+    if (t->fd >= 0 && (fstat(t->fd, &a) != 0 || lstat(t->tmp, &b) != 0 ||
+                       a.st_dev != b.st_dev || a.st_ino != b.st_ino)) {
+        st = jf_io_fail(err, JF_ERR_IO, name, 0,
+                        "its temporary %s was replaced by another process", t->tmp);
+        close(t->fd);
+        t->fd = -1;
+    }
     if (t->fd >= 0 && close(t->fd) != 0)
         st = jf_io_fail(err, JF_ERR_IO, name, 0, "close failed: %s", strerror(errno));
     t->fd = -1;

@@ -30,6 +30,7 @@ struct jf_writer {
     char **names;
     int header_done;
     size_t nfaces;
+    int face_count4;                 /* a face over 255 vertices: uint counts */
     const size_t *foff;
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
@@ -109,7 +110,11 @@ static jf_status write_header(jf_writer *w)
         if (w->foff) {
             snprintf(line, sizeof line, "element face %zu\n", w->nfaces);
             jf_wf_puts(f, line);
-            jf_wf_puts(f, "property list uchar int vertex_indices\n");
+            /* uchar counts, as every PLY mesh tool writes them; a polygon
+             * over 255 vertices needs uint counts (PLY allows any integer
+             * type for a list count) */
+            jf_wf_puts(f, w->face_count4 ? "property list uint int vertex_indices\n"
+                                         : "property list uchar int vertex_indices\n");
         }
         return jf_wf_puts(f, "end_header\n");
     }
@@ -260,11 +265,11 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
     }
     memcpy(taken, w->names, w->ncols * sizeof *taken);
     for (size_t k = w->ncols; k < nn; k++) taken[k] = (char *)jf__las_fmt0_dims[k - w->ncols];
-    int bad = jf__attrs_names(a, taken, nn, nm) != 0;
+    int bad = jf__attrs_names(a, taken, nn, nm);
     free(taken);
     if (bad) {
         free(nm);
-        return JF_ERR_INVALID;
+        return bad == -2 ? JF_ERR_NOMEM : JF_ERR_INVALID;
     }
     size_t need = w->row_max + a->nattrs * 32;
     w->las.a = a;
@@ -308,13 +313,16 @@ jf_status jf_writer_faces(jf_writer *w, size_t nfaces, const size_t *off,
 {
     if (!w || w->header_done || (nfaces && (!off || !idx)))
         return JF_ERR_INVALID;
+    int wide = 0;
     for (size_t f = 0; f < nfaces; f++) {
-        if (off[f + 1] < off[f] || off[f + 1] - off[f] > 255)
+        if (off[f + 1] < off[f] || off[f + 1] - off[f] > UINT32_MAX)
             return JF_ERR_INVALID;
+        wide |= off[f + 1] - off[f] > 255;
         for (size_t k = off[f]; k < off[f + 1]; k++)
-            if (idx[k] >= w->nrows)
+            if (idx[k] >= w->nrows || idx[k] > INT32_MAX) /* written as PLY int */
                 return JF_ERR_INVALID;
     }
+    w->face_count4 = wide;
     w->nfaces = nfaces;
     w->foff = off;
     w->fidx = idx;
@@ -445,7 +453,12 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
     const int nt = threads > 0 ? threads : omp_get_max_threads();
-    const size_t row_max = w->row_max, slot = ROWS_BLOCK * row_max;
+    /* wide rows (a CSV of 100,000 named columns: 3 MB a row) take fewer
+     * rows a block, so the scratch stays near 8 MB a thread */
+    const size_t row_max = w->row_max,
+                 blk = row_max * ROWS_BLOCK <= ((size_t)8 << 20) ? ROWS_BLOCK
+                       : row_max >= ((size_t)8 << 20) ? 1 : ((size_t)8 << 20) / row_max,
+                 slot = blk * row_max;
     char *scratch = malloc((size_t)nt * slot);
     size_t *len = malloc((size_t)nt * sizeof *len);
     if (!scratch || !len) {
@@ -453,13 +466,13 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
         free(len);
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
     }
-    /* each round: thread t formats the t-th block of ROWS_BLOCK rows into
+    /* each round: thread t formats the t-th block of blk rows into
      * its slot, then the slots go out in order, unbuffered */
     for (size_t r0 = 0; r0 < nrows && f->st == JF_OK;
-         r0 += (size_t)nt * ROWS_BLOCK) {
+         r0 += (size_t)nt * blk) {
 #pragma omp parallel for num_threads(nt) schedule(static, 1)
         for (int t = 0; t < nt; t++) {
-            size_t a = r0 + (size_t)t * ROWS_BLOCK, b = a + ROWS_BLOCK;
+            size_t a = r0 + (size_t)t * blk, b = a + blk;
             char *o = scratch + (size_t)t * slot;
             len[t] = 0;
             for (size_t r = a; r < b && r < nrows; r++)
@@ -546,7 +559,13 @@ static jf_status write_faces(jf_writer *w)
             }
             *o++ = '\n';
         } else {
-            *o++ = (char)(unsigned char)k;
+            if (w->face_count4) {
+                uint32_t c = (uint32_t)k;
+                for (int t = 0; t < 4; t++)
+                    *o++ = (char)(unsigned char)(c >> (8 * t)); /* the file is little-endian */
+            } else {
+                *o++ = (char)(unsigned char)k;
+            }
             for (size_t j = 0; j < k; j++) {
                 int32_t x = (int32_t)ix[j];
                 unsigned char b[4];
@@ -727,8 +746,8 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
     if (c->nfaces && (st = jf_writer_faces(w, c->nfaces, c->face_off,
                                            c->face_idx)) != JF_OK) {
         jf_writer_abort(w);
-        return jf_io_fail(err, st, nm, 0, "a face has more than 255 "
-                                          "vertices or bad offsets");
+        return jf_io_fail(err, st, nm, 0, "a face has bad offsets or a vertex "
+                                          "index out of range");
     }
     for (size_t i = 0; i < c->n && st == JF_OK; i++) {
         double v[6];

@@ -382,6 +382,28 @@ static int set_maxcol(tab *t)
     return t->maxcol;
 }
 
+/* Room for more rows: the arrays grow by half, up to the line count and
+ * JF_MAX_POINTS.  1 done, 0 at the limit, -1 out of memory. */
+static int grow_rows(jf_cloud *c, size_t *cap, size_t lines, int have_nrm)
+{
+    size_t lim = lines < JF_MAX_POINTS ? lines : JF_MAX_POINTS;
+    if (*cap >= lim)
+        return 0;
+    size_t nc = *cap + *cap / 2 + 16;
+    nc = nc < lim ? nc : lim;
+    double *q = realloc(c->xyz, nc * 3 * sizeof *q);
+    if (!q)
+        return -1;
+    c->xyz = q;
+    if (have_nrm) {
+        if (!(q = realloc(c->nrm, nc * 3 * sizeof *q)))
+            return -1;
+        c->nrm = q;
+    }
+    *cap = nc;
+    return 1;
+}
+
 static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                          const char *name, const jf_read_opts *o, jf_cloud *c,
                          jf_error *err, text_attrs *ta)
@@ -481,6 +503,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                 continue;
         }
         double v[6];
+        int room;
         if (fast && fast_row(ls, le, nf0, v))
             goto store;
         const char *p = ls, *fs, *fe;
@@ -534,9 +557,14 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         if (ta && !text_attrs_row(&t, n, ls, le, bad))
             return jf_io_fail(err, JF_ERR_NOMEM, name, tx.line, "out of memory");
     store:
-        if (n == cap) /* cannot happen for rows that parse: the bound */
-            return jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
-                              "more rows than supported");
+        /* rows that parse fit the byte bound; bad rows kept as NaN under
+         * --bad-rows skip can be shorter ("4 5"): only the line count
+         * bounds them, so the arrays grow up to it */
+        if (n == cap && (room = grow_rows(c, &cap, lines, have_nrm)) <= 0)
+            return room < 0 ? jf_io_fail(err, JF_ERR_NOMEM, name, tx.line,
+                                         "out of memory for %zu points", n + 1)
+                            : jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
+                                         "more than %zu rows", (size_t)JF_MAX_POINTS);
         memcpy(c->xyz + 3 * n, v, 3 * sizeof(double));
         if (have_nrm)
             memcpy(c->nrm + 3 * n, v + 3, 3 * sizeof(double));
