@@ -14,3 +14,6 @@ if(JF_PY3 AND TARGET jetfit_shared)
            ${PROJECT_SOURCE_DIR}/src/jetfit.h $<TARGET_FILE:jetfit_shared>)
   set_tests_properties(check_abi PROPERTIES LABELS docs)
 endif()
+add_test(NAME check_man COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_man.sh
+         ${PROJECT_SOURCE_DIR}/docs/jetfit.1)
+set_tests_properties(check_man PROPERTIES LABELS docs SKIP_RETURN_CODE 77)

@@ -10,7 +10,7 @@
  *     (jetfit.h) takes the GIL back at most every 0.1 s, on the calling
  *     thread, to run Python's signal handlers: Ctrl-C raises
  *     KeyboardInterrupt in the handler, the hook says stop, every OpenMP
- *     thread leaves after its current block of 256 points.
+ *     thread leaves after its current block (JF_BLOCK_MAX points).
  *  3. The results go into the Result's arrays block by block as they are
  *     fitted (jf_estimate_blocks' sink, on the estimate's threads), except
  *     with orient='mst', which needs every normal first: then n results
@@ -53,8 +53,6 @@ static int check_signals(void *user)
 static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *faces)
 {
     jf_estimate_opts *o = &po->e.o;
-    if (!po->e.orient_set && c->nrm) o->orient = JF_ORIENT_INPUT; /* as the command */
-    if (!po->e.orient_set && c->scanner) o->orient = JF_ORIENT_SCANNER; /* as for PTX */
     if (o->orient == JF_ORIENT_SCANNER && !c->scanner) {
         PyErr_SetString(PyExc_ValueError,
                         "orient='scanner' needs scanners=: the (N, 3) position of the scanner "

@@ -178,9 +178,9 @@ def test_bad_arrays():
 
 
 def test_library_errors_keep_the_commands_words():
-    with pytest.raises(ValueError, match="^--orient input: the input file has no normals$"):
+    with pytest.raises(ValueError, match="^orient input: the cloud has no normals$"):
         jetfit.estimate(BASE[:100], orient="input")
-    with pytest.raises(ValueError, match=r"^--neighbors rings needs a mesh"):
+    with pytest.raises(ValueError, match=r"^neighbors rings needs a mesh"):
         jetfit.estimate(BASE[:100], neighbors="rings")
     v = np.eye(3)
     with pytest.raises(ValueError, match=r"^face 0: vertex index 7 out of range \(3 vertices\)$"):

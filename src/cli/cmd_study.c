@@ -258,11 +258,6 @@ static int load_input(jf_study_args *c)
         fprintf(stderr, "jetfit: %s\n", msg);
         return 1;
     }
-    /* as estimate: input normals orient the result unless told otherwise */
-    if (!c->base.orient_set && c->cloud.nrm)
-        for (int i = 0; i < c->nsetting; i++) c->setting[i].orient = JF_ORIENT_INPUT;
-    if (!c->base.orient_set && c->cloud.scanner) /* PTX: towards each scan's scanner */
-        for (int i = 0; i < c->nsetting; i++) c->setting[i].orient = JF_ORIENT_SCANNER;
     return 0;
 }
 

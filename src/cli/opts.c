@@ -1,6 +1,7 @@
 /* opts.c -- estimation options shared by `jetfit estimate` and `jetfit
  * study` (opts.h): the parsing moved out of cmd_estimate.c unchanged, so
  * both commands accept and reject the same text with the same words. */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -121,7 +122,6 @@ int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_b
             return bad_(bad, name, val, "expected a number >= 1");
         o->params.max_cond = dv;
     } else if (!strcmp(name, "--orient")) {
-        e->orient_set = 1;
         if (!strcmp(val, "none")) o->orient = JF_ORIENT_NONE;
         else if (!strcmp(val, "input")) o->orient = JF_ORIENT_INPUT;
         else if (!strncmp(val, "viewpoint:", 10)) {
@@ -245,6 +245,23 @@ unsigned long long jf_cli_parse_size(const char *s)
     return (unsigned long long)(v * mul);
 }
 
+/* "X,Y,Z" (or one value for the three axes) of finite numbers into v; 0 if
+ * not, or (positive) a value <= 0. */
+static int parse_xyz(const char *s, double v[3], int positive)
+{
+    int k = 0;
+    for (const char *p = s;; k++) {
+        char *end;
+        if (k == 3 || !*p || isspace((unsigned char)*p)) return 0;
+        v[k] = strtod(p, &end);
+        if (end == p || !isfinite(v[k]) || (positive && !(v[k] > 0))) return 0;
+        if (!*end) break;
+        if (*end != ',') return 0;
+        p = end + 1;
+    }
+    if (k == 0) v[1] = v[2] = v[0];
+    return k == 0 || k == 2;
+}
 
 int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad)
 {
@@ -287,7 +304,8 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
             snprintf(name, sizeof name, "%s", a);
             if (i + 1 >= argc)
                 return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--keep") &&
-                               strcmp(name, "--memory") &&
+                               strcmp(name, "--memory") && strcmp(name, "--las-scale") &&
+                               strcmp(name, "--las-offset") &&
                                jf_cli_est_takes_value(name) != 1
                            ? bad_set(bad, "unknown option", a, "not an option of estimate")
                            : bad_set(bad, a, "", "needs a value");
@@ -298,6 +316,13 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
         } else if (!strcmp(name, "--memory")) {
             if (!(cmd->memory = jf_cli_parse_size(val)))
                 return bad_set(bad, "--memory", val, "expected a size such as 8G, 256M or 1500000000");
+        } else if (!strcmp(name, "--las-scale") || !strcmp(name, "--las-offset")) {
+            int sc = name[6] == 's';
+            if (!parse_xyz(val, sc ? cmd->las_scale : cmd->las_offset, sc))
+                return bad_set(bad, sc ? "--las-scale" : "--las-offset", val,
+                               sc ? "expected X,Y,Z (or one value): positive numbers"
+                                  : "expected X,Y,Z (or one value): finite numbers");
+            *(sc ? &cmd->las_scale_set : &cmd->las_offset_set) = 1;
         } else if (!strcmp(name, "--keep")) {
             if (!strcmp(val, "all")) cmd->keep = 1;
             else if (!strcmp(val, "none")) cmd->keep = 0;

@@ -24,7 +24,6 @@ typedef struct {
     const char *nbspec;    /* --neighbors text (parsed by _finish)       */
     int monge;             /* --monge-degree, -1 = from the degree       */
     const char *monge_s;
-    int orient_set;        /* --orient given (else: input if normals)    */
 } jf_cli_est;
 
 /* What was wrong: option, its value, why (static or argv strings). */
@@ -54,6 +53,8 @@ typedef struct {
     int quiet, ascii, keep, help;  /* keep: --keep all (1) or none (0) */
     unsigned long long memory;     /* --memory in bytes, 0 = not given  */
     char badname[32];              /* the option *bad names, when cut from "--opt=VALUE" */
+    int las_scale_set, las_offset_set; /* --las-scale, --las-offset given */
+    double las_scale[3], las_offset[3];
 } jf_cli_estimate_cmd;
 
 /* Parses argv[1..] (argv[0] is the command's name).  0, or -1 with *bad

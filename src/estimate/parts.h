@@ -40,6 +40,13 @@ typedef struct {
  * JF_ERR_INVALID (bad parameters). */
 jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q);
 
+/* The checks every whole-cloud entry point makes once (parameters, size,
+ * orientation against the cloud, rings against faces), with *use = *o and
+ * its orient "auto" resolved (jf_orient_resolve).  Defined in
+ * estimate/pipeline.c; used by estimate/parts_run.c. */
+jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_estimate_opts *use,
+                             jf_error *err);
+
 /* Step 1 in one process: part[i] in 0..nparts-1 for each finite point,
  * -1 for the others.  Part r holds the finite points of ranks
  * [nf r / P, nf (r+1) / P) in the (Morton key, index) order (nf finite

@@ -196,20 +196,12 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     }
     if (st != JF_OK || nparts == 1 || c->n == 0)
         return jf_estimate_blocks(c, o, sink, user, err); /* its own checks */
-    /* the whole cloud's checks first (a bad option fails before any work) */
-    if (o->orient == JF_ORIENT_INPUT && !c->nrm) {
-        set_err(err, "--orient input: the input file has no normals");
-        return JF_ERR_INVALID;
-    }
-    if (o->orient == JF_ORIENT_SCANNER && (!c->scan || !c->scanner || !c->nscans)) {
-        set_err(err, "--orient scanner: the input has no scanner positions (PTX input has)");
-        return JF_ERR_INVALID;
-    }
+    /* the whole cloud's checks first (a bad option fails before any work);
+     * the parts then share one resolved orientation */
+    jf_estimate_opts use;
+    if ((st = jf__estimate_check(c, o, &use, err)) != JF_OK) return st;
+    o = &use;
     const size_t n = c->n;
-    if (n >= UINT32_MAX - 2) {
-        set_err(err, "too many points (2^32 - 2 at most)");
-        return JF_ERR_TOO_LARGE;
-    }
     const int P = nparts, nt = o->threads > 0 ? o->threads : omp_get_max_threads();
     int32_t *part = malloc(n * sizeof *part);
     size_t *count = calloc((size_t)P, sizeof *count), cmax = 0;

@@ -38,7 +38,7 @@
 #include "parts.h"
 #include "planes_internal.h"
 
-#define CHUNK 256      /* points per scheduling unit (and progress tick) */
+#define CHUNK JF_BLOCK_MAX /* points per scheduling unit (and progress tick) */
 
 void jf_estimate_opts_init(jf_estimate_opts *o)
 {
@@ -48,8 +48,14 @@ void jf_estimate_opts_init(jf_estimate_opts *o)
     o->nb.kind = JF_NB_KNN;
     o->nb.k = JF_ESTIMATE_DEFAULT_K;
     o->normal = JF_NORMAL_AUTO;
-    o->orient = JF_ORIENT_NONE;
+    o->orient = JF_ORIENT_AUTO;
     o->orient_k = 8;
+}
+
+jf_orient_mode jf_orient_resolve(jf_orient_mode m, int has_normals, int has_scanners)
+{
+    if (m != JF_ORIENT_AUTO) return m;
+    return has_scanners ? JF_ORIENT_SCANNER : has_normals ? JF_ORIENT_INPUT : JF_ORIENT_NONE;
 }
 
 static void set_err(jf_error *err, const char *msg)
@@ -227,7 +233,7 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
     x->nflags = calloc(n, sizeof *x->nflags);
     if (!x->nflags) return JF_ERR_NOMEM;
     if (src == JF_NORMAL_INPUT && !c->nrm) {
-        set_err(err, "--normal input: the input file has no normals");
+        set_err(err, "normal input: the cloud has no normals");
         return JF_ERR_INVALID;
     }
     if (src != JF_NORMAL_INPUT) {
@@ -679,15 +685,27 @@ static jf_status pass_status(jf_status failed, jf_error *err)
     return failed;
 }
 
-/* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
- * parts.h's mask (NULL: every point). */
-static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
-                          jf_result *out, jf_block_fn sink, void *user, jf_error *err)
+jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_estimate_opts *use,
+                             jf_error *err)
 {
     const char *bad = NULL;
-    if (err) err->msg[0] = '\0';
-    if (!c || !o || (c->n && (!c->xyz || (!out && !sink)))) {
-        set_err(err, out || !sink ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
+    *use = *o;
+    use->orient = jf_orient_resolve(o->orient, c->nrm != NULL,
+                                    c->scan && c->scanner && c->nscans);
+    if (use->orient == JF_ORIENT_INPUT && !c->nrm) {
+        set_err(err, "orient input: the cloud has no normals");
+        return JF_ERR_INVALID;
+    }
+    if (use->orient == JF_ORIENT_SCANNER && (!c->scan || !c->scanner || !c->nscans)) {
+        set_err(err, "orient scanner: the cloud has no scanner positions (PTX input has)");
+        return JF_ERR_INVALID;
+    }
+    if (o->nb.kind == JF_NB_RINGS && !c->nfaces) {
+        set_err(err, "neighbors rings needs a mesh (faces in the input)");
+        return JF_ERR_INVALID;
+    }
+    if ((unsigned)o->orient > JF_ORIENT_AUTO) {
+        set_err(err, "invalid parameter 'orient'");
         return JF_ERR_INVALID;
     }
     if (jf_params_validate(&o->params, &bad) != JF_OK) {
@@ -696,23 +714,28 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o, const ui
         set_err(err, m);
         return JF_ERR_INVALID;
     }
-    size_t n = c->n;
-    if (n >= UINT32_MAX - 2) {
+    if (c->n >= UINT32_MAX - 2) {
         set_err(err, "too many points (2^32 - 2 at most)");
         return JF_ERR_TOO_LARGE;
     }
-    if (o->orient == JF_ORIENT_INPUT && !c->nrm) {
-        set_err(err, "--orient input: the input file has no normals");
+    return JF_OK;
+}
+
+/* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
+ * parts.h's mask (NULL: every point). */
+static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const uint8_t *fit,
+                          jf_result *out, jf_block_fn sink, void *user, jf_error *err)
+{
+    if (err) err->msg[0] = '\0';
+    if (!c || !o_in || (c->n && (!c->xyz || (!out && !sink)))) {
+        set_err(err, out || !sink ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
         return JF_ERR_INVALID;
     }
-    if (o->orient == JF_ORIENT_SCANNER && (!c->scan || !c->scanner || !c->nscans)) {
-        set_err(err, "--orient scanner: the input has no scanner positions (PTX input has)");
-        return JF_ERR_INVALID;
-    }
-    if (o->nb.kind == JF_NB_RINGS && !c->nfaces) {
-        set_err(err, "--neighbors rings needs a mesh (faces in the input file)");
-        return JF_ERR_INVALID;
-    }
+    jf_estimate_opts use;
+    jf_status cst = jf__estimate_check(c, o_in, &use, err);
+    if (cst != JF_OK) return cst;
+    const jf_estimate_opts *o = &use;
+    size_t n = c->n;
     if (n == 0) return JF_OK;
     if (!out && o->orient == JF_ORIENT_SCANNER)
         for (size_t i = 0; i < n; i++) /* blocks go out oriented: check first */

@@ -7,6 +7,7 @@
 #include <check.h>
 #include <signal.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 
 /* Whole contents, malloc'd and NUL-ended (NULL if unreadable). */
@@ -319,9 +320,5 @@ int main(void)
     tcase_add_test(tc, dangling_link_named);
     tcase_add_test(tc, empty_subset_refused);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

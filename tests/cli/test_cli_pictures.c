@@ -7,6 +7,7 @@
 #include <check.h>
 #include <signal.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 
 /* Whole contents, malloc'd (NULL if unreadable). */
@@ -211,9 +212,5 @@ int main(void)
     tcase_add_test(tc, study_convergence_temporaries_swapped);
     tcase_add_test(tc, control_characters_in_names);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }
