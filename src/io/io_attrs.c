@@ -115,8 +115,11 @@ void jf__attr_name(char dst[64], const char *s, size_t len)
 int jf__attrs_add(jf_attrs *a, const char *name, size_t len, jf_attr_type t,
                   uint32_t offset, unsigned shift, unsigned bits)
 {
-    if (a->nattrs % 16 == 0) {
-        jf_attr *q = realloc(a->attr, (a->nattrs + 16) * sizeof *q);
+    /* capacity: powers of two from 16 (a CSV of 100,000 named columns
+     * grew by 16 at a time: quadratic copying) */
+    size_t n = a->nattrs;
+    if (n % 16 == 0 && (n < 16 || (n & (n - 1)) == 0)) {
+        jf_attr *q = realloc(a->attr, (n < 16 ? 16 : 2 * n) * sizeof *q);
         if (!q)
             return 0;
         a->attr = q;

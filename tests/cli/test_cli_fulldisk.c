@@ -15,6 +15,7 @@
 #include <sched.h>
 #include <sys/mount.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 
 static char disk[300]; /* the tmpfs */
@@ -211,11 +212,8 @@ int main(void)
     tcase_add_test(tc, study_full_disk);
     tcase_add_test(tc, convergence_full_disk);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
+    int failures = jf_test_run(s);
     umount2(disk, MNT_DETACH);
     rmdir(disk);
-    return failures ? 1 : 0;
+    return failures;
 }

@@ -7,6 +7,7 @@
 #include <check.h>
 #include <signal.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 #include "jf_test.h"
 
