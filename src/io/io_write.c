@@ -407,7 +407,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     jf_wfile *f = &w->f;
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
-    const int nt = threads > 0 ? threads : omp_get_max_threads();
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
     const size_t row_max = w->row_max, slot = ROWS_BLOCK * row_max;
     char *scratch = malloc((size_t)nt * slot);
     size_t *len = malloc((size_t)nt * sizeof *len);

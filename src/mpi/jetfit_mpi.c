@@ -181,7 +181,7 @@ static void write_rows(jf_mpi *m, const outputs *o, const char *out, const jf_mp
             if (c->own[j]) pos[k++] = j;
             j++;
         }
-#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads())
+#pragma omp parallel for num_threads(threads > 0 ? threads : jf_default_threads(NULL))
         for (int t = 0; t < k; t++) {
             const size_t p = pos[t];
             double *v = vals + (size_t)t * ncols;
@@ -425,7 +425,10 @@ int main(int argc, char **argv)
     MPI_Comm_rank(m.comm, &m.rank);
     MPI_Comm_size(m.comm, &m.size);
     MPI_Comm_set_errhandler(m.comm, MPI_ERRORS_ARE_FATAL);
-    int rc;
+    int rc, asked, nt = jf_default_threads(&asked);
+    if (nt != asked && m.rank == 0)
+        fprintf(stderr, "jetfit-mpi: OMP_NUM_THREADS asks for %d threads: %d by default here "
+                        "(the processors available; --threads N overrides)\n", asked, nt);
     if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
         if (m.rank == 0) usage(stdout);
         rc = 0;
