@@ -91,6 +91,16 @@ errors)
   head -c 5000 "$d/lattice.las" >"$d/cut.las" # past the VLRs, into the records
   refused "point record" 2 "$d/cut.las" -o "$d/err.ply"
   refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
+  # one fault, one message: jetfit estimate's words (issue 32.5, 33.8)
+  printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n' >"$d/xonly.ply"
+  head -c 24 /dev/zero >>"$d/xonly.ply"
+  printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$d/empty.ply"
+  for f in xonly.ply empty.ply; do
+    "$jetfit" estimate "$d/$f" -o "$d/err.ply" --quiet 2>"$d/want"; rc=$?
+    want=$(sed 's/^jetfit[^:]*: //' "$d/want")
+    [ $rc -eq 1 ] && [ -n "$want" ] || bad "jetfit estimate $f: exit $rc, '$want'"
+    for np in 1 3; do refused "$want" $np "$d/$f" -o "$d/err.ply"; done
+  done
   # a rank that fails mid-run: one line, exit 1, the old output intact
   echo old >"$d/keep.ply"
   JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -q -x JETFIT_MPI_TEST_FAIL \
