@@ -39,6 +39,17 @@ extern "C" {
 /* Run-time version string ("0.1.0"). */
 const char *jf_version(void);
 
+/* The most threads any call runs (the command's --threads limit). */
+#define JF_THREADS_MAX 4096
+
+/* The thread count a call with threads <= 0 runs: OpenMP's default
+ * (OMP_NUM_THREADS, else every processor) clamped to [1, the processors
+ * this process may run on] and to JF_THREADS_MAX, so no environment value
+ * can start thousands of threads.  *asked (may be NULL) gets OpenMP's
+ * default before the clamp (the caller may say when they differ).
+ * Thread-safe. */
+int jf_default_threads(int *asked);
+
 /* ------------------------------------------------------------------ */
 /* Status codes (stable: values never change once released).          */
 /* ------------------------------------------------------------------ */

@@ -4,7 +4,7 @@
 # mpirun.  Not under the sanitizers: OpenMPI's own allocations make ASan's
 # leak report noisy (the MPI code paths run in the Release suite).
 if(TARGET jetfit-mpi AND NOT JF_SANITIZE)
-  foreach(mode equal-knn equal-more errors)
+  foreach(mode equal-knn equal-more errors full-disk)
     add_test(NAME test_mpi_${mode}
              COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/mpi/test_mpi.sh $<TARGET_FILE:jetfit>
                      $<TARGET_FILE:jetfit-mpi> ${CMAKE_CURRENT_BINARY_DIR} ${mode})

@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 __version__: str
 STATUS: Dict[str, int]
-OPENMP_RUNTIME: str  # "libomp" (fork-safe) or "libgomp"
+OPENMP_RUNTIME: str  # "libgomp", the command's runtime
 
 _Path = Union[str, bytes, PathLike]
 _Points = npt.ArrayLike            # (N, 3) numbers; float64 C order is not copied

@@ -6,11 +6,11 @@
  *     normals) as (N, 3) float64 C arrays, passed without a copy when they
  *     already are (arrays.c).
  *  2. The Result's arrays are made first (so nothing fails after the
- *     work), then jf_estimate runs with the GIL released.  Its cancel hook
- *     (jetfit.h) takes the GIL back at most every 0.1 s, on the calling
- *     thread, to run Python's signal handlers: Ctrl-C raises
- *     KeyboardInterrupt in the handler, the hook says stop, every OpenMP
- *     thread leaves after its current block (JF_BLOCK_MAX points).
+ *     work), then jf_estimate runs on a thread of its own, the GIL
+ *     released (offthread.c); the calling thread runs Python's signal
+ *     handlers every 0.1 s: Ctrl-C raises KeyboardInterrupt there, the
+ *     cancel hook (jetfit.h) says stop, every OpenMP thread leaves after
+ *     its current block (JF_BLOCK_MAX points).
  *  3. The results go into the Result's arrays block by block as they are
  *     fitted (jf_estimate_blocks' sink, on the estimate's threads), except
  *     with orient='mst', which needs every normal first: then n results
@@ -18,35 +18,36 @@
  * Memory: the library's own (k-d tree ~40 B/point; with mst 216 B/point
  * of jf_result) plus the Result's arrays (116-188 B/point); no copy of
  * the points when they are float64 C-contiguous. */
-#include <time.h>
-
-#include <omp.h>
-
 #include "jfpy.h"
 
-typedef struct {
-    PyThreadState *ts; /* the released thread state                    */
-    double next;       /* monotonic time of the next signal check       */
-} cancel_ctx;
-
-static double now_s(void)
+/* jf_cancel_fn: read on the estimate's threads; set by jf_py_off_thread
+ * when a signal handler raised (KeyboardInterrupt). */
+static int check_stop(void *user)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    return __atomic_load_n((volatile int *)user, __ATOMIC_ACQUIRE);
 }
 
-/* jf_cancel_fn: called by jf_estimate on this thread, without the GIL. */
-static int check_signals(void *user)
+typedef struct {
+    jf_cloud *c;
+    jf_estimate_opts *o;
+    jf_result *res; /* n results (orient mst), else NULL */
+    PyObject *result;
+    jf_error err;
+    jf_status st;
+} est_job;
+
+/* On jf_py_off_thread's thread, without the GIL. */
+static void est_work(void *p)
 {
-    cancel_ctx *cx = user;
-    double t = now_s();
-    if (t < cx->next) return 0;
-    cx->next = t + 0.1;
-    PyEval_RestoreThread(cx->ts);
-    int stop = PyErr_CheckSignals() < 0; /* the exception stays set */
-    cx->ts = PyEval_SaveThread();
-    return stop;
+    est_job *j = p;
+    if (j->res) {
+        j->st = jf_estimate(j->c, j->o, j->res, &j->err);
+        if (j->st == JF_OK)
+            jf_py_result_fill(j->result, j->res, j->c->n,
+                              j->o->threads > 0 ? j->o->threads : jf_default_threads(NULL));
+    } else {
+        j->st = jf_estimate_blocks(j->c, j->o, jf_py_result_block, j->result, &j->err);
+    }
 }
 
 /* Runs the estimate on cloud c with options o into a new Result. */
@@ -70,24 +71,16 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
         Py_DECREF(result);
         return PyErr_NoMemory();
     }
-    jf_error err = {{0}};
-    cancel_ctx cx = {NULL, now_s() + 0.1};
-    o->cancel = check_signals;
-    o->cancel_user = &cx;
-    cx.ts = PyEval_SaveThread();
-    jf_status st;
-    if (whole) {
-        st = jf_estimate(c, o, res, &err);
-        if (st == JF_OK)
-            jf_py_result_fill(result, res, c->n, o->threads > 0 ? o->threads : omp_get_max_threads());
-    } else {
-        st = jf_estimate_blocks(c, o, jf_py_result_block, result, &err);
-    }
-    PyEval_RestoreThread(cx.ts);
+    volatile int stop = 0;
+    o->cancel = check_stop;
+    o->cancel_user = (void *)&stop;
+    est_job j = {c, o, whole ? res : NULL, result, {{0}}, JF_OK};
+    jf_py_off_thread(est_work, &j, &stop);
+    jf_status st = j.st;
     PyMem_RawFree(res);
     if (st != JF_OK) {
         Py_DECREF(result);
-        return jf_py_status_error(st, err.msg);
+        return jf_py_status_error(st, j.err.msg);
     }
     return result;
 }

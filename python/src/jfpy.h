@@ -5,6 +5,7 @@
  *              own option parser (src/cli/opts.c), so values are accepted
  *              and rejected with the command's words
  *   estimate.c estimate(), estimate_mesh(): GIL released, Ctrl-C polled
+ *   offthread.c the OpenMP work of a call on a thread of its own
  *   result.c   the Result type and as_structured()
  *   files.c    read(), write() over the library's readers and writers
  *   fitjet.c   fit_jet(): one neighbourhood
@@ -48,6 +49,12 @@ void jf_py_faces_free(jf_cloud *c);
 PyObject *jf_py_faces_out(const jf_cloud *c);
 /* New uninitialised arrays. */
 PyArrayObject *jf_py_empty(int nd, npy_intp d0, npy_intp d1, int type);
+
+/* offthread.c */
+/* Runs fn(arg) on a new thread (offthread.c says why) and waits, the GIL
+ * released; every 0.1 s runs Python's signal handlers and sets *stop
+ * (when stop is not NULL) if one raised.  Called with the GIL held. */
+void jf_py_off_thread(void (*fn)(void *), void *arg, volatile int *stop);
 
 /* options.c */
 typedef struct {

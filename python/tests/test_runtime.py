@@ -117,13 +117,12 @@ def test_ctrl_c_interrupts_within_a_second():
     assert 10 * per_30k > 2 * (t1 - t0), (per_30k, t1 - t0)
 
 
-@pytest.mark.skipif(jetfit.OPENMP_RUNTIME != "libomp",
-                    reason="built on GCC's libgomp, which cannot run OpenMP in a forked child")
 @pytest.mark.parametrize("open3d_first", [False, True], ids=["after-jetfit", "after-open3d"])
 def test_estimate_in_a_forked_child(open3d_first):
     """multiprocessing's fork: a child forked after the parent ran OpenMP
     (jetfit's own estimate, or Open3D's import) estimates on 2 threads and
-    gets the parent's bits."""
+    gets the parent's bits (libgomp: each call's OpenMP on a thread of its
+    own, src/offthread.c)."""
     if open3d_first:
         pytest.importorskip("open3d", reason="python3-open3d is not installed")
     pts = fib_sphere(20000)

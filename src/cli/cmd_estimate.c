@@ -88,7 +88,7 @@ static void usage(FILE *f)
         "Columns: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z [b0..b3] [c0..c4]\n"
         "         degree neighbors cond residual status\n"
         "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
-        JF_MAX_DEGREE, p.degree, p.max_cond, omp_get_max_threads());
+        JF_MAX_DEGREE, p.degree, p.max_cond, jf_default_threads(NULL));
 }
 
 /* MemAvailable of /proc/meminfo in bytes, or 0 when unknown. */
@@ -348,7 +348,7 @@ int jf_cmd_estimate(int argc, char **argv)
         if (!(nl = strchr(wl, '\n'))) break;
         fprintf(stderr, "jetfit: %.*s\n", (int)(nl - wl), wl);
     }
-    const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
+    const int nt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
     sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
     if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {

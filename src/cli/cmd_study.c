@@ -343,7 +343,23 @@ int jf_cmd_study(int argc, char **argv)
     }
     if (make_cells(&c) || prepare_dir(c.dir)) goto fail;
     int kept = 0;
+    char def[8192];
+    if (jf_study_def_make(&c, def, sizeof def, msg, sizeof msg)) {
+        fprintf(stderr, "jetfit: %s\n", msg);
+        goto fail;
+    }
+    /* a resume keeps cells of this study only (study_def.c) */
+    char csv[4096];
+    jf_study_path(c.dir, "study.csv", csv, sizeof csv);
+    if (c.resume && access(csv, F_OK) == 0 && jf_study_def_check(c.dir, def, msg, sizeof msg)) {
+        fprintf(stderr, "jetfit: %s\n", msg);
+        goto fail;
+    }
     if (c.resume && (kept = jf_study_read_csv(s, c.dir, msg, sizeof msg)) < 0) {
+        fprintf(stderr, "jetfit: %s\n", msg);
+        goto fail;
+    }
+    if (jf_study_def_write(c.dir, def, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;
     }

@@ -77,6 +77,10 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
+    int asked, nt = jf_default_threads(&asked); /* OMP_NUM_THREADS clamped: say so, once */
+    if (nt != asked)
+        fprintf(stderr, "jetfit: OMP_NUM_THREADS asks for %d threads: %d by default here "
+                        "(the processors available; --threads N overrides)\n", asked, nt);
     if (!strcmp(argv[1], "--version")) {
         printf("jetfit %s\n", jf_version());
         const char *cgal = jfb_cgal_version(); /* NULL: built with -DJF_CGAL=OFF */

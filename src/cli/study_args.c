@@ -28,7 +28,7 @@ static void usage(FILE *f)
         "  SURFACE         exp, paraboloid, revolution, sphere, ellipsoid, cylinder,\n"
         "                  torus:\n"
         "                  `jetfit generate SURFACE --n N --seed S+r` with exact truth\n"
-        "  -o DIR          the folder (made if missing): study.csv, best.csv,\n"
+        "  -o DIR          the folder (made if missing): study.csv, study.def, best.csv,\n"
         "                  normal.png, curvature.png, k.png, report.html\n"
         "\n"
         "Lists are ';'-separated (numbers also ','):\n"
@@ -51,6 +51,7 @@ static void usage(FILE *f)
         "                        k2_median, k2_p95\n"
         "  --threads N           OpenMP threads of each estimate\n"
         "  --resume              keep the finished cells of DIR/study.csv, run the rest\n"
+        "                        (refused when DIR/study.def: input, truth, options, differ)\n"
         "  --quiet               no progress line, no summary\n"
         "  any other estimate option (e.g. --orient, --columns, --robust) applies\n"
         "  to every cell, before the cell's flag set.\n"
@@ -244,6 +245,14 @@ static void record_command(jf_study *s, int argc, char **argv)
     }
 }
 
+/* Appends " NAME[=VALUE]" to the estimate options that define the study. */
+static void base_add(jf_study_args *c, const char *name, const char *val)
+{
+    size_t u = strlen(c->base_text);
+    snprintf(c->base_text + u, sizeof c->base_text - u, "%s%s%s%s", u ? " " : "", name,
+             val ? "=" : "", val ? val : "");
+}
+
 int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
 {
     jf_study *s = &c->s;
@@ -276,6 +285,7 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
         if (jf_cli_est_takes_value(a) == 0) {
             jf_cli_bad bad;
             (void)jf_cli_est_option(&c->base, a, NULL, &bad);
+            base_add(c, a, NULL);
             continue;
         }
         if (a[0] != '-' || !a[1]) {
@@ -322,6 +332,7 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
         } else if (jf_cli_est_takes_value(name) == 1) {
             jf_cli_bad bad;
             if (jf_cli_est_option(&c->base, name, val, &bad)) return bad_opt(bad.opt, bad.val, bad.why);
+            if (strcmp(name, "--threads")) base_add(c, name, val);
         } else {
             return bad_opt("unknown option", a, "not an option of study");
         }

@@ -20,6 +20,8 @@ typedef struct {
     size_t npoints;              /* --n                                */
     size_t ndraw;                /* points of each draw (cmd_study.c)  */
     jf_cli_est base;             /* options outside --flags           */
+    char base_text[2048];        /* them as given (study.def), --threads
+                                    left out: results do not depend on it */
     jf_estimate_opts *setting;   /* strategy x degree x flags, in the
                                     order of jf_study_setting         */
     int nsetting;
@@ -33,6 +35,15 @@ typedef struct {
 /* Parses argv into *c (zeroed by the caller).  0; -1 after --help
  * (printed); or the exit status of a bad option (2), its line printed. */
 int jf_study_args_parse(jf_study_args *c, int argc, char **argv);
+
+/* study_def.c: DIR/study.def, what defines the study (its file says
+ * which lines).  make: the text for c (-1 with msg: an unreadable file);
+ * write: onto DIR/study.def (atomic); check: 0 if DIR/study.def says the
+ * same, else -1 with one line naming what differs (or that it is
+ * missing). */
+int jf_study_def_make(const jf_study_args *c, char *def, size_t len, char *msg, size_t mlen);
+int jf_study_def_write(const char *dir, const char *def, char *msg, size_t len);
+int jf_study_def_check(const char *dir, const char *def, char *msg, size_t len);
 
 /* Frees what parse and cmd_study.c allocated. */
 void jf_study_args_free(jf_study_args *c);

@@ -229,16 +229,38 @@ int jf_study_read_csv(jf_study *s, const char *dir, char *msg, size_t len)
             continue;
         }
         double v[NCOL];
-        int okn = n == (int)NCOL;
-        for (size_t j = 0; okn && j < NCOL; j++)
-            if (j != 0 && j != 2 && j != NKEY + JF_M_COUNT + 4) okn = !num(fld[j], &v[j]);
-        unsigned long long seed = okn ? strtoull(fld[7], NULL, 10) : 0; /* > 2^53 too */
-        if (!okn) {
+        if (n != (int)NCOL) {
             snprintf(msg, len, "%s:%zu: malformed row (%d fields, expected %zu)", path, lineno,
                      n, NCOL);
             found = -1;
             break;
         }
+        /* every value as jetfit writes it: numbers, counts whole and not
+         * negative, an ok cell's normal errors finite (a NaN there was not
+         * written by jetfit: refused, naming the field and its column) */
+        const size_t ST = NKEY + JF_M_COUNT + 4;
+        const int ok_cell = !strcmp(fld[ST], "ok");
+        int badcol = -1;
+        const char *why = "";
+        for (size_t j = 0; badcol < 0 && j < NCOL; j++) {
+            if (j == 0 || j == 2 || j == ST) continue;
+            const int whole = (j == 1 || (j >= 6 && j < NKEY) || (j >= NKEY + JF_M_COUNT && j < ST));
+            if (num(fld[j], &v[j])) badcol = (int)j, why = "not a number";
+            else if (whole && !(v[j] >= 0 && v[j] == floor(v[j]) && v[j] < 0x1p63))
+                badcol = (int)j, why = "not a count";
+            else if (ok_cell && j >= NKEY && j < NKEY + 3 && v[9] > 0 && !isfinite(v[j]))
+                badcol = (int)j, why = "not finite in a finished cell";
+        }
+        if (badcol >= 0) {
+            const char *name = (size_t)badcol < NKEY ? head_key[badcol]
+                             : (size_t)badcol < NKEY + JF_M_COUNT ? jf_study_metric[badcol - (int)NKEY]
+                             : head_tail[badcol - (int)(NKEY + JF_M_COUNT)];
+            snprintf(msg, len, "%s:%zu: column %d (%s): '%s' is %s; move study.csv away or "
+                     "run without --resume", path, lineno, badcol + 1, name, fld[badcol], why);
+            found = -1;
+            break;
+        }
+        unsigned long long seed = strtoull(fld[7], NULL, 10); /* > 2^53 too */
         jf_study_key k;
         k.strategy = find_str(s->strategy, s->nstrategy, fld[0]);
         k.degree = -1;

@@ -36,7 +36,7 @@ jf_status jf_fit_cloud(const jf_params *p, const double *xyz, size_t n,
     jf_params q = *p;
     if (longest > q.max_neighbors) q.max_neighbors = longest;
     if (jf_params_validate(&q, NULL) != JF_OK) return JF_ERR_TOO_LARGE;
-    int nth = threads > 0 ? threads : omp_get_max_threads();
+    int nth = threads > 0 ? threads : jf_default_threads(NULL);
     if ((size_t)nth > n) nth = (int)n;
 
     jf_status err = JF_OK;

@@ -239,7 +239,7 @@ jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int 
     *halo = NULL;
     if (stats) memset(stats, 0, sizeof *stats);
     if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
-    const int nt = threads > 0 ? threads : omp_get_max_threads();
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
     const size_t P = (size_t)nparts, scratch = max_sz(q->cap, q->min_count) + 1;
     jf_status st = JF_OK;
     /* members of each part (CSR, ascending input index), their coordinates,

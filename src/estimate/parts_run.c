@@ -202,7 +202,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     if ((st = jf__estimate_check(c, o, &use, err)) != JF_OK) return st;
     o = &use;
     const size_t n = c->n;
-    const int P = nparts, nt = o->threads > 0 ? o->threads : omp_get_max_threads();
+    const int P = nparts, nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     int32_t *part = malloc(n * sizeof *part);
     size_t *count = calloc((size_t)P, sizeof *count), cmax = 0;
     double *box = malloc((size_t)P * 6 * sizeof *box);

@@ -744,7 +744,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
                 return JF_ERR_INVALID;
             }
 
-    int nt = o->threads > 0 ? o->threads : omp_get_max_threads();
+    int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     const jf_params *p = &o->params;
     nbctx x = {0};
     jf_nb_spec nb = o->nb;

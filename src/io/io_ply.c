@@ -658,7 +658,20 @@ jf_status jf__ply_layout(const char *buf, size_t len, uint64_t size, const char 
     if (st == JF_OK && h->format == 0)
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "an ascii PLY: distributed runs read "
                         "binary PLY (jetfit estimate IN -o OUT.ply converts)");
-    else if (st == JF_OK && !vertex_rows(h, body, size, &iv, &at, &vrow))
+    /* the faults the reader names, in its words and order (issue 32.5) */
+    for (int k = 0; st == JF_OK && k < h->nelems; k++) {
+        const ply_elem *el = &h->elems[k];
+        if (strcmp(el->name, "vertex")) continue;
+        if (prop_index(el, "x", 0) < 0 || prop_index(el, "y", 0) < 0 || prop_index(el, "z", 0) < 0)
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "element vertex has no x, y, z properties");
+        else if (el->count > JF_MAX_POINTS)
+            st = jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu vertices: more than supported",
+                            (unsigned long long)el->count);
+        else if (el->count == 0) /* as jf_cloud_read: 0 vertices is an empty file */
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
+        break;
+    }
+    if (st == JF_OK && !vertex_rows(h, body, size, &iv, &at, &vrow))
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "needs vertex rows of fixed size (no "
                         "lists) and a file as long as its header says");
     if (st == JF_OK) {

@@ -452,7 +452,7 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
     jf_wfile *f = &w->f;
     if (ready_for(w, nrows) != JF_OK)
         return f->st;
-    const int nt = threads > 0 ? threads : omp_get_max_threads();
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
     /* wide rows (a CSV of 100,000 named columns: 3 MB a row) take fewer
      * rows a block, so the scratch stays near 8 MB a thread */
     const size_t row_max = w->row_max,

@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <omp.h>
@@ -108,10 +109,46 @@ static void abort_outputs(outputs *o)
     o->bin = o->txt = NULL;
 }
 
+/* An MPI-IO failure of this rank, in MPI's words. */
+static void io_fail(jf_mpi *m, const char *out, const char *what, int rc)
+{
+    char s[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    if (MPI_Error_string(rc, s, &len) != MPI_SUCCESS) snprintf(s, sizeof s, "error %d", rc);
+    jf_mpi_fail(m, "%s: MPI-IO %s failed: %s", out, what, s);
+}
+
+/* Rank 0: the temporary gets its full length before any rank writes, so a
+ * disk without room fails here, before the fit (a filesystem that cannot
+ * preallocate is left to the checked writes and the final length). */
+static void reserve(jf_mpi *m, const outputs *o, const char *out, uint64_t bytes)
+{
+    if (getenv("JETFIT_MPI_TEST_NO_RESERVE")) return; /* tests reach the write checks */
+    int fd = open(o->tmp, O_WRONLY);
+    int e = fd < 0 ? errno : posix_fallocate(fd, 0, (off_t)bytes);
+    if (fd >= 0) close(fd);
+    if (e && e != EOPNOTSUPP && e != EINVAL)
+        jf_mpi_fail(m, "%s: cannot reserve %llu bytes for the output: %s", out,
+                    (unsigned long long)bytes, strerror(e));
+}
+
+/* Rank 0, before the rename: the temporary is as long as its header says. */
+static int commit_length(jf_mpi *m, const outputs *o, const char *out, uint64_t bytes)
+{
+    struct stat sb;
+    if (stat(o->tmp, &sb) != 0)
+        return jf_mpi_fail(m, "%s: %s", out, strerror(errno));
+    if ((uint64_t)sb.st_size != bytes)
+        return jf_mpi_fail(m, "%s: the rows written are %llu bytes, %llu expected (disk full?)",
+                           out, (unsigned long long)sb.st_size, (unsigned long long)bytes);
+    return 0;
+}
+
 /* Each rank writes its own rows at header + index * row size (collective
  * writes in rounds of BLOCK rows, so MPI-IO can gather them). */
-static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const jf_result *res,
-                       const jf_column *cols, size_t ncols, int monge, int threads)
+static void write_rows(jf_mpi *m, const outputs *o, const char *out, const jf_mpi_cloud *c,
+                       const jf_result *res, const jf_column *cols, size_t ncols, int monge,
+                       int threads)
 {
     enum { BLOCK = 16384 };
     jf_col_type types[JF_RESULT_MAX_COLS];
@@ -144,7 +181,7 @@ static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const
             if (c->own[j]) pos[k++] = j;
             j++;
         }
-#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads())
+#pragma omp parallel for num_threads(threads > 0 ? threads : jf_default_threads(NULL))
         for (int t = 0; t < k; t++) {
             const size_t p = pos[t];
             double *v = vals + (size_t)t * ncols;
@@ -159,11 +196,23 @@ static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const
         }
         rc = MPI_File_set_view(fh, 0, MPI_BYTE, ft, "native", MPI_INFO_NULL);
         MPI_Status st;
-        if (rc == MPI_SUCCESS) rc = MPI_File_write_all(fh, buf, (int)((size_t)k * rowb), MPI_BYTE, &st);
-        if (rc != MPI_SUCCESS) jf_mpi_fail(m, "%s: MPI-IO write failed (disk full?)", path);
+        /* every write_all is collective: a rank that failed still joins
+         * the later rounds with its rows (the check comes after) */
+        const int want = (int)((size_t)k * rowb);
+        if (rc == MPI_SUCCESS) rc = MPI_File_write_all(fh, buf, want, MPI_BYTE, &st);
+        int got = 0;
+        if (rc == MPI_SUCCESS && MPI_Get_count(&st, MPI_BYTE, &got) == MPI_SUCCESS && got != want)
+            jf_mpi_fail(m, "%s: wrote %d of %d bytes of rows (disk full?)", out, got, want);
+        else if (rc != MPI_SUCCESS) io_fail(m, out, "write", rc);
         if (k) MPI_Type_free(&ft);
     }
-    if (MPI_File_close(&fh) != MPI_SUCCESS) jf_mpi_fail(m, "%s: MPI-IO close failed", path);
+    /* Open MPI's ompio reports a failed pwritev only on stderr (issue 32):
+     * the sync and close results are checked too, and rank 0 checks the
+     * file's length before the rename (commit_length) */
+    rc = MPI_File_sync(fh);
+    if (rc != MPI_SUCCESS) io_fail(m, out, "sync", rc);
+    rc = MPI_File_close(&fh);
+    if (rc != MPI_SUCCESS) io_fail(m, out, "close", rc);
     free(pos);
     free(vals);
     free(buf);
@@ -286,6 +335,14 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         return 1;
     }
     MPI_Bcast(&w.header, 1, MPI_UINT64_T, 0, m->comm);
+    size_t rowb = 0;
+    for (size_t j = 0; j < ncols; j++) rowb += cols[j].type == JF_COL_F64 ? 8 : 4;
+    const uint64_t bytes = w.header + lay.count * (uint64_t)rowb;
+    if (m->rank == 0) reserve(m, &w, out, bytes);
+    if (jf_mpi_check(m)) {
+        abort_outputs(&w);
+        return 1;
+    }
 
     jf_mpi_cloud c;
     int normals = o.orient == JF_ORIENT_INPUT;
@@ -310,12 +367,12 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     }
     double t2 = MPI_Wtime();
     if (!failed) {
-        write_rows(m, &w, &c, res, cols, ncols, cmd.e.monge, o.threads);
+        write_rows(m, &w, out, &c, res, cols, ncols, cmd.e.monge, o.threads);
         failed = jf_mpi_check(m);
     }
     free(res);
     double t3 = MPI_Wtime();
-    if (!failed && m->rank == 0) {
+    if (!failed && m->rank == 0 && !commit_length(m, &w, out, bytes)) {
         jf_error err = {{0}};
         if (w.txt) {
             convert_text(m, &w, cols, ncols, lay.count, o.threads);
@@ -368,7 +425,10 @@ int main(int argc, char **argv)
     MPI_Comm_rank(m.comm, &m.rank);
     MPI_Comm_size(m.comm, &m.size);
     MPI_Comm_set_errhandler(m.comm, MPI_ERRORS_ARE_FATAL);
-    int rc;
+    int rc, asked, nt = jf_default_threads(&asked);
+    if (nt != asked && m.rank == 0)
+        fprintf(stderr, "jetfit-mpi: OMP_NUM_THREADS asks for %d threads: %d by default here "
+                        "(the processors available; --threads N overrides)\n", asked, nt);
     if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
         if (m.rank == 0) usage(stdout);
         rc = 0;

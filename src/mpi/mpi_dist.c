@@ -440,7 +440,7 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
 
     /* each own point's requests, then where they go */
     int ok = 1;
-#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads()) reduction(&& : ok)
+#pragma omp parallel num_threads(threads > 0 ? threads : jf_default_threads(NULL)) reduction(&& : ok)
     {
         uint32_t *ti = malloc(scratch * sizeof *ti);
         double *td = malloc(scratch * sizeof *td);

@@ -222,7 +222,7 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     if (m) {
         const kd_builder b = {ix->pts, ix->id, ix->nodes};
         const kd_builder *bp = &b;
-        const int nt = threads > 0 ? threads : omp_get_max_threads();
+        const int nt = threads > 0 ? threads : jf_default_threads(NULL);
 #pragma omp parallel if (m >= 2 * KD_TASK_MIN) num_threads(nt) default(none) shared(bp, m)
 #pragma omp single
         build_node(bp, 0, 0, m, 1);

@@ -15,7 +15,10 @@
  *  - Ctrl-C cancels the running cell and keeps the finished ones;
  *  - bad input: one line, no DIR; a failing cell is recorded, the rest go
  *    on; one progress line with an ETA for the whole study; user text
- *    (a folder name) runs nothing through gnuplot and is escaped. */
+ *    (a folder name) runs nothing through gnuplot and is escaped;
+ *  - --resume refuses another study (surface, --n, an estimate option, an
+ *    input of the same size) and a value jetfit cannot have written
+ *    (NaN, a non-number, a fractional count), naming the field (issue 32). */
 #include <check.h>
 #include <signal.h>
 #include <time.h>
@@ -485,8 +488,8 @@ START_TEST(resume_after_kill_gives_the_same_files)
 
     /* no temporary left in either folder */
     const char *files[] = {"study.csv", "best.csv", "report.html", "normal.png",
-                           "curvature.png", "k.png"};
-    for (int i = 0; i < 6; i++) {
+                           "curvature.png", "k.png", "study.def"};
+    for (int i = 0; i < 7; i++) {
         snprintf(pa, sizeof pa, "%s/%s", a, files[i]);
         unlink(pa);
         snprintf(pb, sizeof pb, "%s/%s", b, files[i]);
@@ -673,6 +676,116 @@ START_TEST(bad_input_one_line_no_folder)
 }
 END_TEST
 
+/* ---- a resume is the study its command line describes (issue 32.3, 32.4) ---- */
+
+/* Replaces field `col` (0-based) of line `line` (1-based) of path with val. */
+static void plant(const char *path, int line, int col, const char *val)
+{
+    size_t len;
+    char *t = slurp(path, &len), out[65536];
+    ck_assert(t && len < sizeof out - 64);
+    size_t u = 0;
+    int ln = 1, c = 0;
+    for (size_t i = 0; i < len; i++) {
+        if (ln == line && c == col) {
+            u += (size_t)snprintf(out + u, sizeof out - u, "%s", val);
+            while (i < len && t[i] != ',' && t[i] != '\n') i++;
+            c++;
+        }
+        if (i < len) out[u++] = t[i];
+        if (i < len && t[i] == '\n') ln++, c = 0;
+        else if (i < len && t[i] == ',' && ln == line) c++;
+    }
+    free(t);
+    FILE *f = fopen(path, "wb");
+    ck_assert(f && fwrite(out, 1, u, f) == u);
+    fclose(f);
+}
+
+START_TEST(resume_refuses_another_study)
+{
+    cli_setup();
+    char dir[300], csv[340], copy[340];
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
+    snprintf(csv, sizeof csv, "%s/study.csv", dir);
+    snprintf(copy, sizeof copy, "%s/kept.csv", cli_dir);
+#define STUDY(surf, ...) cli_run("study", surf, "-o", dir, "--neighbors", "knn:12;knn:16", \
+                                 "--quiet", __VA_ARGS__, NULL)
+    ck_assert_msg(STUDY("ellipsoid", "--n", "400") == 0, "%s", cli_err);
+    size_t clen;
+    char *ctext = slurp(csv, &clen);
+    FILE *cf = fopen(copy, "wb");
+    ck_assert(ctext && cf && fwrite(ctext, 1, clen, cf) == clen);
+    fclose(cf);
+    free(ctext);
+    struct {
+        const char *surf, *a, *b, *says;
+    } cases[] = {
+        {"sphere", "--n", "400", "surface was 'ellipsoid', is now 'sphere'"},
+        {"ellipsoid", "--n", "500", "n was '400', is now '500'"},
+        {"ellipsoid", "--robust", "huber", "options was '(none)', is now '--robust=huber'"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        int rc = cases[k].a[2] == 'n' ? STUDY(cases[k].surf, cases[k].a, cases[k].b, "--resume")
+                                     : STUDY(cases[k].surf, "--n", "400", cases[k].a, cases[k].b,
+                                             "--resume");
+        ck_assert_msg(rc == 1, "case %zu: exit %d: %s", k, rc, cli_err);
+        ck_assert_msg(strstr(cli_err, cases[k].says), "case %zu: %s", k, cli_err);
+        ck_assert_int_eq(count_str(cli_err, "\n"), 1);
+        ck_assert_msg(same_file(csv, copy), "case %zu: study.csv changed", k);
+    }
+    /* the same study resumes; --threads does not define it */
+    ck_assert_msg(STUDY("ellipsoid", "--n", "400", "--threads", "2", "--resume") == 0, "%s",
+                  cli_err);
+    /* two input files of the same size: the content hash tells them apart */
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "300", "-o", cli_path("a.ply"),
+                             "--truth", cli_path("ta.csv"), NULL), 0);
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "300", "--seed", "5", "-o",
+                             cli_path("b.ply"), "--truth", cli_path("tb.csv"), NULL), 0);
+    char a[300], ta[300], b[300], tb[300];
+    snprintf(a, sizeof a, "%s", cli_path("a.ply"));
+    snprintf(ta, sizeof ta, "%s", cli_path("ta.csv"));
+    snprintf(b, sizeof b, "%s", cli_path("b.ply"));
+    snprintf(tb, sizeof tb, "%s", cli_path("tb.csv"));
+    ck_assert_msg(cli_run("study", a, "--truth", ta, "-o", dir, "--quiet", NULL) == 0, "%s",
+                  cli_err);
+    ck_assert_int_eq(cli_run("study", b, "--truth", tb, "-o", dir, "--quiet", "--resume", NULL),
+                     1);
+    ck_assert_msg(strstr(cli_err, "input was '") && strstr(cli_err, "fnv1a64"), "%s", cli_err);
+    ck_assert_int_eq(count_str(cli_err, "\n"), 1);
+#undef STUDY
+    cli_teardown();
+}
+END_TEST
+
+START_TEST(resume_refuses_values_jetfit_did_not_write)
+{
+    cli_setup();
+    char dir[300], csv[340];
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
+    snprintf(csv, sizeof csv, "%s/study.csv", dir);
+    const char *const planted[][2] = {{"nan", "column 11 (normal_rms): 'nan' is not finite"},
+                                      {"abc", "column 11 (normal_rms): 'abc' is not a number"}};
+    for (int k = 0; k < 2; k++) {
+        ck_assert_msg(cli_run("study", "sphere", "-o", dir, "--n", "400", "--repeat", "2",
+                              "--quiet", NULL) == 0, "%s", cli_err);
+        plant(csv, 3, 10, planted[k][0]); /* row 2's normal_rms */
+        int rc = cli_run("study", "sphere", "-o", dir, "--n", "400", "--repeat", "2", "--quiet",
+                         "--resume", NULL);
+        ck_assert_msg(rc == 1, "%s: exit %d: %s", planted[k][0], rc, cli_err);
+        ck_assert_msg(strstr(cli_err, "study.csv:3: ") && strstr(cli_err, planted[k][1]), "%s",
+                      cli_err);
+        ck_assert_int_eq(count_str(cli_err, "\n"), 1);
+    }
+    /* a count that is not whole */
+    plant(csv, 2, 8, "12.5");
+    ck_assert_int_eq(cli_run("study", "sphere", "-o", dir, "--n", "400", "--repeat", "2",
+                             "--quiet", "--resume", NULL), 1);
+    ck_assert_msg(strstr(cli_err, "column 9 (points): '12.5' is not a count"), "%s", cli_err);
+    cli_teardown();
+}
+END_TEST
+
 START_TEST(failing_cell_recorded_study_goes_on)
 {
     cli_setup();
@@ -772,6 +885,8 @@ int main(void)
     tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
+    tcase_add_test(t, resume_refuses_another_study);
+    tcase_add_test(t, resume_refuses_values_jetfit_did_not_write);
     tcase_add_test(t, one_progress_line_with_eta);
     tcase_add_test(t, user_text_stays_text);
     suite_add_tcase(s, t);

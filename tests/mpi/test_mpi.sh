@@ -8,6 +8,8 @@
 #       part, NaN rows, big-endian floats with normals), for knn, radius,
 #       knn+radius, every fit option, orientation none/input/viewpoint, and
 #       the text outputs.
+#   full-disk: on a 2 MB tmpfs (skipped where it cannot be mounted) every
+#       np ends with exit 1, one line, the old output intact, no temporary.
 #   errors: refused options and inputs, bad files and a failing rank end
 #       every rank with one line, exit 1, no output (an old one intact),
 #       no temporary left.
@@ -89,6 +91,16 @@ errors)
   head -c 5000 "$d/lattice.las" >"$d/cut.las" # past the VLRs, into the records
   refused "point record" 2 "$d/cut.las" -o "$d/err.ply"
   refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
+  # one fault, one message: jetfit estimate's words (issue 32.5, 33.8)
+  printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n' >"$d/xonly.ply"
+  head -c 24 /dev/zero >>"$d/xonly.ply"
+  printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$d/empty.ply"
+  for f in xonly.ply empty.ply; do
+    "$jetfit" estimate "$d/$f" -o "$d/err.ply" --quiet 2>"$d/want"; rc=$?
+    want=$(sed 's/^jetfit[^:]*: //' "$d/want")
+    [ $rc -eq 1 ] && [ -n "$want" ] || bad "jetfit estimate $f: exit $rc, '$want'"
+    for np in 1 3; do refused "$want" $np "$d/$f" -o "$d/err.ply"; done
+  done
   # a rank that fails mid-run: one line, exit 1, the old output intact
   echo old >"$d/keep.ply"
   JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -q -x JETFIT_MPI_TEST_FAIL \
@@ -99,6 +111,35 @@ errors)
   else echo "ok   failing rank: $(cat "$d/stderr")"; fi
   left=$(ls -A "$d" | grep -c tmp)
   [ "$left" -eq 0 ] || bad "temporaries left: $(ls -A "$d")"
+  ;;
+full-disk)
+  # a 2 MB tmpfs holding an old output: the 4 MB result cannot fit; every
+  # np, binary and text output, with and without the up-front reservation
+  # (JETFIT_MPI_TEST_NO_RESERVE reaches the checks after the MPI-IO writes)
+  mnt=$(mktemp -d "$d/disk.XXXXXX")
+  if ! mount -t tmpfs -o size=2m tmpfs "$mnt" 2>"$d/mount.err"; then
+    echo "SKIP: cannot mount a 2 MB tmpfs for the full-disk case: $(cat "$d/mount.err")"
+    rmdir "$mnt"; exit 77
+  fi
+  trap 'umount "$mnt"; rmdir "$mnt"' EXIT
+  "$jetfit" generate torus -o "$d/torus.ply" --n 30000 --seed 3 || bad "jetfit generate"
+  for np in 1 3; do for ext in ply csv; do for reserve in 0 1; do
+    echo old >"$mnt/keep.$ext"
+    JETFIT_MPI_TEST_NO_RESERVE=$reserve
+    [ $reserve = 1 ] && export JETFIT_MPI_TEST_NO_RESERVE || unset JETFIT_MPI_TEST_NO_RESERVE
+    mpirun --allow-run-as-root --oversubscribe -q $( [ $reserve = 1 ] && echo -x JETFIT_MPI_TEST_NO_RESERVE) \
+      -np $np "$jmpi" estimate "$d/torus.ply" -o "$mnt/keep.$ext" --quiet --neighbors knn:12 \
+      2>"$d/stderr" >/dev/null; rc=$?
+    unset JETFIT_MPI_TEST_NO_RESERVE
+    # Open MPI's own "mca_fbtl_posix_pwritev" lines are not ours to count
+    ours=$(grep -c '^jetfit-mpi' "$d/stderr")
+    what="np $np .$ext no-reserve=$reserve"
+    if [ $rc -ne 1 ] || [ "$ours" -ne 1 ] || ! grep -q "keep.$ext" "$d/stderr"; then
+      bad "$what: expected exit 1 and one line naming keep.$ext, got exit $rc:"; cat "$d/stderr"
+    elif [ "$(cat "$mnt/keep.$ext")" != old ]; then bad "$what: the old output was changed"
+    elif [ "$(ls -A "$mnt" | grep -vc '^keep\.')" -ne 0 ]; then bad "$what: left $(ls -A "$mnt")"
+    else echo "ok   $what: $(grep '^jetfit-mpi' "$d/stderr")"; fi
+  done; done; done
   ;;
 *) echo "unknown mode $mode"; exit 2 ;;
 esac
