@@ -421,6 +421,7 @@
   /* a small hook for the tests (tests/cli/view_check.js) */
   window.__jetfit = {
     ready: true, firstFrameMs: firstFrameMs, scriptMs: firstFrameMs - T0, ndrawn: M, nvisible: function () { return nvis; },
+    click: function (x, y) { showRow(pick(x, y)); return $('row').textContent; },
     setColor: setColor, setClip: setClip, toggle: toggle, view: setView, pick: pick, colorOf: colorOf,
     barPixel: barPixel, setPointSize: setPointSize, range: function () { return [state.lo, state.hi, state.diverging]; },
     setFlags: function (f) { state.flags = f.slice(); rebuild(); },
