@@ -484,8 +484,8 @@ START_TEST(resume_after_kill_gives_the_same_files)
 
     /* no temporary left in either folder */
     const char *files[] = {"study.csv", "best.csv", "report.html", "normal.png",
-                           "curvature.png", "k.png"};
-    for (int i = 0; i < 6; i++) {
+                           "curvature.png", "k.png", "best.ply", "view.html"};
+    for (int i = 0; i < 8; i++) {
         snprintf(pa, sizeof pa, "%s/%s", a, files[i]);
         unlink(pa);
         snprintf(pb, sizeof pb, "%s/%s", b, files[i]);
