@@ -4,8 +4,8 @@
 # need no share folder; three.js is read at run time from JF_THREE_DIR
 # (Debian's libjs-three; the project ships no copy).
 set(JF_THREE_DIR "/usr/share/javascript/three" CACHE PATH
-    "three.js for jetfit view (three.min.js, examples/js/controls/OrbitControls.js)")
-set(JF_VIEW_SRC ${PROJECT_BINARY_DIR}/view_page.c)
+    "three.js for jetfit view (three.min.js and the OrbitControls of its examples)")
+set(JF_VIEW_SRC ${PROJECT_BINARY_DIR}/jf_view_template.c)
 add_custom_command(OUTPUT ${JF_VIEW_SRC}
   COMMAND ${CMAKE_COMMAND} -DOUT=${JF_VIEW_SRC} -DDIR=${PROJECT_SOURCE_DIR}/src/cli/view
           -P ${PROJECT_SOURCE_DIR}/cmake/embed_view.cmake

@@ -236,7 +236,9 @@
     }
     var g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(a.subarray(0, 6 * n), 3));
-    var ls = new THREE.LineSegments(g, new THREE.LineBasicMaterial({color: col}));
+    /* over the points: in the tangent plane they would fight the points' depth */
+    var ls = new THREE.LineSegments(g, new THREE.LineBasicMaterial({color: col, depthTest: false}));
+    ls.renderOrder = 1;
     ls.visible = false;
     scene.add(ls);
     glyph[name] = ls;
@@ -318,7 +320,7 @@
     line('row', String(o.row + 1) + ' of ' + meta.nrows);
     cols.forEach(function (c) {
       var v = o.values[c.name];
-      if (Array.isArray(v)) line(c.name, v.map(fmt).join(' '));
+      if (Array.isArray(v)) line({pos: 'x y z', normal: 'nx ny nz', d1: 'd1x d1y d1z', d2: 'd2x d2y d2z'}[c.name], v.map(fmt).join(' '));
       else line(c.name, c.name === 'status' && isFinite(v) ? v + ' (' + flagNames(v) + ')' : fmt(v));
     });
     if (byName.k1 && byName.k2) {
@@ -418,7 +420,7 @@
   gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
   var firstFrameMs = performance.now();
 
-  /* a small hook for the tests (tests/cli/view_check.js) */
+  /* a small hook for the tests (tests/view/view_check.js) */
   window.__jetfit = {
     ready: true, firstFrameMs: firstFrameMs, scriptMs: firstFrameMs - T0, ndrawn: M, nvisible: function () { return nvis; },
     click: function (x, y) { showRow(pick(x, y)); return $('row').textContent; },
