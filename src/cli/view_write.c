@@ -244,7 +244,11 @@ int jf_view_write(const char *in, const char *out, const jf_view_opts *o, int qu
         }
     }
     if (o->color) {
-        int found = !strcmp(o->color, "mean") || !strcmp(o->color, "gauss");
+        int k1 = jf_eval_table_col(&t, "k1") >= 0 && jf_eval_table_col(&t, "k2") >= 0;
+        int rgb = jf_eval_table_col(&t, "red") >= 0 && jf_eval_table_col(&t, "green") >= 0 &&
+                  jf_eval_table_col(&t, "blue") >= 0;
+        int found = (k1 && (!strcmp(o->color, "mean") || !strcmp(o->color, "gauss"))) ||
+                    (rgb && !strcmp(o->color, "rgb"));
         for (size_t k = 0; k < pg.cs.n; k++) found |= !strcmp(pg.cs.c[k].name, o->color);
         if (!found) {
             snprintf(msg, len, "%s: no column '%.64s' to colour by", in, o->color);

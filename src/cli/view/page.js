@@ -152,7 +152,8 @@
   function colour() {
     var q = state.q;
     if (q === 'rgb') {
-      var mx = Math.max.apply(null, rgbCols.map(function (c) { return c.off + (c.enc === 'u8' ? 254 : 65534); }));
+      var mx = 0; /* 8-bit colours, or 16-bit as LAS stores them */
+      for (var k = 0; k < M; k++) for (var c0 = 0; c0 < 3; c0++) { var x = value(rgbCols[c0], k); if (x > mx) mx = x; }
       var sc = mx > 255 ? 255 / 65535 : 1;
       for (var i = 0; i < M; i++)
         for (var c = 0; c < 3; c++) { var v = value(rgbCols[c], i); COL[3 * i + c] = isFinite(v) ? Math.round(v * sc) : 127; }
