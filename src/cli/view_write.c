@@ -73,7 +73,12 @@ static int choose_columns(const jf_eval_table *t, const jf_view_opts *o, colset 
     for (size_t j = 0; j < t->ncols; j++) {
         if (used[j] || (!o->all_columns && is_monge(t->names[j]))) continue;
         jf_view_col *v = &cs->c[cs->n++];
-        if (t->names[j][0]) snprintf(v->name, sizeof v->name, "%s", t->names[j]);
+        /* the page's own names (triplets, derived columns) stay unique */
+        static const char *const own[] = {"pos", "normal", "d1", "d2", "mean", "gauss", "rgb"};
+        int clash = 0;
+        for (size_t k = 0; k < sizeof own / sizeof own[0]; k++) clash |= !strcmp(t->names[j], own[k]);
+        if (t->names[j][0] && !clash) snprintf(v->name, sizeof v->name, "%s", t->names[j]);
+        else if (clash) snprintf(v->name, sizeof v->name, "%s (column %zu)", t->names[j], j + 1);
         else snprintf(v->name, sizeof v->name, "column %zu", j + 1);
         v->col = (int)j;
         v->enc = JF_VE_F16; /* chosen over the drawn rows later */

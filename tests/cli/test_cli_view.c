@@ -220,6 +220,32 @@ START_TEST(subsample_estimate_and_size)
 }
 END_TEST
 
+START_TEST(study_report_links_the_best_result)
+{
+    if (!have_three) return;
+    ck_assert_int_eq(cli_run("study", "sphere", "-o", cli_path("st"), "--n", "600", "--degree", "2,3",
+                             "--quiet", NULL), 0);
+    ck_assert_int_eq(meta_num(cli_path("st/view.html"), "ndrawn"), 600);
+    jf_eval_table t;
+    jf_error e = {{0}};
+    ck_assert_int_eq(jf_eval_table_read(cli_path("st/best.ply"), &t, &e), JF_OK);
+    ck_assert_uint_eq(t.nrows, 600);
+    ck_assert_int_ge(jf_eval_table_col(&t, "k1"), 0);
+    jf_eval_table_free(&t);
+    FILE *f = fopen(cli_path("st/report.html"), "rb");
+    ck_assert_ptr_nonnull(f);
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    ck_assert_ptr_nonnull(strstr(buf, "<a href=\"view.html\">"));
+    const char *rm[] = {"/bin/rm", "-rf", cli_path("st"), NULL};
+    pid_t pid = fork();
+    if (pid == 0) { execv(rm[0], (char *const *)rm); _exit(127); }
+    waitpid(pid, NULL, 0);
+}
+END_TEST
+
 int main(void)
 {
     char v[8192];
@@ -241,6 +267,7 @@ int main(void)
     tcase_add_test(tc, errors_name_the_file_and_write_nothing);
     tcase_add_test(tc, no_three_is_one_clear_line);
     tcase_add_test(tc, subsample_estimate_and_size);
+    tcase_add_test(tc, study_report_links_the_best_result);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
