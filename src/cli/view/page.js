@@ -140,6 +140,7 @@
   }
   function entry(v) { /* the table entry of value v, -1 when missing */
     var q = state.q;
+    if (!q || q === 'rgb') return -1;
     if (q.log) v = v > 0 ? Math.log10(v) : NaN;
     if (!isFinite(v)) return v === Infinity ? 255 : v === -Infinity ? 0 : -1;
     var t = (v - state.lo) / (state.hi - state.lo);
