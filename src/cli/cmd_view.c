@@ -55,8 +55,11 @@ static int count_arg(const char *a, const char *v, size_t lo, size_t *out)
     char *end;
     errno = 0;
     unsigned long long n = strtoull(v, &end, 10);
-    if (end == v || *end || errno || *v == '-' || n < lo || n > 4294967295ull)
-        return bad("%s wants a count, not this", a);
+    if (end == v || *end || errno || *v == '-' || n < lo || n > 4294967295ull) {
+        fprintf(stderr, "jetfit view: %s wants a count %zu..4294967295, not '%s' (jetfit view --help)\n",
+                a, lo, v);
+        return 2;
+    }
     *out = (size_t)n;
     return 0;
 }
