@@ -9,4 +9,5 @@ int jf_cmd_convergence(int argc, char **argv); /* cmd_convergence.c */
 int jf_cmd_render(int argc, char **argv);      /* cmd_render.c      */
 int jf_cmd_eval(int argc, char **argv);        /* cmd_eval.c        */
 int jf_cmd_study(int argc, char **argv);       /* cmd_study.c       */
+int jf_cmd_view(int argc, char **argv);        /* cmd_view.c        */
 #endif

@@ -31,6 +31,8 @@
 #include "eval_errors.h"
 #include "jetfit.h"
 #include "study_args.h"
+#include "rows.h"
+#include "view.h"
 
 static double now_s(void)
 {
@@ -281,7 +283,7 @@ static int prepare_dir(const char *dir)
     /* jf_tmpfile names: ".NAME.RANDOM.tmp", RANDOM a few letters and
      * digits (io_tmpfile.c) */
     static const char *const ours[] = {"study.csv", "best.csv", "normal.png", "curvature.png",
-                                       "k.png", "report.html"};
+                                       "k.png", "report.html", "best.ply", "view.html"};
     DIR *d = opendir(dir);
     struct dirent *en;
     while (d && (en = readdir(d))) {
@@ -302,6 +304,72 @@ static int prepare_dir(const char *dir)
     }
     if (d) closedir(d);
     return 0;
+}
+
+/* ---- the 3D view of the best setting (jetfit view) ---- */
+
+/* DIR/best.ply, the best setting's result on the first noise level's
+ * first draw (by the first --metrics metric, else the median normal
+ * error), and DIR/view.html showing it.  0, 1 when there is no best
+ * setting, -1 with msg. */
+static int study_view(jf_study_args *c, char *msg, size_t len)
+{
+    jf_study *s = &c->s;
+    int metric = JF_M_NORMAL_MEDIAN;
+    for (int m = JF_M_COUNT - 1; m >= 0; m--)
+        if (s->best[m]) metric = m;
+    jf_study_key lvl = {0}, best;
+    jf_study_stat bs;
+    if (!jf_study_best(s, &lvl, metric, &best, &bs)) return 1;
+    best.repeat = 0;
+    size_t n = c->ndraw;
+    jf_result *res = malloc(n * sizeof *res);
+    double *truth5 = malloc(5 * n * sizeof *truth5);
+    jf_sample smp = {0};
+    jf_writer *w = NULL;
+    jf_error e = {{0}};
+    char ply[4200], html[4200];
+    jf_study_path(c->dir, "best.ply", ply, sizeof ply);
+    jf_study_path(c->dir, "view.html", html, sizeof html);
+    jf_status st = res && truth5 ? make_draw(c, &best, &smp, truth5) : JF_ERR_NOMEM;
+    jf_estimate_opts o = c->setting[jf_study_setting(s, &best)];
+    if (st == JF_OK) {
+        jf_cloud cloud = {.n = smp.n, .xyz = smp.xyz, .nfaces = smp.nfaces,
+                          .face_off = smp.face_off, .face_idx = smp.face_idx};
+        if (!c->is_surface) {
+            cloud.nrm = c->cloud.nrm;
+            cloud.nfaces = c->cloud.nfaces;
+            cloud.face_off = c->cloud.face_off;
+            cloud.face_idx = c->cloud.face_idx;
+        }
+        st = jf_estimate(&cloud, &o, res, &e);
+    }
+    jf_column cols[JF_CLI_MAX_COLS];
+    int monge = o.params.monge_degree;
+    size_t ncols = jf_cli_columns(monge, cols);
+    if (st == JF_OK) st = jf_writer_open(ply, cols, ncols, smp.n, 0, &w, &e);
+    for (size_t i = 0; st == JF_OK && i < smp.n; i++) {
+        double v[JF_CLI_MAX_COLS];
+        jf_cli_row(smp.xyz + 3 * i, &res[i], monge, v);
+        st = jf_writer_row(w, v);
+    }
+    if (w && st != JF_OK) jf_writer_abort(w);
+    else if (w) st = jf_writer_commit(w, &e);
+    jf_sample_free(&smp);
+    free(res), free(truth5);
+    if (st != JF_OK) {
+        if (e.msg[0]) snprintf(msg, len, "%s", e.msg);
+        else snprintf(msg, len, "%.4000s: %s", ply, jf_strerror(st));
+        return -1;
+    }
+    char label[200], title[400];
+    jf_study_label(s, &best, label, sizeof label);
+    snprintf(title, sizeof title, "best by %s: %s, noise %g/%g/%g", jf_study_metric[metric], label,
+             s->noise[0], s->noise_u[0], s->outliers[0]);
+    jf_view_opts vo;
+    jf_view_opts_init(&vo);
+    vo.title = title;
+    return jf_view_write(ply, html, &vo, 1, msg, len) ? -1 : 0;
 }
 
 /* ---- the command ---- */
@@ -454,6 +522,7 @@ int jf_cmd_study(int argc, char **argv)
     /* gnuplot missing is a note (the plots are optional); gnuplot failing,
      * or a picture cut short, is an error once the report is written */
     int plot_err = nplots == -1;
+    if (study_view(&c, msg, sizeof msg) < 0) fprintf(stderr, "jetfit study: no 3D view: %s\n", msg);
     if (jf_study_report(s, c.dir, msg, sizeof msg)) {
         fprintf(stderr, "jetfit: %s\n", msg);
         goto fail;

@@ -10,6 +10,7 @@
 #include "cgal_bridge.h"
 #include "cmd.h"
 #include "jetfit.h"
+#include "view.h"
 
 static const struct {
     const char *name;
@@ -22,6 +23,7 @@ static const struct {
     {"render", jf_cmd_render, "a PNG of a result coloured by curvature"},
     {"eval", jf_cmd_eval, "errors of a result against ground truth"},
     {"study", jf_cmd_study, "neighbourhoods x degrees x flags x noise: table, plots, report"},
+    {"view", jf_cmd_view, "a self-contained 3D page of a result (HTML, three.js)"},
 };
 
 /* The OpenMP specification version from _OPENMP's date (yyyymm). */
@@ -89,6 +91,9 @@ int main(int argc, char **argv)
         else
             printf("built without CGAL (natural with --normal poles|mincirc unavailable), "
                    "GSL %s, OpenMP %s\n", GSL_VERSION, openmp_version());
+        char three[4200];
+        jf_view_three_describe(three, sizeof three);
+        printf("view: %s\n", three);
         return 0;
     }
     for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)

@@ -240,6 +240,14 @@ int jf_study_report(const jf_study *s, const char *dir, char *msg, size_t len)
           "Means over repeats, &plusmn; their standard deviation.  Click a column heading to sort."
           "</p>\n<h2>Best setting per noise level</h2>\n", f);
     best_table(f, s);
+    char vpath[4200]; /* cmd_study.c's study_view: the best setting in 3D */
+    jf_study_path(dir, "view.html", vpath, sizeof vpath);
+    FILE *vf = fopen(vpath, "rb");
+    if (vf) {
+        fclose(vf);
+        fputs("<p><a href=\"view.html\">view.html</a>: the best setting's result (best.ply) in 3D, "
+              "coloured by curvature; click a point for its row (<code>jetfit view</code>).</p>\n", f);
+    }
     fputs("<h2>Plots</h2>\n", f);
     int np = embed_png(f, dir, "normal.png", "normal error against noise");
     np += embed_png(f, dir, "curvature.png", "curvature errors against noise");

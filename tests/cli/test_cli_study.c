@@ -488,8 +488,8 @@ START_TEST(resume_after_kill_gives_the_same_files)
 
     /* no temporary left in either folder */
     const char *files[] = {"study.csv", "best.csv", "report.html", "normal.png",
-                           "curvature.png", "k.png", "study.def"};
-    for (int i = 0; i < 7; i++) {
+                           "curvature.png", "k.png", "study.def", "best.ply", "view.html"};
+    for (int i = 0; i < 9; i++) {
         snprintf(pa, sizeof pa, "%s/%s", a, files[i]);
         unlink(pa);
         snprintf(pb, sizeof pb, "%s/%s", b, files[i]);
