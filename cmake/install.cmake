@@ -37,9 +37,9 @@ install(FILES ${PROJECT_BINARY_DIR}/jetfitConfig.cmake ${PROJECT_BINARY_DIR}/jet
 # pkg-config: paths relative to the .pc file, so `--prefix P` at install
 # time (not the configure-time prefix) is what the file describes
 if(JF_CGAL)
-  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lstdc++ -lgmp -lmpfr -lm")
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lexpat -lstdc++ -lgmp -lmpfr -lm")
 else()
-  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lm")
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lexpat -lm")
 endif()
 file(RELATIVE_PATH JF_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit.pc.in ${PROJECT_BINARY_DIR}/jetfit.pc @ONLY)
