@@ -203,6 +203,9 @@ static jf_status scan_header(ctx *c, size_t s, int vc, scaninfo *si, jf_e57_fiel
     if (!jf__e57_logical((uint64_t)off, &si->sec))
         FAIL("XML line %zu: data3D[%zu] points: fileOffset %lld is inside a page checksum",
              line, s, (long long)off);
+    if (si->sec > c->loglen || c->loglen - si->sec < 32 || c->log[si->sec] != 1)
+        FAIL("XML line %zu: data3D[%zu] points: fileOffset %lld is not a CompressedVector "
+             "binary section (no section id 1 there)", line, s, (long long)off);
     /* a record costs a bit at least: a count the whole file cannot hold lies */
     if ((uint64_t)cnt > (uint64_t)c->loglen * 8 || (uint64_t)cnt > JF_MAX_POINTS)
         FAIL("XML line %zu: data3D[%zu] points: recordCount %lld is more than the file's "
@@ -292,6 +295,9 @@ jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_re
                       jf_cloud *cl, jf_error *err)
 {
     const unsigned char *b = (const unsigned char *)buf;
+    if (len >= 8 && len < 48 && !memcmp(b, "ASTM-E57", 8))
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "truncated: %zu bytes, shorter than "
+                          "the 48-byte E57 header", len);
     if (len < 48 || memcmp(b, "ASTM-E57", 8))
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "not an E57 file (no ASTM-E57 "
                           "signature in its first 8 bytes)");
