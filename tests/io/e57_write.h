@@ -21,6 +21,7 @@ typedef struct {
     long long min, max; /* EW_INT / EW_SCALED raw bounds                */
     double scale;       /* EW_SCALED: value = raw * scale (offset 0)    */
     const double *v;    /* n values (EW_SCALED: raw integers)           */
+    size_t stride;      /* value i at v[i * stride]; 0 means 1          */
 } ew_field;
 
 typedef struct {
@@ -75,18 +76,19 @@ static inline unsigned ew_bits(long long min, long long max)
 /* Field f's whole bytestream (*len bytes). */
 static inline unsigned char *ew_stream(const ew_field *f, size_t n, size_t *len)
 {
+    size_t vs = f->stride ? f->stride : 1;
     if (f->kind == EW_FLOAT || f->kind == EW_DOUBLE) {
         size_t w = f->kind == EW_FLOAT ? 4 : 8;
         unsigned char *s = malloc(n * w + 1);
         for (size_t i = 0; i < n; i++) {
             uint64_t u = 0;
             if (w == 4) {
-                float x = (float)f->v[i];
+                float x = (float)f->v[i * vs];
                 uint32_t u32;
                 memcpy(&u32, &x, 4);
                 u = u32;
             } else {
-                memcpy(&u, &f->v[i], 8);
+                memcpy(&u, &f->v[i * vs], 8);
             }
             ew_le(s + w * i, u, (int)w);
         }
@@ -97,7 +99,7 @@ static inline unsigned char *ew_stream(const ew_field *f, size_t n, size_t *len)
     size_t bytes = (n * w + 7) / 8;
     unsigned char *s = calloc(bytes + 1, 1);
     for (size_t i = 0; i < n; i++) {
-        uint64_t raw = (uint64_t)((long long)f->v[i] - f->min);
+        uint64_t raw = (uint64_t)((long long)f->v[i * vs] - f->min);
         for (unsigned k = 0; k < w; k++) /* one bit at a time: LSB first */
             if ((raw >> k) & 1) {
                 size_t bit = i * w + k;
