@@ -46,8 +46,8 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
-jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
-                      jf_error *err);
+jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err);
 jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,
                       jf_cloud *c, jf_error *err);
 

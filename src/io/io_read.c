@@ -370,7 +370,7 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_read_las(buf, len, name, o, c, err);
         break;
     case JF_FMT_PTX:
-        st = jf_read_ptx(buf, len, name, c, err);
+        st = jf_read_ptx(buf, len, name, o, c, err);
         break;
     case JF_FMT_E57:
         st = jf_read_e57(buf, len, name, o, c, err);

@@ -288,16 +288,16 @@ static unsigned char *two_scans(size_t *len, void (*edit)(char *, size_t))
         }
     }
     static const ew_field f0[6] = {
-        {"cartesianX", EW_FLOAT, 0, 0, 0, v[0][0]}, {"cartesianY", EW_FLOAT, 0, 0, 0, v[0][1]},
-        {"cartesianZ", EW_FLOAT, 0, 0, 0, v[0][2]}, {"cartesianInvalidState", EW_INT, 0, 2, 0, v[0][3]},
-        {"colorRed", EW_INT, 0, 255, 0, v[0][4]},   {"intensity", EW_FLOAT, 0, 0, 0, v[0][5]}};
+        {"cartesianX", EW_FLOAT, 0, 0, 0, v[0][0], 0}, {"cartesianY", EW_FLOAT, 0, 0, 0, v[0][1], 0},
+        {"cartesianZ", EW_FLOAT, 0, 0, 0, v[0][2], 0}, {"cartesianInvalidState", EW_INT, 0, 2, 0, v[0][3], 0},
+        {"colorRed", EW_INT, 0, 255, 0, v[0][4], 0},   {"intensity", EW_FLOAT, 0, 0, 0, v[0][5], 0}};
     static const ew_field f1[6] = {
-        {"sphericalRange", EW_SCALED, 0, 8388607, 1e-6, v[1][0]},
-        {"sphericalAzimuth", EW_DOUBLE, 0, 0, 0, v[1][1]},
-        {"sphericalElevation", EW_DOUBLE, 0, 0, 0, v[1][2]},
-        {"sphericalInvalidState", EW_INT, 0, 2, 0, v[1][3]},
-        {"rowIndex", EW_INT, 0, NE - 1, 0, v[1][4]},
-        {"intensity", EW_DOUBLE, 0, 0, 0, v[1][5]}};
+        {"sphericalRange", EW_SCALED, 0, 8388607, 1e-6, v[1][0], 0},
+        {"sphericalAzimuth", EW_DOUBLE, 0, 0, 0, v[1][1], 0},
+        {"sphericalElevation", EW_DOUBLE, 0, 0, 0, v[1][2], 0},
+        {"sphericalInvalidState", EW_INT, 0, 2, 0, v[1][3], 0},
+        {"rowIndex", EW_INT, 0, NE - 1, 0, v[1][4], 0},
+        {"intensity", EW_DOUBLE, 0, 0, 0, v[1][5], 0}};
     ew_scan sc[2] = {{{0}, {0}, NS, f0, 6}, {{0}, {0}, NS, f1, 6}};
     for (int s = 0; s < 2; s++) {
         memcpy(sc[s].q, SQ[s], sizeof SQ[s]);
