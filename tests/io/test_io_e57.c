@@ -7,7 +7,8 @@
  * with one pose, spherical scaled integers with another, invalid rows)
  * back in one frame within the encodings' rounding, every normal of a
  * sphere facing its own scanner; every damaged or lying file a one-line
- * FILE: reason, an empty cloud, and (command) exit status 1, no output. */
+ * FILE: reason, an empty cloud, and (command) exit status 1, no output;
+ * the command's default orientation on E57 is each row's own scanner. */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <math.h>
@@ -479,6 +480,47 @@ START_TEST(command_exit_status)
 }
 END_TEST
 
+/* The command on the two-scan file, no --orient given: x y z, the
+ * attributes, then the normals, each facing the scanner of its row's scan. */
+START_TEST(command_default_orientation)
+{
+    size_t len;
+    unsigned char *b = two_scans(&len, NULL);
+    char in[300], out[300], cmd[1024];
+    snprintf(in, sizeof in, "%s/two.e57", tmpdir);
+    snprintf(out, sizeof out, "%s/out.csv", tmpdir);
+    ck_assert_int_eq(ew_save(in, b, len), 0);
+    free(b);
+    snprintf(cmd, sizeof cmd, "'%s/jetfit' estimate '%s' -o '%s' --quiet", JF_BUILD_DIR, in, out);
+    ck_assert_int_eq(system(cmd), 0);
+    FILE *f = fopen(out, "r");
+    ck_assert_ptr_nonnull(f);
+    char line[4096];
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    ck_assert_msg(!strncmp(line, "x,y,z,colorRed,intensity,rowIndex,scan,nx,ny,nz,", 48), "%s", line);
+    size_t good = 0, fitted = 0, rows = 0;
+    double v[10];
+    while (fgets(line, sizeof line, f)) {
+        char *p = line;
+        for (int k = 0; k < 10; k++) {
+            v[k] = strtod(p, &p);
+            if (*p == ',') p++;
+        }
+        rows++;
+        if (isnan(v[0])) continue;
+        int s = (int)v[6];
+        ck_assert(s == 0 || s == 1);
+        double dt = 0;
+        for (int k = 0; k < 3; k++) dt += v[7 + k] * (ST[s][k] - v[k]);
+        fitted++;
+        good += dt > 0;
+    }
+    fclose(f);
+    ck_assert_uint_eq(rows, 2 * NS);
+    ck_assert_msg(good * 100 >= fitted * 99, "%zu of %zu", good, fitted);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("io_e57");
@@ -491,6 +533,7 @@ static Suite *suite(void)
     tcase_add_test(tc, lies_refused);
     tcase_add_test(tc, empty_scans_refused);
     tcase_add_test(tc, command_exit_status);
+    tcase_add_test(tc, command_default_orientation);
     suite_add_tcase(s, tc);
     return s;
 }
