@@ -257,6 +257,16 @@ static jf_status scan_header(ctx *c, size_t s, int vc, scaninfo *si, jf_e57_fiel
         if (f[j].max > ac->max)
             ac->max = f[j].max;
     }
+    /* the values' bits against the section's bytes, before anything is
+     * allocated from the count (the decoder checks each field again) */
+    uint64_t bpr = 0, seclen = le64(c->log + si->sec + 8);
+    for (size_t q = 0; q < nf; q++)
+        bpr += f[q].kind == JF_E57_FLOAT ? 32 : f[q].kind == JF_E57_DOUBLE ? 64 : f[q].bits;
+    if (bpr && si->count > (seclen > c->loglen ? c->loglen : seclen) * 8 / bpr)
+        FAIL("XML line %zu: data3D[%zu] points: recordCount %llu needs %llu bits a record, "
+             "more than its binary section's %llu bytes hold", line, s,
+             (unsigned long long)si->count, (unsigned long long)bpr,
+             (unsigned long long)seclen);
     if ((have & 7) == 7)
         si->spherical = 0;
     else if ((have & 0x38) == 0x38)

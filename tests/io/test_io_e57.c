@@ -415,7 +415,8 @@ START_TEST(lies_refused)
 {
     char rc[64];
     snprintf(rc, sizeof rc, "recordCount=\"%d\"", NS);
-    lie(rc, "recordCount=\"100000\"", "recordCount is 100000 but the binary section holds");
+    lie(rc, "recordCount=\"100000\"", "recordCount 100000 needs 138 bits a record, more than its binary section");
+    lie(rc, "recordCount=\"300\"", "recordCount is 300 but the binary section holds 288 values of field cartesianX");
     lie(rc, "recordCount=\"99999999999\"", "more than the file's");
     lie("maximum=\"8388607\"", "maximum=\"36893488147419103232\"", "not a 64-bit integer");
     lie("<colorRed type=\"Integer\"", "<colorRed type=\"Bogus\"", "type 'Bogus' cannot be a point field");
