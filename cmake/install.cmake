@@ -10,7 +10,7 @@ install(TARGETS jetfit_shared EXPORT jetfitTargets
 install(FILES ${PROJECT_SOURCE_DIR}/src/jetfit.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
 # libjetfit.a (JF_STATIC_LIB): the library and the CGAL bridge in one
-# archive; a program links it with `pkg-config --static --libs jetfit` (GSL,
+# archive; a program links it with `pkg-config --static --libs jetfit` (GSL, expat,
 # OpenMP, the C++ runtime, and CGAL's GMP/MPFR) or jetfit::jetfit_static.
 if(JF_STATIC_LIB)
   add_library(jetfit_static STATIC $<TARGET_OBJECTS:jetfit_obj> $<TARGET_OBJECTS:jetfit_cgal_obj>)
@@ -18,9 +18,9 @@ if(JF_STATIC_LIB)
   target_include_directories(jetfit_static PUBLIC
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(JF_CGAL)
-    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp expat stdc++ gmp mpfr m)
   else()
-    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp m)
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp expat m)
   endif()
   install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
