@@ -10,7 +10,7 @@ install(TARGETS jetfit_shared EXPORT jetfitTargets
 install(FILES ${PROJECT_SOURCE_DIR}/src/jetfit.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
 # libjetfit.a (JF_STATIC_LIB): the library and the CGAL bridge in one
-# archive; a program links it with `pkg-config --static --libs jetfit` (GSL,
+# archive; a program links it with `pkg-config --static --libs jetfit` (GSL, expat,
 # OpenMP, the C++ runtime, and CGAL's GMP/MPFR) or jetfit::jetfit_static.
 if(JF_STATIC_LIB)
   add_library(jetfit_static STATIC $<TARGET_OBJECTS:jetfit_obj> $<TARGET_OBJECTS:jetfit_cgal_obj>)
@@ -18,9 +18,9 @@ if(JF_STATIC_LIB)
   target_include_directories(jetfit_static PUBLIC
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(JF_CGAL)
-    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp stdc++ gmp mpfr m)
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp expat stdc++ gmp mpfr m)
   else()
-    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp m)
+    target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp expat m)
   endif()
   install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
@@ -37,9 +37,9 @@ install(FILES ${PROJECT_BINARY_DIR}/jetfitConfig.cmake ${PROJECT_BINARY_DIR}/jet
 # pkg-config: paths relative to the .pc file, so `--prefix P` at install
 # time (not the configure-time prefix) is what the file describes
 if(JF_CGAL)
-  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lstdc++ -lgmp -lmpfr -lm")
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lexpat -lstdc++ -lgmp -lmpfr -lm")
 else()
-  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lm")
+  set(JF_PC_PRIVATE "-lgsl -lgslcblas -lgomp -lexpat -lm")
 endif()
 file(RELATIVE_PATH JF_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit.pc.in ${PROJECT_BINARY_DIR}/jetfit.pc @ONLY)

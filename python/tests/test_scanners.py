@@ -3,6 +3,8 @@ file's scan and scanner position per row (attributes "scan", "scanner"),
 estimate(..., scanners=) orients every normal towards the scanner of its
 point, and read + estimate + write gives the command's output file byte for
 byte (the command's default for PTX is --orient scanner)."""
+import os
+
 import numpy as np
 import pytest
 
@@ -54,7 +56,8 @@ def test_read_gives_scans(two_scans):
     pts, nrm, faces, at = jetfit.read(str(path))
     n0, n1 = len(scans[0][0]) + 1, len(scans[1][0]) + 1
     assert pts.shape == (n0 + n1, 3) and nrm is None and faces is None
-    assert sorted(at) == ["scan", "scanner"]
+    assert sorted(at) == ["intensity", "scan", "scanner"]  # intensity kept (issue 26.5)
+    assert np.array_equal(at["intensity"], np.repeat([0.5, 0.0, 0.5, 0.0], [n0 - 1, 1, n1 - 1, 1]))
     assert at["scan"].dtype == np.int32 and at["scanner"].shape == (n0 + n1, 3)
     assert np.array_equal(at["scan"], np.repeat([0, 1], [n0, n1]))
     assert np.array_equal(at["scanner"][:n0], np.tile(scans[0][1], (n0, 1)))
@@ -81,7 +84,9 @@ def test_normals_face_their_scanner(two_scans):
 
 def test_same_file_as_the_command(two_scans, tmp_path, cmd):
     path, _ = two_scans
-    cmd("estimate", path, "-o", tmp_path / "c.csv", "--quiet", "--neighbors", "knn:16")
+    # --keep none: the PTX attributes (intensity, scan; issue 26.5) are not in p.csv
+    cmd("estimate", path, "-o", tmp_path / "c.csv", "--quiet", "--neighbors", "knn:16",
+        "--keep", "none")
     pts, _, _, at = jetfit.read(str(path))
     r = jetfit.estimate(pts, neighbors="knn:16", scanners=at["scanner"], threads=2)
     jetfit.write(str(tmp_path / "p.csv"), r)
@@ -96,3 +101,19 @@ def test_scanner_without_positions_is_a_value_error():
         jetfit.estimate(p, scanners=np.zeros((99, 3)))
     with pytest.raises(ValueError):
         jetfit.estimate(p, scanners=np.zeros((100, 2)))
+
+
+def test_read_e57():
+    """An E57 file (libE57Format's test data, tests/data/e57/SOURCE.md): its
+    7680 points within the prototype's [-0.5, 0.5], colours, scan and
+    scanner (the identity pose: the origin) per row (issue 26.6)."""
+    from conftest import TOP
+    path = os.path.join(TOP, "tests", "data", "e57", "ColouredCubeFloat.e57")
+    pts, nrm, faces, at = jetfit.read(path)
+    assert pts.shape == (7680, 3) and nrm is None and faces is None
+    assert pts.min() == -0.5 and pts.max() == 0.5
+    assert {"colorRed", "colorGreen", "colorBlue", "scan", "scanner"} <= set(at)
+    assert at["colorRed"].dtype == np.uint8
+    assert (at["scan"] == 0).all() and (at["scanner"] == 0).all()
+    with pytest.raises(Exception, match="bad-crc.e57: page 0"):
+        jetfit.read(os.path.join(TOP, "tests", "data", "e57", "bad-crc.e57"))

@@ -27,7 +27,7 @@ static void usage(FILE *f)
         "\n"
         "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
         "and writes one row per input point, in input order.\n"
-        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx   OUTPUT: .ply .csv .xyz .txt .las\n"
+        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx .e57   OUTPUT: .ply .csv .xyz .txt .las\n"
         "\n"
         "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
         "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
@@ -283,7 +283,7 @@ int jf_cmd_estimate(int argc, char **argv)
     }
     if (o.orient == JF_ORIENT_SCANNER && !c.scanner) {
         fprintf(stderr, "jetfit: %s: --orient scanner needs the scanner positions of a PTX "
-                        "file; this input has none\n", in);
+                        "or E57 file; this input has none\n", in);
         jf_cloud_free(&c);
         return 1;
     }

@@ -22,7 +22,8 @@ typedef enum {
     JF_FMT_CSV,
     JF_FMT_OFF,
     JF_FMT_LAS,   /* .las; .laz is recognised only to be refused */
-    JF_FMT_PTX    /* .ptx (Leica/Faro scans with their scanner poses) */
+    JF_FMT_PTX,   /* .ptx (Leica/Faro scans with their scanner poses) */
+    JF_FMT_E57    /* .e57 (ASTM E2807 scans with their poses) */
 } jf_format;
 
 /* Format from the extension (any case); JF_FMT_UNKNOWN if none fits. */
@@ -45,8 +46,10 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
-jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
-                      jf_error *err);
+jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err);
+jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err);
 
 /* io_ply.c: a binary PLY whose elements all have fixed-size rows and
  * whose length matches its header, read from fd (len bytes) a chunk at a

@@ -27,6 +27,8 @@
  * (--orient scanner).
  * A point "0 0 0" is the scanner's "no return": kept as a row of NaN (the
  * pipeline marks it nonfinite) so rows stay one per grid cell.
+ * Attributes (unless o->no_attrs): each line's intensity, the scan index
+ * and, when any line has them, its red green blue (0 where a line has not).
  */
 #include <math.h>
 #include <stdint.h>
@@ -80,14 +82,37 @@ static double rotation_error(double (*m)[4], double *det)
     return e;
 }
 
-jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
-                      jf_error *err)
+/* The attribute record (issue 26.5): intensity (double, as written),
+ * scan (uint32), red green blue (uint8, dropped when no line has them). */
+enum { PTX_REC = 15, PTX_REC_GREY = 12 };
+
+/* *p holds at least want bytes (capacity doubling). */
+static int grow_bytes(unsigned char **p, size_t *cap, size_t want)
+{
+    if (want <= *cap)
+        return 1;
+    size_t nc = *cap ? *cap : 4096;
+    while (nc < want)
+        nc *= 2;
+    unsigned char *q = realloc(*p, nc);
+    if (!q)
+        return 0;
+    *p = q;
+    *cap = nc;
+    return 1;
+}
+
+jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err)
 {
     /* a UTF-8 byte order mark is not the column count */
     size_t bom = len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) ? 3 : 0;
     jf_text t = {buf + bom, buf + len, 0, 0};
     jf_dvec xyz = {0}, sc = {0};
     jf_uvec scan = {0};
+    unsigned char *rec = NULL;
+    size_t rcap = 0;
+    int keep = !(o && o->no_attrs), rgb = 0;
     jf_status st = JF_OK;
     const char *ls, *le;
     size_t npts = 0, nscans = 0;
@@ -145,7 +170,8 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
         if (nscans >= UINT32_MAX - 1)
             FAIL(JF_ERR_TOO_LARGE, head_line, "too many scans");
         if (!jf_dvec_reserve(&xyz, 3 * (npts + cnt)) || !jf_uvec_reserve(&scan, npts + cnt) ||
-            !jf_dvec_reserve(&sc, 3 * (nscans + 1)))
+            !jf_dvec_reserve(&sc, 3 * (nscans + 1)) ||
+            (keep && !grow_bytes(&rec, &rcap, (npts + cnt) * PTX_REC)))
             FAIL(JF_ERR_NOMEM, head_line, "out of memory for %llu points",
                  (unsigned long long)cnt);
         int identity = 1;
@@ -170,6 +196,22 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
                     q[a] = v[0] * m[0][a] + v[1] * m[1][a] + v[2] * m[2][a] + m[3][a];
             }
             scan.v[npts + i] = (uint32_t)nscans;
+            if (keep) {
+                unsigned char *r = rec + (npts + i) * PTX_REC;
+                uint32_t sn = (uint32_t)nscans;
+                uint64_t ib;
+                memcpy(&ib, &v[3], 8);
+                for (int b = 0; b < 8; b++) r[b] = (unsigned char)(ib >> (8 * b)); /* little endian */
+                for (int b = 0; b < 4; b++) r[8 + b] = (unsigned char)(sn >> (8 * b));
+                r[12] = r[13] = r[14] = 0;
+                for (int b = 0; k == 7 && b < 3; b++) {
+                    if (!(v[4 + b] >= 0 && v[4 + b] <= 255 && v[4 + b] == (int)v[4 + b]))
+                        FAIL(JF_ERR_FORMAT, t.line, "scan %zu: colour must be integers 0-255",
+                             nscans + 1);
+                    r[12 + b] = (unsigned char)v[4 + b];
+                }
+                rgb |= k == 7;
+            }
         }
         npts += (size_t)cnt;
         nscans++;
@@ -181,8 +223,24 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
     c->scan = scan.v;
     c->scanner = sc.v;
     c->nscans = nscans;
+    if (keep) {
+        jf_attrs *a = &c->attrs;
+        if (!rgb) /* no colour anywhere: the records shrink in place */
+            for (size_t i = 1; i < npts; i++)
+                memmove(rec + i * PTX_REC_GREY, rec + i * PTX_REC, PTX_REC_GREY);
+        a->rec = rec;
+        a->stride = rgb ? PTX_REC : PTX_REC_GREY;
+        rec = NULL;
+        if (!jf__attrs_add(a, "intensity", 9, JF_ATTR_F64, 0, 0, 0) ||
+            !jf__attrs_add(a, "scan", 4, JF_ATTR_U32, 8, 0, 0) ||
+            (rgb && (!jf__attrs_add(a, "red", 3, JF_ATTR_U8, 12, 0, 0) ||
+                     !jf__attrs_add(a, "green", 5, JF_ATTR_U8, 13, 0, 0) ||
+                     !jf__attrs_add(a, "blue", 4, JF_ATTR_U8, 14, 0, 0))))
+            return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory"); /* the caller frees c */
+    }
     return JF_OK;
 out:
+    free(rec);
     free(xyz.v);
     free(scan.v);
     free(sc.v);

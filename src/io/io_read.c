@@ -99,6 +99,8 @@ jf_format jf_format_from_path(const char *path)
         return JF_FMT_LAS;
     if (!strcmp(ext, "ptx"))
         return JF_FMT_PTX;
+    if (!strcmp(ext, "e57"))
+        return JF_FMT_E57;
     return JF_FMT_UNKNOWN;
 }
 
@@ -368,12 +370,15 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_read_las(buf, len, name, o, c, err);
         break;
     case JF_FMT_PTX:
-        st = jf_read_ptx(buf, len, name, c, err);
+        st = jf_read_ptx(buf, len, name, o, c, err);
+        break;
+    case JF_FMT_E57:
+        st = jf_read_e57(buf, len, name, o, c, err);
         break;
     default:
         st = jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                         "unknown file extension (expected .ply, .xyz, .pts, "
-                        ".txt, .csv, .off, .las or .ptx)");
+                        ".txt, .csv, .off, .las, .ptx or .e57)");
     }
     /* a header announcing 0 vertices is as useless as an empty file */
     if (st == JF_OK && c->n == 0)
@@ -395,10 +400,6 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     if (!path)
         return jf_io_fail(err, JF_ERR_INVALID, "(null)", 0, "no file name");
     size_t plen = strlen(path);
-    if (plen >= 4 && !strcasecmp(path + plen - 4, ".e57"))
-        return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
-                          "E57 is not read: convert it first, e.g. `pdal translate in.e57 "
-                          "out.las` or CloudCompare (File > Save as LAS or PLY)");
     if (plen >= 4 && !strcasecmp(path + plen - 4, ".laz"))
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "compressed LAS (LAZ) is not read: decompress it first, e.g. "
@@ -407,7 +408,7 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     if (fmt == JF_FMT_UNKNOWN)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
                           "unknown file extension (expected .ply, .xyz, "
-                          ".pts, .txt, .csv, .off, .las or .ptx)");
+                          ".pts, .txt, .csv, .off, .las, .ptx or .e57)");
     /* O_NONBLOCK: a FIFO or device must not block the open; only regular
      * files are read.  The file is read (not mapped): a file that shrinks
      * while it is read is an I/O error, never a SIGBUS. */

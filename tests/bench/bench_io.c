@@ -13,7 +13,11 @@
  * cache).  "seconds" is wall time (the machine may be shared), "cpu s"
  * the step's own CPU time, points/s = N / seconds, MB/s = the file's size
  * (10^6 bytes) / seconds.  Also the table writer on 10^6 rows x 28 columns
- * (the estimate command's widest output) as binary PLY and CSV.
+ * (the estimate command's widest output) as binary PLY and CSV.  E57
+ * (issue 26): the same points as one scan of single-precision Cartesian
+ * floats (as scanners write them), written by the tests' E57 writer
+ * (tests/io/e57_write.h, not timed against anything) and read by jetfit,
+ * against reading them as LAS format 0 (uncompressed) in the same run.
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -28,6 +32,8 @@
 #include <unistd.h>
 
 #include "jetfit.h"
+
+#include "e57_write.h"
 
 static size_t N = 10000000;
 static char dir[512] = "/tmp";
@@ -136,7 +142,10 @@ static double read_cloud(const char *ext)
      * scale step (1e-7 m for this 100 m cloud: io_las_write.c) */
     double *x = gen(N);
     int same = c.n == N;
-    if (same && strcmp(ext, "las") == 0) {
+    if (same && strcmp(ext, "e57") == 0) { /* single floats */
+        for (size_t i = 0; i < 3 * N && same; i++)
+            same = c.xyz[i] == (double)(float)x[i];
+    } else if (same && strcmp(ext, "las") == 0) {
         for (size_t i = 0; i < 3 * N && same; i++)
             same = fabs(c.xyz[i] - x[i]) <= 0.5e-7 * (1 + 1e-6) + 1e-15 * fabs(x[i]);
     } else if (same) {
@@ -147,6 +156,26 @@ static double read_cloud(const char *ext)
     if (!same)
         fprintf(stderr, "%s: read back differs\n", p);
     return same ? t : -1;
+}
+
+/* One scan of x y z as single floats, 21000-byte stream pieces a packet. */
+static double write_e57(void)
+{
+    double *x = gen(N);
+    ew_field f[3] = {{"cartesianX", EW_FLOAT, 0, 0, 0, x, 3},
+                     {"cartesianY", EW_FLOAT, 0, 0, 0, x + 1, 3},
+                     {"cartesianZ", EW_FLOAT, 0, 0, 0, x + 2, 3}};
+    ew_scan s = {{1, 0, 0, 0}, {0, 0, 0}, N, f, 3};
+    double t = now();
+    size_t len;
+    unsigned char *b = ew_make(&s, 1, 21000, NULL, &len);
+    char p[600];
+    path(p, "e57");
+    int bad = ew_save(p, b, len);
+    t = now() - t;
+    free(b);
+    free(x);
+    return bad ? -1 : t;
 }
 
 static double read_fscanf(void)
@@ -223,6 +252,7 @@ static double run(const step *s)
     case 1: return write_fprintf();
     case 2: return read_cloud(s->ext);
     case 3: return read_fscanf();
+    case 5: return write_e57();
     default: return write_table(s->ext);
     }
 }
@@ -248,6 +278,8 @@ int main(int argc, char **argv)
         {"read LAS format 0 (jetfit)", 2, "las", 0, 0},
         {"table N/10 x 28 cols, binary PLY", 4, "t.ply", 0, 1},
         {"table N/10 x 28 cols, CSV", 4, "t.csv", 0, 1},
+        {"write E57 float (tests' writer)", 5, "e57", 0, 0},
+        {"read E57 float (jetfit)", 2, "e57", 0, 0},
     };
     size_t nsteps = sizeof steps / sizeof *steps;
     double secs[16], cpus[16];
@@ -309,8 +341,11 @@ int main(int argc, char **argv)
     if (secs[5] > 0 && secs[9] > 0 && cpus[9] > 0)
         printf("read LAS: %.2fx the points/s of read binary PLY (CPU time: %.2fx)\n",
                secs[5] / secs[9], cpus[5] / cpus[9]);
+    if (secs[9] > 0 && secs[13] > 0 && cpus[9] > 0)
+        printf("read E57 float: %.2fx the time of read LAS (CPU time: %.2fx; goal <= 2x)\n",
+               secs[13] / secs[9], cpus[13] / cpus[9]);
     static const char *const exts[] = {"ply", "a.ply", "xyz", "peer.xyz",
-                                       "las", "t.ply", "t.csv"};
+                                       "las", "t.ply", "t.csv", "e57"};
     for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
         char p[600];
         path(p, exts[i]);

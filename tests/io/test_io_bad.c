@@ -218,7 +218,7 @@ START_TEST(fuzz_regressions)
     static const struct { const char *dir; jf_format fmt; } r[] = {
         {"ply", JF_FMT_PLY}, {"xyz", JF_FMT_XYZ}, {"pts", JF_FMT_PTS},
         {"csv", JF_FMT_CSV}, {"off", JF_FMT_OFF}, {"las", JF_FMT_LAS},
-        {"ptx", JF_FMT_PTX}};
+        {"ptx", JF_FMT_PTX}, {"e57", JF_FMT_E57}};
     int replayed = 0;
     for (size_t i = 0; i < sizeof r / sizeof r[0]; i++) {
         char dir[512];

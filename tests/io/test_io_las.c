@@ -2,7 +2,7 @@
  * format 0-10 in files written here (versions 1.2 and 1.4, legacy and
  * 64-bit counts, records longer than their format), georeferenced values
  * exact; the two real laspy samples against their x y z listings; every
- * header lie, LAZ and E57 a one-line error. */
+ * header lie, LAZ and a LAS file named .e57 a one-line error. */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <math.h>
@@ -200,7 +200,7 @@ START_TEST(header_lies)
     refused("empty.las", m, len, "no points");
     refused("short.las", b, 100, "at least 227");
     refused("sig.las", (const unsigned char *)"PLY not LAS", 11, "LASF");
-    refused("x.e57", b, len, "E57 is not read");
+    refused("x.e57", b, len, "not an E57 file");
     free(m);
     free(b);
 }

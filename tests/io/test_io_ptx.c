@@ -61,6 +61,30 @@ START_TEST(two_scans_exact)
             }
     }
     ck_assert_uint_eq(nan_rows, 2 * (PTX_COLS + 1));
+    /* attributes (issue 26.5): intensity as written, the scan, colour
+     * where the line has it (scan 0), else 0 */
+    int in = jf_attr_find(&c.attrs, "intensity"), sc = jf_attr_find(&c.attrs, "scan");
+    int rgb[3] = {jf_attr_find(&c.attrs, "red"), jf_attr_find(&c.attrs, "green"),
+                  jf_attr_find(&c.attrs, "blue")};
+    ck_assert(in >= 0 && sc >= 0 && rgb[0] >= 0 && rgb[1] >= 0 && rgb[2] >= 0);
+    ck_assert_uint_eq(c.attrs.nattrs, 5);
+    for (size_t i = 0; i < c.n; i++) {
+        int s = (int)(i / (PTX_COLS * PTX_ROWS)), row = (int)(i % PTX_ROWS),
+            col = (int)(i % (PTX_COLS * PTX_ROWS) / PTX_ROWS);
+        int nr = ptx_noreturn(row, col);
+        ck_assert(jf_attr_get(&c.attrs, (size_t)in, i) == (nr ? 0.5 : 0.25));
+        ck_assert(jf_attr_get(&c.attrs, (size_t)sc, i) == s);
+        for (int k = 0; k < 3; k++)
+            ck_assert(jf_attr_get(&c.attrs, (size_t)rgb[k], i) == (s || nr ? 0 : 10 * (k + 1)));
+    }
+    jf_cloud_free(&c);
+    /* --keep none */
+    jf_read_opts ro;
+    jf_read_opts_init(&ro);
+    ro.no_attrs = 1;
+    ck_assert(jf_cloud_read(path, &ro, &c, &e) == JF_OK);
+    ck_assert_uint_eq(c.attrs.nattrs, 0);
+    ck_assert_ptr_null(c.attrs.rec);
     jf_cloud_free(&c);
     ck_assert_ptr_null(c.scan);
     ck_assert_ptr_null(c.scanner);
