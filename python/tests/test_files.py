@@ -28,7 +28,7 @@ def test_read_columns(tmp_path):
     np.savetxt(tmp_path / "c.txt", data, fmt="%.17g")
     pts, _, _, _ = jetfit.read(str(tmp_path / "c.txt"), columns=[4, 2, 0])
     assert np.array_equal(pts, data[:, [4, 2, 0]])
-    with pytest.raises(ValueError, match="^--columns '1,2': expected 3 or 6 column numbers$"):
+    with pytest.raises(ValueError, match="^columns=1,2: expected 3 or 6 column numbers$"):
         jetfit.read(str(tmp_path / "c.txt"), columns=[1, 2])
 
 
@@ -114,7 +114,7 @@ def test_read_bad_rows(tmp_path, cmd):
         pts, _, _, _ = jetfit.read(str(f), bad_rows="skip")
     assert "jetfit: " + str(w[0].message) in err
     assert pts.shape == (4, 3) and np.isnan(pts[2]).all() and (pts[3] == [0, 1, 0]).all()
-    with pytest.raises(ValueError, match="^--bad-rows 'keep': "):
+    with pytest.raises(ValueError, match="^bad_rows=keep: "):
         jetfit.read(str(f), bad_rows="keep")
 
 
