@@ -169,6 +169,52 @@ static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, si
     return 1;
 }
 
+/* Normals in Extra Bytes (a LAS file jetfit wrote: nx ny nz; PDAL's
+ * NormalX NormalY NormalZ), float or double: into c->nrm, so that
+ * orient input works on them.  0 on a failed allocation. */
+static int las_normals(jf_cloud *c, const unsigned char *b, size_t hsize, size_t data_off,
+                       uint32_t nvlr, unsigned base, unsigned rec_len)
+{
+    static const char *const names[2][3] = {{"nx", "ny", "nz"}, {"normalx", "normaly", "normalz"}};
+    int at[3] = {-1, -1, -1}, dts[3] = {0, 0, 0};
+    size_t p = hsize;
+    for (uint32_t v = 0; v < nvlr && p + 54 <= data_off; v++) {
+        size_t rl = u16(b + p + 20);
+        if (rl > data_off - p - 54)
+            break;
+        if (!memcmp(b + p + 2, "LASF_Spec\0", 10) && u16(b + p + 18) == 4) {
+            unsigned off = base;
+            for (size_t d = p + 54; d + 192 <= p + 54 + rl; d += 192) {
+                unsigned dt = b[d + 2], sz = eb_size(dt, b[d + 3]);
+                if (!sz || sz > rec_len - off)
+                    break;
+                char nm[33] = {0};
+                for (int k = 0; k < 32 && b[d + 4 + k]; k++)
+                    nm[k] = (char)(b[d + 4 + k] | (b[d + 4 + k] >= 'A' && b[d + 4 + k] <= 'Z' ? 0x20 : 0));
+                for (int a = 0; a < 3; a++)
+                    if ((dt == 9 || dt == 10) && (!strcmp(nm, names[0][a]) || !strcmp(nm, names[1][a])))
+                        at[a] = (int)off, dts[a] = (int)dt;
+                off += sz;
+            }
+            break;
+        }
+        p += 54 + rl;
+    }
+    if (at[0] < 0 || at[1] < 0 || at[2] < 0)
+        return 1;
+    if (!(c->nrm = malloc(c->n * 3 * sizeof(double))))
+        return 0;
+    const unsigned char *r = b + data_off;
+    for (size_t i = 0; i < c->n; i++, r += rec_len)
+        for (int a = 0; a < 3; a++) {
+            uint32_t w = u32(r + at[a]); /* little endian whatever the host */
+            float f;
+            memcpy(&f, &w, sizeof f);
+            c->nrm[3 * i + a] = dts[a] == 9 ? (double)f : f64(r + at[a]);
+        }
+    return 1;
+}
+
 /* The header's checks (every lie named), from the first `have` bytes of a
  * file of `size` bytes. */
 typedef struct {
@@ -269,6 +315,8 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
     for (size_t i = 0; i < c->n; i++, r += rec_len)
         for (int a = 0; a < 3; a++)
             c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
+    if (!las_normals(c, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu normals", c->n);
     if (o->no_attrs)
         return JF_OK;
     /* the records whole, the header and VLRs, the EVLRs (1.4: the count

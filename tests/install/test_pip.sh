@@ -7,7 +7,7 @@ set -eu
 src=$1; jetfit=$2
 py=/usr/bin/python3
 [ -x "$py" ] || py=$(command -v python3)
-"$py" -c 'import pip, venv, numpy, setuptools' 2>/dev/null || {
+"$py" -c 'import setuptools, pip, venv, numpy' 2>/dev/null || {
   echo "skipped: needs python3-pip, python3-venv, python3-numpy, python3-setuptools"; exit 77; }
 tmp=$(mktemp -d /tmp/jf-pip.XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
