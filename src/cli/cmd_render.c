@@ -351,10 +351,16 @@ int jf_cmd_render(int argc, char **argv)
     fprintf(gp, "\nunset key\nset border 0\nunset xtics\nunset ytics\nunset ztics\n");
     fprintf(gp, diverging ? "set palette defined (0 '#762a83', 0.5 '#f2f2f2', 1 '#1b7837')\n"
                           : "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n");
-    if (need_k)
-        fprintf(gp, "set cbrange [%.9g:%.9g]\nset cblabel '%s'\n", vlo, vhi, color);
-    else
+    if (need_k) {
+        /* curvatures are 1/length (the input's unit); gauss 1/length^2;
+         * aniso is a ratio */
+        const char *unit = !strcmp(color, "gauss")   ? " (1/length^2)"
+                           : !strcmp(color, "aniso") ? " (no unit)"
+                                                     : " (1/length)";
+        fprintf(gp, "set cbrange [%.9g:%.9g]\nset cblabel '%s%s'\n", vlo, vhi, color, unit);
+    } else {
         fprintf(gp, "unset colorbox\n");
+    }
     /* data: x y z value; glyph segments: x y z dx dy dz, per direction */
     fprintf(gp, "$pts << EOD\n");
     for (size_t k = 0; k < n; k++) {

@@ -1,6 +1,8 @@
 /* test_cli_las_normals.c -- a LAS file jetfit wrote carries its normals
  * as nx ny nz Extra Bytes; read back they are the cloud's normals (issue
- * 31), so --orient input works on it and follows them. */
+ * 31), so --orient input works on it and follows them.  Its header says
+ * when it was made (creation day and year, not 0/0). */
+#include <time.h>
 #include <check.h>
 
 #include "test_cli_util.h"
@@ -45,12 +47,53 @@ START_TEST(las_extra_bytes_are_normals)
 }
 END_TEST
 
+/* bytes 90..93 of the header: day of year and year, little endian */
+static void las_date(const char *path, unsigned *day, unsigned *year)
+{
+    unsigned char h[94];
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_uint_eq(fread(h, 1, sizeof h, f), sizeof h);
+    fclose(f);
+    *day = h[90] | h[91] << 8;
+    *year = h[92] | h[93] << 8;
+}
+
+START_TEST(las_creation_date)
+{
+    cli_setup();
+    cli_write_text(cli_path("p.xyz"), "0 0 0\n1 0 0\n0 1 0\n1 1 0.1\n0.5 0.5 0\n2 2 0\n2 0 0.2\n0 2 0\n");
+    time_t t0 = time(NULL);
+    ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("d.las"), "--quiet",
+                             "--neighbors", "knn:6", NULL), 0);
+    time_t t1 = time(NULL);
+    unsigned day, year;
+    las_date(cli_path("d.las"), &day, &year);
+    struct tm a, b;
+    gmtime_r(&t0, &a);
+    gmtime_r(&t1, &b);
+    ck_assert_msg((day == (unsigned)a.tm_yday + 1 && year == (unsigned)a.tm_year + 1900) ||
+                      (day == (unsigned)b.tm_yday + 1 && year == (unsigned)b.tm_year + 1900),
+                  "creation day %u year %u", day, year);
+    /* SOURCE_DATE_EPOCH (reproducible files): 2000-03-01 is day 61 of a leap year */
+    setenv("SOURCE_DATE_EPOCH", "951868800", 1);
+    ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("e.las"), "--quiet",
+                             "--neighbors", "knn:6", NULL), 0);
+    unsetenv("SOURCE_DATE_EPOCH");
+    las_date(cli_path("e.las"), &day, &year);
+    ck_assert_uint_eq(day, 61);
+    ck_assert_uint_eq(year, 2000);
+    cli_teardown();
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_las_normals");
     TCase *t = tcase_create("las");
     tcase_set_timeout(t, 120);
     tcase_add_test(t, las_extra_bytes_are_normals);
+    tcase_add_test(t, las_creation_date);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);
     srunner_run_all(r, CK_NORMAL);
