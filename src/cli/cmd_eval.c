@@ -10,6 +10,7 @@
 #include "args.h"
 #include "cmd.h"
 #include "eval_errors.h"
+#include "pipes.h"
 #include "jetfit.h"
 
 static void usage(FILE *out)
@@ -34,6 +35,8 @@ static void usage(FILE *out)
         "orienting the estimate along the true normal.  PCPNet's .curv holds two\n"
         "curvatures per point, sorted here as k1 >= k2 w.r.t. its .normals with\n"
         "the sign convention of jetfit (a sphere with outward normals has k < 0).\n"
+        "  --input-format FMT  read RESULT as FMT (ply csv xyz txt las); '-' as\n"
+        "               RESULT is standard input (jetfit estimate ... -o - | ...)\n"
         "  -h, --help   this text\n");
 }
 
@@ -80,7 +83,9 @@ int jf_cmd_eval(int argc, char **argv)
         {"--help", 0, 'h', NULL},
         {"--subset", 1, 0, NULL},
         {"--by-status", 0, 0, NULL},
+        {"--input-format", 1, 0, NULL},
         {NULL, 0, 0, NULL}};
+    const char *in_fmt = NULL;
     const jf_cli_optdef *const tables[] = {optdefs, NULL};
     jf_cli_args args;
     jf_cli_args_init(&args, argc, argv, tables);
@@ -102,6 +107,8 @@ int jf_cmd_eval(int argc, char **argv)
             return 0;
         } else if (!strcmp(args.name, "--subset")) {
             subset_path = args.val;
+        } else if (!strcmp(args.name, "--input-format")) {
+            in_fmt = args.val;
         } else { /* --by-status */
             by_status = 1;
         }
@@ -119,7 +126,11 @@ int jf_cmd_eval(int argc, char **argv)
     char msg[4200];
     jf_eval_table res;
     jf_error e;
-    jf_status st = jf_eval_table_read(res_path, &res, &e);
+    e.msg[0] = '\0';
+    jf_cli_in rin; /* '-' and --input-format (pipes.h) */
+    jf_status st = jf_cli_in_begin(&rin, res_path, in_fmt, &e);
+    if (st == JF_OK) st = jf_eval_table_read(rin.path, &res, &e);
+    jf_cli_in_end(&rin, st != JF_OK ? &e : NULL);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit eval: %s\n", e.msg[0] ? e.msg : jf_strerror(st));
         return 1;

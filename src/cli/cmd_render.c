@@ -25,6 +25,7 @@
 #include "args.h"
 #include "cmd.h"
 #include "gnuplot.h"
+#include "pipes.h"
 #include "jetfit.h"
 
 #ifndef M_PI
@@ -58,6 +59,8 @@ static void usage(FILE *out)
         "  --size W,H    pixels (default 800,700)\n"
         "  --small       gnuplot's libgd png terminal (256 colours, no\n"
         "                anti-aliasing): files several times smaller\n"
+        "  --input-format FMT  read RESULT as FMT (ply csv xyz txt las); '-' as\n"
+        "                RESULT is standard input (jetfit estimate ... -o - | ...)\n"
         "  -h, --help    this text\n");
 }
 
@@ -132,7 +135,9 @@ int jf_cmd_render(int argc, char **argv)
         {"--point-size", 1, 0, NULL},
         {"--title", 1, 0, NULL},
         {"--size", 1, 0, NULL},
+        {"--input-format", 1, 0, NULL},
         {NULL, 0, 0, NULL}};
+    const char *in_fmt = NULL;
     const jf_cli_optdef *const tables[] = {optdefs, NULL};
     jf_cli_args args;
     jf_cli_args_init(&args, argc, argv, tables);
@@ -161,6 +166,8 @@ int jf_cmd_render(int argc, char **argv)
         char *end;
         if (!strcmp(a, "--output")) {
             out = v;
+        } else if (!strcmp(a, "--input-format")) {
+            in_fmt = v;
         } else if (!strcmp(a, "--title")) {
             title = v;
         } else if (!strcmp(a, "--color")) {
@@ -210,7 +217,10 @@ int jf_cmd_render(int argc, char **argv)
 
     jf_eval_table t;
     jf_error err = {{0}};
-    jf_status st = jf_eval_table_read(in, &t, &err);
+    jf_cli_in rin; /* '-' and --input-format (pipes.h) */
+    jf_status st = jf_cli_in_begin(&rin, in, in_fmt, &err);
+    if (st == JF_OK) st = jf_eval_table_read(rin.path, &t, &err);
+    jf_cli_in_end(&rin, st ? &err : NULL);
     if (st) {
         fprintf(stderr, "jetfit render: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;

@@ -77,29 +77,32 @@ static void rename_in_msg(jf_error *err, const char *tmp, const char *shown)
     memcpy(err->msg, out, u + 1);
 }
 
-jf_status jf_cli_cloud_read(const char *path, const char *fmt, const jf_read_opts *o,
-                            jf_cloud *c, jf_error *err)
+jf_status jf_cli_in_begin(jf_cli_in *r, const char *path, const char *fmt, jf_error *err)
 {
+    memset(r, 0, sizeof *r);
     int in_std = !strcmp(path, "-");
-    if (!in_std && !fmt) return jf_cloud_read(path, o, c, err);
-    const char *shown = in_std ? "(standard input)" : path;
+    r->shown = in_std ? "(standard input)" : path;
+    if (!in_std && !fmt) {
+        r->path = path;
+        return JF_OK;
+    }
     if (!fmt)
         return fail(err, JF_ERR_INVALID, "%s: standard input has no extension: give "
                                          "--input-format FMT (ply, xyz, txt, pts, csv, off, las, ptx)%s",
-                    shown, "");
+                    r->shown, "");
     if (!jf_cli_format_ok(fmt))
         return fail(err, JF_ERR_INVALID, "--input-format '%s': expected ply, xyz, txt, pts, csv, "
                                          "off, las or ptx%s", fmt, "");
-    char dir[256], tmp[300];
-    if (private_dir(dir, sizeof dir))
-        return fail(err, JF_ERR_IO, "%s: cannot make a temporary folder: %s", shown, strerror(errno));
-    snprintf(tmp, sizeof tmp, "%s/input.%s", dir, fmt);
+    if (private_dir(r->dir, sizeof r->dir))
+        return fail(err, JF_ERR_IO, "%s: cannot make a temporary folder: %s", r->shown, strerror(errno));
+    snprintf(r->tmp, sizeof r->tmp, "%s/input.%s", r->dir, fmt);
+    r->path = r->tmp;
     jf_status st = JF_OK;
     if (in_std) {
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+        int fd = open(r->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
         int e = fd < 0 ? errno : copy_fd(0, fd);
         if (fd >= 0 && close(fd) && !e) e = errno;
-        if (e) st = fail(err, JF_ERR_IO, "%s: cannot spool to a temporary file: %s", shown, strerror(e));
+        if (e) st = fail(err, JF_ERR_IO, "%s: cannot spool to a temporary file: %s", r->shown, strerror(e));
     } else {
         /* the reader opens the file itself: a link keeps its checks */
         char abs[PATH_MAX];
@@ -109,15 +112,29 @@ jf_status jf_cli_cloud_read(const char *path, const char *fmt, const jf_read_opt
         } else {
             snprintf(abs, sizeof abs, "%s", path);
         }
-        if (symlink(abs, tmp))
-            st = fail(err, JF_ERR_IO, "%s: cannot link: %s", shown, strerror(errno));
+        if (symlink(abs, r->tmp))
+            st = fail(err, JF_ERR_IO, "%s: cannot link: %s", r->shown, strerror(errno));
     }
-    if (st == JF_OK) {
-        st = jf_cloud_read(tmp, o, c, err);
-        if (st != JF_OK) rename_in_msg(err, tmp, shown);
-    }
-    unlink(tmp);
-    rmdir(dir);
+    if (st != JF_OK) jf_cli_in_end(r, NULL);
+    return st;
+}
+
+void jf_cli_in_end(jf_cli_in *r, jf_error *err)
+{
+    if (!r->dir[0]) return;
+    if (err && err->msg[0]) rename_in_msg(err, r->tmp, r->shown);
+    unlink(r->tmp);
+    rmdir(r->dir);
+    r->dir[0] = '\0';
+}
+
+jf_status jf_cli_cloud_read(const char *path, const char *fmt, const jf_read_opts *o,
+                            jf_cloud *c, jf_error *err)
+{
+    jf_cli_in r;
+    jf_status st = jf_cli_in_begin(&r, path, fmt, err);
+    if (st == JF_OK) st = jf_cloud_read(r.path, o, c, err);
+    jf_cli_in_end(&r, st == JF_OK ? NULL : err);
     return st;
 }
 
@@ -166,7 +183,11 @@ jf_status jf_cli_out_finish(jf_cli_out *w, int ok, jf_error *err)
     if (!w->dir[0]) return JF_OK;
     jf_status st = JF_OK;
     if (ok && !strcmp(w->out, "-")) {
+        /* removed before the copy: a reader that stops early (head) kills
+         * us with SIGPIPE mid-copy, and nothing must be left behind */
         int fd = open(w->path, O_RDONLY | O_CLOEXEC);
+        unlink(w->path);
+        rmdir(w->dir);
         int e = fd < 0 ? errno : copy_fd(fd, 1);
         if (fd >= 0) close(fd);
         if (e) st = fail(err, JF_ERR_IO, "standard output: write failed: %s%s", strerror(e), "");

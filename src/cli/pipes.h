@@ -10,6 +10,18 @@
  * txt, pts, csv, off, las, ptx. */
 int jf_cli_format_ok(const char *fmt);
 
+/* An input for a reader that takes a path: PATH itself, or standard
+ * input ("-") copied to a private file, or PATH linked under the
+ * extension FMT names.  begin: r->path is what to read; end: removes the
+ * private file and, when err holds a message, names PATH in it. */
+typedef struct {
+    const char *path, *shown;
+    char dir[256], tmp[300];
+} jf_cli_in;
+
+jf_status jf_cli_in_begin(jf_cli_in *r, const char *path, const char *fmt, jf_error *err);
+void jf_cli_in_end(jf_cli_in *r, jf_error *err);
+
 /* jf_cloud_read for PATH ("-": standard input, spooled to a private
  * temporary first, as the readers need to seek) in format FMT (NULL: from
  * the extension).  Messages name PATH ("(standard input)" for "-"). */

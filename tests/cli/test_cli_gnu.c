@@ -5,6 +5,8 @@
  * checked against the plain one byte for byte. */
 #include <check.h>
 
+#include <signal.h>
+
 #include "test_cli_util.h"
 
 /* Runs `jetfit ARGS...` with stdin from in_path (NULL: /dev/null) and
@@ -203,6 +205,65 @@ START_TEST(formats_named_on_the_command_line)
 }
 END_TEST
 
+/* A reader that stops early (head): jetfit dies of SIGPIPE mid-copy and
+ * leaves nothing in $TMPDIR; eval and render read standard input too. */
+START_TEST(closed_pipe_leaves_nothing)
+{
+    cli_setup();
+    sphere_file("s.xyz", 3000);
+    ck_assert_int_eq(mkdir(cli_path("tmpd"), 0700), 0);
+    char tmpd[600];
+    snprintf(tmpd, sizeof tmpd, "%s", cli_path("tmpd"));
+    int pfd[2];
+    ck_assert_int_eq(pipe(pfd), 0);
+    close(pfd[0]); /* no reader at all */
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        setenv("TMPDIR", tmpd, 1);
+        signal(SIGPIPE, SIG_DFL);
+        dup2(pfd[1], 1);
+        int fe = open("/dev/null", O_WRONLY);
+        dup2(fe, 2);
+        execl(JETFIT_BIN, JETFIT_BIN, "estimate", cli_path("s.xyz"), "-q", "-o", "-",
+              "--output-format", "csv", (char *)NULL);
+        _exit(127);
+    }
+    close(pfd[1]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ck_assert_msg(WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) == 1),
+                  "status %d", status);
+    DIR *d = opendir(tmpd);
+    struct dirent *e;
+    int left = 0;
+    while (d && (e = readdir(d)))
+        left += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+    if (d) closedir(d);
+    ck_assert_int_eq(left, 0);
+    rmdir(tmpd);
+    /* eval reads its RESULT from a pipe: the same table as from the file */
+    ck_assert_int_eq(cli_run("estimate", cli_path("s.xyz"), "-q", "-o", cli_path("r.csv"), NULL), 0);
+    ck_assert_int_eq(run_io(NULL, cli_path("e1.txt"), "eval", cli_path("r.csv"), cli_path("r.csv"), NULL), 0);
+    ck_assert_int_eq(run_io(cli_path("r.csv"), cli_path("e2.txt"), "eval", "-", cli_path("r.csv"),
+                            "--input-format", "csv", NULL), 0);
+    /* the first line names the inputs; the table after it must agree */
+    FILE *a = fopen(cli_path("e1.txt"), "r"), *b = fopen(cli_path("e2.txt"), "r");
+    char la[512], lb[512];
+    ck_assert(a && b && fgets(la, sizeof la, a) && fgets(lb, sizeof lb, b));
+    int rows = 0;
+    while (fgets(la, sizeof la, a)) {
+        ck_assert(fgets(lb, sizeof lb, b) != NULL);
+        ck_assert_str_eq(la, lb);
+        rows++;
+    }
+    ck_assert_int_ge(rows, 2);
+    fclose(a);
+    fclose(b);
+    cli_teardown();
+}
+END_TEST
+
 START_TEST(help_lists_short_options)
 {
     cli_setup();
@@ -229,6 +290,7 @@ int main(void)
     tcase_add_test(t, double_dash_ends_options);
     tcase_add_test(t, standard_input_and_output);
     tcase_add_test(t, formats_named_on_the_command_line);
+    tcase_add_test(t, closed_pipe_leaves_nothing);
     tcase_add_test(t, help_lists_short_options);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);
