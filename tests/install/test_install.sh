@@ -3,7 +3,9 @@
 # `cmake --install` into a temporary prefix, then examples/normals.c built
 # against the installed package twice (pkg-config on a plain cc line, and
 # CMake's find_package(jetfit)); both must run on the bundled scan and print
-# the same first normal and curvatures as `jetfit estimate` writes.
+# the same first normal and curvatures as `jetfit estimate` writes.  Also:
+# the static library through jetfit-static.pc (no libjetfit.so needed), and
+# a program built without rpath, run under LD_LIBRARY_PATH (docs/library.md).
 # Skipped (77) in a sanitizer build: its libjetfit needs the ASan runtime
 # loaded first, which a plain cc program does not do.
 set -eu
