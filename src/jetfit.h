@@ -542,14 +542,16 @@ typedef struct {
 } jf_attr;
 
 typedef struct {
-    size_t nattrs;       /* 0: no attributes (and the rest NULL/0)      */
+    size_t nattrs;       /* 0: no attributes (and the rest NULL/0 but
+                            las_head)                                   */
     jf_attr *attr;       /* nattrs descriptions                         */
     size_t stride;       /* bytes per point record                      */
     unsigned char *rec;  /* n * stride bytes, point i at rec + i*stride */
     unsigned char *las_head; /* LAS input only: the header block and
                             VLRs verbatim (las_head_len bytes, up to the
                             offset to point data); rec holds the point
-                            records; else NULL                          */
+                            records (NULL under no_attrs: las_head is
+                            then kept for the CRS VLRs); else NULL      */
     size_t las_head_len;
     unsigned char *las_evlr; /* LAS 1.3/1.4 input: its EVLRs verbatim,
                             or NULL                                     */
@@ -676,6 +678,18 @@ typedef struct {
 
 typedef struct jf_writer jf_writer;
 
+/* The estimate's output table: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z,
+ * then b0..b3 when monge >= 3 and c0..c4 when monge >= 4 (the Monge degree
+ * of the fit), then degree neighbors cond residual status (I32 for
+ * degree, neighbors and status).  jf_result_columns fills cols (at least
+ * JF_RESULT_MAX_COLS entries; names are static) and returns their number;
+ * jf_result_row writes point p's row of r into v in that order and
+ * returns the number of values.  The command, jetfit-mpi and the Python
+ * module write this one list.  Thread-safe. */
+#define JF_RESULT_MAX_COLS 32
+size_t jf_result_columns(int monge, jf_column *cols);
+size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v);
+
 /* Opens a table of ncols columns and exactly nrows rows (the PLY header
  * needs the count; commit fails if a different number was written).
  * ascii != 0 asks for ascii PLY (ignored for text formats).  Names must
@@ -693,6 +707,28 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
  * no-op for other formats.  JF_ERR_INVALID after the first row. */
 jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
 
+/* jf_writer_las_frame with the scale and offset of each axis given
+ * (scale[a] > 0; either array may be NULL: that one by the rule, the
+ * offset being the minimum).  Without a scale given, a warning
+ * (jf_writer_warnings) names each axis the rule's scale rounds by more than
+ * 1e-6 of the cloud's bulk size (the largest range of the middle 99% of
+ * the points over the axes: an outlier widening the extent).  Coordinates
+ * that cannot be stored as int32 counts (an extent beyond the largest
+ * double, a scale too small for them) are refused here: JF_ERR_TOO_LARGE,
+ * the writer failed (commit says which axis and extent, no file is made).
+ * JF_ERR_INVALID for a scale <= 0 or not finite, after the first row. */
+jf_status jf_writer_las_frame_given(jf_writer *w, const double *xyz, size_t n,
+                                    const double scale[3], const double offset[3]);
+
+/* The writer's warnings so far, lines "FILE: reason" each ending in a
+ * newline ("" if none), for the caller to show: LAS, an Extra Bytes name
+ * over 32 bytes shortened (to its first bytes and "~N", the first N giving
+ * a name no other holds), the
+ * rule's scale rounding coordinates (above), input VLRs that run past the
+ * point data and are not copied.  Owned by w; valid until the next call on
+ * w.  Never NULL. */
+const char *jf_writer_warnings(jf_writer *w);
+
 /* Carries a cloud's attributes (jf_cloud.attrs) into the table: their
  * columns go after x y z (columns 0-2) and before the others, each named
  * as in the input with `in_` put before the name while it clashes with a
@@ -700,12 +736,13 @@ jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n);
  * `in_nx`).  PLY: each property in its input type (64-bit integers as
  * double); text: integers exact, floats and doubles %.17g (the exact
  * value, so a reader gets the same number back); LAS: from a
- * LAS input (a->las_head) the input's point records are written unchanged
+ * LAS input (a->las_head and a->rec) the input's point records are written unchanged
  * -- same point format, scale, offset, header fields, VLRs and EVLRs --
  * with the table's columns 3.. appended as Extra Bytes after the input's
  * own (x y z of the rows are then not used, and jf_writer_las_frame is
  * not needed); from another input, format 0 with the attributes as Extra
- * Bytes of their type ahead of the table's.  Row r of the table carries
+ * Bytes of their type ahead of the table's (a LAS input read without its
+ * records, no_attrs: format 0 with the input's CRS VLRs copied).  Row r of the table carries
  * the attributes of point r (rows are in input order): `a` is read while
  * rows are written and must stay valid until commit.  Call before the
  * first row.  A table with no attribute (nattrs 0, not LAS) is a no-op.
@@ -1139,11 +1176,12 @@ jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o,
                       jf_result *out, jf_error *err);
 
 /* A block of results from jf_estimate_blocks: res[j] belongs to input
- * point idx[j], j < m (m <= 256); the results are final (oriented).
+ * point idx[j], j < m (m <= JF_BLOCK_MAX); the results are final (oriented).
  * Return JF_OK to go on; any other status stops the estimate, which
  * returns it.  Called concurrently from the OpenMP threads of the fit
  * (blocks are disjoint): it must be thread-safe.  res and idx are the
  * library's, valid during the call only (res may be changed). */
+#define JF_BLOCK_MAX 256
 typedef jf_status (*jf_block_fn)(void *user, const uint32_t *idx, jf_result *res, size_t m);
 
 /* jf_estimate without the n results in memory: the same results, bit for

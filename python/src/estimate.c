@@ -10,7 +10,7 @@
  *     (jetfit.h) takes the GIL back at most every 0.1 s, on the calling
  *     thread, to run Python's signal handlers: Ctrl-C raises
  *     KeyboardInterrupt in the handler, the hook says stop, every OpenMP
- *     thread leaves after its current block of 256 points.
+ *     thread leaves after its current block (JF_BLOCK_MAX points).
  *  3. The results go into the Result's arrays block by block as they are
  *     fitted (jf_estimate_blocks' sink, on the estimate's threads), except
  *     with orient='mst', which needs every normal first: then n results

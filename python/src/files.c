@@ -255,7 +255,7 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
                   data_of(result, "residual"), data_of(result, "degree"),
                   data_of(result, "neighbors"), data_of(result, "status")};
     if (PyErr_Occurred()) goto out;
-    jf_column cols[32];
+    jf_column cols[JF_RESULT_MAX_COLS];
     size_t ncols = jf_py_result_columns(result, cols);
     const char *path = PyBytes_AS_STRING(pathobj);
     jf_error err = {{0}};

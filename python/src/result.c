@@ -120,28 +120,11 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 
 int jf_py_result_monge(PyObject *result) { return ((Result *)result)->monge; }
 
-/* ---- the output file's columns (cmd_estimate.c's make_columns) ---------- */
-
-static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",  "k1",
-                                        "k2",  "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
-static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
-static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
+/* ---- the output file's columns: the library's one list ------------------ */
 
 size_t jf_py_result_columns(PyObject *result, jf_column *cols)
 {
-    int monge = ((Result *)result)->monge;
-    size_t n = 0;
-    for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
-    if (monge >= 3)
-        for (size_t j = 0; j < 4; j++) cols[n++] = (jf_column){b_cols[j], JF_COL_F64};
-    if (monge >= 4)
-        for (size_t j = 0; j < 5; j++) cols[n++] = (jf_column){c_cols[j], JF_COL_F64};
-    cols[n++] = (jf_column){"degree", JF_COL_I32};
-    cols[n++] = (jf_column){"neighbors", JF_COL_I32};
-    cols[n++] = (jf_column){"cond", JF_COL_F64};
-    cols[n++] = (jf_column){"residual", JF_COL_F64};
-    cols[n++] = (jf_column){"status", JF_COL_I32};
-    return n;
+    return jf_result_columns(((Result *)result)->monge, cols);
 }
 
 /* The source array of column j and its component, in file order. */
@@ -199,7 +182,7 @@ static PyObject *as_structured(Result *r, PyObject *args, PyObject *kw)
         return PyErr_Format(PyExc_ValueError, "points: %zd rows for a Result of %zd",
                             (Py_ssize_t)PyArray_DIM(pts, 0), r->n);
     }
-    jf_column cols[32];
+    jf_column cols[JF_RESULT_MAX_COLS];
     size_t nc = jf_py_result_columns((PyObject *)r, cols);
     PyObject *spec = PyList_New((Py_ssize_t)nc);
     for (size_t j = 0; spec && j < nc; j++) {

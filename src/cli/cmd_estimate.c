@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -15,7 +16,6 @@
 #include "jetfit.h"
 #include "opts.h"
 #include "pipes.h"
-#include "rows.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -85,6 +85,11 @@ static void usage(FILE *f)
         "                        a LAS output keeps the LAS records) go to the output\n"
         "                        after x y z, a name that clashes renamed in_NAME;\n"
         "                        none: jetfit's columns only\n"
+        "  --las-scale X,Y,Z     a LAS output's scale per axis (or one value), and\n"
+        "  --las-offset X,Y,Z    its offset (default: the minimum); without them\n"
+        "                        the scale is the smallest power of ten >= 1e-7\n"
+        "                        keeping counts in int32, with a warning when an\n"
+        "                        outlier makes it coarse (docs/formats.md)\n"
         "  -q, --quiet           no progress line, no summary\n"
         "  -h, --help            this text\n"
         "Options follow GNU conventions: --opt=V or --opt V, -oFILE, unique\n"
@@ -212,7 +217,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
 /* ---- rows straight to the output ------------------------------------- */
 
 /* design (docs/scale.md): results are never held for the whole cloud.
- * jf_estimate_blocks hands over blocks of <= 256 results from the fit's
+ * jf_estimate_blocks hands over blocks of <= JF_BLOCK_MAX results from the fit's
  * threads; each block becomes rows written at their input index
  * (jf_writer_put: in place for binary PLY and LAS, through a binary spool
  * for text).  What stays per point: the coordinates, the index, and the
@@ -222,7 +227,7 @@ typedef struct {
     const double *xyz;
     int monge, nt;
     size_t ncols;
-    double *rows;    /* nt x 256 x ncols: one block per thread          */
+    double *rows;    /* nt x JF_BLOCK_MAX x ncols: a block per thread    */
     tally *tl;       /* nt                                              */
     double *cond;    /* n, or NULL (--quiet)                            */
     int wfail;       /* a jf_writer_put failed (atomic)                 */
@@ -233,9 +238,9 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     sinkctx *s = user;
     int t = omp_get_thread_num();
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
-    double *v = s->rows + (size_t)t * 256 * s->ncols;
+    double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
     for (size_t j = 0; j < m; j++) {
-        jf_cli_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;
     }
@@ -296,8 +301,8 @@ int jf_cmd_estimate(int argc, char **argv)
     }
 
     /* open the output first: a missing folder fails before the work */
-    jf_column cols[32];
-    size_t ncols = jf_cli_columns(monge, cols);
+    jf_column cols[JF_RESULT_MAX_COLS];
+    size_t ncols = jf_result_columns(monge, cols);
     jf_writer *w = NULL;
     jf_cli_out po; /* "-o -" and --output-format: through a private file */
     st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
@@ -312,7 +317,28 @@ int jf_cmd_estimate(int argc, char **argv)
     /* a mesh keeps its faces in a PLY output (MeshLab shows the fields on
      * the surface); polygons over 255 vertices: vertices only */
     if (c.nfaces) (void)jf_writer_faces(w, c.nfaces, c.face_off, c.face_idx);
-    (void)jf_writer_las_frame(w, c.xyz, c.n); /* .las: the scale and offset */
+    /* .las: the scale and offset (--las-scale, --las-offset, else the
+     * rule); a cloud LAS cannot hold is refused here, before the work and
+     * with no file made.  Kept LAS records keep their own. */
+    size_t olen = strlen(out);
+    int las_out = olen >= 4 && !strcasecmp(out + olen - 4, ".las");
+    if ((cmd.las_scale_set || cmd.las_offset_set) && (!las_out || (keep && c.attrs.las_head))) {
+        fprintf(stderr, "jetfit: %s: --las-scale and --las-offset %s\n", out,
+                !las_out ? "apply to a .las output"
+                         : "do not apply: the LAS input's records are kept with their own scale "
+                           "and offset (add --keep none for new ones)");
+        jf_writer_abort(w);
+        jf_cloud_free(&c);
+        return 1;
+    }
+    if (!(keep && c.attrs.las_head) &&
+        jf_writer_las_frame_given(w, c.xyz, c.n, cmd.las_scale_set ? cmd.las_scale : NULL,
+                                  cmd.las_offset_set ? cmd.las_offset : NULL) != JF_OK) {
+        st = jf_writer_commit(w, &err); /* removes the temporary, says why */
+        fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        jf_cloud_free(&c);
+        return 1;
+    }
     /* the input's attributes after x y z (a LAS output from a LAS input
      * keeps its records) */
     st = jf_writer_attrs(w, &c.attrs);
@@ -327,8 +353,14 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
+    /* the writer's warnings (a name shortened, coordinates rounded): also
+     * under --quiet, since they say the output differs from the input */
+    for (const char *wl = jf_writer_warnings(w), *nl; *wl; wl = nl + 1) {
+        if (!(nl = strchr(wl, '\n'))) break;
+        fprintf(stderr, "jetfit: %.*s\n", (int)(nl - wl), wl);
+    }
     const int nt = o.threads > 0 ? o.threads : omp_get_max_threads();
-    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * 256 * ncols * sizeof(double)),
+    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
     if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
         /* a failed begin is reported by commit's message below */

@@ -1,6 +1,7 @@
 /* opts.c -- estimation options shared by `jetfit estimate` and `jetfit
  * study` (opts.h): the parsing moved out of cmd_estimate.c unchanged, so
  * both commands accept and reject the same text with the same words. */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -259,6 +260,23 @@ unsigned long long jf_cli_parse_size(const char *s)
     return (unsigned long long)(v * mul);
 }
 
+/* "X,Y,Z" (or one value for the three axes) of finite numbers into v; 0 if
+ * not, or (positive) a value <= 0. */
+static int parse_xyz(const char *s, double v[3], int positive)
+{
+    int k = 0;
+    for (const char *p = s;; k++) {
+        char *end;
+        if (k == 3 || !*p || isspace((unsigned char)*p)) return 0;
+        v[k] = strtod(p, &end);
+        if (end == p || !isfinite(v[k]) || (positive && !(v[k] > 0))) return 0;
+        if (!*end) break;
+        if (*end != ',') return 0;
+        p = end + 1;
+    }
+    if (k == 0) v[1] = v[2] = v[0];
+    return k == 0 || k == 2;
+}
 
 /* estimate's own options (and jetfit-mpi estimate's) */
 static const jf_cli_optdef estimate_optdefs[] = {
@@ -270,6 +288,8 @@ static const jf_cli_optdef estimate_optdefs[] = {
     {"--memory", 1, 0, NULL},
     {"--input-format", 1, 0, NULL},
     {"--output-format", 1, 0, NULL},
+    {"--las-scale", 1, 0, NULL},
+    {"--las-offset", 1, 0, NULL},
     {NULL, 0, 0, NULL}};
 
 int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad)
@@ -304,6 +324,13 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
         } else if (!strcmp(name, "--memory")) {
             if (!(cmd->memory = jf_cli_parse_size(val)))
                 return bad_set(bad, "--memory", val, "expected a size such as 8G, 256M or 1500000000");
+        } else if (!strcmp(name, "--las-scale") || !strcmp(name, "--las-offset")) {
+            int sc = name[6] == 's';
+            if (!parse_xyz(val, sc ? cmd->las_scale : cmd->las_offset, sc))
+                return bad_set(bad, sc ? "--las-scale" : "--las-offset", val,
+                               sc ? "expected X,Y,Z (or one value): positive numbers"
+                                  : "expected X,Y,Z (or one value): finite numbers");
+            *(sc ? &cmd->las_scale_set : &cmd->las_offset_set) = 1;
         } else if (!strcmp(name, "--keep")) {
             if (!strcmp(val, "all")) cmd->keep = 1;
             else if (!strcmp(val, "none")) cmd->keep = 0;

@@ -57,6 +57,8 @@ typedef struct {
     unsigned long long memory;     /* --memory in bytes, 0 = not given  */
     const char *in_fmt, *out_fmt;  /* --input-format, --output-format, or NULL */
     jf_cli_args args;              /* the scanner (its message outlives the parse) */
+    int las_scale_set, las_offset_set; /* --las-scale, --las-offset given */
+    double las_scale[3], las_offset[3];
 } jf_cli_estimate_cmd;
 
 /* Parses argv[1..] (argv[0] is the command's name).  0, or -1 with *bad

@@ -38,7 +38,7 @@
 #include "parts.h"
 #include "planes_internal.h"
 
-#define CHUNK 256      /* points per scheduling unit (and progress tick) */
+#define CHUNK JF_BLOCK_MAX /* points per scheduling unit (and progress tick) */
 
 void jf_estimate_opts_init(jf_estimate_opts *o)
 {

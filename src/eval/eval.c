@@ -414,6 +414,9 @@ jf_status jf_eval_table_read(const char *path, jf_eval_table *t, jf_error *err)
         if (st != JF_OK) jf_eval_table_free(t);
         return st;
     }
+    /* a UTF-8 byte order mark (a text editor's) is not the first name */
+    unsigned char bom[3];
+    if (fread(bom, 1, 3, fp) != 3 || memcmp(bom, "\xEF\xBB\xBF", 3)) rewind(fp);
     jf_status st = !strcmp(ext, "ply") ? read_ply(fp, path, t, err)
                                        : read_text(fp, path, ext, t, err);
     fclose(fp);

@@ -129,11 +129,25 @@ typedef struct {
     const jf_attrs *a;
     char (*anames)[64];
     double scale[3], offset[3], lo[3], hi[3];
+    char (*ebn)[33];     /* the Extra Bytes names: the attributes', then
+                            columns 3..'s, at most 32 bytes (jf__las_names) */
+    char *warn_frame, *warn_names; /* warning lines "FILE: ...\n", or NULL */
 } jf_las_out;
 size_t jf__las_prefix_size(const jf_las_out *L);
 size_t jf__las_record_size(const jf_las_out *L);
-void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3],
-                   double lo[3], double hi[3]);
+/* The frame of a format-0 output from the cloud: scale and offset per axis
+ * by the rule, or as given (scale or offset NULL: by the rule); a warning
+ * (warn_frame) when the rule's scale rounds coordinates by more than 1e-6
+ * of the cloud's bulk size.  JF_ERR_TOO_LARGE, why filled (the axis and its
+ * extent), when the coordinates cannot be stored as int32 counts. */
+jf_status jf__las_frame(jf_las_out *L, const char *file, const double *xyz, size_t n,
+                        const double *scale, const double *offset, char *why, size_t whylen);
+/* The Extra Bytes names (ebn) from anames and the column names: up to 32
+ * bytes kept, longer ones shortened to distinct names with a warning line
+ * each (warn_names).  0, or -1 out of memory. */
+int jf__las_names(jf_las_out *L, const char *file);
+/* Frees ebn and the warnings. */
+void jf__las_out_free(jf_las_out *L);
 size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, char *o);
 int jf__las_write_prefix(int fd, const jf_las_out *L);
 /* The dimension names of point format 0 (as the LAS reader names them). */

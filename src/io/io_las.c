@@ -12,10 +12,13 @@
  * dimension by dimension (laspy's names, bit fields included), the Extra
  * Bytes by the "LASF_Spec" record 4 VLR's descriptions (so a file jetfit
  * wrote reads back with its columns); the header, VLRs and EVLRs are kept
- * verbatim for a LAS output.  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
+ * verbatim for a LAS output (the header block even without attributes:
+ * the output keeps the CRS).  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
  * sets it) is refused with how to convert it.  Every header field that
  * points into the file is checked against its size before use, so a lying
- * header is a one-line error, never a read past the end.
+ * header is a one-line error, never a read past the end; a format byte
+ * outside 0-10, two disagreeing point counts and whole records past the
+ * count are refused too (issue 30.1, 33.7), never read as something else.
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -260,14 +263,19 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
     uint32_t data_off = u32(b + 96);
     unsigned fmt_byte = b[104], rec_len = u16(b + 105);
     uint64_t n = u32(b + 107);
-    if (fmt_byte & 0x80)
+    /* bits 7 and 6 flag compression (LASzip sets 7, and 6 too in some
+     * versions); the low six bits are the format, 0-10 (LAS 1.4 R15 §2.4):
+     * any other byte is refused as the file holds it, never masked */
+    if ((fmt_byte & 0x3f) > 10)
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                          "header: point data record format %u (byte 104 holds 0x%02X; "
+                          "formats 0 to 10 are read, bits 7 and 6 meaning compression)",
+                          fmt_byte, fmt_byte);
+    if (fmt_byte & 0xc0)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                           "compressed LAS (LAZ) is not read: decompress it first, e.g. "
                           "`pdal translate in.laz out.las` or `las2las -i in.laz -o out.las`");
     unsigned fmt = fmt_byte & 0x3f;
-    if (fmt > 10)
-        return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
-                          "header: point data record format %u (0 to 10 are read)", fmt);
     if (hsize < 227 || hsize > size || hsize > have)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "header: header size %u (at least 227, at most the file's %llu bytes)",
@@ -277,8 +285,15 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
             return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                               "header: LAS 1.4 header size %u (at least 375)", hsize);
         uint64_t n14 = u64(b + 247);
+        /* the legacy count is 0 (formats 6-10, beyond 2^32) or the same
+         * (LAS 1.4 R15 §2.4): two different counts, neither is trusted */
+        if (n14 && n && n != n14)
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "header: legacy point count %llu disagrees with the 64-bit "
+                              "point count %llu (LAS 1.4: the legacy one is 0 or the same)",
+                              (unsigned long long)n, (unsigned long long)n14);
         if (n14)
-            n = n14; /* the 64-bit count; the legacy one is 0 beyond 2^32 or for formats 6-10 */
+            n = n14; /* a 1.4 header whose 64-bit count is 0: the legacy one */
     }
     if (rec_len < base_len[fmt])
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
@@ -300,6 +315,21 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
     if (n > JF_MAX_POINTS)
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: more than supported",
                           (unsigned long long)n);
+    /* whole records after the counted ones, before the EVLRs (or the
+     * waveform data) or the end: a count too small, as a PLY with extra
+     * rows is; bytes short of one record are not a point (docs/formats.md) */
+    uint64_t stop = size, end = data_off + n * rec_len;
+    if (minor >= 4 && have >= 375 && u32(b + 243) && u64(b + 235) >= end && u64(b + 235) < stop)
+        stop = u64(b + 235);
+    if (minor >= 3 && hsize >= 235 && (u16(b + 6) & 2) && u64(b + 227) >= end &&
+        u64(b + 227) < stop)
+        stop = u64(b + 227);
+    if ((stop - end) / rec_len)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "header: point count %llu, but %llu more whole records of %u bytes "
+                          "follow point record %llu (count too small, or data appended)",
+                          (unsigned long long)n, (unsigned long long)((stop - end) / rec_len),
+                          rec_len, (unsigned long long)n);
     for (int a = 0; a < 3; a++) {
         h->scale[a] = f64(b + 131 + 8 * a);
         h->offset[a] = f64(b + 155 + 8 * a);
@@ -336,19 +366,22 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
             c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
     if (!las_normals(c, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu normals", c->n);
-    if (o->no_attrs)
-        return JF_OK;
-    /* the records whole, the header and VLRs, the EVLRs (1.4: the count
-     * and start in the header; 1.3: the waveform data record) */
+    /* the header and VLRs, even without attributes: a LAS output keeps
+     * the CRS (a CRS is not an attribute; docs/formats.md) */
     jf_attrs *at = &c->attrs;
-    at->stride = rec_len;
-    at->rec = malloc(c->n * rec_len);
-    at->las_head = malloc(data_off);
-    if (!at->rec || !at->las_head)
-        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
-    memcpy(at->rec, b + data_off, c->n * rec_len);
+    if (!(at->las_head = malloc(data_off)))
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the header");
     memcpy(at->las_head, b, data_off);
     at->las_head_len = data_off;
+    if (o->no_attrs)
+        return JF_OK;
+    /* the records whole, the EVLRs (1.4: the count and start in the
+     * header; 1.3: the waveform data record) */
+    at->stride = rec_len;
+    at->rec = malloc(c->n * rec_len);
+    if (!at->rec)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
+    memcpy(at->rec, b + data_off, c->n * rec_len);
     size_t end = data_off + c->n * rec_len;
     uint64_t evlr = 0;
     if (minor >= 4 && u32(b + 243))

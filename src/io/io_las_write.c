@@ -7,7 +7,10 @@
  *
  * design: X Y Z are int32 counts of a scale per axis, the smallest power
  * of ten >= max(1e-7, extent / 2e9): 0.1 µm wherever the extent allows
- * (below about 200 m), never an overflow; the offset is the minimum.  The
+ * (below about 200 m), never an overflow; the offset is the minimum (or
+ * both as the caller gives them; counts beyond int32, an extent beyond the
+ * largest double: refused, issue 30.4).  A warning names an axis the rule
+ * rounds by more than 1e-6 of the cloud's bulk size (issue 30.3).  The
  * frame comes from the whole cloud (jf_writer_las_frame) before the first
  * row; the header, which holds the point count and the bounds, is written
  * over the placeholder at offset 0 when the table is committed.  A non-finite
@@ -21,9 +24,13 @@
  * input's own (whose descriptions are copied, renamed when they clash:
  * `nx` -> `in_nx`; undescribed bytes get an "undocumented" description so
  * the offsets stay right).  From any other input, format 0 as above with
- * the attributes as Extra Bytes of their own type ahead of jetfit's.
+ * the attributes as Extra Bytes of their own type ahead of jetfit's (and
+ * a LAS input's CRS VLRs under --keep none).  Extra Bytes names fill the
+ * 32-byte field whole; longer ones become distinct "first bytes~N" with a
+ * warning (jf__las_names, issue 30.2).
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,9 +60,61 @@ static void putd(unsigned char *p, double d)
     put64(p, b);
 }
 
-void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3],
-                   double lo[3], double hi[3])
+/* Appends one line "FILE: ..." to *buf (left as it was without memory). */
+static void warn_add(char **buf, const char *file, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void warn_add(char **buf, const char *file, const char *fmt, ...)
 {
+    char line[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    size_t old = *buf ? strlen(*buf) : 0, add = strlen(file) + strlen(line) + 4;
+    char *b = realloc(*buf, old + add);
+    if (!b) return;
+    snprintf(b + old, add, "%s: %s\n", file, line);
+    *buf = b;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The cloud's bulk size: the largest over the axes of the range of the
+ * middle 99% of the finite points (from every k-th point, at most 65,536),
+ * which a few outliers do not widen.  0 without memory or points. */
+static double bulk_size(const double *xyz, size_t n)
+{
+    enum { SAMPLE = 65536 };
+    size_t step = n / SAMPLE + 1, m = 0, cap = n < SAMPLE ? n + 1 : SAMPLE;
+    double *v = malloc(3 * cap * sizeof *v), size = 0;
+    if (!v) return 0;
+    for (size_t i = 0; i < n && m < cap; i += step) {
+        const double *p = xyz + 3 * i;
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+        for (int a = 0; a < 3; a++) v[a * cap + m] = p[a];
+        m++;
+    }
+    for (int a = 0; m > 1 && a < 3; a++) {
+        double *q = v + a * cap;
+        qsort(q, m, sizeof *q, cmp_double);
+        double r = q[(size_t)(0.995 * (double)(m - 1))] - q[(size_t)(0.005 * (double)(m - 1))];
+        size = r > size ? r : size;
+    }
+    free(v);
+    return size;
+}
+
+jf_status jf__las_frame(jf_las_out *L, const char *file, const double *xyz, size_t n,
+                        const double *gscale, const double *goffset, char *why, size_t whylen)
+{
+    double lo[3], hi[3];
     for (int a = 0; a < 3; a++) lo[a] = INFINITY, hi[a] = -INFINITY;
     for (size_t i = 0; i < n; i++) {
         const double *p = xyz + 3 * i;
@@ -65,15 +124,57 @@ void jf__las_frame(const double *xyz, size_t n, double scale[3], double offset[3
             hi[a] = p[a] > hi[a] ? p[a] : hi[a];
         }
     }
+    free(L->warn_frame);
+    L->warn_frame = NULL;
     for (int a = 0; a < 3; a++) {
         if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0; /* no finite point */
-        double need = fmax(1e-7, (hi[a] - lo[a]) / 2e9);
-        scale[a] = pow(10.0, ceil(log10(need) - 1e-12));
-        offset[a] = lo[a];
+        double off = goffset ? goffset[a] : lo[a];
+        /* how far the counts reach from the offset (the rule's offset is
+         * the minimum: 0 to the extent) */
+        double reach = fmax(hi[a] - off, off - lo[a]), s;
+        if (!isfinite(reach)) {
+            snprintf(why, whylen, "%c: coordinates from %.17g to %.17g%s: too far apart for a "
+                     "LAS file (int32 counts of one scale per axis)", "xyz"[a], lo[a], hi[a],
+                     goffset ? " (with the offset given)" : "");
+            return JF_ERR_TOO_LARGE;
+        }
+        if (gscale) {
+            s = gscale[a];
+        } else {
+            double need = fmax(1e-7, reach / 2e9);
+            s = pow(10.0, ceil(log10(need) - 1e-12));
+        }
+        if (!(s > 0 && isfinite(s) && isfinite(off)) || reach / s > 2147483647.0) {
+            snprintf(why, whylen, "%c: coordinates from %.17g to %.17g do not fit int32 counts "
+                     "of the scale %.17g from the offset %.17g", "xyz"[a], lo[a], hi[a], s, off);
+            return JF_ERR_TOO_LARGE;
+        }
+        L->scale[a] = s;
+        L->offset[a] = off;
         /* the bounds as stored: what X * scale + offset gives back */
-        hi[a] = offset[a] + (double)llround((hi[a] - offset[a]) / scale[a]) * scale[a];
-        lo[a] = offset[a];
+        L->hi[a] = off + (double)llround((hi[a] - off) / s) * s;
+        L->lo[a] = off + (double)llround((lo[a] - off) / s) * s;
     }
+    if (gscale) return JF_OK; /* the caller's choice: no warning */
+    /* the largest rounding per axis, against the bulk size: an outlier
+     * that widens the extent coarsens every coordinate (issue 30.3) */
+    double r[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+        for (int a = 0; a < 3; a++) {
+            double q = L->offset[a] + (double)llround((p[a] - L->offset[a]) / L->scale[a]) *
+                                          L->scale[a];
+            r[a] = fabs(q - p[a]) > r[a] ? fabs(q - p[a]) : r[a];
+        }
+    }
+    double bulk = bulk_size(xyz, n);
+    for (int a = 0; a < 3; a++)
+        if (r[a] > 1e-6 * bulk)
+            warn_add(&L->warn_frame, file, "%c: the LAS scale %g (for coordinates from %.17g to "
+                     "%.17g) rounds them by up to %.3g, more than 1e-6 of the cloud's bulk size "
+                     "%.6g (an outlier?)", "xyz"[a], L->scale[a], lo[a], hi[a], r[a], bulk);
+    return JF_OK;
 }
 
 const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS] = {
@@ -85,7 +186,9 @@ const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS] = {
 static const unsigned char eb_code[10] = {2, 1, 4, 3, 6, 5, 8, 7, 9, 10};
 static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
 
-static int keep(const jf_las_out *L) { return L->a && L->a->las_head; }
+static int keep(const jf_las_out *L) { return L->a && L->a->las_head && L->a->rec; }
+/* A LAS input read without its records (no_attrs): its CRS VLRs only. */
+static int crs_only(const jf_las_out *L) { return L->a && L->a->las_head && !L->a->rec; }
 
 static uint16_t g16(const unsigned char *p) { return (uint16_t)(p[0] | p[1] << 8); }
 static uint32_t g32(const unsigned char *p)
@@ -133,6 +236,9 @@ static int is_eb(const unsigned char *v)
     return !memcmp(v + 2, "LASF_Spec\0", 10) && g16(v + 18) == 4;
 }
 
+/* GeoTIFF keys, OGC WKT (LAS 1.4 R15 §2.5.1): the "LASF_Projection" VLRs */
+static int is_crs(const unsigned char *v) { return !memcmp(v + 2, "LASF_Projection\0", 16); }
+
 /* The Extra Bytes VLR of the input (NULL if none) and its descriptions
  * that fit the record (the reader's rule). */
 typedef struct { const unsigned char *eb; size_t len; } eb_find;
@@ -178,6 +284,10 @@ static void sum_vlr(void *u, const unsigned char *v, size_t len)
     vlr_sum *s = u;
     if (!is_eb(v)) s->bytes += len, s->n++;
 }
+static void sum_crs(void *u, const unsigned char *v, size_t len)
+{
+    if (is_crs(v)) sum_vlr(u, v, len);
+}
 
 int jf__las_fits(const jf_las_out *L)
 {
@@ -188,7 +298,7 @@ int jf__las_fits(const jf_las_out *L)
 size_t jf__las_prefix_size(const jf_las_out *L)
 {
     vlr_sum s = {0, 0};
-    if (keep(L)) walk_vlrs(L, sum_vlr, &s);
+    if (keep(L) || crs_only(L)) walk_vlrs(L, keep(L) ? sum_vlr : sum_crs, &s);
     return LAS_HEADER + s.bytes + VLR_HEADER + EB_DESC * out_descs(L);
 }
 
@@ -246,13 +356,83 @@ static void copy_vlr(void *u, const unsigned char *v, size_t len)
     memcpy(c->o, v, len);
     c->o += len;
 }
+static void copy_crs(void *u, const unsigned char *v, size_t len)
+{
+    if (is_crs(v)) copy_vlr(u, v, len);
+}
 
-/* One description: type, name, and description text. */
+/* One description: type, name (all 32 bytes of the field: LAS 1.4 R15
+ * table 24 needs no NUL in a full one), and description text. */
 static void put_desc(unsigned char *d, unsigned code, const char *name, const char *what)
 {
     d[2] = (unsigned char)code;
-    snprintf((char *)d + 4, 32, "%s", name);
+    memcpy(d + 4, name, strnlen(name, 32));
     snprintf((char *)d + 160, 32, "%s", what);
+}
+
+static void no_vlr(void *u, const unsigned char *v, size_t len) { (void)u, (void)v, (void)len; }
+
+int jf__las_names(jf_las_out *L, const char *file)
+{
+    size_t na = L->a ? L->a->nattrs : 0, nc = L->ncols - 3, nt = na + nc;
+    free(L->ebn);
+    free(L->warn_names);
+    L->ebn = NULL;
+    L->warn_names = NULL;
+    char(*e)[33] = calloc(nt ? nt : 1, sizeof *e);
+    const char **full = malloc((nt ? nt : 1) * sizeof *full);
+    unsigned char *used = calloc(nt ? nt : 1, 1);
+    if (!e || !full || !used) {
+        free(e), free(full), free(used);
+        return -1;
+    }
+    /* the names written as descriptions: keep mode, the Extra Bytes
+     * attributes (the format's own dimensions lie before base) */
+    unsigned base = keep(L) ? base_len[in_fmt(L)] : 0;
+    for (size_t k = 0; k < na; k++)
+        full[k] = L->anames[k], used[k] = L->a->attr[k].offset >= base;
+    for (size_t j = 0; j < nc; j++) full[na + j] = L->names[3 + j], used[na + j] = 1;
+    for (size_t k = 0; k < nt; k++)
+        if (strlen(full[k]) <= 32) memcpy(e[k], full[k], strlen(full[k]));
+    /* longer: the first bytes (whole UTF-8 characters) and "~N", N = 1, 2,
+     * ... the first that no other name holds (docs/formats.md) */
+    for (size_t k = 0; k < nt; k++) {
+        if (strlen(full[k]) <= 32) continue;
+        for (unsigned t = 1;; t++) {
+            char suf[16], cand[33];
+            size_t sl = (size_t)snprintf(suf, sizeof suf, "~%u", t), cut = 32 - sl;
+            while (cut && ((unsigned char)full[k][cut] & 0xC0) == 0x80) cut--;
+            memcpy(cand, full[k], cut);
+            memcpy(cand + cut, suf, sl + 1);
+            int clash = 0;
+            for (size_t q = 0; q < nt && !clash; q++) clash = used[q] && !strcmp(e[q], cand);
+            if (clash) continue;
+            memcpy(e[k], cand, strlen(cand) + 1);
+            if (used[k])
+                warn_add(&L->warn_names, file, "Extra Bytes name '%s' is longer than LAS's 32 "
+                         "bytes: written as '%s'", full[k], cand);
+            break;
+        }
+    }
+    free(full);
+    free(used);
+    L->ebn = e;
+    if (keep(L) || crs_only(L)) {
+        uint32_t seen = walk_vlrs(L, no_vlr, NULL), decl = g32(L->a->las_head + 100);
+        if (seen < decl)
+            warn_add(&L->warn_names, file, "the input's VLR %u of %u runs past its point data: "
+                     "VLRs %u to %u are not copied", seen + 1, decl, seen + 1, decl);
+    }
+    return 0;
+}
+
+void jf__las_out_free(jf_las_out *L)
+{
+    free(L->ebn);
+    free(L->warn_frame);
+    free(L->warn_names);
+    L->ebn = NULL;
+    L->warn_frame = L->warn_names = NULL;
 }
 
 /* The header fields a keep-mode output copies or recomputes. */
@@ -339,6 +519,16 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
         walk_vlrs(L, copy_vlr, &c);
         v = c.o;
         nvlr += s.n;
+    } else if (crs_only(L)) {
+        /* new records, the input's CRS: its VLRs and the WKT bit (4) of
+         * the global encoding */
+        vlr_copy c = {v};
+        vlr_sum s = {0, 0};
+        walk_vlrs(L, sum_crs, &s);
+        walk_vlrs(L, copy_crs, &c);
+        v = c.o;
+        nvlr += s.n;
+        b[6] = (unsigned char)(L->a->las_head[6] & 0x10);
     }
     put32(b + 100, nvlr); /* the input's VLRs, then the Extra Bytes one */
     size_t nd = out_descs(L);
@@ -360,7 +550,8 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
                 while (m < L->a->nattrs && L->a->attr[m].offset < base) m++;
                 if (m < L->a->nattrs) {
                     memset(d + 4, 0, 32);
-                    snprintf((char *)d + 4, 32, "%s", L->anames[m++]);
+                    memcpy(d + 4, L->ebn[m], strnlen(L->ebn[m], 32));
+                    m++;
                 }
             }
         }
@@ -372,13 +563,13 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
         }
     } else {
         for (size_t j = 0; L->a && j < L->a->nattrs; j++, d += EB_DESC)
-            put_desc(d, eb_code[jf__attr_out_type(&L->a->attr[j])], L->anames[j], "input attribute");
+            put_desc(d, eb_code[jf__attr_out_type(&L->a->attr[j])], L->ebn[j], "input attribute");
     }
     for (size_t j = 3; j < L->ncols; j++, d += EB_DESC) {
         char what[32];
         snprintf(what, sizeof what, "jetfit %s", L->names[j]);
         put_desc(d, L->types[j] == JF_COL_F64 ? 10 : L->types[j] == JF_COL_F32 ? 9 : 6,
-                 L->names[j], what);
+                 L->ebn[(L->a ? L->a->nattrs : 0) + j - 3], what);
     }
     size_t done = 0;
     while (done < len) {

@@ -54,7 +54,9 @@ static int keyword(const char *s, const char *e, int *normals)
 jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err)
 {
-    jf_text t = {buf, buf + len, 0, 0};
+    /* a UTF-8 byte order mark is not part of the header keyword */
+    size_t bom = len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) ? 3 : 0;
+    jf_text t = {buf + bom, buf + len, 0, 0};
     const char *ls, *le, *p, *ts = buf, *te = buf;
     int normals = 0;
     if (!data_line(&t, &ls, &le))

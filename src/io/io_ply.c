@@ -73,7 +73,9 @@ static int tok_is(const char *s, const char *e, const char *word)
 static jf_status parse_header(ply *h, const char *buf, size_t len,
                               size_t *body)
 {
-    jf_text t = {buf, buf + len, 0, 0};
+    /* a UTF-8 byte order mark before "ply" (a text editor's) is skipped */
+    size_t bom = len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) ? 3 : 0;
+    jf_text t = {buf + bom, buf + len, 0, 0};
     const char *ls, *le, *ts, *te, *q;
     if (!jf_text_line(&t, &ls, &le) || !tok_is(ls, le, "ply"))
         return jf_io_fail(h->err, JF_ERR_FORMAT, h->name, 1,

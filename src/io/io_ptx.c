@@ -64,10 +64,28 @@ static const char *const what[8] = {
     "scanner position", "scanner axis X", "scanner axis Y", "scanner axis Z",
     "transform row 1",  "transform row 2", "transform row 3", "transform row 4"};
 
+/* How far the rotation rows m[0..2][0..2] are from orthonormal: the largest
+ * |(R R^T - I)_ij|; *det their determinant. */
+static double rotation_error(double (*m)[4], double *det)
+{
+    double e = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double d = m[i][0] * m[j][0] + m[i][1] * m[j][1] + m[i][2] * m[j][2] - (i == j);
+            e = fabs(d) > e ? fabs(d) : e;
+        }
+    *det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    return e;
+}
+
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c,
                       jf_error *err)
 {
-    jf_text t = {buf, buf + len, 0, 0};
+    /* a UTF-8 byte order mark is not the column count */
+    size_t bom = len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3) ? 3 : 0;
+    jf_text t = {buf + bom, buf + len, 0, 0};
     jf_dvec xyz = {0}, sc = {0};
     jf_uvec scan = {0};
     jf_status st = JF_OK;
@@ -109,6 +127,14 @@ jf_status jf_read_ptx(const char *buf, size_t len, const char *name, jf_cloud *c
         if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
             FAIL(JF_ERR_FORMAT, t.line, "scan %zu: transform: last column must be 0 0 0 1 "
                  "(rotation rows, then the translation row)", nscans + 1);
+        /* a registration is a rigid motion: a scale, shear or mirror would
+         * change the surfaces' curvature (or their side), so it is refused,
+         * not guessed at; 1e-3 leaves room for matrices printed to 4 digits */
+        double det, rerr = rotation_error(m, &det);
+        if (!(rerr <= 1e-3) || det < 0)
+            FAIL(JF_ERR_FORMAT, t.line, "scan %zu: transform: the rotation rows are %s "
+                 "(|R R^T - I| = %.3g, determinant %.6g): a registration must be a rotation",
+                 nscans + 1, rerr <= 1e-3 ? "a reflection" : "not orthonormal", rerr, det);
         uint64_t cnt = dim[0] * dim[1]; /* both <= 2^32: no overflow */
         /* the shortest point line, "0 0 0 0\n", has 8 bytes */
         if (cnt > JF_MAX_POINTS - npts || cnt > (uint64_t)(t.end - t.p) / 8 + 1)

@@ -41,6 +41,7 @@ struct jf_writer {
     int put;                         /* begun, not yet drained           */
     int put_threads;                 /* for the drain's formatting       */
     jf_spool *spool;                 /* io_spool.c                       */
+    char *warn;                      /* jf_writer_warnings' text         */
 };
 
 /* The attribute columns go after column 2 (x y z). */
@@ -69,7 +70,7 @@ static jf_status write_header(jf_writer *w)
     if (w->fmt == FMT_LAS) {
         /* a placeholder of the header's size: the real one, with the
          * count and bounds, is written over it at commit */
-        if (!w->las_framed && !(w->attrs && w->attrs->las_head))
+        if (!w->las_framed && !(w->attrs && w->attrs->las_head && w->attrs->rec))
             return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
                                                  "(jf_writer_las_frame) before the rows");
         size_t n = jf__las_prefix_size(&w->las);
@@ -183,6 +184,8 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     w->las.types = w->types;
     w->las.ncols = ncols;
     w->las.nrows = nrows;
+    if (st == JF_OK && w->fmt == FMT_LAS && jf__las_names(&w->las, path) != 0)
+        st = jf_wf_fail(&w->f, JF_ERR_NOMEM, "out of memory");
     if (st != JF_OK) {
         if (err) {
             *err = w->f.err;
@@ -198,13 +201,40 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
 
 jf_status jf_writer_las_frame(jf_writer *w, const double *xyz, size_t n)
 {
+    return jf_writer_las_frame_given(w, xyz, n, NULL, NULL);
+}
+
+jf_status jf_writer_las_frame_given(jf_writer *w, const double *xyz, size_t n,
+                                    const double scale[3], const double offset[3])
+{
     if (!w || w->header_done || (n && !xyz))
         return JF_ERR_INVALID;
     if (w->fmt != FMT_LAS)
         return JF_OK;
-    jf__las_frame(xyz, n, w->las.scale, w->las.offset, w->las.lo, w->las.hi);
+    for (int a = 0; a < 3; a++)
+        if ((scale && !(scale[a] > 0 && isfinite(scale[a]))) || (offset && !isfinite(offset[a])))
+            return jf_wf_fail(&w->f, JF_ERR_INVALID, "LAS scale %c: must be positive and "
+                              "finite, offsets finite", "xyz"[a]);
+    char why[400];
+    jf_status st = jf__las_frame(&w->las, w->f.final ? w->f.final : "(output)", xyz, n, scale,
+                                 offset, why, sizeof why);
+    if (st != JF_OK)
+        return jf_wf_fail(&w->f, st, "%s", why);
     w->las_framed = 1;
     return JF_OK;
+}
+
+const char *jf_writer_warnings(jf_writer *w)
+{
+    if (!w) return "";
+    const char *a = w->las.warn_names ? w->las.warn_names : "";
+    const char *b = w->las.warn_frame ? w->las.warn_frame : "";
+    size_t n = strlen(a) + strlen(b) + 1;
+    char *t = realloc(w->warn, n);
+    if (!t) return a;
+    snprintf(t, n, "%s%s", a, b);
+    w->warn = t;
+    return t;
 }
 
 jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
@@ -213,7 +243,7 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
         return JF_ERR_INVALID;
     if (!a || (!a->nattrs && !(a->las_head && w->fmt == FMT_LAS)))
         return JF_OK; /* nothing to carry */
-    if (w->ncols < 3 || (a->nattrs && !a->rec) || (a->las_head && !a->rec))
+    if (w->ncols < 3 || (a->nattrs && !a->rec))
         return JF_ERR_INVALID;
     char (*nm)[64] = calloc(a->nattrs ? a->nattrs : 1, sizeof *nm);
     if (!nm)
@@ -221,7 +251,7 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
     /* a format 0 LAS output also has its own dimensions: an Extra Byte
      * named as one (intensity, classification, ...) would be a second
      * dimension of that name to LAS readers */
-    int fmt0 = w->fmt == FMT_LAS && !a->las_head;
+    int fmt0 = w->fmt == FMT_LAS && !(a->las_head && a->rec);
     size_t nn = w->ncols + (fmt0 ? JF__LAS_FMT0_NDIMS : 0);
     char **taken = malloc(nn * sizeof *taken);
     if (!taken) {
@@ -259,6 +289,13 @@ jf_status jf_writer_attrs(jf_writer *w, const jf_attrs *a)
         }
         w->f.buf = b;
         w->f.cap = need;
+    }
+    if (w->fmt == FMT_LAS && jf__las_names(&w->las, w->f.final ? w->f.final : "(output)")) {
+        w->las.a = NULL;
+        w->las.anames = NULL;
+        free(nm);
+        jf__las_names(&w->las, w->f.final ? w->f.final : "(output)");
+        return JF_ERR_NOMEM;
     }
     w->row_max = need;
     w->attrs = a;
@@ -577,6 +614,8 @@ static void free_writer(jf_writer *w)
     free(w->names);
     free(w->types);
     free(w->anames);
+    jf__las_out_free(&w->las);
+    free(w->warn);
     free(w);
 }
 
@@ -596,7 +635,7 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
         write_faces(w);
     /* LAS: the input's EVLRs after the records, then the header */
     if (f->st == JF_OK && w->fmt == FMT_LAS && w->attrs && w->attrs->las_head &&
-        w->attrs->las_evlr)
+        w->attrs->rec && w->attrs->las_evlr)
         jf_wf_write(f, (const char *)w->attrs->las_evlr, w->attrs->las_evlr_len);
     if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
         jf__las_write_prefix(f->fd, &w->las) != 0)
@@ -682,7 +721,9 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
     jf_status st = jf_writer_open(path, cols, nc, c->n, ascii, &w, err);
     if (st != JF_OK)
         return st;
-    (void)jf_writer_las_frame(w, c->xyz, c->n); /* .las: scale and offset from the cloud */
+    /* .las: scale and offset from the cloud; commit names a refusal */
+    if (jf_writer_las_frame(w, c->xyz, c->n) != JF_OK)
+        return jf_writer_commit(w, err);
     if (c->nfaces && (st = jf_writer_faces(w, c->nfaces, c->face_off,
                                            c->face_idx)) != JF_OK) {
         jf_writer_abort(w);

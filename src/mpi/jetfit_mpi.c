@@ -2,7 +2,7 @@
  * the estimate of `jetfit estimate`, over MPI, byte for byte the same file.
  *
  * design: the options are parsed by the command's own code (src/cli/opts.c)
- * and the rows made by it (src/cli/rows.c); mpi_dist.c gives each rank its
+ * and the rows made by it (jf_result_row); mpi_dist.c gives each rank its
  * part of the cloud and the part's exact halo; the fit is the pipeline's
  * (jf__estimate_masked: the halo points are neighbours, not fitted); each
  * rank writes its rows with MPI-IO at their input-order offsets into the
@@ -27,7 +27,6 @@
 #include "io_internal.h"
 #include "mpi_internal.h"
 #include "opts.h"
-#include "rows.h"
 
 static void usage(FILE *f)
 {
@@ -117,7 +116,7 @@ static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const
                        const jf_column *cols, size_t ncols, int monge, int threads)
 {
     enum { BLOCK = 16384 };
-    jf_col_type types[JF_CLI_MAX_COLS];
+    jf_col_type types[JF_RESULT_MAX_COLS];
     size_t rowb = 0;
     for (size_t j = 0; j < ncols; j++) {
         types[j] = cols[j].type;
@@ -151,7 +150,7 @@ static void write_rows(jf_mpi *m, const outputs *o, const jf_mpi_cloud *c, const
         for (int t = 0; t < k; t++) {
             const size_t p = pos[t];
             double *v = vals + (size_t)t * ncols;
-            jf_cli_row(c->xyz + 3 * p, &res[p], monge, v);
+            jf_result_row(c->xyz + 3 * p, &res[p], monge, v);
             jf__ply_row_le(types, ncols, v, buf + (size_t)t * rowb);
         }
         for (int t = 0; t < k; t++) disp[t] = (MPI_Aint)(o->header + (uint64_t)c->gid[pos[t]] * rowb);
@@ -284,8 +283,8 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     if (jf__part_query_init(&o, &q) != JF_OK)
         return refuse(m, "%s: invalid parameters", in);
 
-    jf_column cols[JF_CLI_MAX_COLS];
-    size_t ncols = jf_cli_columns(cmd.e.monge, cols);
+    jf_column cols[JF_RESULT_MAX_COLS];
+    size_t ncols = jf_result_columns(cmd.e.monge, cols);
     outputs w;
     memset(&w, 0, sizeof w);
     /* open the output first: a missing folder fails before the work */

@@ -9,6 +9,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 #define N 300
 
@@ -180,9 +181,5 @@ int main(void)
     tcase_add_test(tc, colour_carried);
     tcase_add_test(tc, keep_none_is_todays_bytes);
     suite_add_tcase(s, tc);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

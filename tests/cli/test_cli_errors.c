@@ -5,6 +5,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 /* Runs estimate on `name` (already written in cli_dir), expects failure,
  * `want` in stderr, exactly one stderr line and only the input left. */
@@ -240,9 +241,5 @@ int main(void)
     tcase_add_test(tc, nan_row_kept);
     tcase_add_test(tc, too_few_points);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

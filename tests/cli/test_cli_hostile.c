@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 static void write_file(const char *path, const char *text)
 {
@@ -371,9 +372,5 @@ int main(void)
     tcase_add_test(tc, messages);
     tcase_add_test(tc, eval_other_cloud);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

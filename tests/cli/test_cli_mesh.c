@@ -6,6 +6,7 @@
 #include <math.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 /* A 5x5 grid of z = x^2 + y^2 / 2 as OFF, 32 triangles, then `extra`
  * faces and vertices appended verbatim. */
@@ -84,9 +85,5 @@ int main(void)
     tcase_add_test(tc, face_index_out_of_range);
     tcase_add_test(tc, nonmanifold_isolated_degenerate);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

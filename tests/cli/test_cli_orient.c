@@ -7,6 +7,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 #define N 2500
 static const double R = 1.5, C[3] = {0.2, -0.4, 1.1};
@@ -129,9 +130,5 @@ int main(void)
     tcase_add_test(tc, input_normals);
     tcase_add_test(tc, bunny_scan_mst_vs_viewpoint);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -8,6 +8,7 @@
 
 #include "test_cli_util.h"
 #include "../io/test_ptx_sphere.h"
+#include "jf_test.h"
 
 /* n . (S - p) for row i of t, p and S from the generator (NaN for a
  * no-return cell). */
@@ -104,9 +105,5 @@ int main(void)
     tcase_add_test(tc, scanner_without_positions_refused);
     tcase_add_test(tc, scanner_on_las_refused);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 #define SIDE 48
 
@@ -171,9 +172,5 @@ int main(void)
     tcase_add_test(tc, bad_values);
     tcase_add_test(tc, robust_normals_preset);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

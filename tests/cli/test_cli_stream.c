@@ -17,14 +17,14 @@
 #include "io_internal.h"
 #include "jetfit.h"
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 /* ---- fixtures ------------------------------------------------------- */
 
 static uint64_t rng = 88172645463325252ULL;
 static double urand(void)
 {
-    rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
+    return jf_unit(jf_xorshift64(&rng));
 }
 
 /* A jittered grid on the paper's §6.1 surface z = 0.1 exp(2x + y - y^2)
@@ -586,9 +586,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *r = srunner_create(suite());
-    srunner_run_all(r, CK_NORMAL);
-    int nf = srunner_ntests_failed(r);
-    srunner_free(r);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(suite());
 }

@@ -21,6 +21,7 @@
 #include <time.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 /* ---- helpers ---- */
 
@@ -820,9 +821,5 @@ int main(void)
     tcase_add_test(t, one_progress_line_with_eta);
     tcase_add_test(t, user_text_stays_text);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -7,6 +7,7 @@
 
 #include "cgal_bridge.h"
 #include "jetfit.h"
+#include "jf_test.h"
 
 #define JETFIT_BIN JF_BUILD_DIR "/jetfit"
 
@@ -41,9 +42,5 @@ int main(void)
     TCase *tc = tcase_create("version");
     tcase_add_test(tc, version_lines);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "gnuplot.h"
+#include "jf_test.h"
 
 #define NSTR 400
 #define MAXLEN 60
@@ -76,9 +77,5 @@ int main(void)
     TCase *tc = tcase_create("quote");
     tcase_add_test(tc, random_strings_round_trip);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

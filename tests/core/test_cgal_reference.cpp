@@ -31,6 +31,7 @@
 
 #include "cgalref_svd.hpp"
 #include "jetfit.h"
+#include "jf_test.h"
 
 // check.h last: it defines a macro `fail` that breaks std::ios::fail.
 #include <check.h>
@@ -602,9 +603,5 @@ static Suite *suite(void)
 int main(void)
 {
     std::printf("CGAL SVD: %s\n", jf_cgalref::cgal_svd_name);
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(suite());
 }

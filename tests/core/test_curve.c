@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 static jf_fitter *make(double max_cond)
 {
@@ -167,9 +168,5 @@ int main(void)
     tcase_add_test(tc, test_curve_cubic_dk);
     tcase_add_test(tc, test_curve_degenerate);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

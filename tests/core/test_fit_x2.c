@@ -16,15 +16,12 @@
 
 #include "fitter_internal.h"
 #include "jetfit.h"
+#include "jf_test.h"
 
 static uint64_t rng_state;
 static double urand(void) /* splitmix64, deterministic */
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
+    return jf_unit(jf_splitmix64(&rng_state));
 }
 
 static int same_bits(const double *a, const double *b, size_t n)
@@ -263,9 +260,5 @@ int main(void)
     tcase_add_test(tc, test_fit_x2_bits);
     tcase_add_test(tc, test_estimate_vs_loop);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

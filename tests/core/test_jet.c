@@ -13,16 +13,13 @@
 
 #include "fitter_internal.h"
 #include "jetfit.h"
+#include "jf_test.h"
 
 /* splitmix64: a small deterministic PRNG (no libc rand state) */
 static uint64_t rng_state;
 static double urand(void)
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
+    return jf_unit(jf_splitmix64(&rng_state));
 }
 
 #define IDX(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j))
@@ -594,9 +591,5 @@ int main(void)
     tcase_add_test(tc, test_solver_fast_path);
     tcase_add_test(tc, test_gram_extremes);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

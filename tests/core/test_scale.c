@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 #define N 40
 
@@ -137,9 +138,5 @@ int main(void)
     tcase_add_test(tc, scale_decimal);
     tcase_add_test(tc, nonfinite_never_ok);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

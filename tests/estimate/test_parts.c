@@ -14,14 +14,12 @@
 #include "index_internal.h"
 #include "jetfit.h"
 #include "parts.h"
+#include "jf_test.h"
 
 static uint64_t rng_state = 0x51ED27A3C0FFEE11ULL;
 static double urand(void) /* in [0, 1): xorshift64*, as test_rand.h */
 {
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
+    return jf_unit(jf_xorshift64s(&rng_state));
 }
 
 typedef struct {
@@ -332,9 +330,5 @@ int main(void)
     tcase_add_test(t, masked_estimate_equals_whole);
     tcase_add_test(t, refused_kinds);
     suite_add_tcase(s, t);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 static void fib_sphere(size_t n, double R, const double c[3], double *xyz)
 {
@@ -391,9 +392,5 @@ int main(void)
     tcase_add_test(tc, rings_on_mesh);
     tcase_add_test(tc, natural_on_sphere);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -8,12 +8,12 @@
 
 #include "fitter_internal.h"
 #include "planes_internal.h"
+#include "jf_test.h"
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
 static double urand(void) /* in [0, 1) */
 {
-    rng ^= rng >> 12, rng ^= rng << 25, rng ^= rng >> 27;
-    return (double)((rng * 2685821657736338717ull) >> 11) * 0x1.0p-53;
+    return jf_unit(jf_xorshift64s(&rng));
 }
 
 /* a random rotation q (columns: eigenvectors) from a unit quaternion */
@@ -123,9 +123,5 @@ int main(void)
     tcase_add_test(tc, coplanar);
     tcase_add_test(tc, refused);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

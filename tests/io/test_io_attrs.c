@@ -17,6 +17,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_attrs_XXXXXX"); }
 
@@ -557,10 +558,6 @@ int main(void)
     tcase_add_test(tc, las_records_kept);
     tcase_add_test(tc, las_dimensions);
     tcase_add_test(tc, las_13_short_header);
-    SRunner *r = srunner_create(s);
     suite_add_tcase(s, tc);
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -16,6 +16,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 /* Reads `name` holding `s`; expects status `st` and a message holding
  * the file name and every one of the (up to 3) fragments. */
@@ -311,9 +312,5 @@ int main(void)
     tcase_add_test(tc, fuzz_regressions);
     tcase_add_test(tc, fuzz_seeds_read);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

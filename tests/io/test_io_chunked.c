@@ -18,6 +18,7 @@
 
 #include "io_internal.h"
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static void put(unsigned char **o, const void *v, size_t n, int big)
 {
@@ -193,9 +194,5 @@ int main(void)
     tcase_set_timeout(t, 120);
     tcase_add_test(t, chunked_equals_whole);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int nf = srunner_ntests_failed(r);
-    srunner_free(r);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

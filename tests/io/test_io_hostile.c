@@ -14,6 +14,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_hostile_XXXXXX"); }
 
@@ -196,9 +197,5 @@ int main(void)
     tcase_add_test(tc, counts_and_duplicates);
     tcase_add_test(tc, bad_rows_skip);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -17,6 +17,7 @@
 
 #include "test_io_util.h"
 #include "test_ptx_sphere.h"
+#include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_ptx_XXXXXX"); }
 
@@ -198,9 +199,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *r = srunner_create(suite());
-    srunner_run_all(r, CK_NORMAL);
-    int nf = srunner_ntests_failed(r);
-    srunner_free(r);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(suite());
 }

@@ -16,6 +16,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static const char *text(const char *name, const char *s)
 {
@@ -529,9 +530,5 @@ int main(void)
     tcase_add_test(tc, parse_vs_strtod);
     tcase_add_test(tc, xyz_one_pass_rows);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -17,6 +17,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static const char *tpath(const char *name)
 {
@@ -57,8 +58,7 @@ static void setup(void)
 static uint64_t rng = 0x9e3779b97f4a7c15u;
 static uint64_t next(void)
 {
-    rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;
-    return rng;
+    return jf_xorshift64(&rng);
 }
 
 START_TEST(g17_matches_printf)
@@ -408,9 +408,5 @@ int main(void)
     tcase_add_test(tc, rows_in_blocks);
     tcase_add_test(tc, temp_then_rename);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

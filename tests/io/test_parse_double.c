@@ -15,14 +15,12 @@
 #include <string.h>
 
 #include "io_internal.h"
+#include "jf_test.h"
 
 static uint64_t rng_state;
 static uint64_t rnd64(void) /* splitmix64, deterministic */
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return jf_splitmix64(&rng_state);
 }
 
 static uint64_t bits_of(double v)
@@ -204,9 +202,5 @@ int main(void)
     tcase_add_test(tc, test_edge_cases);
     tcase_add_test(tc, test_lemire_direct);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 static char tmpdir[256];
 
@@ -252,12 +253,9 @@ int main(void)
     tcase_add_test(tc, read_ply);
     tcase_add_test(tc, cmd_eval_end_to_end);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
+    int rc = jf_test_run(s);
     char cmd[512];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0) { /* leftover temp files are harmless */ }
-    return failed ? 1 : 0;
+    return rc;
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 /* src/robust/robust.c's bench-only setter of the selection constants */
 int jf__robust_tune(const char *name, double v);
@@ -41,11 +42,7 @@ static void truth(double u, double v, double n[3], double *k1, double *k2)
 static uint64_t rng_state;
 static double urand(void)
 {
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+    return jf_unit(jf_splitmix64(&rng_state));
 }
 static double grand(void)
 {
@@ -673,9 +670,5 @@ int main(void)
     tcase_add_test(tc, new_params_validated);
     tcase_add_test(tc, robust_normals_preset);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

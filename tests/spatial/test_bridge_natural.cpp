@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
 typedef CGAL::Triangulation_vertex_base_with_info_2<unsigned, K> Vb2;
@@ -310,9 +311,5 @@ Suite *natural_suite(void) {
 }
 
 int main(void) {
-    SRunner *sr = srunner_create(natural_suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(natural_suite());
 }

@@ -13,6 +13,7 @@
 
 #define JF_TEST_SEED 88172645463325252ULL
 #include "test_rand.h"
+#include "jf_test.h"
 
 /* Merge sort by (d2, index): the sanitizers' qsort interceptor is slow. */
 static void sort_pairs(pair *a, size_t n)
@@ -580,9 +581,5 @@ static Suite *kdtree_suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(kdtree_suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(kdtree_suite());
 }

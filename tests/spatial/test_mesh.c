@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 /* A g x g grid, vertex i + g*j at (i, j, 0), each cell split by the
  * diagonal (i,j)-(i+1,j+1).  Its edge graph is the hexagonal lattice:
@@ -356,9 +357,5 @@ static Suite *mesh_suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(mesh_suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(mesh_suite());
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 static const double kPi = 3.14159265358979323846;
 
@@ -308,9 +309,5 @@ static Suite *natural_suite(void) {
 }
 
 int main(void) {
-    SRunner *sr = srunner_create(natural_suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(natural_suite());
 }

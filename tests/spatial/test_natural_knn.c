@@ -19,6 +19,7 @@
 
 #define JF_TEST_SEED 0x2545F4914F6CDD1Dull
 #include "test_rand.h"
+#include "jf_test.h"
 
 /* Neighbourhoods of every point in both forms; returns how many differ
  * among the points with keep[i] (NULL: all). */
@@ -156,9 +157,5 @@ int main(void) {
     tcase_add_test(tc, flat_and_far);
     tcase_add_test(tc, small_and_odd);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int nf = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return nf ? 1 : 0;
+    return jf_test_run(s);
 }

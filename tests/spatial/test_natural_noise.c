@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 #define NPTS 4000
 static const double AX[3] = {1.0, 0.7, 0.5}; /* ellipsoid semi-axes */
@@ -168,9 +169,5 @@ int main(void)
     tcase_add_test(tc, noisy_ellipsoid);
     tcase_add_test(tc, clean_ellipsoid);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int nf = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

@@ -19,6 +19,7 @@
 
 #define JF_TEST_SEED 0x9E3779B97F4A7C15ull
 #include "test_rand.h"
+#include "jf_test.h"
 
 #define CAP 512
 
@@ -191,9 +192,5 @@ int main(void) {
     tcase_add_test(tc, noisy_rows);
     tcase_add_test(tc, live_rows);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

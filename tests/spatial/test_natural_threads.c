@@ -17,6 +17,7 @@
 
 #include "cgal_bridge.h"
 #include "jetfit.h"
+#include "jf_test.h"
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static double urand(void) { /* xorshift64*, [0, 1) */
@@ -237,9 +238,5 @@ int main(void) {
     tcase_add_test(tc, bridge_threads);
     tcase_add_test(tc, grid_any_order);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int nf = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(s);
 }

@@ -10,6 +10,7 @@
 
 #define JF_TEST_SEED 0x9E3779B97F4A7C15ULL
 #include "test_rand.h"
+#include "jf_test.h"
 
 static size_t brute(const double *xyz, size_t n, const double q[3], pair *out)
 {
@@ -240,9 +241,5 @@ static Suite *nb_suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(nb_suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(nb_suite());
 }

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 /* Deterministic LCG in [0,1). */
 static double rnd(unsigned long long *s)
@@ -217,9 +218,5 @@ int main(void)
     tcase_add_test(tc, bad_args);
     tcase_add_test(tc, mst_graph_equals_queries);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -7,14 +7,12 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include "jf_test.h"
 
 static uint64_t rng_state = JF_TEST_SEED;
 static double urand(void) /* in [0, 1) */
 {
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
+    return jf_unit(jf_xorshift64s(&rng_state));
 }
 
 static inline double gauss(void) /* standard normal, Box-Muller */

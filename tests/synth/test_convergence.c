@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 static double f61(double u, double v) { return 0.1 * exp(2 * u + v - v * v); }
 
@@ -158,9 +159,5 @@ int main(void)
     TCase *tc = tcase_create("core");
     tcase_add_test(tc, test_theorem3);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

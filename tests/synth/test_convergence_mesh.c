@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "convergence.h"
+#include "jf_test.h"
 
 START_TEST(approximation_slopes_match_theorem_3)
 {
@@ -116,9 +117,5 @@ int main(void)
     tcase_add_test(tc, slope_floor_rule);
     tcase_add_test(tc, bad_config);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "jetfit.h"
+#include "jf_test.h"
 
 #define BIN JF_BUILD_DIR "/jetfit"
 
@@ -337,9 +338,5 @@ int main(void)
     tcase_add_test(tc, render_pictures);
     tcase_add_test(tc, estimate_on_generated_meshes);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

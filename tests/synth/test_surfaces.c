@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "surfaces.h"
+#include "jf_test.h"
 
 static double dot3(const double a[3], const double b[3])
 {
@@ -391,9 +392,5 @@ int main(void)
     tcase_add_test(tc, graph_grid_layout_and_determinism);
     tcase_add_test(tc, noise_models);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : 0;
+    return jf_test_run(s);
 }

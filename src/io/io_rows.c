@@ -1,12 +1,14 @@
-/* rows.c -- the output table of `jetfit estimate` (rows.h). */
-#include "rows.h"
+/* io_rows.c -- the estimate's output table (jf_result_columns,
+ * jf_result_row): one list of columns for the command, jetfit-mpi and the
+ * Python module's files. */
+#include "jetfit.h"
 
 static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",  "k1",
                                         "k2",  "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"};
 static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
 static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
 
-size_t jf_cli_columns(int monge, jf_column *cols)
+size_t jf_result_columns(int monge, jf_column *cols)
 {
     size_t n = 0;
     for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
@@ -22,7 +24,7 @@ size_t jf_cli_columns(int monge, jf_column *cols)
     return n;
 }
 
-size_t jf_cli_row(const double *p, const jf_result *r, int monge, double *v)
+size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v)
 {
     size_t n = 0;
     for (int j = 0; j < 3; j++) v[n++] = p[j];

@@ -1,0 +1,50 @@
+/* jf_test.h -- what the Check suites share (one copy, issue 24.6): the
+ * runner of a suite and the reproducible generators the suites draw their
+ * inputs from.  Each suite keeps its own seed, so its inputs do not depend
+ * on any other suite. */
+#ifndef JF_TEST_H
+#define JF_TEST_H
+
+#include <check.h>
+#include <stdint.h>
+
+/* Runs every case of s (Check's normal output, its summary line); the
+ * process's exit status: 0 if all passed, else 1. */
+static inline int jf_test_run(Suite *s)
+{
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}
+
+/* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */
+static inline uint64_t jf_splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* xorshift64* (Vigna 2016): the next 64 bits of *state (never 0). */
+static inline uint64_t jf_xorshift64s(uint64_t *state)
+{
+    *state ^= *state >> 12;
+    *state ^= *state << 25;
+    *state ^= *state >> 27;
+    return *state * 2685821657736338717ULL;
+}
+
+/* xorshift64 (Marsaglia 2003, shifts 13, 7, 17): the next state. */
+static inline uint64_t jf_xorshift64(uint64_t *state)
+{
+    *state ^= *state << 13, *state ^= *state >> 7, *state ^= *state << 17;
+    return *state;
+}
+
+/* A double in [0, 1) from the top 53 bits of a 64-bit draw. */
+static inline double jf_unit(uint64_t bits) { return (double)(bits >> 11) * 0x1.0p-53; }
+
+#endif
