@@ -7,6 +7,7 @@
 
 #include <signal.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 
 /* Runs `jetfit ARGS...` with stdin from in_path (NULL: /dev/null) and
@@ -293,9 +294,5 @@ int main(void)
     tcase_add_test(t, closed_pipe_leaves_nothing);
     tcase_add_test(t, help_lists_short_options);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int nf = srunner_ntests_failed(r);
-    srunner_free(r);
-    return nf ? 1 : 0;
+    return jf_test_run(s);
 }

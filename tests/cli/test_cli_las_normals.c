@@ -5,6 +5,7 @@
 #include <time.h>
 #include <check.h>
 
+#include "jf_test.h"
 #include "test_cli_util.h"
 
 START_TEST(las_extra_bytes_are_normals)
@@ -95,9 +96,5 @@ int main(void)
     tcase_add_test(t, las_extra_bytes_are_normals);
     tcase_add_test(t, las_creation_date);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int nf = srunner_ntests_failed(r);
-    srunner_free(r);
-    return nf ? 1 : 0;
+    return jf_test_run(s);
 }
