@@ -10,8 +10,11 @@ install(TARGETS jetfit_shared EXPORT jetfitTargets
 install(FILES ${PROJECT_SOURCE_DIR}/src/jetfit.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
 # libjetfit.a (JF_STATIC_LIB): the library and the CGAL bridge in one
-# archive; a program links it with `pkg-config --static --libs jetfit` (GSL, expat,
-# OpenMP, the C++ runtime, and CGAL's GMP/MPFR) or jetfit::jetfit_static.
+# archive; a program links it with `pkg-config --libs jetfit-static` (the
+# archive by path, then GSL, expat, OpenMP, the C++ runtime and CGAL's GMP/MPFR:
+# `pkg-config --static --libs jetfit` says -ljetfit, which the linker
+# resolves to the shared library when both are installed) or
+# jetfit::jetfit_static.
 if(JF_STATIC_LIB)
   add_library(jetfit_static STATIC $<TARGET_OBJECTS:jetfit_obj> $<TARGET_OBJECTS:jetfit_cgal_obj>)
   set_target_properties(jetfit_static PROPERTIES OUTPUT_NAME jetfit EXPORT_NAME jetfit_static)
@@ -23,6 +26,7 @@ if(JF_STATIC_LIB)
     target_link_libraries(jetfit_static INTERFACE gsl gslcblas gomp expat m)
   endif()
   install(TARGETS jetfit_static EXPORT jetfitTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  set(JF_PC_STATIC ON)
 endif()
 install(FILES ${PROJECT_SOURCE_DIR}/docs/jetfit.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 
@@ -44,3 +48,7 @@ endif()
 file(RELATIVE_PATH JF_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit.pc.in ${PROJECT_BINARY_DIR}/jetfit.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/jetfit.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+if(JF_PC_STATIC)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/jetfit-static.pc.in ${PROJECT_BINARY_DIR}/jetfit-static.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/jetfit-static.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endif()

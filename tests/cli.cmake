@@ -1,6 +1,6 @@
 # cli.cmake -- the end-to-end tests of `jetfit estimate` run the built
 # binary (JF_BUILD_DIR/jetfit): build it before them, label them.
-foreach(t test_cli_version test_cli_hostile test_cli_hostile33 test_cli_pictures test_cli_fulldisk test_cli_errors test_cli_formats test_cli_orient test_cli_mesh test_cli_robust
+foreach(t test_cli_version test_cli_gnu test_cli_las_normals test_cli_hostile test_cli_hostile33 test_cli_pictures test_cli_fulldisk test_cli_errors test_cli_formats test_cli_orient test_cli_mesh test_cli_robust
           test_cli_study test_cli_attrs)
   if(TARGET ${t})
     add_dependencies(${t} jetfit)

@@ -17,3 +17,29 @@ endif()
 add_test(NAME check_man COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_man.sh
          ${PROJECT_SOURCE_DIR}/docs/jetfit.1)
 set_tests_properties(check_man PROPERTIES LABELS docs SKIP_RETURN_CODE 77)
+# the Python that imports the module, when it is built (python blocks,
+# the docstring); else python3
+set(JF_DOC_PY ${JF_PY3})
+if(Python3_EXECUTABLE)
+  set(JF_DOC_PY ${Python3_EXECUTABLE})
+endif()
+# Every default quoted in the documents is the code's (issue 31):
+# print_defaults prints them from the code, check_defaults.py compares.
+add_executable(print_defaults ${CMAKE_CURRENT_SOURCE_DIR}/docs/print_defaults.c
+               ${PROJECT_SOURCE_DIR}/src/cli/opts.c ${PROJECT_SOURCE_DIR}/src/cli/args.c)
+target_include_directories(print_defaults PRIVATE ${PROJECT_SOURCE_DIR}/src/cli ${JF_INTERNAL_INCLUDES})
+target_link_libraries(print_defaults PRIVATE jetfit_lib)
+set_target_properties(print_defaults PROPERTIES LINKER_LANGUAGE CXX)
+if(JF_PY3)
+  add_test(NAME check_defaults COMMAND ${JF_DOC_PY} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_defaults.py
+           ${PROJECT_SOURCE_DIR} $<TARGET_FILE:print_defaults> $<TARGET_FILE:jetfit>
+           ${PROJECT_BINARY_DIR}/python)
+  set_tests_properties(check_defaults PROPERTIES LABELS docs)
+endif()
+# The doc-test (issue 31): README's and docs/' sh and python blocks run as
+# written against this build (installing and building steps skipped, listed)
+if(JF_PY3)
+  add_test(NAME check_commands COMMAND ${JF_DOC_PY} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_commands.py
+           ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR})
+  set_tests_properties(check_commands PROPERTIES LABELS docs TIMEOUT 1800)
+endif()

@@ -9,7 +9,7 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
 # §6.1 convergence (Figs. 5-12): CSVs, gnuplot script and PNGs
-"$B" convergence --out "$F/convergence"
+"$B" convergence -o "$F/convergence"
 
 # Fig. 1: the elliptic paraboloid z = 2x^2 + y^2, its two umbilics (+-1/4, 0)
 "$B" generate paraboloid --mesh --n 5000 --seed 1 -o "$T/par.ply"

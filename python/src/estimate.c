@@ -61,6 +61,13 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
                         "attributes['scanner'])");
         return NULL;
     }
+    if ((o->orient == JF_ORIENT_INPUT || o->normal == JF_NORMAL_INPUT) && !c->nrm && c->n) {
+        PyErr_Format(PyExc_ValueError,
+                     "%s='input' needs normals=: an (N, 3) array of the points' normals "
+                     "(jetfit.read gives a file's as its second value)",
+                     o->orient == JF_ORIENT_INPUT ? "orient" : "normal");
+        return NULL;
+    }
     PyObject *result = jf_py_result_new(c->n, po->e.monge, points, faces);
     if (!result) return NULL;
     /* mst orients after every normal is known: jf_estimate_blocks would

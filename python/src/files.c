@@ -282,6 +282,8 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
         /* a mesh keeps its faces in a PLY output, as the command does */
         if (fc.nfaces && (st = jf_writer_faces(w, fc.nfaces, fc.face_off, fc.face_idx)) != JF_OK)
             jf_writer_abort(w);
+        /* .las: the scale and offset from the points, as the command sets them */
+        if (st == JF_OK) (void)jf_writer_las_frame(w, s.xyz, n);
         for (size_t b0 = 0; st == JF_OK && b0 < n; b0 += BLOCK) {
             size_t nb = n - b0 < BLOCK ? n - b0 : BLOCK;
             for (size_t k = 0; k < nb; k++) make_row(&s, b0 + k, monge, rows + k * ncols);

@@ -5,15 +5,39 @@
  * to the command's own parser (src/cli/opts.c): the same values are
  * accepted, the same defaults follow (Monge degree, max_neighbors, orient
  * input when normals are given), and a bad value raises ValueError with
- * the command's words ("--degree '12': expected an integer 1..9").  A value
+ * the command's words, its flags spelt as keywords ("degree=12: expected
+ * an integer 1..9").  A value
  * of the wrong Python type raises TypeError naming the keyword. */
 #include <math.h>
 
 #include "jfpy.h"
 
+/* The command's words with its flags as keywords: "--degree-select" ->
+ * "degree_select" (a Python user never typed the flag). */
+static void as_keywords(const char *in, char *out, size_t len)
+{
+    size_t u = 0;
+    for (const char *p = in; *p && u + 1 < len; p++) {
+        if (p[0] == '-' && p[1] == '-' && p[2] >= 'a' && p[2] <= 'z' && (p == in || p[-1] == ' ')) {
+            for (p += 2; *p && u + 1 < len && ((*p >= 'a' && *p <= 'z') || *p == '-'); p++)
+                out[u++] = *p == '-' ? '_' : *p;
+            p--;
+        } else {
+            out[u++] = *p;
+        }
+    }
+    out[u] = '\0';
+}
+
 static int bad(const jf_cli_bad *b)
 {
-    PyErr_Format(PyExc_ValueError, "%s '%s': %s", b->opt, b->val, b->why);
+    char opt[64], why[256];
+    as_keywords(b->opt ? b->opt : "", opt, sizeof opt);
+    as_keywords(b->why, why, sizeof why);
+    if (b->val && *b->val)
+        PyErr_Format(PyExc_ValueError, "%s=%s: %s", opt, b->val, why);
+    else
+        PyErr_Format(PyExc_ValueError, "%s: %s", opt, why);
     return -1;
 }
 

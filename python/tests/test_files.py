@@ -28,7 +28,7 @@ def test_read_columns(tmp_path):
     np.savetxt(tmp_path / "c.txt", data, fmt="%.17g")
     pts, _, _, _ = jetfit.read(str(tmp_path / "c.txt"), columns=[4, 2, 0])
     assert np.array_equal(pts, data[:, [4, 2, 0]])
-    with pytest.raises(ValueError, match="^--columns '1,2': expected 3 or 6 column numbers$"):
+    with pytest.raises(ValueError, match="^columns=1,2: expected 3 or 6 column numbers$"):
         jetfit.read(str(tmp_path / "c.txt"), columns=[1, 2])
 
 
@@ -114,7 +114,7 @@ def test_read_bad_rows(tmp_path, cmd):
         pts, _, _, _ = jetfit.read(str(f), bad_rows="skip")
     assert "jetfit: " + str(w[0].message) in err
     assert pts.shape == (4, 3) and np.isnan(pts[2]).all() and (pts[3] == [0, 1, 0]).all()
-    with pytest.raises(ValueError, match="^--bad-rows 'keep': "):
+    with pytest.raises(ValueError, match="^bad_rows=keep: "):
         jetfit.read(str(f), bad_rows="keep")
 
 
@@ -188,3 +188,17 @@ def test_read_attributes_las(tmp_path, cmd):
     for name in ref.dtype.names[3:]:
         assert np.array_equal(attrs2[name], ref[name], equal_nan=True), name
     assert attrs2["degree"].dtype == np.int32 and attrs2["nx"].dtype == np.float64
+
+
+def test_write_las_then_read_its_normals(tmp_path):
+    """issue 31: write() sets the LAS frame itself (it failed naming an
+    internal function), and the nx ny nz Extra Bytes read back as normals."""
+    pts = np.random.default_rng(3).normal(size=(800, 3))
+    pts /= np.linalg.norm(pts, axis=1)[:, None]
+    r = jetfit.estimate(pts, neighbors="knn:12", orient="viewpoint:0,0,0")
+    jetfit.write(str(tmp_path / "o.las"), r)
+    p2, n2, _, attrs = jetfit.read(str(tmp_path / "o.las"))
+    assert np.abs(p2 - pts).max() < 1e-6  # LAS stores integers at its scale
+    assert n2 is not None and np.array_equal(n2, r.normal)  # doubles in Extra Bytes
+    r2 = jetfit.estimate(p2, normals=n2, neighbors="knn:12", orient="input")
+    assert ((r2.normal * p2).sum(axis=1) < 0).all()  # inwards, as the file's

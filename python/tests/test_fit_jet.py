@@ -45,7 +45,7 @@ def test_weights_and_errors():
         jetfit.fit_jet(nb, 2, weights=np.ones(29))
     with pytest.raises(ValueError, match="weights: expected finite values >= 0"):
         jetfit.fit_jet(nb, 2, weights=-np.ones(30))
-    with pytest.raises(ValueError, match="^--degree '10': expected an integer 1..9$"):
+    with pytest.raises(ValueError, match="^degree=10: expected an integer 1..9$"):
         jetfit.fit_jet(nb, 10)
     few = jetfit.fit_jet(nb[:2], 2)
     assert few.status & jetfit.STATUS["failed"] and np.isnan(few.k1)

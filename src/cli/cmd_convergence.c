@@ -1,4 +1,4 @@
-/* cmd_convergence.c -- `jetfit convergence --out DIR [--quick]`: the §6.1
+/* cmd_convergence.c -- `jetfit convergence -o DIR [--quick]`: the §6.1
  * experiment end to end (src/synth/convergence.c), its tables and the plots of
  * Figures 5-12 made with gnuplot (optional: without it the CSVs are still
  * written and a note goes to stderr). */
@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "args.h"
 #include "cmd.h"
 #include "gnuplot.h"
 #include "convergence.h"
@@ -17,7 +18,7 @@
 static void usage(FILE *out)
 {
     fprintf(out,
-        "usage: jetfit convergence --out DIR [--quick] [--seed S] [--finest K]\n"
+        "usage: jetfit convergence -o DIR [--quick] [--seed S] [--finest K]\n"
         "         [--no-plots]\n"
         "\n"
         "The paper's 6.1 experiment: f(u,v) = 0.1 exp(2u + v - v^2) on a\n"
@@ -28,7 +29,7 @@ static void usage(FILE *out)
         "lattice over [-0.25, 0.25]^2; errors against the exact values: sine of\n"
         "the normal angle, relative errors of kmin and kmax (average, maximum).\n"
         "\n"
-        "  --out DIR   writes DIR/convergence.csv\n"
+        "  -o, --output DIR  (also --out DIR) writes DIR/convergence.csv\n"
         "              (mode,degree,h,normal_avg,normal_max,kmin_avg,kmin_max,\n"
         "              kmax_avg,kmax_max), DIR/slopes.csv (mode,degree,\n"
         "              normal_slope,kmin_slope,kmax_slope: least-squares slopes of\n"
@@ -40,7 +41,8 @@ static void usage(FILE *out)
         "  --seed S    grid perturbation seed (default 1); same seed, same bits\n"
         "  --finest K  h down to 2^-K, K in 3..9 (default 6, the paper's; 8 or 9\n"
         "              shows the double-precision floor of high degrees)\n"
-        "  --no-plots  do not run gnuplot\n");
+        "  --no-plots  do not run gnuplot\n"
+        "  -h, --help  this text\n");
 }
 
 static const char *mode_name(jf_fit_mode m) { return m == JF_FIT_INTERP ? "interp" : "approx"; }
@@ -222,39 +224,51 @@ int jf_cmd_convergence(int argc, char **argv)
     int quick = 0, plots = 1;
     unsigned long long seed = 1;
     int finest = 6;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+    static const jf_cli_optdef optdefs[] = {
+        {"--output", 1, 'o', NULL},
+        {"--out", 1, 0, "--output"},
+        {"--help", 0, 'h', NULL},
+        {"--quick", 0, 0, NULL},
+        {"--no-plots", 0, 0, NULL},
+        {"--finest", 1, 0, NULL},
+        {"--seed", 1, 0, NULL},
+        {NULL, 0, 0, NULL}};
+    const jf_cli_optdef *const tables[] = {optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        const char *a = args.name, *v = args.val;
+        if (k == JF_CLI_ERROR || k == JF_CLI_OPERAND) {
+            if (k == JF_CLI_OPERAND) snprintf(args.err, sizeof args.err, "unexpected argument '%s'", v);
+            fprintf(stderr, "jetfit convergence: %s (jetfit convergence --help)\n", args.err);
+            return 2;
+        } else if (!strcmp(a, "--help")) {
             usage(stdout);
             return 0;
-        } else if (!strcmp(argv[i], "--quick")) {
+        } else if (!strcmp(a, "--quick")) {
             quick = 1;
-        } else if (!strcmp(argv[i], "--no-plots")) {
+        } else if (!strcmp(a, "--no-plots")) {
             plots = 0;
-        } else if (!strcmp(argv[i], "--out") && i + 1 < argc) {
-            dir = argv[++i];
-        } else if (!strcmp(argv[i], "--finest") && i + 1 < argc) {
-            const char *v = argv[++i];
+        } else if (!strcmp(a, "--output")) {
+            dir = v;
+        } else if (!strcmp(a, "--finest")) {
             if (strlen(v) != 1 || v[0] < '3' || v[0] > '9') {
                 fprintf(stderr, "jetfit convergence: --finest wants K in 3..9, not '%s'\n", v);
                 return 2;
             }
             finest = v[0] - '0';
-        } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+        } else { /* --seed */
             char *end;
-            const char *v = argv[++i];
             errno = 0;
             seed = strtoull(v, &end, 10);
             if (end == v || *end || errno || *v == '-') {
                 fprintf(stderr, "jetfit convergence: --seed wants a non-negative integer, not '%s'\n", v);
                 return 2;
             }
-        } else {
-            fprintf(stderr, "jetfit convergence: unknown or incomplete option '%s' (jetfit convergence --help)\n", argv[i]);
-            return 2;
         }
     }
     if (!dir) {
-        fprintf(stderr, "jetfit convergence: --out DIR is required (jetfit convergence --help)\n");
+        fprintf(stderr, "jetfit convergence: -o DIR is required (jetfit convergence --help)\n");
         return 2;
     }
     struct stat sb;

@@ -15,6 +15,7 @@
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
 #include "jetfit.h"
 #include "opts.h"
+#include "pipes.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -23,13 +24,18 @@ static void usage(FILE *f)
     jf_params p;
     jf_params_init(&p);
     fprintf(f,
-        "usage: jetfit estimate INPUT -o OUTPUT [options]\n"
+        "usage: jetfit estimate [options] INPUT -o OUTPUT\n"
         "\n"
         "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
         "and writes one row per input point, in input order.\n"
         "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx .e57   OUTPUT: .ply .csv .xyz .txt .las\n"
         "\n"
-        "  -o, --output FILE     output file (written to a temporary, renamed at the end)\n"
+        "  -o, --output FILE     output file (written to a temporary, renamed at the end);\n"
+        "                        '-' is standard output (with --output-format)\n"
+        "  --input-format FMT    read INPUT as FMT (ply xyz txt pts csv off las ptx)\n"
+        "                        whatever its extension; needed when INPUT is '-'\n"
+        "                        (standard input, e.g. a pipe from PDAL or awk)\n"
+        "  --output-format FMT   write FMT (ply csv xyz txt las) whatever the name\n"
         "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
         "                        | natural[:N]     (default " DEFAULT_NEIGHBORS "; K and N count\n"
         "                        the point; radius:R keeps at most the 256 nearest)\n"
@@ -40,7 +46,9 @@ static void usage(FILE *f)
         "  --frame MODE          pca | axis (default pca)\n"
         "  --max-cond X          lower the degree while cond > X (default %g)\n"
         "  --orient MODE         none | input | viewpoint:X,Y,Z | scanner | mst[:K]\n"
-        "                        (default: input if INPUT has normals, else none;\n"
+        "                        (default: scanner for a PTX INPUT (its scanner\n"
+        "                        positions), else input if INPUT has normals,\n"
+        "                        else none;\n"
         "                        mst uses K nearest neighbours, default 8)\n"
         "  --normal MODE         natural only: tangent plane from auto | poles |\n"
         "                        mincirc (both: 3D Delaunay) | pca (PCA of knn:16)\n"
@@ -82,8 +90,10 @@ static void usage(FILE *f)
         "                        the scale is the smallest power of ten >= 1e-7\n"
         "                        keeping counts in int32, with a warning when an\n"
         "                        outlier makes it coarse (docs/formats.md)\n"
-        "  --quiet               no progress line, no summary\n"
+        "  -q, --quiet           no progress line, no summary\n"
         "  -h, --help            this text\n"
+        "Options follow GNU conventions: --opt=V or --opt V, -oFILE, unique\n"
+        "abbreviations (--deg 3), '--' ends the options.\n"
         "\n"
         "Columns: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z [b0..b3] [c0..c4]\n"
         "         degree neighbors cond residual status\n"
@@ -105,6 +115,10 @@ static unsigned long long mem_available(void)
 
 static int bad_option(const char *opt, const char *val, const char *why)
 {
+    if (!opt) { /* the scanner's whole message (args.h) */
+        fprintf(stderr, "jetfit estimate: %s (jetfit estimate --help)\n", why);
+        return 2;
+    }
     fprintf(stderr, "jetfit estimate: %s '%s': %s (jetfit estimate --help)\n", opt,
             val ? val : "", why);
     return 2;
@@ -266,7 +280,7 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
-    jf_status st = jf_cloud_read(in, &e.ro, &c, &err);
+    jf_status st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;
@@ -292,9 +306,13 @@ int jf_cmd_estimate(int argc, char **argv)
     jf_column cols[JF_RESULT_MAX_COLS];
     size_t ncols = jf_result_columns(monge, cols);
     jf_writer *w = NULL;
-    st = jf_writer_open(out, cols, ncols, c.n, ascii, &w, &err);
+    jf_cli_out po; /* "-o -" and --output-format: through a private file */
+    st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
+    if (st == JF_OK) st = jf_writer_open(po.path, cols, ncols, c.n, ascii, &w, &err);
     if (st != JF_OK) {
+        jf_cli_out_msg(&po, &err);
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -339,6 +357,7 @@ int jf_cmd_estimate(int argc, char **argv)
                                          "Extra Bytes"
                                        : jf_strerror(st));
         jf_writer_abort(w);
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -356,11 +375,13 @@ int jf_cmd_estimate(int argc, char **argv)
         if (!sk.rows || !sk.tl || (!quiet && !sk.cond))
             fprintf(stderr, "jetfit: out of memory (%zu points)\n", c.n);
         st = jf_writer_commit(w, &err);
+        jf_cli_out_msg(&po, &err);
         if (st != JF_OK && sk.rows && sk.tl && (quiet || sk.cond))
             fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         free(sk.rows);
         free(sk.tl);
         free(sk.cond);
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -393,6 +414,7 @@ int jf_cmd_estimate(int argc, char **argv)
          * why (commit fails on it, and removes the temporary) */
         jf_error werr = {{0}};
         if (sk.wfail && jf_writer_commit(w, &werr) != JF_OK && werr.msg[0]) {
+            jf_cli_out_msg(&po, &werr);
             fprintf(stderr, "jetfit: %s\n", werr.msg);
         } else {
             if (!sk.wfail) jf_writer_abort(w);
@@ -400,6 +422,7 @@ int jf_cmd_estimate(int argc, char **argv)
         }
         free(sk.tl);
         free(sk.cond);
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -433,6 +456,8 @@ int jf_cmd_estimate(int argc, char **argv)
                         "failed or nonfinite)\n", in, unfit, c.n);
     /* commit reports a failed row too, and removes the temporary */
     st = jf_writer_commit(w, &err);
+    if (st == JF_OK) st = jf_cli_out_finish(&po, 1, &err); /* to standard output, or renamed */
+    else jf_cli_out_msg(&po, &err), jf_cli_out_finish(&po, 0, NULL);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         free(sk.tl);

@@ -7,8 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "args.h"
 #include "cmd.h"
 #include "eval_errors.h"
+#include "pipes.h"
 #include "jetfit.h"
 
 static void usage(FILE *out)
@@ -32,7 +34,10 @@ static void usage(FILE *out)
         "k_rel = |k - k_t| / max(|k_t|, 1) (PCPNet) and k_abs = |k - k_t|, after\n"
         "orienting the estimate along the true normal.  PCPNet's .curv holds two\n"
         "curvatures per point, sorted here as k1 >= k2 w.r.t. its .normals with\n"
-        "the sign convention of jetfit (a sphere with outward normals has k < 0).\n");
+        "the sign convention of jetfit (a sphere with outward normals has k < 0).\n"
+        "  --input-format FMT  read RESULT as FMT (ply csv xyz txt las); '-' as\n"
+        "               RESULT is standard input (jetfit estimate ... -o - | ...)\n"
+        "  -h, --help   this text\n");
 }
 
 /* Column indices of a result, -1 where missing. */
@@ -74,28 +79,38 @@ int jf_cmd_eval(int argc, char **argv)
 {
     const char *res_path = NULL, *truth_path = NULL, *subset_path = NULL;
     int by_status = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            usage(stdout);
-            return 0;
-        } else if (!strcmp(argv[i], "--subset")) {
-            if (++i >= argc) {
-                fprintf(stderr, "jetfit eval: --subset needs a file\n");
+    static const jf_cli_optdef optdefs[] = {
+        {"--help", 0, 'h', NULL},
+        {"--subset", 1, 0, NULL},
+        {"--by-status", 0, 0, NULL},
+        {"--input-format", 1, 0, NULL},
+        {NULL, 0, 0, NULL}};
+    const char *in_fmt = NULL;
+    const jf_cli_optdef *const tables[] = {optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        if (k == JF_CLI_ERROR) {
+            fprintf(stderr, "jetfit eval: %s (jetfit eval --help)\n", args.err);
+            return 2;
+        } else if (k == JF_CLI_OPERAND) {
+            if (!res_path) {
+                res_path = args.val;
+            } else if (!truth_path) {
+                truth_path = args.val;
+            } else {
+                fprintf(stderr, "jetfit eval: unexpected argument '%s'\n", args.val);
                 return 2;
             }
-            subset_path = argv[i];
-        } else if (!strcmp(argv[i], "--by-status")) {
+        } else if (!strcmp(args.name, "--help")) {
+            usage(stdout);
+            return 0;
+        } else if (!strcmp(args.name, "--subset")) {
+            subset_path = args.val;
+        } else if (!strcmp(args.name, "--input-format")) {
+            in_fmt = args.val;
+        } else { /* --by-status */
             by_status = 1;
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            fprintf(stderr, "jetfit eval: unknown option '%s'\n", argv[i]);
-            return 2;
-        } else if (!res_path) {
-            res_path = argv[i];
-        } else if (!truth_path) {
-            truth_path = argv[i];
-        } else {
-            fprintf(stderr, "jetfit eval: unexpected argument '%s'\n", argv[i]);
-            return 2;
         }
     }
     if (!res_path || !truth_path) {
@@ -111,7 +126,11 @@ int jf_cmd_eval(int argc, char **argv)
     char msg[4200];
     jf_eval_table res;
     jf_error e;
-    jf_status st = jf_eval_table_read(res_path, &res, &e);
+    e.msg[0] = '\0';
+    jf_cli_in rin; /* '-' and --input-format (pipes.h) */
+    jf_status st = jf_cli_in_begin(&rin, res_path, in_fmt, &e);
+    if (st == JF_OK) st = jf_eval_table_read(rin.path, &res, &e);
+    jf_cli_in_end(&rin, st != JF_OK ? &e : NULL);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit eval: %s\n", e.msg[0] ? e.msg : jf_strerror(st));
         return 1;

@@ -9,11 +9,18 @@
 #include <string.h>
 #include <strings.h>
 
+#include "args.h"
 #include "cmd.h"
+#include "pipes.h"
 #include "jetfit.h"
 #include "surfaces.h"
 
 #define DEFAULT_N 10000
+
+static int gen_write(jf_surface surf, const char *surf_name, int grid, int mesh, double grid_h,
+                     double perturb, unsigned long long n, jf_density density,
+                     unsigned long long seed, double noise, double noise_u, double outliers,
+                     const char *truth, int ascii, const char *out);
 
 static void usage(FILE *out)
 {
@@ -37,8 +44,10 @@ static void usage(FILE *out)
         "              hyperbolic inside); area-uniform samples\n"
         "              closed surfaces: outward normal (so convex k < 0)\n"
         "\n"
-        "  -o FILE          output: .ply (binary; --ascii for ascii), .off, .xyz,\n"
-        "                   .txt, .csv (a mesh needs .ply or .off)\n"
+        "  -o, --output FILE  output: .ply (binary; --ascii for ascii), .off, .xyz,\n"
+        "                   .txt, .csv, .las (a mesh needs .ply or .off); '-' is\n"
+        "                   standard output (with --output-format)\n"
+        "  --output-format FMT  write FMT (ply off xyz txt csv las) whatever the name\n"
         "  --n N            N random samples (default %d); with --mesh, a grid\n"
         "                   of about N vertices\n"
         "  --grid-h H       a grid of side H in parameter space instead (graphs:\n"
@@ -191,9 +200,37 @@ int jf_cmd_generate(int argc, char **argv)
     int mesh = 0, ascii = 0, have_perturb = 0;
     jf_density density = JF_DENSITY_UNIFORM;
 
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+    static const jf_cli_optdef optdefs[] = {
+        {"--output", 1, 'o', NULL},
+        {"--output-format", 1, 0, NULL},
+        {"--help", 0, 'h', NULL},
+        {"--mesh", 0, 0, NULL},
+        {"--ascii", 0, 0, NULL},
+        {"--truth", 1, 0, NULL},
+        {"--n", 1, 0, NULL},
+        {"--seed", 1, 0, NULL},
+        {"--density", 1, 0, NULL},
+        {"--grid-h", 1, 0, NULL},
+        {"--perturb", 1, 0, NULL},
+        {"--noise", 1, 0, NULL},
+        {"--noise-uniform", 1, 0, NULL},
+        {"--outliers", 1, 0, NULL},
+        {NULL, 0, 0, NULL}};
+    const jf_cli_optdef *const tables[] = {optdefs, NULL};
+    const char *out_fmt = NULL;
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        const char *a = args.name, *v = args.val;
+        if (k == JF_CLI_ERROR)
+            return fail("%s", args.err);
+        if (k == JF_CLI_OPERAND) {
+            if (surf_name)
+                return fail("unexpected argument '%s'", v);
+            surf_name = v;
+            continue;
+        }
+        if (!strcmp(a, "--help")) {
             usage(stdout);
             return 0;
         }
@@ -205,26 +242,11 @@ int jf_cmd_generate(int argc, char **argv)
             ascii = 1;
             continue;
         }
-        if (a[0] != '-') {
-            if (surf_name)
-                return fail("unexpected argument '%s'", a);
-            surf_name = a;
-            continue;
-        }
-        static const char *const valued[] = {
-            "-o", "--truth", "--n", "--seed", "--density", "--grid-h",
-            "--perturb", "--noise", "--noise-uniform", "--outliers"};
-        int known = 0;
-        for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
-            known |= !strcmp(a, valued[k]);
-        if (!known)
-            return fail("unknown option '%s'", a);
-        if (i + 1 >= argc)
-            return fail("%s needs a value", a);
-        const char *v = argv[++i];
         double d;
-        if (!strcmp(a, "-o")) {
+        if (!strcmp(a, "--output")) {
             out = v;
+        } else if (!strcmp(a, "--output-format")) {
+            out_fmt = v;
         } else if (!strcmp(a, "--truth")) {
             truth = v;
         } else if (!strcmp(a, "--n")) {
@@ -281,9 +303,32 @@ int jf_cmd_generate(int argc, char **argv)
         return fail("%s", "--perturb applies to grids (--grid-h or --mesh)");
     if (grid && density != JF_DENSITY_UNIFORM)
         return fail("%s", "--density applies to random clouds (not --grid-h or --mesh)");
-    if (mesh && !has_ext(out, ".ply") && !has_ext(out, ".off"))
-        return fail("--mesh needs a .ply or .off output, not '%s'", out);
+    /* "-o -" and --output-format: through a private file (pipes.h) */
+    jf_cli_out po;
+    jf_error perr = {{0}};
+    if (jf_cli_out_begin(&po, out, out_fmt, &perr))
+        return fail("%s", perr.msg);
+    const char *shown = out;
+    out = po.path;
+    if (mesh && !has_ext(out, ".ply") && !has_ext(out, ".off")) {
+        jf_cli_out_finish(&po, 0, NULL);
+        return fail("--mesh needs a .ply or .off output, not '%s'", shown);
+    }
+    int rc = gen_write(surf, surf_name, grid, mesh, grid_h, perturb, n, density, seed, noise,
+                       noise_u, outliers, truth, ascii, out);
+    if (jf_cli_out_finish(&po, rc == 0, &perr)) {
+        fprintf(stderr, "jetfit generate: %s\n", perr.msg);
+        return 1;
+    }
+    return rc;
+}
 
+/* Samples and writes (out: the file to write, maybe a private one). */
+static int gen_write(jf_surface surf, const char *surf_name, int grid, int mesh, double grid_h,
+                     double perturb, unsigned long long n, jf_density density,
+                     unsigned long long seed, double noise, double noise_u, double outliers,
+                     const char *truth, int ascii, const char *out)
+{
     jf_rng rng;
     jf_rng_seed(&rng, (uint64_t)seed);
     jf_sample s;

@@ -22,8 +22,10 @@
 #include <strings.h>
 #include <sys/wait.h>
 
+#include "args.h"
 #include "cmd.h"
 #include "gnuplot.h"
+#include "pipes.h"
 #include "jetfit.h"
 
 #ifndef M_PI
@@ -41,7 +43,7 @@ static void usage(FILE *out)
         "                .csv, .xyz/.txt, .las): columns x y z, k1 k2 for --color,\n"
         "                d1x..d2z for --directions (mesh faces are not drawn:\n"
         "                the vertices are)\n"
-        "  -o FILE.png   the picture (PNG, gnuplot's pngcairo terminal)\n"
+        "  -o, --output FILE.png  the picture (PNG, gnuplot's pngcairo terminal)\n"
         "  --color Q     k1 (kmax), k2 (kmin), mean (k1+k2)/2 (default), gauss\n"
         "                k1 k2, aniso (k1 - k2)/(|k1| + |k2|) (0 at umbilics), or\n"
         "                none; range =\n"
@@ -56,7 +58,10 @@ static void usage(FILE *out)
         "  --title TEXT  a title (default: the file name and the colour)\n"
         "  --size W,H    pixels (default 800,700)\n"
         "  --small       gnuplot's libgd png terminal (256 colours, no\n"
-        "                anti-aliasing): files several times smaller\n");
+        "                anti-aliasing): files several times smaller\n"
+        "  --input-format FMT  read RESULT as FMT (ply csv xyz txt las); '-' as\n"
+        "                RESULT is standard input (jetfit estimate ... -o - | ...)\n"
+        "  -h, --help    this text\n");
 }
 
 static int bad(const char *fmt, const char *arg)
@@ -119,9 +124,34 @@ int jf_cmd_render(int argc, char **argv)
     int dirs = 0, small = 0, top = 0, w = 800, hgt = 700;
     double rotx = 60, rotz = 30, ps = 0;
     unsigned long glyphs = 400;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+    static const jf_cli_optdef optdefs[] = {
+        {"--output", 1, 'o', NULL},
+        {"--help", 0, 'h', NULL},
+        {"--directions", 0, 0, NULL},
+        {"--small", 0, 0, NULL},
+        {"--color", 1, 0, NULL},
+        {"--view", 1, 0, NULL},
+        {"--glyphs", 1, 0, NULL},
+        {"--point-size", 1, 0, NULL},
+        {"--title", 1, 0, NULL},
+        {"--size", 1, 0, NULL},
+        {"--input-format", 1, 0, NULL},
+        {NULL, 0, 0, NULL}};
+    const char *in_fmt = NULL;
+    const jf_cli_optdef *const tables[] = {optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        const char *a = args.name, *v = args.val;
+        if (k == JF_CLI_ERROR)
+            return bad("%s", args.err);
+        if (k == JF_CLI_OPERAND) {
+            if (in)
+                return bad("unexpected argument '%s'", v);
+            in = v;
+            continue;
+        }
+        if (!strcmp(a, "--help")) {
             usage(stdout);
             return 0;
         }
@@ -133,22 +163,11 @@ int jf_cmd_render(int argc, char **argv)
             small = 1;
             continue;
         }
-        if (a[0] != '-') {
-            if (in)
-                return bad("unexpected argument '%s'", a);
-            in = a;
-            continue;
-        }
-        if (strcmp(a, "-o") && strcmp(a, "--color") && strcmp(a, "--view") &&
-            strcmp(a, "--glyphs") && strcmp(a, "--point-size") &&
-            strcmp(a, "--title") && strcmp(a, "--size"))
-            return bad("unknown option '%s'", a);
-        if (i + 1 >= argc)
-            return bad("%s needs a value", a);
-        const char *v = argv[++i];
         char *end;
-        if (!strcmp(a, "-o")) {
+        if (!strcmp(a, "--output")) {
             out = v;
+        } else if (!strcmp(a, "--input-format")) {
+            in_fmt = v;
         } else if (!strcmp(a, "--title")) {
             title = v;
         } else if (!strcmp(a, "--color")) {
@@ -198,7 +217,10 @@ int jf_cmd_render(int argc, char **argv)
 
     jf_eval_table t;
     jf_error err = {{0}};
-    jf_status st = jf_eval_table_read(in, &t, &err);
+    jf_cli_in rin; /* '-' and --input-format (pipes.h) */
+    jf_status st = jf_cli_in_begin(&rin, in, in_fmt, &err);
+    if (st == JF_OK) st = jf_eval_table_read(rin.path, &t, &err);
+    jf_cli_in_end(&rin, st ? &err : NULL);
     if (st) {
         fprintf(stderr, "jetfit render: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;
@@ -337,10 +359,16 @@ int jf_cmd_render(int argc, char **argv)
     fprintf(gp, "\nunset key\nset border 0\nunset xtics\nunset ytics\nunset ztics\n");
     fprintf(gp, diverging ? "set palette defined (0 '#762a83', 0.5 '#f2f2f2', 1 '#1b7837')\n"
                           : "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n");
-    if (need_k)
-        fprintf(gp, "set cbrange [%.9g:%.9g]\nset cblabel '%s'\n", vlo, vhi, color);
-    else
+    if (need_k) {
+        /* curvatures are 1/length (the input's unit); gauss 1/length^2;
+         * aniso is a ratio */
+        const char *unit = !strcmp(color, "gauss")   ? " (1/length^2)"
+                           : !strcmp(color, "aniso") ? " (no unit)"
+                                                     : " (1/length)";
+        fprintf(gp, "set cbrange [%.9g:%.9g]\nset cblabel '%s%s'\n", vlo, vhi, color, unit);
+    } else {
         fprintf(gp, "unset colorbox\n");
+    }
     /* data: x y z value; glyph segments: x y z dx dy dz, per direction */
     fprintf(gp, "$pts << EOD\n");
     for (size_t k = 0; k < n; k++) {

@@ -239,7 +239,7 @@ int jf_cli_truth_coords_check(const char *truth_path, const jf_eval_table *res, 
     } else if (exact && worst_d > 1e-9 * diag) {
         snprintf(msg, len, "%s: row %zu: point differs from the result's by %.3g (%.3g of the "
                            "bounding-box diagonal): not the same cloud",
-                 path, worst, worst_d, diag > 0 ? worst_d / diag : INFINITY);
+                 path, worst + 1, worst_d, diag > 0 ? worst_d / diag : INFINITY);
         rc = -1;
     } else if (!exact && nd) {
         qsort(d, nd, sizeof *d, cmp_double);

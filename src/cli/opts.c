@@ -62,16 +62,33 @@ void jf_cli_est_init(jf_cli_est *e)
     e->dsel_s = "";
 }
 
-static const char *const valued[] = {
-    "--neighbors", "--neighbours", "--degree", "--monge-degree", "--fit", "--frame",
-    "--max-cond", "--orient", "--normal", "--robust", "--scales", "--degree-select",
-    "--dist-weight", "--columns", "--threads", "--bad-rows"};
+/* The estimation options, one per line (a new option: one row here and
+ * its branch in jf_cli_est_option).  Every command that takes them scans
+ * its command line with this table (args.h). */
+const jf_cli_optdef jf_cli_est_optdefs[] = {
+    {"--neighbors", 1, 0, NULL},
+    {"--neighbours", 1, 0, "--neighbors"},
+    {"--degree", 1, 0, NULL},
+    {"--monge-degree", 1, 0, NULL},
+    {"--fit", 1, 0, NULL},
+    {"--frame", 1, 0, NULL},
+    {"--max-cond", 1, 0, NULL},
+    {"--orient", 1, 0, NULL},
+    {"--normal", 1, 0, NULL},
+    {"--robust", 1, 0, NULL},
+    {"--scales", 1, 0, NULL},
+    {"--degree-select", 1, 0, NULL},
+    {"--dist-weight", 1, 0, NULL},
+    {"--columns", 1, 0, NULL},
+    {"--threads", 1, 0, NULL},
+    {"--bad-rows", 1, 0, NULL},
+    {"--robust-normals", 0, 0, NULL},
+    {NULL, 0, 0, NULL}};
 
 int jf_cli_est_takes_value(const char *name)
 {
-    if (!strcmp(name, "--robust-normals")) return 0;
-    for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
-        if (!strcmp(name, valued[k])) return 1;
+    for (const jf_cli_optdef *d = jf_cli_est_optdefs; d->name; d++)
+        if (!strcmp(name, d->name)) return d->arg;
     return -1;
 }
 
@@ -263,56 +280,49 @@ static int parse_xyz(const char *s, double v[3], int positive)
     return k == 0 || k == 2;
 }
 
+/* estimate's own options (and jetfit-mpi estimate's) */
+static const jf_cli_optdef estimate_optdefs[] = {
+    {"--output", 1, 'o', NULL},
+    {"--quiet", 0, 'q', NULL},
+    {"--help", 0, 'h', NULL},
+    {"--ascii", 0, 0, NULL},
+    {"--keep", 1, 0, NULL},
+    {"--memory", 1, 0, NULL},
+    {"--input-format", 1, 0, NULL},
+    {"--output-format", 1, 0, NULL},
+    {"--las-scale", 1, 0, NULL},
+    {"--las-offset", 1, 0, NULL},
+    {NULL, 0, 0, NULL}};
+
 int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad)
 {
     memset(cmd, 0, sizeof *cmd);
     cmd->keep = 1;
     jf_cli_est *e = &cmd->e;
     jf_cli_est_init(e);
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    const jf_cli_optdef *const tables[] = {estimate_optdefs, jf_cli_est_optdefs, NULL};
+    jf_cli_args *a = &cmd->args;
+    jf_cli_args_init(a, argc, argv, tables);
+    int k;
+    while ((k = jf_cli_args_next(a)) != JF_CLI_END) {
+        const char *name = a->name, *val = a->val;
+        if (k == JF_CLI_ERROR) return bad_set(bad, NULL, "", a->err); /* the whole message */
+        if (k == JF_CLI_OPERAND) {
+            if (cmd->in) return bad_set(bad, "argument", val, "only one INPUT file is accepted");
+            cmd->in = val;
+        } else if (!strcmp(name, "--help")) {
             cmd->help = 1;
             return 0;
-        }
-        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+        } else if (!strcmp(name, "--quiet")) {
             cmd->quiet = 1;
-            continue;
-        }
-        if (!strcmp(a, "--ascii")) {
+        } else if (!strcmp(name, "--ascii")) {
             cmd->ascii = 1;
-            continue;
-        }
-        if (jf_cli_est_takes_value(a) == 0) {
-            (void)jf_cli_est_option(e, a, NULL, bad);
-            continue;
-        }
-        if (a[0] != '-' || !a[1]) {
-            if (cmd->in) return bad_set(bad, "argument", a, "only one INPUT file is accepted");
-            cmd->in = a;
-            continue;
-        }
-        /* every other option takes a value: "--opt VALUE" or "--opt=VALUE" */
-        char name[32];
-        const char *val = NULL, *eq = strchr(a, '=');
-        if (eq && (size_t)(eq - a) < sizeof name) {
-            memcpy(name, a, (size_t)(eq - a));
-            name[eq - a] = '\0';
-            val = eq + 1;
-        } else {
-            snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc)
-                return strcmp(name, "-o") && strcmp(name, "--output") && strcmp(name, "--keep") &&
-                               strcmp(name, "--memory") && strcmp(name, "--las-scale") &&
-                               strcmp(name, "--las-offset") &&
-                               jf_cli_est_takes_value(name) != 1
-                           ? bad_set(bad, "unknown option", a, "not an option of estimate")
-                           : bad_set(bad, a, "", "needs a value");
-            val = argv[++i];
-        }
-        if (!strcmp(name, "-o") || !strcmp(name, "--output")) {
+        } else if (!strcmp(name, "--output")) {
             cmd->out = val;
+        } else if (!strcmp(name, "--input-format")) {
+            cmd->in_fmt = val;
+        } else if (!strcmp(name, "--output-format")) {
+            cmd->out_fmt = val;
         } else if (!strcmp(name, "--memory")) {
             if (!(cmd->memory = jf_cli_parse_size(val)))
                 return bad_set(bad, "--memory", val, "expected a size such as 8G, 256M or 1500000000");
@@ -327,18 +337,12 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
             if (!strcmp(val, "all")) cmd->keep = 1;
             else if (!strcmp(val, "none")) cmd->keep = 0;
             else return bad_set(bad, "--keep", val, "expected all or none");
-        } else if (jf_cli_est_takes_value(name) != 1) {
-            return bad_set(bad, "unknown option", a, "not an option of estimate");
         } else if (jf_cli_est_option(e, name, val, bad)) {
-            if (bad->opt == name) { /* name dies with this loop */
-                memcpy(cmd->badname, name, sizeof cmd->badname);
-                bad->opt = cmd->badname;
-            }
             return -1;
         }
     }
-    if (!cmd->in) return bad_set(bad, "INPUT", "", "missing input file");
-    if (!cmd->out) return bad_set(bad, "-o", "", "missing output file");
+    if (!cmd->in) return bad_set(bad, "INPUT", "", "missing input file ('-': standard input)");
+    if (!cmd->out) return bad_set(bad, "-o", "", "missing output file ('-o -': standard output)");
     if (jf_cli_est_finish(e, bad)) return -1;
     return 0;
 }

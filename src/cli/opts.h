@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 
+#include "args.h"
 #include "jetfit.h"
 
 /* Strict parsing: the whole string must be consumed; 0 or -1. */
@@ -35,6 +36,9 @@ typedef struct {
 
 void jf_cli_est_init(jf_cli_est *e);
 
+/* The estimation options' names (args.h), ended by a {NULL} row. */
+extern const jf_cli_optdef jf_cli_est_optdefs[];
+
 /* 1 if NAME is an estimation option taking a value, 0 if it is one
  * without (--robust-normals), -1 if it is not an estimation option. */
 int jf_cli_est_takes_value(const char *name);
@@ -52,7 +56,8 @@ typedef struct {
     const char *in, *out;
     int quiet, ascii, keep, help;  /* keep: --keep all (1) or none (0) */
     unsigned long long memory;     /* --memory in bytes, 0 = not given  */
-    char badname[32];              /* the option *bad names, when cut from "--opt=VALUE" */
+    const char *in_fmt, *out_fmt;  /* --input-format, --output-format, or NULL */
+    jf_cli_args args;              /* the scanner (its message outlives the parse) */
     int las_scale_set, las_offset_set; /* --las-scale, --las-offset given */
     double las_scale[3], las_offset[3];
 } jf_cli_estimate_cmd;

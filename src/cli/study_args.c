@@ -28,7 +28,7 @@ static void usage(FILE *f)
         "  SURFACE         exp, paraboloid, revolution, sphere, ellipsoid, cylinder,\n"
         "                  torus:\n"
         "                  `jetfit generate SURFACE --n N --seed S+r` with exact truth\n"
-        "  -o DIR          the folder (made if missing): study.csv, study.def, best.csv,\n"
+        "  -o, --output DIR  the folder (made if missing): study.csv, study.def, best.csv,\n"
         "                  normal.png, curvature.png, k.png, report.html,\n"
         "                  best.ply and view.html (the best setting in 3D)\n"
         "\n"
@@ -53,7 +53,7 @@ static void usage(FILE *f)
         "  --threads N           OpenMP threads of each estimate\n"
         "  --resume              keep the finished cells of DIR/study.csv, run the rest\n"
         "                        (refused when DIR/study.def: input, truth, options, differ)\n"
-        "  --quiet               no progress line, no summary\n"
+        "  -q, --quiet           no progress line, no summary\n"
         "  any other estimate option (e.g. --orient, --columns, --robust) applies\n"
         "  to every cell, before the cell's flag set.\n"
         "\n"
@@ -67,20 +67,6 @@ static int bad_opt(const char *opt, const char *val, const char *why)
     fprintf(stderr, "jetfit study: %s '%s': %s (jetfit study --help)\n", opt, val ? val : "",
             why);
     return 2;
-}
-
-/* 1 if option `n` takes a value (the study's own or estimate's): an
- * unknown option given last is then named as unknown, not as lacking a
- * value (issue 11.10).  Keep in step with the parser below. */
-static int takes_value(const char *n)
-{
-    static const char *const own[] = {"-o", "--output", "--truth", "--subset", "--neighbors",
-                                      "--neighbours", "--degree", "--flags", "--noise",
-                                      "--noise-uniform", "--outliers", "--metrics", "--repeat",
-                                      "--seed", "--n"};
-    for (size_t k = 0; k < sizeof own / sizeof own[0]; k++)
-        if (!strcmp(n, own[k])) return 1;
-    return jf_cli_est_takes_value(n) == 1;
 }
 
 /* ---- lists ---- */
@@ -265,53 +251,65 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
     s->seed = 1;
     for (int m = 0; m < JF_M_COUNT; m++) s->best[m] = 1;
     jf_cli_est_init(&c->base);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    static const jf_cli_optdef optdefs[] = {
+        {"--output", 1, 'o', NULL},
+        {"--help", 0, 'h', NULL},
+        {"--quiet", 0, 'q', NULL},
+        {"--resume", 0, 0, NULL},
+        {"--mesh", 0, 0, NULL},
+        {"--truth", 1, 0, NULL},
+        {"--subset", 1, 0, NULL},
+        {"--flags", 1, 0, NULL},
+        {"--noise", 1, 0, NULL},
+        {"--noise-uniform", 1, 0, NULL},
+        {"--outliers", 1, 0, NULL},
+        {"--metrics", 1, 0, NULL},
+        {"--repeat", 1, 0, NULL},
+        {"--seed", 1, 0, NULL},
+        {"--n", 1, 0, NULL},
+        {NULL, 0, 0, NULL}};
+    /* --neighbors and --degree are the study's axes (lists), from estimate's table */
+    const jf_cli_optdef *const tables[] = {optdefs, jf_cli_est_optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        const char *name = args.name, *val = args.val;
+        if (k == JF_CLI_ERROR) {
+            fprintf(stderr, "jetfit study: %s (jetfit study --help)\n", args.err);
+            return 2;
+        }
+        if (k == JF_CLI_OPERAND) {
+            if (pos) return bad_opt("argument", val, "only one INPUT or SURFACE is accepted");
+            pos = val;
+            continue;
+        }
+        if (!strcmp(name, "--help")) {
             usage(stdout);
             return -1;
         }
-        if (!strcmp(a, "--resume")) {
+        if (!strcmp(name, "--resume")) {
             c->resume = 1;
             continue;
         }
-        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+        if (!strcmp(name, "--quiet")) {
             c->quiet = 1;
             continue;
         }
-        if (!strcmp(a, "--mesh")) {
+        if (!strcmp(name, "--mesh")) {
             c->mesh = 1;
             continue;
         }
-        if (jf_cli_est_takes_value(a) == 0) {
+        if (jf_cli_est_takes_value(name) == 0) {
             jf_cli_bad bad;
-            (void)jf_cli_est_option(&c->base, a, NULL, &bad);
-            base_add(c, a, NULL);
+            (void)jf_cli_est_option(&c->base, name, NULL, &bad);
+            base_add(c, name, NULL);
             continue;
-        }
-        if (a[0] != '-' || !a[1]) {
-            if (pos) return bad_opt("argument", a, "only one INPUT or SURFACE is accepted");
-            pos = a;
-            continue;
-        }
-        char name[32];
-        const char *val, *eq = strchr(a, '=');
-        if (eq && (size_t)(eq - a) < sizeof name) {
-            memcpy(name, a, (size_t)(eq - a));
-            name[eq - a] = '\0';
-            val = eq + 1;
-        } else {
-            snprintf(name, sizeof name, "%s", a);
-            if (i + 1 >= argc)
-                return takes_value(name) ? bad_opt(a, "", "needs a value")
-                                         : bad_opt("unknown option", a, "not an option of study");
-            val = argv[++i];
         }
         int iv;
-        if (!strcmp(name, "-o") || !strcmp(name, "--output")) c->dir = val;
+        if (!strcmp(name, "--output")) c->dir = val;
         else if (!strcmp(name, "--truth")) s->truth = val;
         else if (!strcmp(name, "--subset")) s->subset = val;
-        else if (!strcmp(name, "--neighbors") || !strcmp(name, "--neighbours")) c->nb_text = val;
+        else if (!strcmp(name, "--neighbors")) c->nb_text = val;
         else if (!strcmp(name, "--degree")) c->deg_text = val;
         else if (!strcmp(name, "--flags")) c->flags_text = val;
         else if (!strcmp(name, "--noise")) noise = val;
@@ -334,8 +332,6 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
             jf_cli_bad bad;
             if (jf_cli_est_option(&c->base, name, val, &bad)) return bad_opt(bad.opt, bad.val, bad.why);
             if (strcmp(name, "--threads")) base_add(c, name, val);
-        } else {
-            return bad_opt("unknown option", a, "not an option of study");
         }
     }
     if (!pos) return bad_opt("INPUT", "", "missing INPUT file or SURFACE name");

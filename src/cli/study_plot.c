@@ -21,11 +21,15 @@
 #include "jetfit.h"
 #include "study.h"
 
-/* Line i's look: gnuplot's 8 colours, then the next dash and point. */
+/* Line i's look: 8 colours that read on white (Okabe & Ito's palette
+ * without its yellow, which gnuplot's own 5th colour is), then the next
+ * dash and point. */
 static const char *style(int i)
 {
-    static char buf[80];
-    snprintf(buf, sizeof buf, "lw 2 lc %d dt %d pt %d", 1 + i % 8, 1 + (i / 8) % 5,
+    static const char *const rgb[8] = {"#0072b2", "#d55e00", "#009e73", "#cc79a7",
+                                       "#000000", "#e69f00", "#56b4e9", "#8c564b"};
+    static char buf[96];
+    snprintf(buf, sizeof buf, "lw 2 lc rgb '%s' dt %d pt %d", rgb[i % 8], 1 + (i / 8) % 5,
              (int[]){7, 5, 9, 11, 13}[(i / 8) % 5]);
     return buf;
 }
@@ -56,6 +60,7 @@ static void set_axis(jf_study_key *k, int ax, int i)
 static int noise_lines(FILE *gp, const jf_study *s, int m, int first_block)
 {
     int ax = jf_study_noise_axis(s), nl = 0, blk = first_block;
+    double lo = INFINITY, hi = 0;
     jf_study_key k = {0};
     /* the data blocks */
     for (k.strategy = 0; k.strategy < s->nstrategy; k.strategy++)
@@ -68,9 +73,13 @@ static int noise_lines(FILE *gp, const jf_study *s, int m, int first_block)
                     jf_study_stat st;
                     jf_study_mean(s, &q, m, &st);
                     if (st.n) fprintf(gp, "%.9g %.9g %.9g\n", axis_val(s, ax, i), st.mean, st.sd);
+                    if (st.n) lo = fmin(lo, st.mean), hi = fmax(hi, st.mean);
                 }
                 fprintf(gp, "EOD\n");
             }
+    /* values that span more than a decade (errors at noise 0 against
+     * noisy ones): a log axis, else the small ones lie flat on zero */
+    fprintf(gp, lo > 0 && hi >= 20 * lo ? "set logscale y\n" : "unset logscale y\n");
     blk = first_block;
     for (k.strategy = 0; k.strategy < s->nstrategy; k.strategy++)
         for (k.degree = 0; k.degree < s->ndegree; k.degree++)

@@ -60,6 +60,9 @@ static const char style_script[] =
     "<style>\n"
     "body{font-family:sans-serif;margin:1.5em;color:#222}\n"
     "table{border-collapse:collapse;margin:0.5em 0 1.5em;font-size:13px}\n"
+    /* a wide table scrolls inside the page (a 1280-pixel window): the page never does */
+    "div.scroll{max-width:100%;overflow-x:auto}\n"
+    "td.t{max-width:24em;overflow-wrap:anywhere}\n"
     "th,td{border:1px solid #ccc;padding:2px 6px;text-align:right}\n"
     "td.t,th.t{text-align:left}\n"
     "th{background:#eef;cursor:pointer;user-select:none}\n"
@@ -120,7 +123,7 @@ static void best_table(FILE *f, const jf_study *s)
 {
     static const char *const h[] = {"metric", "noise", "noise_uniform", "outliers", "strategy",
                                     "degree", "flags", "mean", "sd", "repeats"};
-    fputs("<table id=\"best\" class=\"sortable\">\n", f);
+    fputs("<div class=\"scroll\"><table id=\"best\" class=\"sortable\">\n", f);
     head_cells(f, h, 10);
     jf_study_key lvl = {0};
     for (lvl.noise = 0; lvl.noise < s->nnoise; lvl.noise++)
@@ -137,7 +140,7 @@ static void best_table(FILE *f, const jf_study *s)
                     num(f, st.sd);
                     fprintf(f, "<td>%d</td></tr>\n", st.n);
                 }
-    fputs("</tbody></table>\n", f);
+    fputs("</tbody></table></div>\n", f);
 }
 
 static void summary_table(FILE *f, const jf_study *s)
@@ -154,7 +157,7 @@ static void summary_table(FILE *f, const jf_study *s)
         h[7 + 2 * m] = names[m][1];
     }
     h[6 + 2 * JF_M_COUNT] = "repeats";
-    fputs("<table id=\"summary\" class=\"sortable\">\n", f);
+    fputs("<div class=\"scroll\"><table id=\"summary\" class=\"sortable\">\n", f);
     head_cells(f, h, 7 + 2 * JF_M_COUNT);
     for (size_t i = 0; i < s->ncells; i++) {
         const jf_study_key *k = &s->cell[i].key;
@@ -172,7 +175,7 @@ static void summary_table(FILE *f, const jf_study *s)
         }
         fprintf(f, "<td>%d</td></tr>\n", nrep);
     }
-    fputs("</tbody></table>\n", f);
+    fputs("</tbody></table></div>\n", f);
 }
 
 static void cells_table(FILE *f, const jf_study *s)
@@ -185,7 +188,7 @@ static void cells_table(FILE *f, const jf_study *s)
     for (int i = 0; i < 8; i++) h[i] = a[i];
     for (int m = 0; m < JF_M_COUNT; m++) h[8 + m] = jf_study_metric[m];
     for (int i = 0; i < 7; i++) h[8 + JF_M_COUNT + i] = b[i];
-    fputs("<table id=\"cells\" class=\"sortable\">\n", f);
+    fputs("<div class=\"scroll\"><table id=\"cells\" class=\"sortable\">\n", f);
     head_cells(f, h, 8 + JF_M_COUNT + 7);
     for (size_t i = 0; i < s->ncells; i++) {
         const jf_study_cell *c = &s->cell[i];
@@ -203,7 +206,7 @@ static void cells_table(FILE *f, const jf_study *s)
         num(f, c->points_per_s);
         fputs("</tr>\n", f);
     }
-    fputs("</tbody></table>\n", f);
+    fputs("</tbody></table></div>\n", f);
 }
 
 int jf_study_report(const jf_study *s, const char *dir, char *msg, size_t len)

@@ -68,7 +68,7 @@ typedef struct {
     uint64_t count;        /* points                                     */
     uint64_t vertex_off;   /* file offset of row 0                       */
     size_t row;            /* bytes per row                              */
-    int has_normals;       /* PLY: nx ny nz are properties               */
+    int has_normals;       /* PLY: nx ny nz are properties; LAS: Extra Bytes */
     int swap;              /* PLY: byte order differs from the machine's */
     int type[6];           /* PLY: x y z nx ny nz scalar types           */
     size_t off[6];         /* PLY: their offsets in the row              */
@@ -90,6 +90,9 @@ jf_status jf__las_layout(const char *buf, size_t len, uint64_t size, const char 
 void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz,
                      double *nrm);
 void jf__las_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz);
+/* LAS with l->has_normals: the Extra Bytes normals of k rows (type[3..5]:
+ * 9 float, 10 double). */
+void jf__las_normal_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *nrm);
 
 /* io_write.c, for rows written by other processes (jetfit-mpi): a binary
  * little-endian PLY table without attributes or faces gets its header

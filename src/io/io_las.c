@@ -172,6 +172,71 @@ static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, si
     return 1;
 }
 
+/* Normals in Extra Bytes (a LAS file jetfit wrote: nx ny nz; PDAL's
+ * NormalX NormalY NormalZ), float or double: their offsets in the record
+ * and types (9 float, 10 double; LAS 1.4 R15 table 24), from the Extra
+ * Bytes VLR among the VLRs in [hsize, end).  1 if all three are there. */
+static int las_normal_fields(const unsigned char *b, size_t hsize, size_t end, uint32_t nvlr,
+                             unsigned base, unsigned rec_len, size_t at[3], int dts[3])
+{
+    static const char *const names[2][3] = {{"nx", "ny", "nz"}, {"normalx", "normaly", "normalz"}};
+    int found = 0;
+    size_t p = hsize;
+    for (uint32_t v = 0; v < nvlr && p + 54 <= end; v++) {
+        size_t rl = u16(b + p + 20);
+        if (rl > end - p - 54)
+            break;
+        if (!memcmp(b + p + 2, "LASF_Spec\0", 10) && u16(b + p + 18) == 4) {
+            unsigned off = base;
+            for (size_t d = p + 54; d + 192 <= p + 54 + rl; d += 192) {
+                unsigned dt = b[d + 2], sz = eb_size(dt, b[d + 3]);
+                if (!sz || sz > rec_len - off)
+                    break;
+                char nm[33] = {0};
+                for (int k = 0; k < 32 && b[d + 4 + k]; k++)
+                    nm[k] = (char)(b[d + 4 + k] | (b[d + 4 + k] >= 'A' && b[d + 4 + k] <= 'Z' ? 0x20 : 0));
+                for (int a = 0; a < 3; a++)
+                    if ((dt == 9 || dt == 10) && (!strcmp(nm, names[0][a]) || !strcmp(nm, names[1][a]))) {
+                        at[a] = off, dts[a] = (int)dt;
+                        found |= 1 << a;
+                    }
+                off += sz;
+            }
+            break;
+        }
+        p += 54 + rl;
+    }
+    return found == 7;
+}
+
+/* k records' normals from their fields (las_normal_fields). */
+static void las_normal_rows(const unsigned char *r, size_t k, size_t rec_len, const size_t at[3],
+                            const int dts[3], double *nrm)
+{
+    for (size_t i = 0; i < k; i++, r += rec_len)
+        for (int a = 0; a < 3; a++) {
+            uint32_t w = u32(r + at[a]); /* little endian whatever the host */
+            float f;
+            memcpy(&f, &w, sizeof f);
+            nrm[3 * i + a] = dts[a] == 9 ? (double)f : f64(r + at[a]);
+        }
+}
+
+/* Into c->nrm when the records carry normals, so that orient input works
+ * on them.  0 on a failed allocation. */
+static int las_normals(jf_cloud *c, const unsigned char *b, size_t hsize, size_t data_off,
+                       uint32_t nvlr, unsigned base, unsigned rec_len)
+{
+    size_t at[3];
+    int dts[3];
+    if (!las_normal_fields(b, hsize, data_off, nvlr, base, rec_len, at, dts))
+        return 1;
+    if (!(c->nrm = malloc(c->n * 3 * sizeof(double))))
+        return 0;
+    las_normal_rows(b + data_off, c->n, rec_len, at, dts, c->nrm);
+    return 1;
+}
+
 /* The header's checks (every lie named), from the first `have` bytes of a
  * file of `size` bytes. */
 typedef struct {
@@ -299,6 +364,8 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
     for (size_t i = 0; i < c->n; i++, r += rec_len)
         for (int a = 0; a < 3; a++)
             c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
+    if (!las_normals(c, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu normals", c->n);
     /* the header and VLRs, even without attributes: a LAS output keeps
      * the CRS (a CRS is not an attribute; docs/formats.md) */
     jf_attrs *at = &c->attrs;
@@ -347,9 +414,23 @@ jf_status jf__las_layout(const char *buf, size_t len, uint64_t size, const char 
     l->vertex_off = h.data_off;
     l->row = h.rec_len;
     l->las = 1;
+    /* normals in Extra Bytes, as jf_read_las finds them (VLRs within the
+     * bytes given) */
+    size_t end = h.data_off < len ? h.data_off : len;
+    const unsigned char *b = (const unsigned char *)buf;
+    int dts[3];
+    l->has_normals = las_normal_fields(b, h.hsize, end, u32(b + 100), base_len[h.fmt], h.rec_len,
+                                       l->off + 3, dts);
+    for (int a = 0; a < 3; a++)
+        l->type[3 + a] = dts[a];
     memcpy(l->scale, h.scale, sizeof l->scale);
     memcpy(l->offset, h.offset, sizeof l->offset);
     return JF_OK;
+}
+
+void jf__las_normal_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *nrm)
+{
+    las_normal_rows(raw, k, l->row, l->off + 3, l->type + 3, nrm);
 }
 
 void jf__las_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz)

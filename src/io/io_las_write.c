@@ -35,6 +35,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "io_internal.h"
@@ -496,6 +497,16 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
     }
     put64(b + 247, L->nrows);
     put64(b + 255, L->nrows);
+    /* creation day of year (January 1 is 1) and year, in UTC (LAS 1.4 R15
+     * table 3); SOURCE_DATE_EPOCH fixes them for reproducible files; a
+     * LAS input's own date is kept below */
+    const char *sde = getenv("SOURCE_DATE_EPOCH");
+    time_t now = sde && *sde ? (time_t)strtoll(sde, NULL, 10) : time(NULL);
+    struct tm tm;
+    if (gmtime_r(&now, &tm)) {
+        put16(b + 90, (unsigned)tm.tm_yday + 1);
+        put16(b + 92, (unsigned)tm.tm_year + 1900);
+    }
     unsigned char *v = b + LAS_HEADER;
     uint32_t nvlr = 1;
     if (keep(L)) {

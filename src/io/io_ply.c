@@ -705,6 +705,8 @@ void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l,
 {
     if (l->las) {
         jf__las_rows(raw, k, l, xyz);
+        if (nrm && l->has_normals)
+            jf__las_normal_rows(raw, k, l, nrm);
         return;
     }
     for (size_t r = 0; r < k; r++, raw += l->row) {

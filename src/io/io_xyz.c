@@ -508,34 +508,34 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
             goto store;
         const char *p = ls, *fs, *fe;
         int j = 0, bad = 0;
-        char why[160];
+        char why[160]; /* rows, like lines and columns, count from 1 (docs/formats.md) */
         why[0] = '\0';
         for (; j <= t.maxcol && next_field(&t, &p, le, &fs, &fe); j++) {
             for (int k = 0; k < 6 && !bad; k++) {
                 if (t.col[k] != j)
                     continue;
                 if (fs == fe)
-                    bad = snprintf(why, sizeof why, "row %zu: empty field in column %d", n,
+                    bad = snprintf(why, sizeof why, "row %zu: empty field in column %d", n + 1,
                                    j + 1);
                 else if (!jf_parse_double(fs, fe, &v[k]))
                     bad = snprintf(why, sizeof why, "row %zu: column %d: '%.*s' is not a number",
-                                   n, j + 1, (int)(fe - fs > 40 ? 40 : fe - fs), fs);
+                                   n + 1, j + 1, (int)(fe - fs > 40 ? 40 : fe - fs), fs);
             }
         }
         int nf = j;
         while (next_field(&t, &p, le, &fs, &fe))
             nf++;
         if (!bad && j <= t.maxcol)
-            bad = snprintf(why, sizeof why, "row %zu: expected %d numbers, found %d", n,
+            bad = snprintf(why, sizeof why, "row %zu: expected %d numbers, found %d", n + 1,
                            t.maxcol + 1, nf);
         /* a row of another width is a broken or shifted line, not data */
         if (!bad && nf0 >= 0 && nf != nf0)
             bad = !t.csv && decimal_commas(ls, le)
                       ? snprintf(why, sizeof why, "row %zu: '%.*s' has decimal commas; jetfit "
-                                 "reads '.' as the decimal point (sed 's/,/./g')", n,
+                                 "reads '.' as the decimal point (sed 's/,/./g')", n + 1,
                                  (int)(le - ls > 40 ? 40 : le - ls), ls)
                       : snprintf(why, sizeof why, "row %zu: %d columns, the first data row has %d",
-                                 n, nf, nf0);
+                                 n + 1, nf, nf0);
         if (bad && !skip)
             return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line, "%s", why);
         if (bad) { /* --bad-rows skip: a NaN row keeps every later index */

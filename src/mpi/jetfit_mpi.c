@@ -42,7 +42,9 @@ static void usage(FILE *f)
         "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
         "(they need the whole cloud at once), LAS output; the input's\n"
         "other properties are not carried (the output is that of --keep none).\n"
-        "docs/scale.md \"Distributed runs\" says how to run on a cluster.\n");
+        "No standard input or output ('-'): each rank reads its share of a named file.\n"
+        "docs/scale.md \"Distributed runs\" says how to run on a cluster.\n"
+        "\n  -h, --help      this text\n  --version       jetfit's and the MPI library's versions\n");
 }
 
 static void on_fatal_signal(int sig)
@@ -278,7 +280,9 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     jf_cli_estimate_cmd cmd;
     jf_cli_bad bad;
     if (jf_cli_estimate_parse(argc, argv, &cmd, &bad)) {
-        if (m->rank == 0)
+        if (m->rank == 0 && !bad.opt)
+            fprintf(stderr, "jetfit-mpi estimate: %s (jetfit-mpi --help)\n", bad.why);
+        else if (m->rank == 0)
             fprintf(stderr, "jetfit-mpi estimate: %s '%s': %s (jetfit estimate --help)\n",
                     bad.opt, bad.val ? bad.val : "", bad.why);
         return 2;
@@ -289,6 +293,10 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     }
     jf_estimate_opts o = cmd.e.o;
     const char *in = cmd.in, *out = cmd.out;
+    if (!strcmp(in, "-") || !strcmp(out, "-") || cmd.in_fmt || cmd.out_fmt)
+        return refuse(m, "%s: distributed runs read and write named files (each rank reads its "
+                         "share): no standard input or output, no --input-format or "
+                         "--output-format; use jetfit estimate for pipes", "-");
     char nbs[64];
     jf_nb_format(&o.nb, nbs, sizeof nbs);
     if (o.nb.kind == JF_NB_NATURAL || o.nb.kind == JF_NB_RINGS)
@@ -431,6 +439,16 @@ int main(int argc, char **argv)
                         "(the processors available; --threads N overrides)\n", asked, nt);
     if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
         if (m.rank == 0) usage(stdout);
+        rc = 0;
+    } else if (argc >= 2 && !strcmp(argv[1], "--version")) {
+        if (m.rank == 0) {
+            int major = 0, minor = 0, len = 0;
+            char lib[MPI_MAX_LIBRARY_VERSION_STRING];
+            MPI_Get_version(&major, &minor);
+            MPI_Get_library_version(lib, &len);
+            lib[strcspn(lib, "\n")] = '\0';
+            printf("jetfit-mpi %s\nMPI %d.%d (%s)\n", jf_version(), major, minor, lib);
+        }
         rc = 0;
     } else if (argc < 2 || strcmp(argv[1], "estimate")) {
         if (m.rank == 0) {

@@ -603,6 +603,24 @@ START_TEST(report_opens_in_chromium)
         ck_assert_int_eq(n, 3 * 2 * 3 * 2);
     }
     free(d);
+    /* in a 1280-pixel window the page never scrolls sideways (issue 31):
+     * wide tables scroll inside their own box */
+    cli_write_text(wrap,
+        "<!DOCTYPE html><html><body style=\"margin:0\"><pre id=\"out\"></pre>\n"
+        "<iframe id=\"f\" src=\"st/report.html\" style=\"width:1280px;height:800px;border:0\" onload=\"go()\"></iframe><script>\n"
+        "function go() {\n"
+        "  var d = document.getElementById('f').contentDocument.documentElement;\n"
+        "  document.getElementById('out').textContent = '\\nWIDTH ' + d.scrollWidth + ' ' + d.clientWidth + '\\n';\n"
+        "}\n</script></body></html>\n");
+    ck_assert_msg(chromium_flag(wrap, "--dump-dom", dom, "--allow-file-access-from-files") == 0,
+                  "chromium: %s", cli_err);
+    d = slurp(dom, NULL);
+    char *wd = d ? strstr(d, "\nWIDTH ") : NULL;
+    ck_assert_msg(wd != NULL, "the width page did not run");
+    long sw = 0, cw = 0;
+    ck_assert_int_eq(sscanf(wd, "\nWIDTH %ld %ld", &sw, &cw), 2);
+    ck_assert_msg(cw > 1000 && sw <= cw, "the report is %ld pixels wide in a %ld-pixel window", sw, cw);
+    free(d);
     /* a screenshot of the page, beside one of an empty page of the same
      * size: plots and tables make a much larger PNG than white */
     const char *empty = cli_path("empty.html");
@@ -618,6 +636,33 @@ START_TEST(report_opens_in_chromium)
     ck_assert_msg(ls > 10 * lb, "screenshot %zu bytes, a blank page %zu", ls, lb);
     free(s);
     free(b);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
+/* issue 31: a natural cell's points carry their normal's source
+ * (JF_PT_NORMAL_PCA...), which is not a problem: they count as ok */
+START_TEST(natural_points_count_as_ok)
+{
+    cli_setup();
+    char dir[300];
+    snprintf(dir, sizeof dir, "%s/nat", cli_dir);
+    int rc = cli_run("study", "sphere", "-o", dir, "--n", "300", "--neighbors", "natural;knn:16",
+                     "--quiet", NULL);
+    ck_assert_msg(rc == 0, "study: %s", cli_err);
+    char csv[400];
+    snprintf(csv, sizeof csv, "%s/study.csv", dir);
+    int nr = 0;
+    csv_row *r = read_csv(csv, &nr);
+    ck_assert_int_eq(nr, 3);
+    int cs = col(&r[0], "strategy"), co = col(&r[0], "ok"), cf = col(&r[0], "flagged");
+    for (int i = 1; i < nr; i++) {
+        ck_assert_msg(!strcmp(r[i].f[co], "300"), "%s: ok = %s", r[i].f[cs], r[i].f[co]);
+        ck_assert_str_eq(r[i].f[cf], "0");
+    }
+    free_csv(r, nr);
     const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
     run_to(NULL, rm);
     cli_teardown();
@@ -883,6 +928,7 @@ int main(void)
     tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
     tcase_add_test(t, report_opens_in_chromium);
+    tcase_add_test(t, natural_points_count_as_ok);
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
     tcase_add_test(t, resume_refuses_another_study);

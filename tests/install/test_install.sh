@@ -3,7 +3,9 @@
 # `cmake --install` into a temporary prefix, then examples/normals.c built
 # against the installed package twice (pkg-config on a plain cc line, and
 # CMake's find_package(jetfit)); both must run on the bundled scan and print
-# the same first normal and curvatures as `jetfit estimate` writes.
+# the same first normal and curvatures as `jetfit estimate` writes.  Also:
+# the static library through jetfit-static.pc (no libjetfit.so needed), and
+# a program built without rpath, run under LD_LIBRARY_PATH (docs/library.md).
 # Skipped (77) in a sanitizer build: its libjetfit needs the ASan runtime
 # loaded first, which a plain cc program does not do.
 set -eu
@@ -39,18 +41,30 @@ cmake -S "$ex" -B "$tmp/b" -DCMAKE_PREFIX_PATH="$p" -DCMAKE_BUILD_RPATH="$libdir
   || { cat "$tmp/cm.log"; fail "find_package(jetfit) configure failed"; }
 cmake --build "$tmp/b" >"$tmp/cb.log" 2>&1 || { cat "$tmp/cb.log"; fail "find_package build failed"; }
 
-# 3. the static library (JF_STATIC_LIB): no libjetfit.so needed at run time
+# 3. the static library (JF_STATIC_LIB): no libjetfit.so needed at run time,
+# through jetfit-static.pc as docs/library.md says (jetfit.pc's -ljetfit
+# would take the shared library)
 if [ -f "$libdir/libjetfit.a" ]; then
-  cc "$ex/normals.c" -I"$p/include" "$libdir/libjetfit.a" \
-     $(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --static --libs-only-l jetfit | sed 's/-ljetfit//') \
-     -o "$tmp/normals-static" || fail "build against libjetfit.a failed"
+  cc "$ex/normals.c" $(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --cflags --libs jetfit-static) \
+     -o "$tmp/normals-static" || fail "build with pkg-config jetfit-static failed"
   ldd "$tmp/normals-static" | grep -q libjetfit && fail "the static build needs libjetfit.so"
 fi
+# 4. a custom prefix without an rpath: the loader does not look in P/lib;
+# LD_LIBRARY_PATH (docs/library.md) or -Wl,-rpath (above) finds it
+cc "$ex/normals.c" $(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --cflags --libs jetfit) \
+   -o "$tmp/normals-norpath" || fail "build without rpath failed"
+if env -u LD_LIBRARY_PATH "$tmp/normals-norpath" "$src/data/bun090.ply" >/dev/null 2>&1; then
+  ldd "$tmp/normals-norpath" | grep -q "libjetfit.so.0 => $libdir" ||
+    echo "note: libjetfit.so.0 found elsewhere than $libdir (a system-wide install?)"
+fi
+LD_LIBRARY_PATH=$libdir "$tmp/normals-norpath" "$src/data/bun090.ply" >"$tmp/ld.out" ||
+  fail "LD_LIBRARY_PATH=$libdir did not make the program run"
 
 scan=$src/data/bun090.ply
 "$tmp/normals-pc" "$scan" >"$tmp/pc.out" || fail "normals (pkg-config) failed"
 "$tmp/b/normals" "$scan" >"$tmp/cm.out" || fail "normals (find_package) failed"
 cmp -s "$tmp/pc.out" "$tmp/cm.out" || fail "the two builds disagree"
+cmp -s "$tmp/pc.out" "$tmp/ld.out" || fail "the LD_LIBRARY_PATH run disagrees"
 if [ -x "$tmp/normals-static" ]; then
   "$tmp/normals-static" "$scan" >"$tmp/st.out" || fail "normals (static) failed"
   cmp -s "$tmp/pc.out" "$tmp/st.out" || fail "the static build disagrees"

@@ -184,18 +184,18 @@ END_TEST
 START_TEST(text_rows)
 {
     bad("s.xyz", "1 2 3\n# c\n4 5\n", 0, JF_ERR_FORMAT,
-        ":3: row 1: expected 3 numbers, found 2", 0, 0);
+        ":3: row 2: expected 3 numbers, found 2", 0, 0);
     bad("w.xyz", "1 2 3\r\n4 x 6\r\n", 0, JF_ERR_FORMAT,
-        ":2: row 1: column 2: 'x' is not a number", 0, 0);
+        ":2: row 2: column 2: 'x' is not a number", 0, 0);
     /* a single number that is not a count line is a short row */
     bad("one.pts", "2\n1 2 3\n7\n4 5 6\n", 0, JF_ERR_FORMAT,
-        ":3: row 1: expected 3 numbers, found 1", 0, 0);
+        ":3: row 2: expected 3 numbers, found 1", 0, 0);
     bad("h.csv", "a,b,c\n1,2,3\n", 0, JF_ERR_FORMAT,
         ":1: CSV header has no columns named x, y and z", 0, 0);
     bad("e.csv", "x,y,z\n1,,3\n", 0, JF_ERR_FORMAT,
-        ":2: row 0: empty field in column 2", 0, 0);
+        ":2: row 1: empty field in column 2", 0, 0);
     bad("n.csv", "x,y,z\n1,2\n", 0, JF_ERR_FORMAT,
-        ":2: row 0: expected 3 numbers, found 2", 0, 0);
+        ":2: row 1: expected 3 numbers, found 2", 0, 0);
     /* bad --columns */
     jf_read_opts o;
     jf_read_opts_init(&o);
@@ -207,7 +207,7 @@ START_TEST(text_rows)
     ck_assert_ptr_null(c.xyz);
     o.columns[1] = 2, o.columns[2] = 7;
     ck_assert_int_eq(jf_cloud_read(p, &o, &c, &e), JF_ERR_FORMAT);
-    ck_assert(strstr(e.msg, ":1: row 0: expected 8 numbers, found 3"));
+    ck_assert(strstr(e.msg, ":1: row 1: expected 8 numbers, found 3"));
 }
 END_TEST
 

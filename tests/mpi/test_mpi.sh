@@ -101,6 +101,14 @@ errors)
     [ $rc -eq 1 ] && [ -n "$want" ] || bad "jetfit estimate $f: exit $rc, '$want'"
     for np in 1 3; do refused "$want" $np "$d/$f" -o "$d/err.ply"; done
   done
+  refused "no standard input or output" 2 - --input-format ply -o "$d/err.ply"
+  # GNU conventions (issue 31): --version, and -oFILE / --opt=V as estimate takes them
+  if "$jmpi" --version | grep -q "^jetfit-mpi .*" && "$jmpi" --version | grep -q "^MPI "; then
+    echo "ok   jetfit-mpi --version: $("$jmpi" --version | head -1)"
+  else bad "jetfit-mpi --version: $("$jmpi" --version 2>&1)"; fi
+  mpi 2 estimate "$d/lattice.ply" "-o$d/gnu.ply" --neighbors=knn:16 --quiet
+  "$jetfit" estimate "$d/lattice.ply" -o "$d/ref.ply" --neighbors knn:16 --quiet --keep none
+  cmp -s "$d/gnu.ply" "$d/ref.ply" && echo "ok   -oFILE --neighbors=knn:16" || bad "-oFILE --opt=V: differs"
   # a rank that fails mid-run: one line, exit 1, the old output intact
   echo old >"$d/keep.ply"
   JETFIT_MPI_TEST_FAIL=2 mpirun --allow-run-as-root --oversubscribe -q -x JETFIT_MPI_TEST_FAIL \

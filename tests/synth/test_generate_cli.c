@@ -201,8 +201,8 @@ START_TEST(bad_options)
         {"generate exp --outliers 2 -o x.ply", "--outliers wants"},
         {"generate exp --noise -1 -o x.ply", "--noise wants"},
         {"generate exp --frobnicate -o x.ply", "unknown option"},
-        {"generate exp -o", "-o needs a value"},
-        {"convergence", "--out DIR is required"},
+        {"generate exp -o", "option '-o' (--output) needs a value"},
+        {"convergence", "-o DIR is required"},
         {"convergence --out d --seed x", "--seed wants"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
