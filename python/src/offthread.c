@@ -3,7 +3,7 @@
  *
  * why: the module and the command share one OpenMP runtime, GCC's libgomp
  * (LLVM's libomp, serving the GOMP_* calls of GCC-built code, aborted in
- * kmp_alloc.cpp or corrupted the heap when two Python threads estimated at
+ * kmp_alloc or corrupted the heap when two Python threads estimated at
  * once -- issue 32 -- and on an empty OMP_NUM_THREADS -- issue 31).
  * libgomp keeps a thread pool per thread that starts a parallel region and
  * frees it when that thread exits; a child forked after the pool's owner

@@ -4,7 +4,7 @@ team; the interpreter must survive and every result equal a single call's
 bits.  On LLVM's libomp (the module's runtime until issue 32) 140,000
 points (above 2 x 65,536, where the k-d tree builds with OpenMP tasks)
 ended in SIGSEGV, SIGBUS or "OMP: Error #13: Assertion failure at
-kmp_alloc.cpp" in 4 runs of 4; knn:6 at degree 1 keeps the fits cheap.  Each case runs in a child interpreter, so a crash fails
+kmp_alloc" in 4 runs of 4; knn:6 at degree 1 keeps the fits cheap.  Each case runs in a child interpreter, so a crash fails
 the test instead of killing pytest.  Also: an empty or huge
 OMP_NUM_THREADS (issue 31, issue 33 item 5) runs with a sane count."""
 import os

@@ -122,7 +122,7 @@ def test_estimate_in_a_forked_child(open3d_first):
     """multiprocessing's fork: a child forked after the parent ran OpenMP
     (jetfit's own estimate, or Open3D's import) estimates on 2 threads and
     gets the parent's bits (libgomp: each call's OpenMP on a thread of its
-    own, src/offthread.c)."""
+    own, python/src/offthread.c)."""
     if open3d_first:
         pytest.importorskip("open3d", reason="python3-open3d is not installed")
     pts = fib_sphere(20000)

@@ -7,6 +7,7 @@
 #include <check.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 static int same_bytes(const char *a, const char *b)
 {
@@ -82,9 +83,5 @@ int main(void)
     tcase_add_test(t, huge_omp_num_threads_clamped);
     tcase_add_test(t, explicit_threads_and_empty_environment);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -9,6 +9,7 @@
 
 #include "test_cli_util.h"
 #include "view.h"
+#include "jf_test.h"
 
 static int have_three;
 
@@ -269,9 +270,6 @@ int main(void)
     tcase_add_test(tc, subsample_estimate_and_size);
     tcase_add_test(tc, study_report_links_the_best_result);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failures = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failures ? 1 : !have_three ? 77 : 0;
+    int rc = jf_test_run(s);
+    return rc ? rc : !have_three ? 77 : 0;
 }

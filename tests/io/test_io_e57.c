@@ -23,6 +23,7 @@
 
 #include "e57_write.h"
 #include "test_io_util.h"
+#include "jf_test.h"
 
 #define DATA JF_TESTS_DIR "/data/e57/"
 #ifndef M_PI
@@ -541,9 +542,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *r = srunner_create(suite());
-    srunner_run_all(r, CK_NORMAL);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(suite());
 }
