@@ -322,6 +322,17 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
         if (!nevlr || evlr < data_off || evlr > len)
             evlr = 0;
     }
+    for (uint64_t k = 0, q = evlr; evlr && k < nevlr; k++) { /* a cut EVLR is lost data */
+        uint64_t el = q + 60 <= len ? g64(b + q + 20) : 0;
+        if (q + 60 > len || el > len - q - 60) {
+            free(ch);
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "EVLR %llu at byte %llu runs past the end of the file (%zu "
+                              "bytes): truncated file", (unsigned long long)k,
+                              (unsigned long long)q, len);
+        }
+        q += 60 + el;
+    }
     size_t head = data_off - z.vlr_len, recs = (size_t)n * rec_len;
     size_t tail = evlr ? len - (size_t)evlr : 0;
     if (recs / rec_len != n || head + recs + tail < recs) {

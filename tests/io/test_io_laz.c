@@ -1,9 +1,10 @@
 /* test_io_laz.c -- the LAZ reader (issue 25): real LASzip files from
- * laz-perf's test set (tests/data/laz/SOURCE.md), point formats 0-3 and
- * extra bytes, decoded to their uncompressed LAS twins byte for byte (the
- * twins were written by other software from the same points); the same
- * records for 1 and N threads; every damaged file a one-line error that
- * names the chunk. */
+ * laz-perf's and laspy's test sets (tests/data/laz/SOURCE.md), point
+ * formats 0-3 and 6 and extra bytes, decoded to their uncompressed LAS
+ * twins byte for byte (the twins were written by other software from the
+ * same points), EVLRs kept; the same records for 1 and N threads on a
+ * 65-chunk file; every damaged file a one-line error that names the chunk.
+ * Formats 7 and 8 have no twin: test_laz_perf compares them with laz-perf. */
 #define _GNU_SOURCE
 #include <check.h>
 #include <omp.h>
@@ -52,7 +53,10 @@ static void twin(const char *laz, const char *las, unsigned fmt, size_t n)
     unsigned char *b = slurp(las, &len);
     uint32_t off = g32(b + 96);
     unsigned rl = b[105] | b[106] << 8;
-    ck_assert_uint_eq(g32(b + 107), n);
+    if (fmt < 6)
+        ck_assert_uint_eq(g32(b + 107), n);
+    else
+        n = g32(b + 247);
     ck_assert_uint_eq(b[104], fmt);
     jf_cloud z, s;
     jf_error e;
@@ -84,16 +88,35 @@ START_TEST(twins_v2)
     twin(DATA "point-color-time.las.laz", DATA "point-color-time.las", 3, 1065);
     twin(DATA "extrabytes.laz", DATA "extrabytes.las", 3, 1065);
     twin(DATA "1815.laz", DATA "1815.las", 1, 1247);
+    twin(DATA "extra.laz", DATA "extrabytes.las", 3, 1065); /* a LAS 1.4 header */
+}
+END_TEST
+
+/* Layered (LAS 1.4, format 6), with an EVLR after the chunk table: the
+ * records and the EVLR are the twin's. */
+START_TEST(twin_v3_evlr)
+{
+    twin(DATA "1_4_w_evlr.laz", DATA "1_4_w_evlr.las", 6, 0);
+    size_t len;
+    unsigned char *b = slurp(DATA "1_4_w_evlr.las", &len);
+    uint32_t at = g32(b + 235);
+    jf_cloud z;
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(DATA "1_4_w_evlr.laz", NULL, &z, &e) == JF_OK, "%s", e.msg);
+    ck_assert_uint_eq(z.attrs.las_evlr_len, len - at);
+    ck_assert(memcmp(z.attrs.las_evlr, b + at, len - at) == 0);
+    jf_cloud_free(&z);
+    free(b);
 }
 END_TEST
 
 /* A .las name with the compression bit is read as LAZ (the bit decides,
- * not the name), and the same bytes with the reading threads at 1 and 3
- * give the same records. */
+ * not the name), and the 65 variable-size chunks of a COPC file read with
+ * 1 and 3 threads give the same records. */
 START_TEST(by_bit_and_threads)
 {
     size_t len;
-    unsigned char *b = slurp(DATA "point-color-time.las.laz", &len);
+    unsigned char *b = slurp(DATA "simple.copc.laz", &len);
     const char *p = fixture("named.las", b, len);
     jf_cloud a, c;
     jf_error e;
@@ -101,8 +124,9 @@ START_TEST(by_bit_and_threads)
     omp_set_num_threads(1);
     ck_assert_msg(jf_cloud_read(p, NULL, &a, &e) == JF_OK, "%s", e.msg);
     omp_set_num_threads(3);
-    ck_assert_msg(jf_cloud_read(DATA "point-color-time.las.laz", NULL, &c, &e) == JF_OK, "%s",
+    ck_assert_msg(jf_cloud_read(DATA "simple.copc.laz", NULL, &c, &e) == JF_OK, "%s",
                   e.msg);
+    ck_assert_uint_eq(a.n, 1065);
     omp_set_num_threads(nt);
     ck_assert_uint_eq(a.n, c.n);
     ck_assert(memcmp(a.attrs.rec, c.attrs.rec, a.n * a.attrs.stride) == 0);
@@ -191,13 +215,43 @@ START_TEST(damaged)
 }
 END_TEST
 
+/* The layered format: a chunk cut, a layer corrupt, a waveform format. */
+START_TEST(damaged_v3)
+{
+    size_t len;
+    unsigned char *b = slurp(DATA "simple.copc.laz", &len);
+    unsigned char *m = malloc(len);
+    uint32_t off = g32(b + 96);
+    /* the first chunk's count (after its raw 36-byte point) */
+    memcpy(m, b, len);
+    p32(m + off + 8 + 36, 5000);
+    refused("count.laz", m, len, "chunk 0");
+    /* a layer's size past the chunk */
+    memcpy(m, b, len);
+    p32(m + off + 8 + 40, 1u << 30);
+    refused("layer.laz", m, len, "run past the chunk");
+    /* corrupt bytes in the first chunk's layers */
+    memcpy(m, b, len);
+    for (size_t k = off + 8 + 40 + 44 + 10; k < off + 8 + 40 + 44 + 60; k++)
+        m[k] ^= 0xa5;
+    refused("corrupt.laz", m, len, "chunk 0");
+    /* the point format of a waveform file */
+    memcpy(m, b, len);
+    m[104] = 0x80 | 10;
+    p16(m + 105, 67);
+    refused("wave.laz", m, len, "waveform");
+    free(m);
+    free(b);
+}
+END_TEST
+
 /* Every prefix of a LAZ file is refused with one line (never a crash:
  * ASan and valgrind run this suite). */
 START_TEST(every_prefix)
 {
     size_t len;
-    unsigned char *b = slurp(DATA "point-color.las.laz", &len);
-    for (size_t k = 0; k < len; k += k < 1400 ? 97 : 1301) {
+    unsigned char *b = slurp(DATA "simple.copc.laz", &len);
+    for (size_t k = 0; k < len; k += k < 1800 ? 97 : 1301) {
         char nm[32];
         snprintf(nm, sizeof nm, "p%zu.laz", k);
         const char *p = fixture(nm, b, k);
@@ -216,7 +270,9 @@ static Suite *suite(void)
     TCase *tc = tcase_create("laz");
     tcase_add_checked_fixture(tc, setup, teardown);
     tcase_add_test(tc, twins_v2);
+    tcase_add_test(tc, twin_v3_evlr);
     tcase_add_test(tc, by_bit_and_threads);
+    tcase_add_test(tc, damaged_v3);
     tcase_add_test(tc, damaged);
     tcase_add_test(tc, every_prefix);
     suite_add_tcase(s, tc);
