@@ -26,7 +26,7 @@ void *lz_alloc(lz_arena *a, size_t bytes)
     if (a->failed)
         return NULL;
     if (!b || b->cap - b->used < bytes) {
-        size_t cap = bytes > (1u << 20) ? bytes : (1u << 20);
+        size_t cap = bytes > (1u << 18) ? bytes : (1u << 18);
         b = malloc(sizeof *b + cap);
         if (!b) {
             a->failed = 1;
@@ -165,16 +165,24 @@ int lz_ic_init(lz_ic *ic, lz_arena *a, uint32_t bits, uint32_t contexts, uint32_
         ic->corr_range = 0;
         ic->corr_min = INT32_MIN;
     }
+    ic->arena = a;
     ic->mbits = lz_alloc(a, sizeof(lz_sym) * contexts);
     ic->corr = lz_alloc(a, sizeof(lz_sym) * ic->corr_bits);
     if (!ic->mbits || !ic->corr)
         return 0;
-    for (uint32_t i = 0; i < contexts; i++)
-        if (!lz_sym_init(&ic->mbits[i], a, ic->corr_bits + 1))
-            return 0;
+    /* nsym 0: not made yet (a fresh model is what LASzip's eager set-up
+     * would hold at its first use) */
+    memset(ic->mbits, 0, sizeof(lz_sym) * contexts);
+    memset(ic->corr, 0, sizeof(lz_sym) * ic->corr_bits);
     lz_bit_init(&ic->corr0);
-    for (uint32_t i = 1; i <= ic->corr_bits; i++)
-        if (!lz_sym_init(&ic->corr[i - 1], a, i <= bits_high ? 1u << i : 1u << bits_high))
-            return 0;
     return 1;
+}
+
+lz_sym *lz_ic_model(lz_dec *d, lz_ic *ic, lz_sym *m, uint32_t nsym)
+{
+    if (lz_sym_init(m, ic->arena, nsym))
+        return m;
+    m->nsym = 0;
+    d->bad = 2;
+    return NULL;
 }

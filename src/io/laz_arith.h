@@ -25,11 +25,20 @@
 #define LZ_DM_SHIFT 15            /* symbol models: distribution in 15 bits */
 #define LZ_DM_MAX (1u << 15)
 
+/* the decoder's steps are a few instructions each: inlined into the item
+ * decoders (gcc would otherwise call lz_decode_sym) */
+#if defined(__GNUC__)
+#define LZ_INLINE static inline __attribute__((always_inline))
+#else
+#define LZ_INLINE static inline
+#endif
+
 typedef struct {
     const uint8_t *p, *end;
     uint32_t value, length;
     size_t over; /* bytes asked for past the end */
-    int bad;     /* an interval collapsed: the stream is not LASzip's */
+    int bad;     /* 1: an interval collapsed (the stream is not LASzip's);
+                    2: out of memory for a model */
 } lz_dec;
 
 typedef struct {
@@ -57,6 +66,7 @@ typedef struct {
     lz_sym *mbits;   /* contexts models of corr_bits + 1 symbols */
     lz_bit corr0;    /* k = 0: the corrector is 0 or 1 */
     lz_sym *corr;    /* k = 1..corr_bits: corr[k - 1] */
+    lz_arena *arena; /* the models are made on first use (most k never come) */
 } lz_ic;
 
 void lz_bit_init(lz_bit *m);
@@ -101,7 +111,7 @@ static inline void lz_renorm(lz_dec *d)
     while ((d->length <<= 8) < LZ_MIN_LENGTH);
 }
 
-static inline uint32_t lz_decode_bit(lz_dec *d, lz_bit *m)
+LZ_INLINE uint32_t lz_decode_bit(lz_dec *d, lz_bit *m)
 {
     uint32_t x = m->prob0 * (d->length >> LZ_BM_SHIFT);
     uint32_t sym = d->value >= x;
@@ -119,7 +129,7 @@ static inline uint32_t lz_decode_bit(lz_dec *d, lz_bit *m)
     return sym;
 }
 
-static inline uint32_t lz_decode_sym(lz_dec *d, lz_sym *m)
+LZ_INLINE uint32_t lz_decode_sym(lz_dec *d, lz_sym *m)
 {
     uint32_t n, sym, x, y = d->length;
     if (m->table) { /* table look-up, then bisection (Said, section 4.4) */
@@ -184,20 +194,27 @@ static inline uint32_t lz_read_int(lz_dec *d)
     return lz_read_bits(d, 16) << 16 | lo;
 }
 
+/* A model of the integer compressor, made on first use; NULL (and
+ * d->bad = 2) on allocation failure. */
+lz_sym *lz_ic_model(lz_dec *d, lz_ic *ic, lz_sym *m, uint32_t nsym);
+
 /* The corrector c: its interval k (symbol), then its place in it. */
-static inline int32_t lz_ic_corrector(lz_dec *d, lz_ic *ic, lz_sym *mbits)
+LZ_INLINE int32_t lz_ic_corrector(lz_dec *d, lz_ic *ic, lz_sym *mbits)
 {
+    if (!mbits->nsym && !lz_ic_model(d, ic, mbits, ic->corr_bits + 1))
+        return 0;
     uint32_t k = ic->k = lz_decode_sym(d, mbits);
     if (!k)
         return (int32_t)lz_decode_bit(d, &ic->corr0);
     if (k >= 32)
         return ic->corr_min;
     uint32_t c;
-    if (k <= ic->bits_high) {
-        c = lz_decode_sym(d, &ic->corr[k - 1]);
-    } else { /* high bits by model, the low k - bits_high raw */
+    lz_sym *m = &ic->corr[k - 1];
+    if (!m->nsym && !lz_ic_model(d, ic, m, k <= ic->bits_high ? 1u << k : 1u << ic->bits_high))
+        return 0;
+    c = lz_decode_sym(d, m);
+    if (k > ic->bits_high) { /* high bits by model, the low k - bits_high raw */
         uint32_t k1 = k - ic->bits_high;
-        c = lz_decode_sym(d, &ic->corr[k - 1]);
         c = c << k1 | lz_read_bits(d, k1);
     }
     /* [0, 2^(k-1)) -> [-(2^k - 1), -2^(k-1)]; [2^(k-1), 2^k) -> [2^(k-1) + 1, 2^k] */
@@ -207,7 +224,7 @@ static inline int32_t lz_ic_corrector(lz_dec *d, lz_ic *ic, lz_sym *mbits)
 }
 
 /* pred + corrector, wrapped into the compressor's range. */
-static inline int32_t lz_ic_decode(lz_dec *d, lz_ic *ic, int32_t pred, uint32_t ctx)
+LZ_INLINE int32_t lz_ic_decode(lz_dec *d, lz_ic *ic, int32_t pred, uint32_t ctx)
 {
     uint32_t real = (uint32_t)pred + (uint32_t)lz_ic_corrector(d, ic, &ic->mbits[ctx]);
     if (ic->corr_range) {

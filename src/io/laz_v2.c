@@ -380,7 +380,9 @@ int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
         /* LASzip's encoder flushes 4 bytes at most past its last symbol */
         if (!rc && (d.over > 4 || d.bad)) {
             snprintf(msg, msglen, "point %u: the compressed stream %s", (unsigned)j,
-                     d.bad ? "is corrupt" : "ends early (truncated chunk)");
+                     d.bad == 2 ? "needs a model: out of memory"
+                     : d.bad  ? "is corrupt"
+                              : "ends early (truncated chunk)");
             rc = -1;
         }
     }

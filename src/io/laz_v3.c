@@ -563,7 +563,9 @@ int jf__laz_v3_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
         for (unsigned k = 0; k < nl && !rc; k++)
             if (all[k]->d.over > 4 || all[k]->d.bad) {
                 snprintf(msg, msglen, "point %u: layer %u %s", (unsigned)j, k,
-                         all[k]->d.bad ? "is corrupt" : "ends early (truncated or corrupt chunk)");
+                         all[k]->d.bad == 2 ? "needs a model: out of memory"
+                         : all[k]->d.bad    ? "is corrupt"
+                                            : "ends early (truncated or corrupt chunk)");
                 rc = -1;
             }
     }
