@@ -26,7 +26,7 @@ void *lz_alloc(lz_arena *a, size_t bytes)
     if (a->failed)
         return NULL;
     if (!b || b->cap - b->used < bytes) {
-        size_t cap = bytes > (1u << 18) ? bytes : (1u << 18);
+        size_t cap = bytes > (1u << 15) ? bytes : (1u << 15);
         b = malloc(sizeof *b + cap);
         if (!b) {
             a->failed = 1;
@@ -185,4 +185,13 @@ lz_sym *lz_ic_model(lz_dec *d, lz_ic *ic, lz_sym *m, uint32_t nsym)
     m->nsym = 0;
     d->bad = 2;
     return NULL;
+}
+
+int lz_sym_make(lz_dec *d, lz_sym *m, uint32_t nsym)
+{
+    if (d->arena && lz_sym_init(m, d->arena, nsym))
+        return 1;
+    memset(m, 0, sizeof *m);
+    d->bad = 2;
+    return 0;
 }

@@ -33,12 +33,22 @@
 #define LZ_INLINE static inline
 #endif
 
+/* A bump allocator for the models of one chunk (freed at once). */
+typedef struct lz_block lz_block;
+typedef struct {
+    lz_block *head;
+    int failed; /* an allocation failed: every later model is NULL */
+} lz_arena;
+void *lz_alloc(lz_arena *a, size_t bytes);
+void lz_arena_free(lz_arena *a);
+
 typedef struct {
     const uint8_t *p, *end;
     uint32_t value, length;
     size_t over; /* bytes asked for past the end */
     int bad;     /* 1: an interval collapsed (the stream is not LASzip's);
                     2: out of memory for a model */
+    lz_arena *arena; /* where lz_decode_lazy makes its models */
 } lz_dec;
 
 typedef struct {
@@ -50,14 +60,6 @@ typedef struct {
     uint32_t nsym, last, total, cycle, until, tsize, tshift;
 } lz_sym;
 
-/* A bump allocator for the models of one chunk (freed at once). */
-typedef struct lz_block lz_block;
-typedef struct {
-    lz_block *head;
-    int failed; /* an allocation failed: every later model is NULL */
-} lz_arena;
-void *lz_alloc(lz_arena *a, size_t bytes);
-void lz_arena_free(lz_arena *a);
 
 /* The integer compressor's decoder (LASzip IntegerCompressor). */
 typedef struct {
@@ -91,7 +93,7 @@ static inline uint32_t lz_byte(lz_dec *d)
 /* Starts the decoder on [p, end): the first four bytes are the value. */
 static inline void lz_dec_init(lz_dec *d, const uint8_t *p, const uint8_t *end)
 {
-    d->p = p, d->end = end, d->over = 0, d->bad = 0;
+    d->p = p, d->end = end, d->over = 0, d->bad = 0, d->arena = NULL;
     d->length = LZ_MAX_LENGTH;
     d->value = lz_byte(d) << 24;
     d->value |= lz_byte(d) << 16;
@@ -172,6 +174,18 @@ LZ_INLINE uint32_t lz_decode_sym(lz_dec *d, lz_sym *m)
     if (--m->until == 0)
         lz_sym_update(m);
     return sym;
+}
+
+/* A symbol from model m of nsym symbols, made on first use (zeroed:
+ * not made yet; a fresh model is what an eager set-up would hold at its
+ * first use, so the output is the same and unused models cost nothing);
+ * 0 and d->bad = 2 when it cannot be made. */
+int lz_sym_make(lz_dec *d, lz_sym *m, uint32_t nsym);
+LZ_INLINE uint32_t lz_decode_lazy(lz_dec *d, lz_sym *m, uint32_t nsym)
+{
+    if (!m->nsym && !lz_sym_make(d, m, nsym))
+        return 0;
+    return lz_decode_sym(d, m);
 }
 
 /* bits raw bits, 1..32 (more than 19 as 16 + the rest). */

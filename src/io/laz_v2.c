@@ -59,15 +59,14 @@ static int p10_init(p10 *s, lz_arena *a, const uint8_t *r)
     s->psid = (uint16_t)(r[18] | r[19] << 8);
     for (int k = 0; k < 16; k++)
         lz_med_init(&s->mx[k]), lz_med_init(&s->my[k]);
-    return lz_sym_init(&s->changed, a, 64) && lz_sym_init(&s->sar_m[0], a, 256) &&
-           lz_sym_init(&s->sar_m[1], a, 256) && lz_ic_init(&s->ic_int, a, 16, 4, 8, 0) &&
+    return lz_ic_init(&s->ic_int, a, 16, 4, 8, 0) &&
            lz_ic_init(&s->ic_psid, a, 16, 1, 8, 0) && lz_ic_init(&s->ic_dx, a, 32, 2, 8, 0) &&
            lz_ic_init(&s->ic_dy, a, 32, 22, 8, 0) && lz_ic_init(&s->ic_z, a, 32, 20, 8, 0);
 }
 
 static int p10_decode(p10 *s, lz_dec *d, lz_arena *a, uint8_t *r)
 {
-    uint32_t cv = lz_decode_sym(d, &s->changed);
+    uint32_t cv = lz_decode_lazy(d, &s->changed, 64);
     unsigned rn, nr, m, l;
     if (cv) {
         lz_sym *mod;
@@ -86,7 +85,7 @@ static int p10_decode(p10 *s, lz_dec *d, lz_arena *a, uint8_t *r)
             s->cls = (uint8_t)lz_decode_sym(d, mod);
         }
         if (cv & 4)
-            s->sar = (uint8_t)(lz_decode_sym(d, &s->sar_m[(s->bits >> 6) & 1]) + s->sar);
+            s->sar = (uint8_t)(lz_decode_lazy(d, &s->sar_m[(s->bits >> 6) & 1], 256) + s->sar);
         if (cv & 2) {
             if (!(mod = lz_sym_lazy(&s->udm[s->ud], a, 256)))
                 return 0;
@@ -138,8 +137,7 @@ static int gps_init(gps11 *s, lz_arena *a, const uint8_t *r)
 {
     memset(s, 0, sizeof *s);
     s->t[0] = rd32(r) | (uint64_t)rd32(r + 4) << 32;
-    return lz_sym_init(&s->multi, a, GPS_TOTAL) && lz_sym_init(&s->zero, a, 6) &&
-           lz_ic_init(&s->ic, a, 32, 9, 8, 0);
+    return lz_ic_init(&s->ic, a, 32, 9, 8, 0);
 }
 
 static int32_t mul32(int32_t a, int32_t b) { return (int32_t)((uint32_t)a * (uint32_t)b); }
@@ -173,7 +171,7 @@ static int gps_decode(gps11 *s, lz_dec *d, uint8_t *r)
             return 0;
         unsigned L = s->last;
         if (s->diff[L] == 0) {
-            uint32_t multi = lz_decode_sym(d, &s->zero);
+            uint32_t multi = lz_decode_lazy(d, &s->zero, 6);
             if (multi == 1) {
                 s->diff[L] = lz_ic_decode(d, &s->ic, 0, 0);
                 s->t[L] += (uint64_t)(int64_t)s->diff[L];
@@ -185,7 +183,7 @@ static int gps_decode(gps11 *s, lz_dec *d, uint8_t *r)
                 continue;
             }
         } else {
-            uint32_t multi = lz_decode_sym(d, &s->multi);
+            uint32_t multi = lz_decode_lazy(d, &s->multi, GPS_TOTAL);
             if (multi == 1) {
                 s->t[L] += (uint64_t)(int64_t)lz_ic_decode(d, &s->ic, s->diff[L], 1);
                 s->extreme[L] = 0;
@@ -236,11 +234,7 @@ static int rgb_init(rgb12 *s, lz_arena *a, const uint8_t *r)
     memset(s, 0, sizeof *s);
     for (int c = 0; c < 3; c++)
         s->rgb[c] = (uint16_t)(r[2 * c] | r[2 * c + 1] << 8);
-    if (!lz_sym_init(&s->used, a, 128))
-        return 0;
-    for (int k = 0; k < 6; k++)
-        if (!lz_sym_init(&s->diff[k], a, 256))
-            return 0;
+    (void)a; /* the models are made on first use */
     return 1;
 }
 
@@ -250,27 +244,27 @@ static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v
 static void rgb_decode(rgb12 *s, lz_dec *d, uint8_t *r)
 {
     const uint16_t *l = s->rgb;
-    unsigned sym = lz_decode_sym(d, &s->used), v[3];
-    v[0] = sym & 1 ? (lz_decode_sym(d, &s->diff[0]) + (l[0] & 0xFF)) & 0xFF : l[0] & 0xFF;
-    v[0] |= sym & 2 ? ((lz_decode_sym(d, &s->diff[1]) + (l[0] >> 8)) & 0xFF) << 8 : l[0] & 0xFF00;
+    unsigned sym = lz_decode_lazy(d, &s->used, 128), v[3];
+    v[0] = sym & 1 ? (lz_decode_lazy(d, &s->diff[0], 256) + (l[0] & 0xFF)) & 0xFF : l[0] & 0xFF;
+    v[0] |= sym & 2 ? ((lz_decode_lazy(d, &s->diff[1], 256) + (l[0] >> 8)) & 0xFF) << 8 : l[0] & 0xFF00;
     if (sym & 64) {
         int diff = (int)(v[0] & 0xFF) - (l[0] & 0xFF);
-        v[1] = sym & 4 ? (lz_decode_sym(d, &s->diff[2]) + clamp8(diff + (l[1] & 0xFF))) & 0xFF
+        v[1] = sym & 4 ? (lz_decode_lazy(d, &s->diff[2], 256) + clamp8(diff + (l[1] & 0xFF))) & 0xFF
                        : l[1] & 0xFF;
         if (sym & 16) {
             diff = (diff + (int)(v[1] & 0xFF) - (l[1] & 0xFF)) / 2;
-            v[2] = (lz_decode_sym(d, &s->diff[4]) + clamp8(diff + (l[2] & 0xFF))) & 0xFF;
+            v[2] = (lz_decode_lazy(d, &s->diff[4], 256) + clamp8(diff + (l[2] & 0xFF))) & 0xFF;
         } else {
             v[2] = l[2] & 0xFF;
         }
         diff = (int)(v[0] >> 8) - (l[0] >> 8);
         if (sym & 8)
-            v[1] |= ((lz_decode_sym(d, &s->diff[3]) + clamp8(diff + (l[1] >> 8))) & 0xFF) << 8;
+            v[1] |= ((lz_decode_lazy(d, &s->diff[3], 256) + clamp8(diff + (l[1] >> 8))) & 0xFF) << 8;
         else
             v[1] |= l[1] & 0xFF00;
         if (sym & 32) {
             diff = (diff + (int)(v[1] >> 8) - (l[1] >> 8)) / 2;
-            v[2] |= ((lz_decode_sym(d, &s->diff[5]) + clamp8(diff + (l[2] >> 8))) & 0xFF) << 8;
+            v[2] |= ((lz_decode_lazy(d, &s->diff[5], 256) + clamp8(diff + (l[2] >> 8))) & 0xFF) << 8;
         } else {
             v[2] |= l[2] & 0xFF00;
         }
@@ -299,16 +293,14 @@ static int byte_init(byte2 *s, lz_arena *a, const uint8_t *r, unsigned n)
     if (!s->last || !s->m)
         return 0;
     memcpy(s->last, r, n);
-    for (unsigned k = 0; k < n; k++)
-        if (!lz_sym_init(&s->m[k], a, 256))
-            return 0;
+    memset(s->m, 0, sizeof(lz_sym) * n); /* made on first use */
     return 1;
 }
 
 static void byte_decode(byte2 *s, lz_dec *d, uint8_t *r)
 {
     for (unsigned k = 0; k < s->n; k++)
-        r[k] = s->last[k] = (uint8_t)(s->last[k] + lz_decode_sym(d, &s->m[k]));
+        r[k] = s->last[k] = (uint8_t)(s->last[k] + lz_decode_lazy(d, &s->m[k], 256));
 }
 
 /* ---- the chunk ------------------------------------------------------ */
@@ -354,6 +346,7 @@ int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
     }
     lz_dec d;
     lz_dec_init(&d, p, end);
+    d.arena = &a;
     for (uint32_t j = 1; j < count && !rc; j++) {
         uint8_t *r = out + (size_t)j * rec_len;
         for (unsigned i = 0; i < nitems && !rc; i++) {

@@ -121,12 +121,7 @@ static int p14_ctx_init(p14ctx *c, lz_arena *a, const p14ctx *from, const uint8_
     for (int k = 0; k < 12; k++)
         lz_med_init(&c->mx[k]), lz_med_init(&c->my[k]);
     c->gt[0] = c->gps;
-    for (int k = 0; k < 8; k++)
-        if (!lz_sym_init(&c->changed[k], a, 128))
-            return 0;
-    return lz_sym_init(&c->sc_m, a, 3) && lz_sym_init(&c->rn_same, a, 13) &&
-           lz_sym_init(&c->gmulti, a, GPS_TOTAL) && lz_sym_init(&c->g0, a, 5) &&
-           lz_ic_init(&c->dx, a, 32, 2, 8, 0) && lz_ic_init(&c->dy, a, 32, 22, 8, 0) &&
+    return lz_ic_init(&c->dx, a, 32, 2, 8, 0) && lz_ic_init(&c->dy, a, 32, 22, 8, 0) &&
            lz_ic_init(&c->iz, a, 32, 20, 8, 0) && lz_ic_init(&c->iint, a, 16, 4, 8, 0) &&
            lz_ic_init(&c->isa, a, 16, 2, 8, 0) && lz_ic_init(&c->ips, a, 16, 1, 8, 0) &&
            lz_ic_init(&c->igps, a, 32, 9, 8, 0);
@@ -162,7 +157,7 @@ static int p14_gps(p14ctx *c, lz_dec *d)
             return 0;
         unsigned s = c->gseq;
         if (c->gdiff[s] == 0) {
-            uint32_t multi = lz_decode_sym(d, &c->g0);
+            uint32_t multi = lz_decode_lazy(d, &c->g0, 5);
             if (multi == 0) {
                 c->gdiff[s] = lz_ic_decode(d, &c->igps, 0, 0);
                 c->gt[s] += (uint64_t)(int64_t)c->gdiff[s];
@@ -174,7 +169,7 @@ static int p14_gps(p14ctx *c, lz_dec *d)
                 continue;
             }
         } else {
-            uint32_t multi = lz_decode_sym(d, &c->gmulti);
+            uint32_t multi = lz_decode_lazy(d, &c->gmulti, GPS_TOTAL);
             if (multi == 1) {
                 c->gt[s] += (uint64_t)(int64_t)lz_ic_decode(d, &c->igps, c->gdiff[s], 1);
                 c->gext[s] = 0;
@@ -218,9 +213,9 @@ static int p14_decode(p14 *s, lz_arena *a, uint8_t *r)
     p14ctx *prev = &s->c[s->cur];
     lz_dec *xy = &s->L[0].d;
     unsigned lpr = (prev->rn == 1) | (prev->rn >= prev->nr) << 1 | (unsigned)prev->gps_change << 2;
-    uint32_t cv = lz_decode_sym(xy, &prev->changed[lpr]);
+    uint32_t cv = lz_decode_lazy(xy, &prev->changed[lpr], 128);
     if (cv & 64) { /* another scanner channel */
-        unsigned sc = (s->cur + lz_decode_sym(xy, &prev->sc_m) + 1) % 4;
+        unsigned sc = (s->cur + lz_decode_lazy(xy, &prev->sc_m, 3) + 1) % 4;
         if (!s->c[sc].used && !p14_ctx_init(&s->c[sc], a, prev, NULL))
             return -1;
         s->cur = sc;
@@ -248,7 +243,7 @@ static int p14_decode(p14 *s, lz_arena *a, uint8_t *r)
                 return -1;
             rn = lz_decode_sym(xy, m);
         } else {
-            rn = (rn + lz_decode_sym(xy, &c->rn_same) + 2) % 16;
+            rn = (rn + lz_decode_lazy(xy, &c->rn_same, 13) + 2) % 16;
         }
     }
     c->rn = (uint8_t)rn;
@@ -321,13 +316,8 @@ static int rgb_ctx_init(rgbctx *c, lz_arena *a, const uint16_t *last, int nir)
     memset(c, 0, sizeof *c);
     memcpy(c->last, last, sizeof c->last);
     c->used = 1;
-    if (!lz_sym_init(&c->rgb_used, a, 128))
-        return 0;
-    for (int k = 0; k < 6; k++)
-        if (!lz_sym_init(&c->rgb_diff[k], a, 256))
-            return 0;
-    return !nir || (lz_sym_init(&c->nir_used, a, 4) && lz_sym_init(&c->nir_diff[0], a, 256) &&
-                    lz_sym_init(&c->nir_diff[1], a, 256));
+    (void)a, (void)nir; /* the models are made on first use */
+    return 1;
 }
 
 static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v; }
@@ -335,28 +325,28 @@ static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v
 /* Colour as RGB12 v2 (laz_v2.c), predicted from `l`. */
 static void rgb_colour(lz_dec *d, rgbctx *c, const uint16_t *l, unsigned *v)
 {
-    unsigned sym = lz_decode_sym(d, &c->rgb_used);
-    v[0] = sym & 1 ? (lz_decode_sym(d, &c->rgb_diff[0]) + (l[0] & 0xFF)) & 0xFF : l[0] & 0xFF;
-    v[0] |= sym & 2 ? ((lz_decode_sym(d, &c->rgb_diff[1]) + (l[0] >> 8)) & 0xFF) << 8
+    unsigned sym = lz_decode_lazy(d, &c->rgb_used, 128);
+    v[0] = sym & 1 ? (lz_decode_lazy(d, &c->rgb_diff[0], 256) + (l[0] & 0xFF)) & 0xFF : l[0] & 0xFF;
+    v[0] |= sym & 2 ? ((lz_decode_lazy(d, &c->rgb_diff[1], 256) + (l[0] >> 8)) & 0xFF) << 8
                     : l[0] & 0xFF00u;
     if (sym & 64) {
         int diff = (int)(v[0] & 0xFF) - (l[0] & 0xFF);
-        v[1] = sym & 4 ? (lz_decode_sym(d, &c->rgb_diff[2]) + clamp8(diff + (l[1] & 0xFF))) & 0xFF
+        v[1] = sym & 4 ? (lz_decode_lazy(d, &c->rgb_diff[2], 256) + clamp8(diff + (l[1] & 0xFF))) & 0xFF
                        : l[1] & 0xFFu;
         if (sym & 16) {
             diff = (diff + (int)(v[1] & 0xFF) - (l[1] & 0xFF)) / 2;
-            v[2] = (lz_decode_sym(d, &c->rgb_diff[4]) + clamp8(diff + (l[2] & 0xFF))) & 0xFF;
+            v[2] = (lz_decode_lazy(d, &c->rgb_diff[4], 256) + clamp8(diff + (l[2] & 0xFF))) & 0xFF;
         } else {
             v[2] = l[2] & 0xFFu;
         }
         diff = (int)(v[0] >> 8) - (l[0] >> 8);
         if (sym & 8)
-            v[1] |= ((lz_decode_sym(d, &c->rgb_diff[3]) + clamp8(diff + (l[1] >> 8))) & 0xFF) << 8;
+            v[1] |= ((lz_decode_lazy(d, &c->rgb_diff[3], 256) + clamp8(diff + (l[1] >> 8))) & 0xFF) << 8;
         else
             v[1] |= l[1] & 0xFF00u;
         if (sym & 32) {
             diff = (diff + (int)(v[1] >> 8) - (l[1] >> 8)) / 2;
-            v[2] |= ((lz_decode_sym(d, &c->rgb_diff[5]) + clamp8(diff + (l[2] >> 8))) & 0xFF) << 8;
+            v[2] |= ((lz_decode_lazy(d, &c->rgb_diff[5], 256) + clamp8(diff + (l[2] >> 8))) & 0xFF) << 8;
         } else {
             v[2] |= l[2] & 0xFF00u;
         }
@@ -389,9 +379,9 @@ static int rgb14_decode(rgb14 *s, lz_arena *a, unsigned sc, uint8_t *r)
     if (s->nir) {
         if (s->L[1].size) {
             lz_dec *d = &s->L[1].d;
-            unsigned sym = lz_decode_sym(d, &c->nir_used), l = last[3], v;
-            v = sym & 1 ? (lz_decode_sym(d, &c->nir_diff[0]) + (l & 0xFF)) & 0xFF : l & 0xFF;
-            v |= sym & 2 ? ((lz_decode_sym(d, &c->nir_diff[1]) + (l >> 8)) & 0xFF) << 8
+            unsigned sym = lz_decode_lazy(d, &c->nir_used, 4), l = last[3], v;
+            v = sym & 1 ? (lz_decode_lazy(d, &c->nir_diff[0], 256) + (l & 0xFF)) & 0xFF : l & 0xFF;
+            v |= sym & 2 ? ((lz_decode_lazy(d, &c->nir_diff[1], 256) + (l >> 8)) & 0xFF) << 8
                          : l & 0xFF00u;
             last[3] = (uint16_t)v;
         }
@@ -422,9 +412,7 @@ static int byte_ctx_init(bytectx *c, lz_arena *a, const uint8_t *last, unsigned 
     if (!c->last || !c->m)
         return 0;
     memcpy(c->last, last, n);
-    for (unsigned k = 0; k < n; k++)
-        if (!lz_sym_init(&c->m[k], a, 256))
-            return 0;
+    memset(c->m, 0, sizeof(lz_sym) * n); /* made on first use */
     return 1;
 }
 
@@ -442,7 +430,7 @@ static int byte14_decode(byte14 *s, lz_arena *a, unsigned sc, uint8_t *r)
     bytectx *c = &s->c[sc];
     for (unsigned k = 0; k < s->n; k++) {
         if (s->L[k].size)
-            last[k] = (uint8_t)(last[k] + lz_decode_sym(&s->L[k].d, &c->m[k]));
+            last[k] = (uint8_t)(last[k] + lz_decode_lazy(&s->L[k].d, &c->m[k], 256));
         r[k] = last[k];
     }
     return 1;
@@ -542,6 +530,7 @@ int jf__laz_v3_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
             lz_dec_init(&all[k]->d, p, p + all[k]->size);
         else
             lz_dec_init(&all[k]->d, p, p); /* never read unless the stream is corrupt */
+        all[k]->d.arena = &a;
         p += all[k]->size;
     }
     if (!rc && count > 1 && !pt->L[0].size) {
