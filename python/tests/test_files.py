@@ -188,3 +188,17 @@ def test_read_attributes_las(tmp_path, cmd):
     for name in ref.dtype.names[3:]:
         assert np.array_equal(attrs2[name], ref[name], equal_nan=True), name
     assert attrs2["degree"].dtype == np.int32 and attrs2["nx"].dtype == np.float64
+
+
+def test_read_laz_equals_las_twin():
+    """A LAZ file (issue 25) reads as its uncompressed LAS twin: the same
+    points and attributes, bit for bit (laz-perf's test files)."""
+    d = os.path.join(TOP, "tests", "data", "laz")
+    for laz, las in (("point-color-time.las.laz", "point-color-time.las"),
+                     ("1_4_w_evlr.laz", "1_4_w_evlr.las")):
+        pz, _, _, az = jetfit.read(os.path.join(d, laz))
+        ps, _, _, as_ = jetfit.read(os.path.join(d, las))
+        assert np.array_equal(pz, ps)
+        assert list(az) == list(as_)
+        for name in as_:
+            assert np.array_equal(az[name], as_[name]), name
