@@ -42,9 +42,15 @@ static void p64(unsigned char *p, uint64_t v)
 
 #define LZ_MAX_ITEMS 16
 #define LZ_VARIABLE 0xFFFFFFFFu
+/* How many record bytes a compressed byte can stand for at most: LASzip's
+ * adaptive models never give a symbol more than about 1 - 2^-15 of the
+ * interval, so a 20-byte point costs at least ~0.008 bit (some 20,000
+ * record bytes a byte); 2^18 is a bound no real file reaches, and it keeps
+ * a tiny lying file from asking for gigabytes. */
+#define LZ_MAX_EXPANSION 18
 
 typedef struct {
-    unsigned compressor, nitems;
+    unsigned compressor, nitems, rec_len;
     uint32_t chunk_size;
     lz_item items[LZ_MAX_ITEMS];
     size_t vlr_at, vlr_len; /* the laszip VLR, header included */
@@ -114,6 +120,7 @@ static jf_status find_vlr(const unsigned char *b, size_t hsize, size_t data_off,
             z->chunk_size = g32(q + 12);
             z->nitems = g16(q + 32);
             z->vlr_at = p, z->vlr_len = 54 + rl;
+            z->rec_len = rec_len;
             if (z->compressor < 1 || z->compressor > 3)
                 return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                                   "laszip VLR: compressor %u (1 pointwise, 2 pointwise "
@@ -194,6 +201,13 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
         if (!c)
             return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
         c->start = data_off, c->bytes = len - data_off, c->count = (uint32_t)n, c->first = 0;
+        if (n * z->rec_len > c->bytes << LZ_MAX_EXPANSION) {
+            free(c);
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "header: %llu points cannot be coded in the %llu bytes of point "
+                              "data (count too large or file truncated)",
+                              (unsigned long long)n, (unsigned long long)(len - data_off));
+        }
         *out = c, *nout = 1;
         return JF_OK;
     }
@@ -255,6 +269,13 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
                             "chunk %u: %u points, more than the header's %llu leave "
                             "(or none)", (unsigned)i, c[i].count,
                             (unsigned long long)(n - total));
+            break;
+        }
+        if (pb < z->rec_len || (uint64_t)c[i].count * z->rec_len > (uint64_t)pb << LZ_MAX_EXPANSION) {
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                            "chunk %u: %u points of %u bytes cannot be coded in its %u bytes "
+                            "(a lying count or chunk table)", (unsigned)i, c[i].count,
+                            z->rec_len, pb);
             break;
         }
         if (pb == 0 || pb > at - pos) {
