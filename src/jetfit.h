@@ -641,6 +641,8 @@ void jf_read_opts_init(jf_read_opts *o);
  *    4x4 row-vector transform); points moved to the registered frame;
  *    "0 0 0" (no return) kept as a NaN row; fills scan/scanner/nscans.
  *  - LAS 1.0-1.4, point formats 0-10: x = X * scale + offset.
+ *  - LAZ (.laz, or .las with the compression bit): LASzip, point formats
+ *    0-3 and 6-8, decoded on the OpenMP threads, then read as that LAS.
  * Attributes (jf_cloud.attrs, unless o->no_attrs): PLY every scalar
  * vertex property but x y z, in its type; CSV/XYZ with a header line
  * every named column but x y z whose fields are all numbers (empty: NaN),

@@ -202,3 +202,17 @@ def test_write_las_then_read_its_normals(tmp_path):
     assert n2 is not None and np.array_equal(n2, r.normal)  # doubles in Extra Bytes
     r2 = jetfit.estimate(p2, normals=n2, neighbors="knn:12", orient="input")
     assert ((r2.normal * p2).sum(axis=1) < 0).all()  # inwards, as the file's
+
+
+def test_read_laz_equals_las_twin():
+    """A LAZ file (issue 25) reads as its uncompressed LAS twin: the same
+    points and attributes, bit for bit (laz-perf's test files)."""
+    d = os.path.join(TOP, "tests", "data", "laz")
+    for laz, las in (("point-color-time.las.laz", "point-color-time.las"),
+                     ("1_4_w_evlr.laz", "1_4_w_evlr.las")):
+        pz, _, _, az = jetfit.read(os.path.join(d, laz))
+        ps, _, _, as_ = jetfit.read(os.path.join(d, las))
+        assert np.array_equal(pz, ps)
+        assert list(az) == list(as_)
+        for name in as_:
+            assert np.array_equal(az[name], as_[name]), name

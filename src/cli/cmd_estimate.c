@@ -280,6 +280,8 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
+    if (o.threads > 0)
+        omp_set_num_threads(o.threads); /* the LAZ reader decodes chunks on them */
     jf_status st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));

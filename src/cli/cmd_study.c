@@ -349,7 +349,7 @@ static int study_view(jf_study_args *c, char *msg, size_t len)
         }
         st = jf_estimate(&cloud, &o, res, &e);
     }
-    jf_column cols[JF_CLI_MAX_COLS];
+    jf_column cols[JF_RESULT_MAX_COLS];
     int monge = o.params.monge_degree;
     size_t ncols = jf_result_columns(monge, cols);
     if (st == JF_OK) st = jf_writer_open(ply, cols, ncols, smp.n, 0, &w, &e);

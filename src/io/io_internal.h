@@ -21,7 +21,7 @@ typedef enum {
     JF_FMT_PTS,
     JF_FMT_CSV,
     JF_FMT_OFF,
-    JF_FMT_LAS,   /* .las; .laz is recognised only to be refused */
+    JF_FMT_LAS,   /* .las and .laz (the compression bit decides) */
     JF_FMT_PTX,   /* .ptx (Leica/Faro scans with their scanner poses) */
     JF_FMT_E57    /* .e57 (ASTM E2807 scans with their poses) */
 } jf_format;
@@ -46,6 +46,11 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
+/* io_laz.c: a LAZ file image decoded into the plain LAS file it stands
+ * for (*img, *img_len: malloc'd, the caller frees; the laszip VLR dropped,
+ * the compression bits cleared).  err "NAME: reason" naming the chunk. */
+jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
+                         size_t *img_len, jf_error *err);
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,

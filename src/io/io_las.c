@@ -14,7 +14,7 @@
  * wrote reads back with its columns); the header, VLRs and EVLRs are kept
  * verbatim for a LAS output (the header block even without attributes:
  * the output keeps the CRS).  Other VLRs are not interpreted.  Compressed LAZ (the compression bit of the format byte, as laszip
- * sets it) is refused with how to convert it.  Every header field that
+ * sets it) is decoded by io_laz.c into the LAS file it stands for.  Every header field that
  * points into the file is checked against its size before use, so a lying
  * header is a one-line error, never a read past the end; a format byte
  * outside 0-10, two disagreeing point counts and whole records past the
@@ -347,6 +347,17 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_re
                       jf_cloud *c, jf_error *err)
 {
     const unsigned char *b = (const unsigned char *)buf;
+    if (len >= 227 && !memcmp(b, "LASF", 4) && (b[104] & 0xc0)) {
+        /* LAZ: decoded to the plain LAS file it stands for (io_laz.c) */
+        char *img;
+        size_t img_len;
+        jf_status zs = jf__laz_unpack(buf, len, name, &img, &img_len, err);
+        if (zs == JF_OK) {
+            zs = jf_read_las(img, img_len, name, o, c, err);
+            free(img);
+        }
+        return zs;
+    }
     las_hdr h;
     jf_status st = las_header(b, len, len, name, &h, err);
     if (st != JF_OK)

@@ -399,11 +399,6 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     memset(c, 0, sizeof *c);
     if (!path)
         return jf_io_fail(err, JF_ERR_INVALID, "(null)", 0, "no file name");
-    size_t plen = strlen(path);
-    if (plen >= 4 && !strcasecmp(path + plen - 4, ".laz"))
-        return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,
-                          "compressed LAS (LAZ) is not read: decompress it first, e.g. "
-                          "`pdal translate in.laz out.las` or `las2las -i in.laz -o out.las`");
     jf_format fmt = jf_format_from_path(path);
     if (fmt == JF_FMT_UNKNOWN)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, path, 0,

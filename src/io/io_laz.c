@@ -1,0 +1,416 @@
+/*
+ * io_laz.c -- LAZ (LASzip-compressed LAS) to LAS: the reader's front end.
+ *
+ * design: a LAZ file is a LAS file whose point format byte has bit 7 (and
+ * for LAS 1.4 bit 6) set, whose VLRs hold the "laszip encoded" record
+ * 22204 (compressor, coder, version, chunk size, the items that make a
+ * point record), and whose point data is a series of chunks, each coded
+ * independently; 8 bytes at the start of the point data give the offset of
+ * the chunk table (every chunk's compressed size and, for variable chunks,
+ * its point count; itself arithmetic coded; an offset of -1 means it is
+ * in the file's last 8 bytes).  We check the VLR, read the table, decode
+ * the chunks in parallel (each into its own records: the bytes do not
+ * depend on the thread count) and hand back the plain LAS file those
+ * records make: the header with the compression bits cleared, the VLRs
+ * without LASzip's, the records, the EVLRs -- so io_las.c reads it as any
+ * LAS, every attribute kept.  Every count and offset is checked against
+ * the file before use; an error names the chunk (and the point in it).
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io_internal.h"
+#include "laz_arith.h"
+#include "laz_internal.h"
+
+static uint16_t g16(const unsigned char *p) { return (uint16_t)(p[0] | p[1] << 8); }
+static uint32_t g32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static uint64_t g64(const unsigned char *p) { return g32(p) | (uint64_t)g32(p + 4) << 32; }
+static void p32(unsigned char *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+static void p64(unsigned char *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+
+#define LZ_MAX_ITEMS 16
+#define LZ_VARIABLE 0xFFFFFFFFu
+/* How many record bytes a compressed byte can stand for at most: LASzip's
+ * adaptive models never give a symbol more than about 1 - 2^-15 of the
+ * interval, so a 20-byte point costs at least ~0.008 bit (some 20,000
+ * record bytes a byte); 2^18 is a bound no real file reaches, and it keeps
+ * a tiny lying file from asking for gigabytes. */
+#define LZ_MAX_EXPANSION 18
+
+typedef struct {
+    unsigned compressor, nitems, rec_len;
+    uint32_t chunk_size;
+    lz_item items[LZ_MAX_ITEMS];
+    size_t vlr_at, vlr_len; /* the laszip VLR, header included */
+} lz_vlr;
+
+typedef struct {
+    uint64_t start, bytes; /* file offset and compressed size */
+    uint32_t count;        /* points                           */
+    uint64_t first;        /* index of its first point         */
+} lz_chunk;
+
+/* Base record length and item list a point format must have (LASzip:
+ * 0-5 pointwise v2, 6-10 layered v3); extra bytes as one BYTE item. */
+static const unsigned lz_base[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+
+static const char *item_name(unsigned t)
+{
+    static const char *const nm[15] = {"BYTE",     "SHORT",     "INT",       "LONG",
+                                       "FLOAT",    "DOUBLE",    "POINT10",   "GPSTIME11",
+                                       "RGB12",    "WAVEPACKET13", "POINT14", "RGB14",
+                                       "RGBNIR14", "WAVEPACKET14", "BYTE14"};
+    return t < 15 ? nm[t] : "unknown";
+}
+
+/* The items the format needs, in order (the extra bytes' item aside). */
+static unsigned want_items(unsigned fmt, unsigned *t)
+{
+    static const unsigned lists[11][4] = {
+        {LZ_POINT10},
+        {LZ_POINT10, LZ_GPSTIME11},
+        {LZ_POINT10, LZ_RGB12},
+        {LZ_POINT10, LZ_GPSTIME11, LZ_RGB12},
+        {LZ_POINT10, LZ_GPSTIME11, LZ_WAVEPACKET13},
+        {LZ_POINT10, LZ_GPSTIME11, LZ_RGB12, LZ_WAVEPACKET13},
+        {LZ_POINT14},
+        {LZ_POINT14, LZ_RGB14},
+        {LZ_POINT14, LZ_RGBNIR14},
+        {LZ_POINT14, LZ_WAVEPACKET14},
+        {LZ_POINT14, LZ_RGBNIR14, LZ_WAVEPACKET14}};
+    static const unsigned cnt[11] = {1, 2, 2, 3, 3, 4, 1, 2, 2, 2, 3};
+    memcpy(t, lists[fmt], sizeof lists[fmt]);
+    return cnt[fmt];
+}
+
+/* The laszip VLR among the VLRs in [hsize, data_off), checked against the
+ * point format and record length. */
+static jf_status find_vlr(const unsigned char *b, size_t hsize, size_t data_off, uint32_t nvlr,
+                          unsigned fmt, unsigned rec_len, const char *name, lz_vlr *z,
+                          jf_error *err)
+{
+    size_t p = hsize;
+    memset(z, 0, sizeof *z);
+    for (uint32_t v = 0; v < nvlr && p + 54 <= data_off; v++) {
+        size_t rl = g16(b + p + 20);
+        if (rl > data_off - p - 54)
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "VLR %u at byte %zu: its %zu bytes run past the point data",
+                              (unsigned)v, p, rl);
+        if (!memcmp(b + p + 2, "laszip encoded\0", 15) && g16(b + p + 18) == 22204) {
+            const unsigned char *q = b + p + 54;
+            if (rl < 34 || rl != 34 + 6u * g16(q + 32))
+                return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                  "laszip VLR at byte %zu: length %zu does not match its items",
+                                  p, rl);
+            z->compressor = g16(q);
+            unsigned coder = g16(q + 2);
+            z->chunk_size = g32(q + 12);
+            z->nitems = g16(q + 32);
+            z->vlr_at = p, z->vlr_len = 54 + rl;
+            z->rec_len = rec_len;
+            if (z->compressor < 1 || z->compressor > 3)
+                return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                                  "laszip VLR: compressor %u (1 pointwise, 2 pointwise "
+                                  "chunked, 3 layered chunked are read)", z->compressor);
+            if (coder != 0)
+                return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                                  "laszip VLR: coder %u (0, arithmetic, is read)", coder);
+            if (!z->nitems || z->nitems > LZ_MAX_ITEMS)
+                return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                  "laszip VLR: %u items (1 to %d)", z->nitems, LZ_MAX_ITEMS);
+            if (z->chunk_size == 0)
+                return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "laszip VLR: chunk size 0");
+            unsigned sum = 0;
+            for (unsigned i = 0; i < z->nitems; i++) {
+                lz_item *it = &z->items[i];
+                it->type = g16(q + 34 + 6 * i);
+                it->size = g16(q + 36 + 6 * i);
+                it->version = g16(q + 38 + 6 * i);
+                sum += it->size;
+            }
+            /* the items must be the format's, then the extra bytes */
+            unsigned want[4], nw = want_items(fmt, want);
+            int layered = fmt >= 6, wave = fmt == 4 || fmt == 5 || fmt >= 9;
+            if (wave)
+                return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                                  "compressed point format %u (with waveform packets) is not "
+                                  "decoded: formats 0-3 and 6-8 are", fmt);
+            if (layered != (z->compressor == 3))
+                return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                  "laszip VLR: compressor %u for point format %u (LASzip codes "
+                                  "formats 6-10 layered, compressor 3, and 0-5 pointwise)",
+                                  z->compressor, fmt);
+            for (unsigned i = 0; i < z->nitems; i++) {
+                const lz_item *it = &z->items[i];
+                unsigned need = i < nw ? want[i] : layered ? LZ_BYTE14 : LZ_BYTE;
+                unsigned size = i < nw ? (need == LZ_POINT10   ? 20
+                                          : need == LZ_GPSTIME11 ? 8
+                                          : need == LZ_RGB12     ? 6
+                                          : need == LZ_POINT14   ? 30
+                                          : need == LZ_RGB14     ? 6
+                                                                 : 8)
+                                       : rec_len - lz_base[fmt];
+                unsigned ver = layered ? 3 : 2;
+                if (it->type != need || it->size != size || i > nw)
+                    return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                      "laszip VLR: item %u is %s of %u bytes, point format %u "
+                                      "needs %s of %u bytes there", i, item_name(it->type),
+                                      it->size, fmt, item_name(need), size);
+                if (it->version != ver && !(layered && it->version == 4))
+                    return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                                      "laszip VLR: item %s version %u (version %u is read)",
+                                      item_name(it->type), it->version, ver);
+            }
+            if (z->nitems < nw || sum != rec_len)
+                return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                  "laszip VLR: the items make %u-byte records, the header "
+                                  "says %u", sum, rec_len);
+            return JF_OK;
+        }
+        p += 54 + rl;
+    }
+    return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                      "compressed point format but no laszip VLR (user \"laszip encoded\", "
+                      "record 22204)");
+}
+
+/* The chunk table: chunk sizes (and counts) from the arithmetic-coded
+ * table, checked to tile [first, table) and to hold the header's n
+ * points. */
+static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_off, uint64_t n,
+                            const lz_vlr *z, const char *name, lz_chunk **out, size_t *nout,
+                            jf_error *err)
+{
+    *out = NULL, *nout = 0;
+    uint64_t first = data_off + 8;
+    if (z->compressor == 1) { /* pointwise, not chunked: one stream */
+        lz_chunk *c = malloc(sizeof *c);
+        if (!c)
+            return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+        c->start = data_off, c->bytes = len - data_off, c->count = (uint32_t)n, c->first = 0;
+        if (n * z->rec_len > c->bytes << LZ_MAX_EXPANSION) {
+            free(c);
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "header: %llu points cannot be coded in the %llu bytes of point "
+                              "data (count too large or file truncated)",
+                              (unsigned long long)n, (unsigned long long)(len - data_off));
+        }
+        *out = c, *nout = 1;
+        return JF_OK;
+    }
+    if (len < first)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "chunk table: the file ends before the point data's 8-byte "
+                          "offset of the chunk table");
+    uint64_t at = g64(b + data_off);
+    if (at == UINT64_MAX && len >= 8) /* written to a stream: the offset is at the end */
+        at = g64(b + len - 8);
+    if (at == first - 8 || at < first || at > len - 8)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "chunk table: offset %llu is %s (the file is %zu bytes): the table "
+                          "is missing or the file truncated", (unsigned long long)at,
+                          at < first ? "before the chunks" : "past the end", len);
+    uint32_t version = g32(b + at), nc = g32(b + at + 4);
+    if (version != 0)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "chunk table at byte %llu: version %u (0 is read)",
+                          (unsigned long long)at, version);
+    /* each chunk holds at least one point and one byte */
+    if (nc == 0 || nc > n || nc > at - first)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "chunk table at byte %llu: %u chunks for %llu points in %llu bytes",
+                          (unsigned long long)at, nc, (unsigned long long)n,
+                          (unsigned long long)(at - first));
+    lz_chunk *c = calloc(nc, sizeof *c);
+    if (!c)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %u chunks", nc);
+    lz_arena a = {0};
+    lz_ic ic;
+    if (!lz_ic_init(&ic, &a, 32, 2, 8, 0)) {
+        lz_arena_free(&a);
+        free(c);
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+    }
+    lz_dec d;
+    lz_dec_init(&d, b + at + 8, b + len);
+    uint32_t pc = 0, pb = 0;
+    uint64_t pos = first, total = 0;
+    jf_status st = JF_OK;
+    for (uint32_t i = 0; i < nc; i++) {
+        if (z->chunk_size == LZ_VARIABLE) {
+            pc = (uint32_t)lz_ic_decode(&d, &ic, (int32_t)pc, 0);
+            c[i].count = pc;
+        } else {
+            c[i].count = n - total < z->chunk_size ? (uint32_t)(n - total) : z->chunk_size;
+        }
+        pb = (uint32_t)lz_ic_decode(&d, &ic, (int32_t)pb, 1);
+        c[i].start = pos, c[i].bytes = pb, c[i].first = total;
+        if (d.over > 4 || d.bad) {
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                            "chunk table at byte %llu: the table is cut short at chunk %u",
+                            (unsigned long long)at, (unsigned)i);
+            break;
+        }
+        if (c[i].count == 0 || c[i].count > n - total) {
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                            "chunk %u: %u points, more than the header's %llu leave "
+                            "(or none)", (unsigned)i, c[i].count,
+                            (unsigned long long)(n - total));
+            break;
+        }
+        if (pb < z->rec_len || (uint64_t)c[i].count * z->rec_len > (uint64_t)pb << LZ_MAX_EXPANSION) {
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                            "chunk %u: %u points of %u bytes cannot be coded in its %u bytes "
+                            "(a lying count or chunk table)", (unsigned)i, c[i].count,
+                            z->rec_len, pb);
+            break;
+        }
+        if (pb == 0 || pb > at - pos) {
+            st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                            "chunk %u at byte %llu: %u bytes run past the chunk table at byte "
+                            "%llu (truncated file or damaged table)", (unsigned)i,
+                            (unsigned long long)pos, pb, (unsigned long long)at);
+            break;
+        }
+        pos += pb;
+        total += c[i].count;
+    }
+    lz_arena_free(&a);
+    if (st == JF_OK && total != n)
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                        "chunk table: its %u chunks hold %llu points, the header says %llu",
+                        nc, (unsigned long long)total, (unsigned long long)n);
+    if (st != JF_OK) {
+        free(c);
+        return st;
+    }
+    *out = c, *nout = nc;
+    return JF_OK;
+}
+
+jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
+                         size_t *img_len, jf_error *err)
+{
+    const unsigned char *b = (const unsigned char *)buf;
+    *img = NULL, *img_len = 0;
+    if (len < 227)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "header: %zu bytes, a LAS header has at least 227", len);
+    unsigned minor = b[25], hsize = g16(b + 94);
+    uint32_t data_off = g32(b + 96), nvlr = g32(b + 100);
+    unsigned fmt = b[104] & 0x3f, rec_len = g16(b + 105);
+    uint64_t n = g32(b + 107);
+    if (minor >= 4 && hsize >= 375 && len >= 375 && g64(b + 247))
+        n = g64(b + 247);
+    if (hsize < 227 || hsize > len || data_off < hsize || data_off > len)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                          "header: header size %u or offset to point data %u is outside the "
+                          "file (%zu bytes)", hsize, (unsigned)data_off, len);
+    if (fmt > 10 || rec_len < lz_base[fmt])
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                          "header: compressed point format %u with %u-byte records", fmt,
+                          rec_len);
+    if (n == 0)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
+    if (n > JF_MAX_POINTS)
+        return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: more than supported",
+                          (unsigned long long)n);
+    lz_vlr z;
+    jf_status st = find_vlr(b, hsize, data_off, nvlr, fmt, rec_len, name, &z, err);
+    if (st != JF_OK)
+        return st;
+    lz_chunk *ch;
+    size_t nc;
+    if ((st = read_table(b, len, data_off, n, &z, name, &ch, &nc, err)) != JF_OK)
+        return st;
+    /* EVLRs (1.4) after the chunk table are kept, moved with the points */
+    uint64_t evlr = 0, nevlr = 0;
+    if (minor >= 4 && hsize >= 375) {
+        evlr = g64(b + 235), nevlr = g32(b + 243);
+        if (!nevlr || evlr < data_off || evlr > len)
+            evlr = 0;
+    }
+    for (uint64_t k = 0, q = evlr; evlr && k < nevlr; k++) { /* a cut EVLR is lost data */
+        uint64_t el = q + 60 <= len ? g64(b + q + 20) : 0;
+        if (q + 60 > len || el > len - q - 60) {
+            free(ch);
+            return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                              "EVLR %llu at byte %llu runs past the end of the file (%zu "
+                              "bytes): truncated file", (unsigned long long)k,
+                              (unsigned long long)q, len);
+        }
+        q += 60 + el;
+    }
+    size_t head = data_off - z.vlr_len, recs = (size_t)n * rec_len;
+    size_t tail = evlr ? len - (size_t)evlr : 0;
+    if (recs / rec_len != n || head + recs + tail < recs) {
+        free(ch);
+        return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: too large",
+                          (unsigned long long)n);
+    }
+    unsigned char *o = malloc(head + recs + tail);
+    if (!o) {
+        free(ch);
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
+                          (unsigned long long)n);
+    }
+    /* header and VLRs without LASzip's; bits 6-7 of the format cleared */
+    memcpy(o, b, z.vlr_at);
+    memcpy(o + z.vlr_at, b + z.vlr_at + z.vlr_len, data_off - z.vlr_at - z.vlr_len);
+    o[104] = (unsigned char)fmt;
+    p32(o + 96, (uint32_t)head);
+    p32(o + 100, nvlr - 1);
+    if (evlr) {
+        p64(o + 235, head + recs);
+        memcpy(o + head + recs, b + evlr, tail);
+    }
+    /* the chunks, in parallel: each writes only its own records; every
+     * chunk is decoded even after a failure, so the error names the first
+     * bad chunk whatever the thread count */
+    int failed = 0;
+    size_t bad_chunk = nc;
+    char bad_msg[160] = "";
+#pragma omp parallel for schedule(dynamic, 1)
+    for (size_t i = 0; i < nc; i++) {
+        char msg[160];
+        const uint8_t *p = b + ch[i].start, *e = p + ch[i].bytes;
+        uint8_t *out = o + head + ch[i].first * rec_len;
+        int rc = z.compressor == 3
+                     ? jf__laz_v3_chunk(z.items, z.nitems, rec_len, p, e, ch[i].count, out, msg,
+                                        sizeof msg)
+                     : jf__laz_v2_chunk(z.items, z.nitems, rec_len, p, e, ch[i].count, out, msg,
+                                        sizeof msg);
+        if (rc) {
+#pragma omp critical(jf_laz_fail)
+            if (i < bad_chunk) {
+                bad_chunk = i;
+                memcpy(bad_msg, msg, sizeof msg);
+                failed = 1;
+            }
+        }
+    }
+    if (failed) {
+        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "chunk %zu (at byte %llu): %s", bad_chunk,
+                        (unsigned long long)ch[bad_chunk].start, bad_msg);
+        free(ch);
+        free(o);
+        return st;
+    }
+    free(ch);
+    *img = (char *)o;
+    *img_len = head + recs + tail;
+    return JF_OK;
+}

@@ -1,0 +1,130 @@
+/*
+ * bench_laz.c -- LAZ decoding speed (issue 25): reading FILE.laz with one
+ * thread and with all threads, against reading the same points from the
+ * uncompressed LAS file they stand for (written here), and against
+ * laz-perf's decoder (npm, WASM, under node) on the same file in the same
+ * run when node and laz-perf are there.
+ *
+ *   bench_laz FILE.laz [REPEATS [NODE_MODULES]]
+ *
+ * Each figure is the best of REPEATS (default 5) wall times of a whole
+ * read (jf_cloud_read: file read, chunks decoded, records and x y z made);
+ * points/s = points / seconds; "CPU s" is the process's CPU time for that
+ * read (all threads; on a shared machine the steadier figure).  laz-perf's figure is its decoding loop
+ * alone (the file already in memory), so the ratio flatters laz-perf.
+ * NODE_MODULES defaults to tests/node_modules of the source tree
+ * (.ci/install-deps puts laz-perf there).
+ */
+#define _GNU_SOURCE
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "jetfit.h"
+
+/* the source tree's tests/ (benchmarks get the data folder's path) */
+#define TESTS_DIR JF_TEST_DATA "/../tests"
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+static double cpu(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Best wall time of `reps` reads of path (and in *cpu_s the CPU time of
+ * that read, all threads); the point count in *n. */
+static double best_read(const char *path, int reps, size_t *n, double *cpu_s)
+{
+    double best = 1e30;
+    for (int r = 0; r < reps; r++) {
+        jf_cloud c;
+        jf_error e;
+        double c0 = cpu(), t = now();
+        if (jf_cloud_read(path, NULL, &c, &e) != JF_OK) {
+            fprintf(stderr, "bench_laz: %s\n", e.msg);
+            exit(1);
+        }
+        t = now() - t;
+        double cs = cpu() - c0;
+        *n = c.n;
+        jf_cloud_free(&c);
+        if (t < best)
+            best = t, *cpu_s = cs;
+    }
+    return best;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: bench_laz FILE.laz [REPEATS [NODE_MODULES]]\n");
+        return 2;
+    }
+    const char *laz = argv[1];
+    int reps = argc > 2 ? atoi(argv[2]) : 5;
+    const char *modules = argc > 3 ? argv[3] : TESTS_DIR "/node_modules";
+    int all = omp_get_max_threads();
+    size_t n = 0;
+    omp_set_num_threads(1);
+    double c1, cn, cl;
+    double t1 = best_read(laz, reps, &n, &c1);
+    omp_set_num_threads(all);
+    double tn = best_read(laz, reps, &n, &cn);
+    /* the LAS file the LAZ stands for: header and VLRs, records, EVLRs */
+    jf_cloud c;
+    jf_error e;
+    if (jf_cloud_read(laz, NULL, &c, &e) != JF_OK) {
+        fprintf(stderr, "bench_laz: %s\n", e.msg);
+        return 1;
+    }
+    char las[] = "/tmp/jf_bench_laz_XXXXXX.las";
+    int fd = mkstemps(las, 4);
+    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    if (!f || fwrite(c.attrs.las_head, 1, c.attrs.las_head_len, f) != c.attrs.las_head_len ||
+        fwrite(c.attrs.rec, c.attrs.stride, c.n, f) != c.n ||
+        (c.attrs.las_evlr_len &&
+         fwrite(c.attrs.las_evlr, 1, c.attrs.las_evlr_len, f) != c.attrs.las_evlr_len) ||
+        fclose(f) != 0) {
+        fprintf(stderr, "bench_laz: cannot write %s\n", las);
+        return 1;
+    }
+    jf_cloud_free(&c);
+    size_t n2 = 0;
+    double tl = best_read(las, reps, &n2, &cl);
+    unlink(las);
+    printf("file: %s, %zu points, best of %d\n", laz, n, reps);
+    printf("| read | threads | seconds | CPU s | points/s |\n|---|---|---|---|---|\n");
+    printf("| LAZ (jetfit) | 1 | %.4f | %.4f | %.3g |\n", t1, c1, n / t1);
+    printf("| LAZ (jetfit) | %d | %.4f | %.4f | %.3g |\n", all, tn, cn, n / tn);
+    printf("| LAS, the same records (jetfit) | %d | %.4f | %.4f | %.3g |\n", all, tl, cl,
+           n2 / tl);
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "node '%s/bench/lazperf_bench.js' '%s' '%s' %d 2>/dev/null",
+             TESTS_DIR, modules, laz, reps);
+    double tp = 0, cp = 0;
+    size_t np = 0;
+    FILE *p = popen(cmd, "r");
+    if (p && fscanf(p, "lazperf %lf %lf %zu", &tp, &cp, &np) == 3 && np == n)
+        printf("| LAZ (laz-perf %s, WASM under node, decode loop only) | 1 | %.4f | %.4f | "
+               "%.3g |\n", "0.0.7", tp, cp, n / tp);
+    else
+        tp = 0, printf("(laz-perf: not run -- no node or no laz-perf in %s)\n", modules);
+    if (p)
+        pclose(p);
+    printf("LAZ all threads / one thread: %.2fx\n", t1 / tn);
+    printf("LAZ one thread / LAS: %.2fx the time\n", t1 / tl);
+    if (tp > 0)
+        printf("LAZ one thread (jetfit) / laz-perf: %.2fx the points/s (CPU time: %.2fx)\n",
+               tp / t1, cp / c1);
+    return 0;
+}

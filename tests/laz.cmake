@@ -1,0 +1,14 @@
+# LAZ (issue 25): the reader's records against laz-perf's (npm, WASM, under
+# node), an independent LASzip decoder; skipped (77) with the reason where
+# node or the laz-perf package (.ci/install-deps puts it in
+# tests/node_modules) is missing.
+if(TEST test_io_laz)
+  set_tests_properties(test_io_laz PROPERTIES LABELS io)
+endif()
+add_executable(laz_dump ${CMAKE_CURRENT_SOURCE_DIR}/io/laz_dump.c)
+target_link_libraries(laz_dump PRIVATE jetfit_lib OpenMP::OpenMP_C)
+target_include_directories(laz_dump PRIVATE ${JF_INTERNAL_INCLUDES})
+add_test(NAME test_laz_perf
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/io/laz_perf_check.sh $<TARGET_FILE:laz_dump>
+                 ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/test_laz_perf)
+set_tests_properties(test_laz_perf PROPERTIES LABELS io SKIP_RETURN_CODE 77)
