@@ -16,6 +16,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_laz_XXXXXX"); }
 
@@ -281,9 +282,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int nf = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(suite());
 }
