@@ -56,7 +56,8 @@ PyDoc_STRVAR(estimate_doc,
 "--\n\n"
 "Normals, principal curvatures and directions and Monge coefficients of every\n"
 "point of an (N, 3) array, as `jetfit estimate` computes them (same options,\n"
-"same defaults, same bits).  Returns a Result.  A C-contiguous float64 array\n"
+"same defaults, same bits).  neighbors='auto' chooses K and the degree per\n"
+"point (Result.sigma: the noise it saw).  Returns a Result.  A C-contiguous float64 array\n"
 "is not copied.  Bad option values raise ValueError with the command's words.\n"
 "The GIL is released; Ctrl-C raises KeyboardInterrupt.");
 

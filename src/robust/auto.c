@@ -22,8 +22,9 @@
  *     covariance).  Noise makes sd fall like 1/(h sqrt K), so a noisy flat
  *     region grows K; curvature makes the quadric's normal drift like h^2
  *     (its bias), which stops the growth.
- *  4. Degree: the cubic's choice unless the quadric's has a smaller sd and
- *     agrees, at the quadric's K, with the cubic's normal within tau sd.
+ *  4. Degree: the cubic's choice, unless the quadric at the largest K of
+ *     its chain where it agrees with the cubic at the same K (within tau
+ *     sd of the cubic) has the smaller sd.
  *  5. The reported fit is the ordinary jet (jf_fit_point) of the chosen
  *     degree on the chosen K points: the same numbers as knn:K --degree d,
  *     flagged JF_PT_AUTO.
@@ -38,6 +39,7 @@
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND 10
+#define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
@@ -242,6 +244,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         if (i + 1 != ks[c]) continue;
         for (int d = 0; d < 2; d++) {
             int nd = d ? 10 : 6;
+            /* a cubic on fewer than 32 points follows the noise */
+            if (d && ks[c] < CUBIC_MINK && ks[c] < nmax) continue;
             if (m >= (size_t)nd + 4 && hK > 0.0)
                 solve_k(G, bz, zz, m, nd, H, hK, fr, &cf[d][c]);
         }
@@ -297,12 +301,18 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     if (c3 < 0) {
         d = 2;
         ci = c2;
-    } else if (c2 >= 0) {
-        double sd2 = sqrt(s2 * cf[0][c2].tr), sd3 = sqrt(s2 * cf[1][c3].tr);
-        if (sd2 < sd3 && cf[1][c2].ok &&
-            jf__angle(cf[0][c2].nrm, cf[1][c2].nrm) <= tau * sqrt(s2 * cf[1][c2].tr)) {
-            d = 2;
-            ci = c2;
+    } else {
+        /* the quadric at the largest K of its chain that agrees with the
+         * cubic at the same K, if its sd is below the cubic's choice */
+        double sd3 = sqrt(s2 * cf[1][c3].tr);
+        for (int i = c2; i >= 0; i--) {
+            if (!cf[0][i].ok || !cf[1][i].ok) continue;
+            if (jf__angle(cf[0][i].nrm, cf[1][i].nrm) > tau * sqrt(s2 * cf[1][i].tr)) continue;
+            if (sqrt(s2 * cf[0][i].tr) < sd3) {
+                d = 2;
+                ci = i;
+            }
+            break;
         }
     }
     if (ci < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
