@@ -12,11 +12,13 @@
  *     preconditioning of §2.3, before the solve).
  *  2. Noise: the unbiased residual variance of the cubic at K = 32 (22
  *     degrees of freedom), where truncation error (O(h^4), Theorem 3) is
- *     least and the noise is still well sampled.  It is what `sigma`
- *     reports.
+ *     least and the noise is still well sampled; the next larger K where
+ *     that exceeds jf__auto_blob x the radius (a blob of noise, whose cubic
+ *     follows it).  It is what `sigma` reports.
  *  3. Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
- *     intersection of confidence intervals of Katkovnik 1999, used for
- *     adaptive neighbourhoods by e.g. Mederos et al. 2003): grow K while the
+ *     intersection of confidence intervals of Katkovnik 1999; the K that
+ *     balances noise and curvature for normals: Mitra, Nguyen & Guibas
+ *     2004): grow K while the
  *     normal at K stays within tau (sd_j + sd_K) of the normal at every
  *     smaller accepted K j, sd from sigma^2 (M^T M)^-1 (the slope's
  *     covariance).  Noise makes sd fall like 1/(h sqrt K), so a noisy flat
@@ -44,7 +46,7 @@
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
 
-/* Lepski's threshold, in sd of the difference (tests/bench/study_auto.sh) */
+/* Lepski's threshold, in sd (chosen on tests/bench/study_auto.sh's data) */
 double jf__auto_tau = 2.0;
 /* A residual above this fraction of the radius is a blob of noise whose
  * cubic follows the noise (and whose residual understates it): the noise
@@ -52,6 +54,8 @@ double jf__auto_tau = 2.0;
 double jf__auto_blob = 0.2;
 /* A normal whose sd exceeds this (rad) is noise: it does not stop K. */
 double jf__auto_sdmax = 0.3;
+/* 1: Goldenshluger-Lepski over every (K, degree) instead (bench --auto-gl
+ * 1; worse, docs/robustness.md "Neighbourhood auto") */
 int jf__auto_gl = 0;
 double jf__auto_varw = 1.0;
 

@@ -4,7 +4,8 @@
 #
 # usage: sh tests/bench/study_auto.sh BUILD [PCPNET_DIR] [--n N] [--threads T]
 #   BUILD       a build folder configured with -DJF_BENCH=ON (jetfit and
-#               tests/bench_pcpnet, CGAL as for the reference harness)
+#               the bench_pcpnet program in its tests folder, CGAL as for
+#               the reference harness)
 #   PCPNET_DIR  folder holding armadillo100k.{xyz,normals,pidx}; without
 #               it only the generated surfaces run
 # Prints two tables:
