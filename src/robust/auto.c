@@ -54,6 +54,8 @@ double jf__auto_tau = 2.0;
 double jf__auto_blob = 0.2;
 /* A normal whose sd exceeds this (rad) is noise: it does not stop K. */
 double jf__auto_sdmax = 0.3;
+/* Noise below this fraction of the radius: cubics on 16-24 points allowed. */
+double jf__auto_clean = 0.05;
 /* 1: Goldenshluger-Lepski over every (K, degree) instead (bench --auto-gl
  * 1; worse, docs/robustness.md "Neighbourhood auto") */
 int jf__auto_gl = 0;
@@ -248,8 +250,6 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         if (i + 1 != ks[c]) continue;
         for (int d = 0; d < 2; d++) {
             int nd = d ? 10 : 6;
-            /* a cubic on fewer than 32 points follows the noise */
-            if (d && ks[c] < CUBIC_MINK && ks[c] < nmax) continue;
             if (m >= (size_t)nd + 4 && hK > 0.0)
                 solve_k(G, bz, zz, m, nd, H, hK, fr, &cf[d][c]);
         }
@@ -265,6 +265,12 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         }
     if (!isfinite(s2)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
     double sigma = sqrt(s2);
+    /* a cubic on fewer than 32 points follows the noise, unless the noise
+     * is a small fraction of its radius (clean data, where the small
+     * cubic is the least biased choice) */
+    for (int i = 0; i < nc; i++)
+        if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= jf__auto_clean * jf__auto_clean * cf[1][i].h * cf[1][i].h))
+            cf[1][i].ok = 0;
 
     if (jf__auto_gl) {
         /* Goldenshluger-Lepski over every (K, degree): the squared bias of a

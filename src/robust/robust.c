@@ -73,6 +73,7 @@ int jf__robust_tune(const char *name, double v)
     else if (!strcmp(name, "auto_blob")) jf__auto_blob = v;
     else if (!strcmp(name, "auto_sdmax")) jf__auto_sdmax = v;
     else if (!strcmp(name, "auto_varw")) jf__auto_varw = v;
+    else if (!strcmp(name, "auto_clean")) jf__auto_clean = v;
     else if (!strcmp(name, "auto_gl")) jf__auto_gl = (int)v;
     else return -1;
     return 0;

@@ -229,6 +229,7 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--auto-blob") && i + 1 < argc) jf__robust_tune("auto_blob", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-sdmax") && i + 1 < argc) jf__robust_tune("auto_sdmax", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-varw") && i + 1 < argc) jf__robust_tune("auto_varw", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-clean") && i + 1 < argc) jf__robust_tune("auto_clean", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-gl") && i + 1 < argc) jf__robust_tune("auto_gl", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--cgal-ks") && i + 1 < argc) cgal_ks = argv[++i];
         else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
