@@ -24,7 +24,8 @@
  *     covariance).  Noise makes sd fall like 1/(h sqrt K), so a noisy flat
  *     region grows K; curvature makes the quadric's normal drift like h^2
  *     (its bias), which stops the growth.
- *  4. Degree: the cubic's choice, unless the quadric at the largest K of
+ *  4. Degree (cubics from K = 32, or smaller K when the noise is under 5%
+ *     of their radius): the cubic's choice, unless the quadric at the largest K of
  *     its chain where it agrees with the cubic at the same K (within tau
  *     sd of the cubic) has the smaller sd.
  *  5. The reported fit is the ordinary jet (jf_fit_point) of the chosen
