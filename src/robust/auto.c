@@ -261,17 +261,19 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     double s2 = NAN;
     for (int i = 0; i < nc; i++)
         if (cf[1][i].ok) {
+            double hb = jf__auto_blob * cf[1][i].h;
             s2 = cf[1][i].s2;
-            if (ks[i] >= NOISE_K && s2 <= jf__auto_blob * jf__auto_blob * cf[1][i].h * cf[1][i].h) break;
+            if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
     if (!isfinite(s2)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
     double sigma = sqrt(s2);
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small
      * cubic is the least biased choice) */
-    for (int i = 0; i < nc; i++)
-        if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= jf__auto_clean * jf__auto_clean * cf[1][i].h * cf[1][i].h))
-            cf[1][i].ok = 0;
+    for (int i = 0; i < nc; i++) {
+        double hc = jf__auto_clean * cf[1][i].h;
+        if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= hc * hc)) cf[1][i].ok = 0;
+    }
 
     if (jf__auto_gl) {
         /* Goldenshluger-Lepski over every (K, degree): the squared bias of a
