@@ -109,9 +109,12 @@ enum {
                                       of the N nearest points, ring on
                                       the jet-projected cloud (noisy
                                       cloud, docs/natural.md)           */
-    JF_PT_NORMAL_PCA = 1u << 16    /* natural: tangent plane from the PCA
+    JF_PT_NORMAL_PCA = 1u << 16,   /* natural: tangent plane from the PCA
                                       of the 16 nearest points (clean
                                       cloud, or --normal pca)           */
+    JF_PT_AUTO = 1u << 17          /* neighbourhood auto: K (n_used) and
+                                      degree were chosen per point
+                                      (params.auto_select)              */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf
@@ -156,6 +159,13 @@ typedef struct {
     double dist_weight;      /* Gaussian distance weights (robust.c):
                                 sigma = dist_weight x the farthest
                                 neighbour's distance; 0 = off (default)   */
+    int auto_select;         /* 1: per point, choose K among the first
+                                entries of nbr (nearest first) and the
+                                degree (2 or 3), estimating the noise
+                                (src/robust/auto.c; the neighbourhood
+                                JF_NB_AUTO sets it); overrides robust,
+                                scales, degree_select, dist_weight and
+                                degree.  0 = off (default)               */
 } jf_params;
 
 /* Fills defaults.  Never fails. */
@@ -205,6 +215,9 @@ typedef struct {
     double d1[3], d2[3];  /* principal directions (unit, d1 x d2 = n)   */
     double b[4];          /* Monge b0..b3 (monge_degree >= 3, else 0)   */
     double c[5];          /* Monge c0..c4 (monge_degree >= 4, else 0)   */
+    double sigma;         /* params.auto_select: the noise the choice
+                             assumed (std. dev. along the normal, length
+                             units); NaN otherwise                      */
 } jf_result;
 
 /* Flips the orientation of a result in place: normal -> -normal, every
@@ -408,9 +421,15 @@ typedef enum {
     JF_NB_KNN_RADIUS, /* knn:K,radius:R  up to K nearest within R, with
                          a minimum-count fallback (jf_nb_query)         */
     JF_NB_RINGS,      /* rings[:N]   mesh rings (jf_nb_query_mesh)      */
-    JF_NB_NATURAL     /* natural[:N] §5.1 natural neighbours (the CGAL
+    JF_NB_NATURAL,    /* natural[:N] §5.1 natural neighbours (the CGAL
                          bridge); n = 0 means its default              */
+    JF_NB_AUTO        /* auto: per point, K among the JF_NB_AUTO_KMAX
+                         nearest and the degree chosen without being
+                         told the noise (params.auto_select; the
+                         estimate runs it as knn:JF_NB_AUTO_KMAX)       */
 } jf_nb_kind;
+
+#define JF_NB_AUTO_KMAX 256 /* neighbors auto: the largest K it considers */
 
 typedef struct {
     jf_nb_kind kind;
@@ -420,7 +439,7 @@ typedef struct {
 } jf_nb_spec;
 
 /* Parses "knn:K", "radius:R", "knn:K,radius:R" (either order), "rings",
- * "rings:N", "natural", "natural:N" (no spaces; K, N positive decimal
+ * "rings:N", "natural", "natural:N", "auto" (no spaces; K, N positive decimal
  * integers; R a positive finite decimal number).  On error returns
  * JF_ERR_INVALID, leaves *spec unchanged and sets *why (if why != NULL)
  * to a static English reason.  Thread-safe. */
@@ -441,6 +460,8 @@ char *jf_nb_format(const jf_nb_spec *s, char *buf, size_t len);
  *                   than M = min(min_count, K, cap) lie within R, the M
  *                   nearest regardless of R (min_count: what the fit
  *                   needs, e.g. N_n for the degree; K always bounds).
+ *  - auto           the min(JF_NB_AUTO_KMAX, cap) nearest (the choice
+ *                   among them is the fit's: params.auto_select).
  * rings and natural: JF_ERR_INVALID (use jf_nb_query_mesh / the bridge).
  * Allocation-free when d2 != NULL.  Thread-safe. */
 jf_status jf_nb_query(const jf_index *ix, const jf_nb_spec *s,
@@ -693,15 +714,16 @@ typedef struct jf_writer jf_writer;
 
 /* The estimate's output table: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z,
  * then b0..b3 when monge >= 3 and c0..c4 when monge >= 4 (the Monge degree
- * of the fit), then degree neighbors cond residual status (I32 for
- * degree, neighbors and status).  jf_result_columns fills cols (at least
+ * of the fit), then degree neighbors cond residual, then sigma when sigma
+ * is non-zero (the noise estimate of neighbors auto), then status (I32
+ * for degree, neighbors and status).  jf_result_columns fills cols (at least
  * JF_RESULT_MAX_COLS entries; names are static) and returns their number;
  * jf_result_row writes point p's row of r into v in that order and
  * returns the number of values.  The command, jetfit-mpi and the Python
  * module write this one list.  Thread-safe. */
 #define JF_RESULT_MAX_COLS 32
-size_t jf_result_columns(int monge, jf_column *cols);
-size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v);
+size_t jf_result_columns(int monge, int sigma, jf_column *cols);
+size_t jf_result_row(const double p[3], const jf_result *r, int monge, int sigma, double *v);
 
 /* Opens a table of ncols columns and exactly nrows rows (the PLY header
  * needs the count; commit fails if a different number was written).

@@ -28,6 +28,7 @@ class Result:
     status: npt.NDArray[np.int32]          # (N,) flags, see STATUS
     cond: npt.NDArray[np.float64]          # (N,)
     residual: npt.NDArray[np.float64]      # (N,)
+    sigma: npt.NDArray[np.float64]         # (N,) neighbors="auto": noise seen; else NaN
     points: object
     faces: Optional[object]
     monge_degree: int

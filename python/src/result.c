@@ -12,6 +12,7 @@ typedef struct {
     PyObject_HEAD
     PyObject *normal, *k1, *k2, *d1, *d2, *b, *c;
     PyObject *degree, *neighbors, *status, *cond, *residual;
+    PyObject *sigma; /* neighbors="auto": the noise it saw; NaN otherwise */
     PyObject *points, *faces; /* as given (points converted on demand) */
     Py_ssize_t n;
     int monge;
@@ -33,6 +34,7 @@ static void result_dealloc(Result *r)
     Py_XDECREF(r->status);
     Py_XDECREF(r->cond);
     Py_XDECREF(r->residual);
+    Py_XDECREF(r->sigma);
     Py_XDECREF(r->points);
     Py_XDECREF(r->faces);
     Py_TYPE(r)->tp_free((PyObject *)r);
@@ -57,10 +59,11 @@ PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *face
     r->status = (PyObject *)jf_py_empty(1, N, 0, NPY_INT32);
     r->cond = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
     r->residual = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
+    r->sigma = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
     r->points = Py_XNewRef(points ? points : Py_None);
     r->faces = Py_XNewRef(faces ? faces : Py_None);
     if (!r->normal || !r->k1 || !r->k2 || !r->d1 || !r->d2 || !r->b || !r->c || !r->degree ||
-        !r->neighbors || !r->status || !r->cond || !r->residual) {
+        !r->neighbors || !r->status || !r->cond || !r->residual || !r->sigma) {
         Py_DECREF(r);
         return NULL;
     }
@@ -71,6 +74,7 @@ PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *face
 typedef struct {
     double *nrm, *k1, *k2, *d1, *d2, *cond, *resid, *b, *c;
     int32_t *deg, *nb, *st;
+    double *sigma;
 } outp;
 
 static outp out_ptrs(Result *r)
@@ -82,7 +86,7 @@ static outp out_ptrs(Result *r)
                   r->monge >= 3 ? PyArray_DATA(ARR(r->b)) : NULL,
                   r->monge >= 4 ? PyArray_DATA(ARR(r->c)) : NULL,
                   PyArray_DATA(ARR(r->degree)), PyArray_DATA(ARR(r->neighbors)),
-                  PyArray_DATA(ARR(r->status))};
+                  PyArray_DATA(ARR(r->status)), PyArray_DATA(ARR(r->sigma))};
 }
 
 static void put(const outp *o, size_t i, const jf_result *p)
@@ -99,6 +103,7 @@ static void put(const outp *o, size_t i, const jf_result *p)
     o->st[i] = (int32_t)p->status;
     o->cond[i] = p->cond;
     o->resid[i] = p->residual;
+    o->sigma[i] = p->sigma;
 }
 
 void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads)
@@ -124,7 +129,7 @@ int jf_py_result_monge(PyObject *result) { return ((Result *)result)->monge; }
 
 size_t jf_py_result_columns(PyObject *result, jf_column *cols)
 {
-    return jf_result_columns(((Result *)result)->monge, cols);
+    return jf_result_columns(((Result *)result)->monge, 0, cols);
 }
 
 /* The source array of column j and its component, in file order. */
@@ -249,6 +254,8 @@ static PyMemberDef members[] = {
      "(N,) int32 flags (jetfit.STATUS; 0 = ok)"},
     {"cond", T_OBJECT_EX, offsetof(Result, cond), READONLY, "(N,) condition number"},
     {"residual", T_OBJECT_EX, offsetof(Result, residual), READONLY, "(N,) RMS fit residual"},
+    {"sigma", T_OBJECT_EX, offsetof(Result, sigma), READONLY,
+     "(N,) neighbors='auto': the noise it estimated (length units); NaN otherwise"},
     {"points", T_OBJECT_EX, offsetof(Result, points), READONLY, "the points, as given"},
     {"faces", T_OBJECT_EX, offsetof(Result, faces), READONLY, "the faces (meshes) or None"},
     {"monge_degree", T_INT, offsetof(Result, monge), READONLY, "Monge degree (2..4)"},

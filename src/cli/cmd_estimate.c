@@ -37,8 +37,10 @@ static void usage(FILE *f)
         "                        (standard input, e.g. a pipe from PDAL or awk)\n"
         "  --output-format FMT   write FMT (ply csv xyz txt las) whatever the name\n"
         "  --neighbors SPEC      knn:K | radius:R | knn:K,radius:R | rings[:N] (mesh input)\n"
-        "                        | natural[:N]     (default " DEFAULT_NEIGHBORS "; K and N count\n"
-        "                        the point; radius:R keeps at most the 256 nearest)\n"
+        "                        | natural[:N] | auto (default " DEFAULT_NEIGHBORS "; K and N count\n"
+        "                        the point; radius:R keeps at most the 256 nearest; auto:\n"
+        "                        per point, K <= 256 and degree 2 or 3 chosen from the\n"
+        "                        data, status flag auto, column sigma = the noise seen)\n"
         "  --degree N            jet degree 1..%d (default %d)\n"
         "  --monge-degree N      2..4, <= degree: 3 adds b0..b3, 4 adds c0..c4\n"
         "                        (default min(degree, 4))\n"
@@ -96,7 +98,7 @@ static void usage(FILE *f)
         "abbreviations (--deg 3), '--' ends the options.\n"
         "\n"
         "Columns: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z [b0..b3] [c0..c4]\n"
-        "         degree neighbors cond residual status\n"
+        "         degree neighbors cond residual [sigma] status\n"
         "k1 >= k2, signed w.r.t. the normal (z = (k1 x^2 + k2 y^2)/2 + ... along it).\n",
         JF_MAX_DEGREE, p.degree, p.max_cond, jf_default_threads(NULL));
 }
@@ -156,14 +158,23 @@ static void progress(void *user, size_t done, size_t total)
 
 /* What the summary counts, per thread (the sink runs on the fit's
  * threads), padded so that threads do not share a cache line. */
+/* neighbors auto: the summary's bins of the chosen K (upper bounds) */
+#define NKBIN 10
+static const int kbin[NKBIN] = {16, 24, 32, 48, 64, 96, 128, 160, 200, JF_NB_AUTO_KMAX};
+
 typedef struct {
-    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1];
+    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1], k[NKBIN];
     size_t unfit; /* failed or nonfinite: no fit at all */
     char pad[64];
 } tally;
 
 static void tally_add(tally *t, const jf_result *r)
 {
+    if (r->status & JF_PT_AUTO) {
+        int b = 0;
+        while (b < NKBIN - 1 && r->n_used > kbin[b]) b++;
+        t->k[b]++;
+    }
     if (!r->status) t->ok++;
     if (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) t->unfit++;
     for (int b = 0; b < 32; b++)
@@ -175,8 +186,10 @@ static void tally_add(tally *t, const jf_result *r)
 static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
                     const char *out)
 {
-    tally t = {{0}, 0, {0}, 0, {0}};
+    tally t = {{0}, 0, {0}, {0}, 0, {0}};
+    size_t nauto = 0;
     for (int k = 0; k < nt; k++) {
+        for (int b = 0; b < NKBIN; b++) t.k[b] += tl[k].k[b];
         t.ok += tl[k].ok;
         for (int b = 0; b < 32; b++) t.flags[b] += tl[k].flags[b];
         for (int d = 0; d <= JF_MAX_DEGREE; d++) t.deg[d] += tl[k].deg[d];
@@ -194,6 +207,15 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
     for (int d = 0; d <= JF_MAX_DEGREE; d++)
         if (t.deg[d]) fprintf(stderr, " %d: %zu", d, t.deg[d]);
     fputc('\n', stderr);
+    for (int b = 0; b < NKBIN; b++) nauto += t.k[b];
+    if (nauto) { /* neighbors auto: what it chose */
+        fprintf(stderr, "  auto K:");
+        for (int b = 0; b < NKBIN; b++)
+            if (t.k[b])
+                fprintf(stderr, " <=%d: %zu (%.0f%%)", kbin[b], t.k[b],
+                        100.0 * (double)t.k[b] / (double)nauto);
+        fputc('\n', stderr);
+    }
     size_t m = 0;
     if (cond)
         for (size_t i = 0; i < n; i++)
@@ -227,7 +249,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
 typedef struct {
     jf_writer *w;
     const double *xyz;
-    int monge, nt;
+    int monge, nt, sigma;
     size_t ncols;
     double *rows;    /* nt x JF_BLOCK_MAX x ncols: a block per thread    */
     tally *tl;       /* nt                                              */
@@ -242,7 +264,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
     double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
     for (size_t j = 0; j < m; j++) {
-        jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, v + j * s->ncols);
+        jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, s->sigma, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;
     }
@@ -306,7 +328,8 @@ int jf_cmd_estimate(int argc, char **argv)
 
     /* open the output first: a missing folder fails before the work */
     jf_column cols[JF_RESULT_MAX_COLS];
-    size_t ncols = jf_result_columns(monge, cols);
+    const int with_sigma = o.nb.kind == JF_NB_AUTO; /* auto: its noise estimate */
+    size_t ncols = jf_result_columns(monge, with_sigma, cols);
     jf_writer *w = NULL;
     jf_cli_out po; /* "-o -" and --output-format: through a private file */
     st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
@@ -324,6 +347,7 @@ int jf_cmd_estimate(int argc, char **argv)
         fprintf(stderr, "jetfit: %s: cannot write its %zu faces to %s: %s\n", in, c.nfaces, out,
                 jf_strerror(st));
         jf_writer_abort(w);
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -338,6 +362,7 @@ int jf_cmd_estimate(int argc, char **argv)
                          : "do not apply: the LAS input's records are kept with their own scale "
                            "and offset (add --keep none for new ones)");
         jf_writer_abort(w);
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -346,6 +371,7 @@ int jf_cmd_estimate(int argc, char **argv)
                                   cmd.las_offset_set ? cmd.las_offset : NULL) != JF_OK) {
         st = jf_writer_commit(w, &err); /* removes the temporary, says why */
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
+        jf_cli_out_finish(&po, 0, NULL);
         jf_cloud_free(&c);
         return 1;
     }
@@ -370,7 +396,7 @@ int jf_cmd_estimate(int argc, char **argv)
         fprintf(stderr, "jetfit: %.*s\n", (int)(nl - wl), wl);
     }
     const int nt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
-    sinkctx sk = {w, c.xyz, monge, nt, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
+    sinkctx sk = {w, c.xyz, monge, nt, with_sigma, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
                   calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
     if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
         /* a failed begin is reported by commit's message below */
@@ -448,6 +474,7 @@ int jf_cmd_estimate(int argc, char **argv)
                 : nonfin < c.n ? ": too few or collinear neighbours (K must be at least 3)"
                                : ": every point is NaN or infinite (a scale or transform that "
                                  "overflows?)");
+        jf_cli_out_finish(&po, 0, NULL);
         free(sk.tl);
         free(sk.cond);
         jf_cloud_free(&c);

@@ -351,11 +351,12 @@ static int study_view(jf_study_args *c, char *msg, size_t len)
     }
     jf_column cols[JF_RESULT_MAX_COLS];
     int monge = o.params.monge_degree;
-    size_t ncols = jf_result_columns(monge, cols);
+    const int sigma = o.nb.kind == JF_NB_AUTO;
+    size_t ncols = jf_result_columns(monge, sigma, cols);
     if (st == JF_OK) st = jf_writer_open(ply, cols, ncols, smp.n, 0, &w, &e);
     for (size_t i = 0; st == JF_OK && i < smp.n; i++) {
         double v[JF_RESULT_MAX_COLS];
-        jf_result_row(smp.xyz + 3 * i, &res[i], monge, v);
+        jf_result_row(smp.xyz + 3 * i, &res[i], monge, sigma, v);
         st = jf_writer_row(w, v);
     }
     if (w && st != JF_OK) jf_writer_abort(w);

@@ -219,6 +219,7 @@ int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad)
     o->params.monge_degree = e->monge;
     /* the fitter must accept the largest neighbourhood we may hand it */
     size_t need = o->nb.kind == JF_NB_KNN || o->nb.kind == JF_NB_KNN_RADIUS ? o->nb.k : o->nb.n;
+    if (o->nb.kind == JF_NB_AUTO) need = JF_NB_AUTO_KMAX;
     for (int j = 0; j < o->params.nscales; j++)
         if (o->params.scales[j] > need) need = o->params.scales[j];
     if (need > JF_MAX_NEIGHBORS) {

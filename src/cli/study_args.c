@@ -34,6 +34,7 @@ static void usage(FILE *f)
         "\n"
         "Lists are ';'-separated (numbers also ','):\n"
         "  --neighbors LIST      e.g. 'knn:16;knn:64;natural:32;knn:64,radius:0.05'\n"
+        "                        or auto (K and degree chosen per point)\n"
         "                        (default " JF_CLI_DEFAULT_NEIGHBORS ")\n"
         "  --degree LIST         jet degrees (default 2)\n"
         "  --flags LIST          estimate option sets, e.g. ';--robust-normals;--scales\n"

@@ -154,6 +154,7 @@ static int job_begin(fit_job *j, jf_fitter *f, const double p[3], const double *
     j->n = n;
     memset(out, 0, sizeof *out);
     out->cond = NAN;
+    out->sigma = NAN;
     f->last_n = n;
     f->have_last = 1;
     f->last_deg = 0;

@@ -86,6 +86,7 @@ void jf__result_nan(jf_result *out)
     out->k1 = out->k2 = nan;
     for (int i = 0; i < 4; i++) out->b[i] = nan;
     for (int i = 0; i < 5; i++) out->c[i] = nan;
+    out->sigma = nan;
 }
 
 static void quantities(const double *a, int deg, int monge_degree, const double r[9],

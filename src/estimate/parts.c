@@ -43,6 +43,9 @@ static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q)
 {
     if (!o || !q) return JF_ERR_INVALID;
+    jf_estimate_opts oa = *o;
+    jf__nb_auto_opts(&oa); /* auto is knn:JF_NB_AUTO_KMAX, as in jf_estimate */
+    o = &oa;
     if (jf_params_validate(&o->params, NULL) != JF_OK) return JF_ERR_INVALID;
     if (o->nb.kind > JF_NB_KNN_RADIUS) return JF_ERR_UNSUPPORTED;
     const jf_params *p = &o->params;

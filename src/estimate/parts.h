@@ -35,6 +35,11 @@ typedef struct {
     size_t min_count; /* N_n of the degree: knn+radius's fallback floor */
 } jf_part_query;
 
+/* neighbors auto (src/robust/auto.c): turns o->nb = auto into knn:
+ * JF_NB_AUTO_KMAX with params.auto_select = 1 (max_neighbors raised to
+ * hold it); other kinds are left alone. */
+void jf__nb_auto_opts(jf_estimate_opts *o);
+
 /* Fills *q from estimate options as jf_estimate does.  JF_OK, or
  * JF_ERR_UNSUPPORTED (rings, natural: not a k-d tree query),
  * JF_ERR_INVALID (bad parameters). */

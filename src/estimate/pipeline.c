@@ -68,7 +68,7 @@ static void nan_result(jf_result *r, unsigned status)
 {
     memset(r, 0, sizeof *r);
     r->status = status;
-    r->cond = r->residual = NAN;
+    r->cond = r->residual = r->sigma = NAN;
     for (int j = 0; j < 3; j++) r->pca_eval[j] = NAN;
     jf__result_nan(r);
 }
@@ -690,6 +690,7 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
 {
     const char *bad = NULL;
     *use = *o;
+    jf__nb_auto_opts(use); /* auto: knn:JF_NB_AUTO_KMAX and the fit's choice */
     use->orient = jf_orient_resolve(o->orient, c->nrm != NULL,
                                     c->scan && c->scanner && c->nscans);
     if (use->orient == JF_ORIENT_INPUT && !c->nrm) {
@@ -719,6 +720,15 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
         return JF_ERR_TOO_LARGE;
     }
     return JF_OK;
+}
+
+void jf__nb_auto_opts(jf_estimate_opts *o)
+{
+    if (o->nb.kind != JF_NB_AUTO) return;
+    o->nb.kind = JF_NB_KNN;
+    o->nb.k = JF_NB_AUTO_KMAX;
+    o->params.auto_select = 1;
+    if (o->params.max_neighbors < JF_NB_AUTO_KMAX) o->params.max_neighbors = JF_NB_AUTO_KMAX;
 }
 
 /* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
@@ -755,6 +765,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     x.xyz = c->xyz;
     x.fit = p->fit;
     x.plain = p->robust == JF_ROBUST_NONE && p->nscales <= 0 && p->degree_select <= 0 &&
+              !p->auto_select &&
               !(p->dist_weight > 0.0);
     x.min_count = jf_jet_size(p->degree);
     x.cap = p->max_neighbors;
@@ -767,6 +778,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         if (o->nb.n) x.cap = o->nb.n;
         break;
     case JF_NB_NATURAL: x.want = x.cap = o->nb.n ? o->nb.n : max_sz(2 * x.min_count, 12); break;
+    case JF_NB_AUTO: break; /* knn by now (jf__nb_auto_opts) */
     }
     x.cap = max_sz(x.cap, 1);
     if (x.cap > p->max_neighbors) {

@@ -8,7 +8,7 @@ static const char *const base_cols[] = {"x",   "y",   "z",   "nx",  "ny",  "nz",
 static const char *const b_cols[] = {"b0", "b1", "b2", "b3"};
 static const char *const c_cols[] = {"c0", "c1", "c2", "c3", "c4"};
 
-size_t jf_result_columns(int monge, jf_column *cols)
+size_t jf_result_columns(int monge, int sigma, jf_column *cols)
 {
     size_t n = 0;
     for (size_t j = 0; j < 14; j++) cols[n++] = (jf_column){base_cols[j], JF_COL_F64};
@@ -20,11 +20,12 @@ size_t jf_result_columns(int monge, jf_column *cols)
     cols[n++] = (jf_column){"neighbors", JF_COL_I32};
     cols[n++] = (jf_column){"cond", JF_COL_F64};
     cols[n++] = (jf_column){"residual", JF_COL_F64};
+    if (sigma) cols[n++] = (jf_column){"sigma", JF_COL_F64};
     cols[n++] = (jf_column){"status", JF_COL_I32};
     return n;
 }
 
-size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v)
+size_t jf_result_row(const double p[3], const jf_result *r, int monge, int sigma, double *v)
 {
     size_t n = 0;
     for (int j = 0; j < 3; j++) v[n++] = p[j];
@@ -41,6 +42,7 @@ size_t jf_result_row(const double p[3], const jf_result *r, int monge, double *v
     v[n++] = r->n_used;
     v[n++] = r->cond;
     v[n++] = r->residual;
+    if (sigma) v[n++] = r->sigma;
     v[n++] = (double)r->status;
     return n;
 }

@@ -155,7 +155,9 @@ static void write_rows(jf_mpi *m, const outputs *o, const char *out, const jf_mp
     enum { BLOCK = 16384 };
     jf_col_type types[JF_RESULT_MAX_COLS];
     size_t rowb = 0;
+    int sigma = 0; /* neighbors auto: the sigma column is there */
     for (size_t j = 0; j < ncols; j++) {
+        if (!strcmp(cols[j].name, "sigma")) sigma = 1;
         types[j] = cols[j].type;
         rowb += cols[j].type == JF_COL_F64 ? 8 : 4;
     }
@@ -187,7 +189,7 @@ static void write_rows(jf_mpi *m, const outputs *o, const char *out, const jf_mp
         for (int t = 0; t < k; t++) {
             const size_t p = pos[t];
             double *v = vals + (size_t)t * ncols;
-            jf_result_row(c->xyz + 3 * p, &res[p], monge, v);
+            jf_result_row(c->xyz + 3 * p, &res[p], monge, sigma, v);
             jf__ply_row_le(types, ncols, v, buf + (size_t)t * rowb);
         }
         for (int t = 0; t < k; t++) disp[t] = (MPI_Aint)(o->header + (uint64_t)c->gid[pos[t]] * rowb);
@@ -333,7 +335,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         return refuse(m, "%s: invalid parameters", in);
 
     jf_column cols[JF_RESULT_MAX_COLS];
-    size_t ncols = jf_result_columns(cmd.e.monge, cols);
+    size_t ncols = jf_result_columns(cmd.e.monge, o.nb.kind == JF_NB_AUTO, cols);
     outputs w;
     memset(&w, 0, sizeof w);
     /* open the output first: a missing folder fails before the work */

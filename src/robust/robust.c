@@ -69,6 +69,12 @@ int jf__robust_tune(const char *name, double v)
     else if (!strcmp(name, "degree_tau")) jf__knob.degree_tau = v;
     else if (!strcmp(name, "degree_sdmin")) jf__knob.degree_sdmin = v;
     else if (!strcmp(name, "degree_floor_n")) jf__knob.degree_floor_n = v;
+    else if (!strcmp(name, "auto_tau")) jf__auto_tau = v;
+    else if (!strcmp(name, "auto_blob")) jf__auto_blob = v;
+    else if (!strcmp(name, "auto_sdmax")) jf__auto_sdmax = v;
+    else if (!strcmp(name, "auto_varw")) jf__auto_varw = v;
+    else if (!strcmp(name, "auto_clean")) jf__auto_clean = v;
+    else if (!strcmp(name, "auto_gl")) jf__auto_gl = (int)v;
     else return -1;
     return 0;
 }

@@ -57,4 +57,12 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
                          const double *nbr, size_t n, double *buf, jf_result *out,
                          double *sigma);
 
+/* neighbors auto (auto.c): chooses K among the first entries of nbr
+ * (nearest first) and the degree; fills out->sigma. */
+jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                       size_t n, jf_result *out);
+/* auto.c's Lepski threshold (bench-only knob) */
+extern double jf__auto_tau, jf__auto_blob, jf__auto_sdmax, jf__auto_varw, jf__auto_clean;
+extern int jf__auto_gl;
+
 #endif

@@ -44,6 +44,7 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
 {
     if (!f || !p || !out || (n && !nbr)) return JF_ERR_INVALID;
     const jf_params *pr = jf_fitter_params(f);
+    if (pr->auto_select) return jf__fit_auto(f, pr, p, nbr, n, out);
     if (pr->robust == JF_ROBUST_NONE && pr->nscales <= 0 && pr->degree_select <= 0 &&
         !(pr->dist_weight > 0.0))
         return jf_fit_point(f, p, nbr, n, out);

@@ -62,6 +62,11 @@ jf_status jf_nb_parse(const char *text, jf_nb_spec *spec, const char **why)
     }
     jf_nb_spec s = {JF_NB_KNN, 0, 0.0, 0};
     const char *p = text;
+    if (strcmp(p, "auto") == 0) {
+        s.kind = JF_NB_AUTO;
+        *spec = s;
+        return JF_OK;
+    }
     if (strcmp(p, "rings") == 0 || strcmp(p, "natural") == 0) {
         s.kind = p[0] == 'r' ? JF_NB_RINGS : JF_NB_NATURAL;
         *spec = s;
@@ -100,8 +105,8 @@ jf_status jf_nb_parse(const char *text, jf_nb_spec *spec, const char **why)
             }
             have_r = 1;
         } else {
-            *why = "expected knn:K, radius:R, knn:K,radius:R, rings[:N] "
-                   "or natural[:N]";
+            *why = "expected knn:K, radius:R, knn:K,radius:R, rings[:N], "
+                   "natural[:N] or auto";
             return JF_ERR_INVALID;
         }
         if (*p == '\0') break;
@@ -137,6 +142,7 @@ char *jf_nb_format(const jf_nb_spec *s, char *buf, size_t len)
         else snprintf(buf, len, "%s", name);
         break;
     }
+    case JF_NB_AUTO: snprintf(buf, len, "auto"); break;
     default: snprintf(buf, len, "?"); break;
     }
     return buf;
@@ -152,6 +158,9 @@ jf_status jf__nb_query_xyz(const jf_index *ix, const jf_nb_spec *s, size_t min_c
     case JF_NB_KNN:
         if (!s->k) return JF_ERR_INVALID;
         return jf__index_query(ix, q, s->k < cap ? s->k : cap, INFINITY, idx, d2, xyz, found);
+    case JF_NB_AUTO:
+        return jf__index_query(ix, q, JF_NB_AUTO_KMAX < cap ? JF_NB_AUTO_KMAX : cap, INFINITY, idx,
+                               d2, xyz, found);
     case JF_NB_RADIUS:
         if (!(s->r >= 0) || !isfinite(s->r)) return JF_ERR_INVALID;
         return jf__index_query(ix, q, cap, s->r * s->r, idx, d2, xyz, found);

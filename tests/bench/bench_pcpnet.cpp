@@ -39,6 +39,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <random>
 #include <string>
 #include <utility>
@@ -136,6 +137,7 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
     for (int i = 0; i < c.nscales; i++) p.scales[i] = c.scales[i];
     p.degree_select = c.dsel;
     p.dist_weight = c.distw;
+    p.auto_select = !std::strcmp(c.name, "jetfit auto"); // neighbors auto
     jf_fitter *f = nullptr;
     const char *bad = nullptr;
     if (jf_params_validate(&p, &bad) != JF_OK || jf_fitter_create(&p, &f) != JF_OK) {
@@ -144,6 +146,8 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
     }
     std::vector<uint32_t> idx(c.k);
     std::vector<double> nbr(3 * c.k), nrm(3 * s.pidx.size());
+    std::map<std::pair<int, int>, size_t> chosen;
+    double sig = 0;
     double t0 = now();
     for (size_t j = 0; j < s.pidx.size(); j++) {
         const double *q = &s.xyz[3 * s.pidx[j]];
@@ -155,6 +159,15 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
         jf_fit_point_full(f, q, nbr.data(), found, &r);
         std::memcpy(&nrm[3 * j], r.normal, 3 * sizeof(double));
         if (r.status & (JF_PT_ROBUST_NOCONV | JF_PT_FAILED)) (*flagged)++;
+        if (p.auto_select) {
+            chosen[std::make_pair(r.n_used, r.degree)]++;
+            sig += r.sigma;
+        }
+    }
+    if (p.auto_select) { // what auto chose: K x degree histogram, mean sigma
+        std::printf("# auto chose (K/degree: points):");
+        for (auto &e : chosen) std::printf(" %d/%d:%zu", e.first.first, e.first.second, e.second);
+        std::printf("; mean sigma %.4g\n", sig / (double)s.pidx.size());
     }
     *secs = now() - t0;
     jf_fitter_free(f);
@@ -191,7 +204,9 @@ int main(int argc, char **argv)
     // the PCPNet folder: argv (any non-option argument), else $JF_DATA/pcpnet
     const char *env = std::getenv("JF_DATA");
     std::string dir = env ? std::string(env) + "/pcpnet" : std::string();
-    bool quick = false, no_cgal = false, no_fixed = false;
+    bool quick = false, no_cgal = false, no_fixed = false, with_auto = false,
+         cgal_jet2 = false; // CGAL: jet degree 2 only (issue 27's peer)
+    const char *cgal_ks = nullptr; // "18,32,64": CGAL's K list (default: the jetfit Ks)
     const char *sweep = nullptr; // "K,deg,robust[,dsel] ...": extra fixed configs
     const char *only_levels = nullptr; // "0,0.012": a subset of the noise levels
     bool same_points = false;    // jetfit fits K + 1 points, CGAL's neighbourhood
@@ -208,6 +223,15 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--dfloorn") && i + 1 < argc) jf__robust_tune("degree_floor_n", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--distw") && i + 1 < argc) g_distw = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--same-points")) same_points = true;
+        else if (!std::strcmp(argv[i], "--auto")) with_auto = true;
+        else if (!std::strcmp(argv[i], "--cgal-jet2")) cgal_jet2 = true;
+        else if (!std::strcmp(argv[i], "--auto-tau") && i + 1 < argc) jf__robust_tune("auto_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-blob") && i + 1 < argc) jf__robust_tune("auto_blob", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-sdmax") && i + 1 < argc) jf__robust_tune("auto_sdmax", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-varw") && i + 1 < argc) jf__robust_tune("auto_varw", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-clean") && i + 1 < argc) jf__robust_tune("auto_clean", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-gl") && i + 1 < argc) jf__robust_tune("auto_gl", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--cgal-ks") && i + 1 < argc) cgal_ks = argv[++i];
         else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
         else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) only_levels = argv[++i];
         else if (!std::strcmp(argv[i], "--sweep") && i + 1 < argc) sweep = argv[++i];
@@ -275,6 +299,7 @@ int main(int argc, char **argv)
             for (int d = 2; d <= 3 && !no_fixed; d++)
                 cfg.push_back({"jetfit degree-select", d, k, JF_ROBUST_NONE, 0, {0}, 1, 0});
         size_t kmax = ks.back();
+        if (with_auto) cfg.push_back({"jetfit auto", 2, JF_NB_AUTO_KMAX, JF_ROBUST_NONE, 0, {0}, 0, 0});
         // --sweep "K,deg,robust ..." (robust 0/1/2 = none/huber/tukey);
         // K may be a scale set "12/18/36" (scale selection, the last the largest)
         for (const char *q = sweep; q && *q;) {
@@ -342,15 +367,26 @@ int main(int argc, char **argv)
                         cc.k, cc.degree, r, secs, fl, g_median, g_p95);
             std::fflush(stdout);
         }
-        for (size_t k : ks) {
+        std::vector<size_t> cks = ks;
+        if (cgal_ks) {
+            cks.clear();
+            for (const char *q = cgal_ks; *q;) {
+                char *e;
+                cks.push_back(std::strtoul(q, &e, 10));
+                if (e == q) break;
+                q = *e == ',' ? e + 1 : e;
+            }
+        }
+        for (size_t k : cks) {
             if (no_cgal) break;
             if (cgal_k && k != cgal_k) continue;
-            for (int d = 2; d <= 3; d++) {
+            for (int d = 2; d <= (cgal_jet2 ? 2 : 3); d++) {
                 double secs, r = run_cgal(s, true, d, k, &secs);
                 std::printf("%-8g %-34s %5zu %4d %9.3f %9.3f -\n", lv, "CGAL jet_estimate_normals", k,
                             d, r, secs);
                 std::fflush(stdout);
             }
+            if (cgal_jet2) continue;
             double secs, r = run_cgal(s, false, 0, k, &secs);
             std::printf("%-8g %-34s %5zu %4s %9.3f %9.3f -\n", lv, "CGAL pca_estimate_normals", k, "-",
                         r, secs);

@@ -255,6 +255,36 @@ START_TEST(study_equals_generate_estimate_eval)
 }
 END_TEST
 
+/* neighbors auto is a strategy (issue 27): its cells are generate +
+ * estimate --neighbors auto + eval, beside knn:K's */
+START_TEST(study_knows_auto)
+{
+    cli_setup();
+    char dir[300];
+    snprintf(dir, sizeof dir, "%s/st", cli_dir);
+    int rc = cli_run("study", "exp", "-o", dir, "--n", "1500", "--neighbors", "knn:16;auto",
+                     "--noise", "0.004", "--seed", "7", "--threads", "2", NULL);
+    ck_assert_msg(rc == 0, "study failed (%d): %s", rc, cli_err);
+    char path[600];
+    snprintf(path, sizeof path, "%s/study.csv", dir);
+    int nr;
+    csv_row *r = read_csv(path, &nr);
+    ck_assert_int_eq(nr, 1 + 2);
+    const csv_row *h = &r[0];
+    int cs = col(h, "strategy"), cseed = col(h, "seed"), cn = col(h, "noise");
+    ck_assert_str_eq(r[2].f[cs], "auto");
+    const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply");
+    const char *g[] = {JETFIT_BIN, "generate", "exp", "--n", "1500", "--seed", r[2].f[cseed],
+                       "--noise", r[2].f[cn], "-o", gen, "--truth", truth, NULL};
+    ck_assert_msg(run_to(NULL, g) == 0, "generate: %s", cli_err);
+    for (int i = 1; i < nr; i++) check_cell(h, &r[i], gen, truth, NULL);
+    free_csv(r, nr);
+    const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
+    run_to(NULL, rm);
+    cli_teardown();
+}
+END_TEST
+
 /* INPUT --truth --subset: the same numbers as estimate + eval --subset */
 START_TEST(study_of_an_input_equals_estimate_eval_subset)
 {
@@ -924,6 +954,7 @@ int main(void)
     TCase *t = tcase_create("study");
     tcase_set_timeout(t, 600);
     tcase_add_test(t, study_equals_generate_estimate_eval);
+    tcase_add_test(t, study_knows_auto);
     tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
     tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);

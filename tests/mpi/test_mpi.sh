@@ -77,6 +77,7 @@ equal-more)
   same "3" lattice.ply csv --neighbors knn:16
   same "2" lattice.ply xyz --neighbors knn:16 --monge-degree 3 --degree 3
   same "3" clusters.ply ply --ascii --neighbors knn:16
+  same "2 3" clusters.ply csv --neighbors auto  # issue 27: per-point K and degree, sigma column
   ;;
 errors)
   refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --neighbors natural

@@ -1,0 +1,122 @@
+/* test_cli_auto.c -- `--neighbors auto` end to end: the extra sigma column
+ * holds the noise estimate (near the noise added), the status column has
+ * the auto bit on every row, neighbors/degree say what was chosen, the
+ * summary line prints the distribution of K, and --memory parts and one
+ * thread give the same bytes as the whole cloud on two threads. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "test_cli_util.h"
+
+#define SIDE 40
+#define NOISE 0.004 /* Gaussian-ish: a sum of 12 uniforms, sd NOISE */
+
+static void write_noisy(const char *path)
+{
+    static double xyz[3 * SIDE * SIDE];
+    cli_surface61(SIDE, xyz, 7);
+    unsigned long long s = 27;
+    for (size_t i = 0; i < 3 * SIDE * SIDE; i++) {
+        double g = -6.0;
+        for (int k = 0; k < 12; k++) {
+            s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+            g += (double)(s >> 11) / 9007199254740992.0;
+        }
+        xyz[i] += NOISE * g;
+    }
+    cli_write_xyz(path, xyz, NULL, SIDE * SIDE);
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+START_TEST(auto_columns_and_summary)
+{
+    write_noisy(cli_path("in.xyz"));
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("a.csv"), "--neighbors",
+                             "auto", "--threads", "2", NULL),
+                     0);
+    ck_assert_msg(strstr(cli_err, "auto K: <="), "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, ", auto 1600"), "%s", cli_err);
+    jf_eval_table t;
+    cli_read(cli_path("a.csv"), &t);
+    ck_assert_uint_eq(t.nrows, SIDE * SIDE);
+    static double sg[SIDE * SIDE];
+    for (size_t i = 0; i < t.nrows; i++) {
+        unsigned st = (unsigned)cli_val(&t, i, "status");
+        ck_assert_uint_ne(st & JF_PT_AUTO, 0);
+        double k = cli_val(&t, i, "neighbors"), d = cli_val(&t, i, "degree");
+        ck_assert(k >= 16 && k <= JF_NB_AUTO_KMAX);
+        ck_assert(d == 2 || d == 3);
+        sg[i] = cli_val(&t, i, "sigma");
+    }
+    jf_eval_table_free(&t);
+    /* the noise along the normal has sd NOISE (isotropic noise) */
+    qsort(sg, SIDE * SIDE, sizeof sg[0], cmp_d);
+    double med = sg[SIDE * SIDE / 2];
+    ck_assert_msg(med > 0.6 * NOISE && med < 1.5 * NOISE, "median sigma %g vs %g", med, NOISE);
+    /* knn runs have no sigma column */
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("k.csv"), "--quiet",
+                             NULL),
+                     0);
+    cli_read(cli_path("k.csv"), &t);
+    ck_assert_int_lt(jf_eval_table_col(&t, "sigma"), 0);
+    jf_eval_table_free(&t);
+}
+END_TEST
+
+static void same_bytes(const char *a, const char *b)
+{
+    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(g);
+    int x, y;
+    long at = 0;
+    do {
+        x = fgetc(f);
+        y = fgetc(g);
+        ck_assert_msg(x == y, "%s and %s differ at byte %ld", a, b, at);
+        at++;
+    } while (x != EOF);
+    fclose(f);
+    fclose(g);
+}
+
+START_TEST(auto_parts_threads)
+{
+    write_noisy(cli_path("in.xyz"));
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("w.ply"), "--neighbors",
+                             "auto", "--threads", "2", "--quiet", NULL),
+                     0);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
+                             "auto", "--threads", "2", "--memory", "16K", "--quiet", NULL),
+                     0);
+    same_bytes(cli_path("w.ply"), cli_path("p.ply"));
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("t.ply"), "--neighbors",
+                             "auto", "--threads", "1", "--quiet", NULL),
+                     0);
+    same_bytes(cli_path("w.ply"), cli_path("t.ply"));
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("cli_auto");
+    TCase *tc = tcase_create("neighbors auto");
+    tcase_add_checked_fixture(tc, cli_setup, cli_teardown);
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, auto_columns_and_summary);
+    tcase_add_test(tc, auto_parts_threads);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? 1 : 0;
+}

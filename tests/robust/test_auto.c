@@ -1,0 +1,216 @@
+/* test_auto.c -- neighbors auto (src/robust/auto.c, issue 27): on a noisy
+ * generated surface its normals are below the default knn:32 and within
+ * 5% of the best fixed K of 16..256 picked in hindsight (both computed
+ * here, not quoted; issue 27 asks for below the best: not reached yet,
+ * measured 1.03-1.04x here, docs/robustness.md), it flags every point, its
+ * noise estimate is near the noise drawn, and it is the same bits for 1
+ * and 2 threads and in parts (jf_estimate_parts) as on the whole cloud. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "jetfit.h"
+#include "synth/surfaces.h"
+
+typedef struct {
+    jf_sample s;
+    double diag;
+} surf;
+
+static surf make(jf_surface kind, size_t n, double noise, jf_density den)
+{
+    surf c;
+    jf_rng rng;
+    jf_rng_seed(&rng, 27);
+    ck_assert_int_eq(jf_sample_random(kind, n, den, &rng, &c.s), JF_OK);
+    double side;
+    jf_bbox_measure(c.s.xyz, c.s.n, &c.diag, &side);
+    jf_noise_gauss(&c.s, noise, &rng);
+    return c;
+}
+
+static jf_result *run(const surf *c, const char *nb, int threads)
+{
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    ck_assert_int_eq(jf_nb_parse(nb, &o.nb, NULL), JF_OK);
+    o.orient = JF_ORIENT_NONE;
+    o.threads = threads;
+    if (o.nb.kind == JF_NB_KNN && o.nb.k > o.params.max_neighbors) o.params.max_neighbors = o.nb.k;
+    jf_cloud cl = {.n = c->s.n, .xyz = c->s.xyz};
+    jf_result *r = malloc(c->s.n * sizeof *r);
+    ck_assert_ptr_nonnull(r);
+    jf_error e;
+    ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
+    return r;
+}
+
+/* RMS unoriented normal angle (degrees) against the exact normals */
+static double rms_normal(const surf *c, const jf_result *r)
+{
+    double s = 0;
+    for (size_t i = 0; i < c->s.n; i++) {
+        const double *t = c->s.truth[i].normal;
+        double d = fabs(r[i].normal[0] * t[0] + r[i].normal[1] * t[1] + r[i].normal[2] * t[2]);
+        double a = isfinite(d) ? acos(d > 1 ? 1 : d) * 180 / M_PI : 90.0;
+        s += a * a;
+    }
+    return sqrt(s / (double)c->s.n);
+}
+
+static void beats_fixed(jf_surface kind, double noise, jf_density den)
+{
+    surf c = make(kind, 6000, noise, den);
+    jf_result *ra = run(&c, "auto", 1);
+    double ea = rms_normal(&c, ra), best = INFINITY, e32 = NAN;
+    size_t kbest = 0, ks[] = {16, 32, 64, 128, 256};
+    for (size_t j = 0; j < sizeof ks / sizeof ks[0]; j++) {
+        char nb[32];
+        snprintf(nb, sizeof nb, "knn:%zu", ks[j]);
+        jf_result *r = run(&c, nb, 1);
+        double e = rms_normal(&c, r);
+        if (ks[j] == 32) e32 = e;
+        if (e < best) {
+            best = e;
+            kbest = ks[j];
+        }
+        free(r);
+    }
+    ck_assert_msg(ea < 1.05 * best && ea < e32,
+                  "%s noise %g: auto %.4f deg, best fixed knn:%zu %.4f deg, knn:32 %.4f deg",
+                  jf_surface_name(kind), noise, ea, kbest, best, e32);
+    /* every point says auto chose, with a finite noise estimate near the
+     * noise drawn (the median: a few curved or sparse spots may differ) */
+    double *sg = malloc(c.s.n * sizeof *sg);
+    for (size_t i = 0; i < c.s.n; i++) {
+        ck_assert_uint_ne(ra[i].status & JF_PT_AUTO, 0);
+        ck_assert(ra[i].n_used >= 16 && ra[i].n_used <= JF_NB_AUTO_KMAX);
+        ck_assert(ra[i].degree == 2 || ra[i].degree == 3);
+        ck_assert(isfinite(ra[i].sigma));
+        sg[i] = ra[i].sigma;
+    }
+    size_t m = c.s.n / 2;
+    for (size_t i = 0; i <= m; i++) /* partial selection of the median */
+        for (size_t j = i + 1; j < c.s.n; j++)
+            if (sg[j] < sg[i]) {
+                double t = sg[i];
+                sg[i] = sg[j];
+                sg[j] = t;
+            }
+    double truth = noise * c.diag;
+    ck_assert_msg(sg[m] > 0.5 * truth && sg[m] < 2.0 * truth, "median sigma %g, noise %g", sg[m],
+                  truth);
+    free(sg);
+    free(ra);
+    jf_sample_free(&c.s);
+}
+
+START_TEST(test_auto_ellipsoid) { beats_fixed(JF_SURF_ELLIPSOID, 0.01, JF_DENSITY_UNIFORM); }
+END_TEST
+
+START_TEST(test_auto_torus_gradient) { beats_fixed(JF_SURF_TORUS, 0.003, JF_DENSITY_GRADIENT); }
+END_TEST
+
+START_TEST(test_auto_threads)
+{
+    surf c = make(JF_SURF_TORUS, 3000, 0.003, JF_DENSITY_GRADIENT);
+    jf_result *r1 = run(&c, "auto", 1), *r2 = run(&c, "auto", 2);
+    ck_assert_int_eq(memcmp(r1, r2, c.s.n * sizeof *r1), 0);
+    free(r1);
+    free(r2);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
+typedef struct {
+    jf_result *r;
+    size_t n, got;
+} collect;
+
+static jf_status sink(void *user, const uint32_t *idx, jf_result *res, size_t m)
+{
+    collect *c = user;
+    for (size_t j = 0; j < m; j++) {
+        if (idx[j] >= c->n) return JF_ERR_INVALID;
+        c->r[idx[j]] = res[j];
+    }
+#pragma omp atomic
+    c->got += m;
+    return JF_OK;
+}
+
+START_TEST(test_auto_parts)
+{
+    surf c = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
+    c.s.xyz[3 * 17] = NAN; /* a non-finite row too */
+    jf_result *whole = run(&c, "auto", 2);
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    ck_assert_int_eq(jf_nb_parse("auto", &o.nb, NULL), JF_OK);
+    o.orient = JF_ORIENT_NONE;
+    o.threads = 2;
+    jf_cloud cl = {.n = c.s.n, .xyz = c.s.xyz};
+    collect k = {calloc(c.s.n, sizeof(jf_result)), c.s.n, 0};
+    jf_error e;
+    ck_assert_int_eq(jf_estimate_parts(&cl, &o, 5, sink, &k, &e), JF_OK);
+    ck_assert_uint_eq(k.got, c.s.n);
+    ck_assert_int_eq(memcmp(whole, k.r, c.s.n * sizeof *whole), 0);
+    ck_assert_uint_ne(whole[17].status & JF_PT_NONFINITE, 0);
+    free(k.r);
+    free(whole);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
+START_TEST(test_auto_spec)
+{
+    jf_nb_spec s;
+    char buf[32];
+    ck_assert_int_eq(jf_nb_parse("auto", &s, NULL), JF_OK);
+    ck_assert_int_eq(s.kind, JF_NB_AUTO);
+    ck_assert_str_eq(jf_nb_format(&s, buf, sizeof buf), "auto");
+    ck_assert_int_ne(jf_nb_parse("auto:5", &s, NULL), JF_OK);
+    char st[64];
+    ck_assert_str_eq(jf_point_status_str(JF_PT_AUTO, st, sizeof st), "auto");
+    /* a fit without auto leaves sigma NaN */
+    jf_params p;
+    jf_params_init(&p);
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    double pts[3 * 9], o[3] = {0, 0, 0};
+    for (int i = 0; i < 9; i++) {
+        pts[3 * i] = i % 3 - 1;
+        pts[3 * i + 1] = i / 3 - 1;
+        pts[3 * i + 2] = 0.1 * pts[3 * i] * pts[3 * i];
+    }
+    jf_result r;
+    ck_assert_int_eq(jf_fit_point_full(f, o, pts, 9, &r), JF_OK);
+    ck_assert(isnan(r.sigma));
+    jf_fitter_free(f);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("auto");
+    TCase *tc = tcase_create("auto");
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, test_auto_spec);
+    tcase_add_test(tc, test_auto_ellipsoid);
+    tcase_add_test(tc, test_auto_torus_gradient);
+    tcase_add_test(tc, test_auto_threads);
+    tcase_add_test(tc, test_auto_parts);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int nf = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+}
