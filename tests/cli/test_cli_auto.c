@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "test_cli_util.h"
+#include "jf_test.h"
 
 #define SIDE 40
 #define NOISE 0.004 /* Gaussian-ish: a sum of 12 uniforms, sd NOISE */
@@ -114,9 +115,5 @@ int main(void)
     tcase_add_test(tc, auto_columns_and_summary);
     tcase_add_test(tc, auto_parts_threads);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? 1 : 0;
+    return jf_test_run(s);
 }

@@ -13,6 +13,7 @@
 
 #include "jetfit.h"
 #include "synth/surfaces.h"
+#include "jf_test.h"
 
 typedef struct {
     jf_sample s;
@@ -208,9 +209,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int nf = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return nf ? EXIT_FAILURE : EXIT_SUCCESS;
+    return jf_test_run(suite());
 }
