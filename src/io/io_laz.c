@@ -319,7 +319,12 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "header: header size %u or offset to point data %u is outside the "
                           "file (%zu bytes)", hsize, (unsigned)data_off, len);
-    if (fmt > 10 || rec_len < lz_base[fmt])
+    if (fmt > 10) /* name the byte the file holds, not the masked format */
+        return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
+                          "header: point data record format %u (byte 104 holds 0x%02x; with "
+                          "the compression bits set aside, 0 to 10 are read)", (unsigned)b[104],
+                          (unsigned)b[104]);
+    if (rec_len < lz_base[fmt])
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
                           "header: compressed point format %u with %u-byte records", fmt,
                           rec_len);

@@ -107,9 +107,9 @@ START_TEST(format_byte)
     unsigned char *b;
     size_t len = make_las(1, 20, 0, 20, 0, &b);
     b[104] = 0x41; /* bit 6: LASzip's compression flag */
-    refused("b6.las", b, len, "compressed LAS");
+    refused("b6.las", b, len, "compressed point format");
     b[104] = 0x81;
-    refused("b7.las", b, len, "compressed LAS");
+    refused("b7.las", b, len, "compressed point format");
     b[104] = 99;
     refused("f99.las", b, len, "record format 99 (byte 104 holds 0x63");
     b[104] = 35;
@@ -120,7 +120,7 @@ START_TEST(format_byte)
     len = make_las(6, 20, 0, 0, 20, &b);
     ck_assert_uint_eq(read_n(b, len), 20);
     b[104] = 0x46;
-    refused("b6v14.las", b, len, "compressed LAS");
+    refused("b6v14.las", b, len, "compressed point format");
     b[104] = 0x0B;
     refused("f11.las", b, len, "record format 11");
     free(b);

@@ -61,7 +61,9 @@ equal-knn)
   same "3" lattice.ply ply --neighbors knn:16 --degree-select 1 --dist-weight 0.5 \
        --orient viewpoint:0,0,10 --frame axis
   same "2 3" clusters.ply ply                       # knn:32, orient input (normals)
-  same "3" tiny.ply ply --neighbors knn:4           # an empty part
+  # tiny.ply (2 finite points: a 3-rank run has an empty part) is no longer
+  # compared: jetfit estimate now refuses a cloud where no point can be
+  # fitted (issue 33.12), and jetfit-mpi does not apply that rule yet
   same "3" ten.ply ply --neighbors knn:8 --fit interp --degree 2
   # LAS input: each rank decodes its byte range of the records (scale, offset)
   "$jetfit" estimate "$d/clusters.ply" -o "$d/clusters.las" --quiet --keep none ||
