@@ -69,6 +69,7 @@ def test_option_too_long_refused():
 
 
 def test_degree_select_message_names_value():
-    # before: "--degree-select '': must not exceed --degree"
-    with pytest.raises(ValueError, match="^--degree-select '5': must not exceed --degree$"):
+    # before: "--degree-select '': must not exceed --degree"; Python names
+    # keywords (issue 31)
+    with pytest.raises(ValueError, match="^degree_select=5: must not exceed degree$"):
         jetfit.estimate(fib_sphere(100), degree=2, degree_select=5)
