@@ -73,54 +73,25 @@ typedef struct {
     double h;      /* radius (farthest planar distance)              */
 } cand_fit;
 
-/* Solves the leading nd x nd block of the rescaled normal equations at one
- * K: G'_ab = G_ab D_a D_b, D_a = (H / hK)^deg(a) (monomials of x / hK).
- * Returns 0 when G' is (near) singular. */
-static int solve_k(const double *G, const double *bz, double zz, size_t m, int nd, double H,
-                   double hK, const double fr[9], cand_fit *out)
+/* Exponents of monomial j (order 1, x, y, x^2, xy, y^2, x^3, ...). */
+static const int mex[NMON] = {0, 1, 0, 2, 1, 0, 3, 2, 1, 0};
+static const int mey[NMON] = {0, 0, 1, 0, 1, 2, 0, 1, 2, 3};
+
+/* Position of the power sum x^i y^j (i + j <= 6) in the moment vector. */
+#define NPOW 28
+static int pidx(int i, int j)
 {
-    double D[NMON], L[NMON * NMON], y[NMON], a[NMON];
-    double s = H / hK;
-    D[0] = 1.0;
-    for (int j = 1; j < nd; j++) D[j] = pow(s, mdeg[j]);
-    for (int i = 0; i < nd; i++)
-        for (int j = 0; j <= i; j++) L[i * NMON + j] = G[i * NMON + j] * D[i] * D[j];
-    /* Cholesky, lower triangle in place */
-    for (int j = 0; j < nd; j++) {
-        double sum = L[j * NMON + j];
-        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
-        if (!(sum > 1e-12 * G[0])) return 0;
-        L[j * NMON + j] = sqrt(sum);
-        for (int i = j + 1; i < nd; i++) {
-            double t = L[i * NMON + j];
-            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
-            L[i * NMON + j] = t / L[j * NMON + j];
-        }
-    }
-    for (int i = 0; i < nd; i++) { /* L y = D bz */
-        double t = bz[i] * D[i];
-        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
-        y[i] = t / L[i * NMON + i];
-    }
-    double rss = zz;
-    for (int i = 0; i < nd; i++) rss -= y[i] * y[i]; /* z'z - b'G^-1 b */
-    for (int i = nd - 1; i >= 0; i--) { /* L^T a = y */
-        double t = y[i];
-        for (int k = i + 1; k < nd; k++) t -= L[k * NMON + i] * a[k];
-        a[i] = t / L[i * NMON + i];
-    }
-    /* [G'^-1]_cc = |L^-1 e_c|^2 for the slope columns c = 1, 2 */
-    double var = 0.0;
-    for (int c = 1; c <= 2; c++) {
-        double zc[NMON] = {0};
-        for (int i = c; i < nd; i++) {
-            double t = i == c ? 1.0 : 0.0;
-            for (int k = c; k < i; k++) t -= L[i * NMON + k] * zc[k];
-            zc[i] = t / L[i * NMON + i];
-            var += zc[i] * zc[i];
-        }
-    }
-    double gx = a[1] / hK, gy = a[2] / hK, g2 = 1.0 + gx * gx + gy * gy;
+    int t = i + j;
+    return t * (t + 1) / 2 + j;
+}
+
+/* The normal of a jet whose slope, in units of x / hK, is (a1, a2), and
+ * the sd^2 of its angle per unit noise variance from the slope's variance
+ * var (same units). */
+static int put_fit(double a1, double a2, double var, double rss, size_t m, int nd, double hK,
+                   const double fr[9], cand_fit *out)
+{
+    double gx = a1 / hK, gy = a2 / hK, g2 = 1.0 + gx * gx + gy * gy;
     double v[3];
     for (int k = 0; k < 3; k++) v[k] = fr[6 + k] - gx * fr[k] - gy * fr[3 + k];
     double nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -132,6 +103,71 @@ static int solve_k(const double *G, const double *bz, double zz, size_t m, int n
     out->h = hK;
     out->ok = isfinite(out->tr) && isfinite(out->s2);
     return out->ok;
+}
+
+/* The quadric (out[0]) and the cubic (out[1]) least-squares jets at one
+ * K, from the power sums S = sum x^i y^j (i + j <= 6) and T = sum x^i y^j z
+ * (i + j <= 3) of its points: G_ab = S(a + b), (M^T z)_a = T(a), rescaled
+ * G'_ab = G_ab D_a D_b, D_a = (H / hK)^deg(a) (monomials of x / hK, §2.3).
+ * The monomials are ordered by degree, so the quadric's G' is the leading
+ * 6 x 6 block of the cubic's and one Cholesky factor L serves both: with
+ * y = L^-1 D M^T z and u_c = L^-1 e_c (c = 1, 2: the slope columns), the
+ * slope is a_c = u_c . y, its variance per unit noise |u_c|^2, and the
+ * residual z'z - |y|^2 -- over the first 6 entries for the quadric, all 10
+ * for the cubic (L^-1 is lower triangular: its leading block inverts G'
+ * of the quadric).  A degree whose block is (near) singular, or with
+ * fewer than its size + 4 points, is left out (ok = 0). */
+static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
+                    const double fr[9], cand_fit out[2])
+{
+    double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON];
+    double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
+    int nd = m >= NMON + 4 ? NMON : m >= 6 + 4 ? 6 : 0;
+    for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
+    for (int i = 0; i < nd; i++)
+        for (int j = 0; j <= i; j++)
+            L[i * NMON + j] = S[pidx(mex[i] + mex[j], mey[i] + mey[j])] * D[i] * D[j];
+    /* Cholesky, lower triangle in place; nd drops to 6 if the cubic's
+     * trailing block is singular */
+    for (int j = 0; j < nd; j++) {
+        double sum = L[j * NMON + j];
+        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
+        if (!(sum > 1e-12 * S[0])) {
+            nd = j >= 6 ? 6 : 0;
+            break;
+        }
+        L[j * NMON + j] = sqrt(sum);
+        double inv = 1.0 / L[j * NMON + j];
+        for (int i = j + 1; i < nd; i++) {
+            double t = L[i * NMON + j];
+            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
+            L[i * NMON + j] = t * inv;
+        }
+    }
+    for (int i = 0; i < nd; i++) { /* L y = D M^T z */
+        double t = T[pidx(mex[i], mey[i])] * D[i];
+        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
+        y[i] = t / L[i * NMON + i];
+    }
+    for (int c = 1; c <= 2; c++) { /* L u = e_c */
+        double *z = u[c - 1];
+        z[0] = 0.0;
+        if (c == 2) z[1] = 0.0;
+        for (int i = c; i < nd; i++) {
+            double t = i == c ? 1.0 : 0.0;
+            for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
+            z[i] = t / L[i * NMON + i];
+        }
+    }
+    double a1 = 0.0, a2 = 0.0, var = 0.0, rss = zz;
+    for (int i = 0; i < nd; i++) {
+        a1 += u[0][i] * y[i];
+        a2 += u[1][i] * y[i];
+        var += u[0][i] * u[0][i] + u[1][i] * u[1][i];
+        rss -= y[i] * y[i];
+        if (i == 5) put_fit(a1, a2, var, rss, m, 6, hK, fr, &out[0]);
+    }
+    if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
 }
 
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
@@ -206,16 +242,17 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     fr[4] = fr[8] * fr[0] - fr[6] * fr[2];
     fr[5] = fr[6] * fr[1] - fr[7] * fr[0];
 
-    double H = 0.0;
+    /* H: a scale for the power sums (the farthest neighbour's distance,
+     * >= every planar distance), so that x / H, y / H <= 1 */
+    double H2 = 0.0;
     for (size_t i = 0; i < nmax; i++) {
         const double *q = nbr + 3 * i;
-        double v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        double x = v[0] * fr[0] + v[1] * fr[1] + v[2] * fr[2];
-        double y = v[0] * fr[3] + v[1] * fr[4] + v[2] * fr[5];
-        double r = hypot(x, y);
-        if (isfinite(r) && r > H) H = r;
+        double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
+        double r2 = v0 * v0 + v1 * v1 + v2 * v2;
+        if (r2 > H2 && isfinite(r2)) H2 = r2;
     }
-    if (!(H > 0.0)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
+    double H = sqrt(H2), iH = 1.0 / H;
+    if (!(H > 0.0) || !isfinite(iH)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
 
     /* the candidates (the last one: the whole list when it is shorter) */
     size_t ks[NCAND];
@@ -223,36 +260,47 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     for (int c = 0; c < NCAND && cand[c] <= nmax; c++) ks[nc++] = cand[c];
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
 
-    double G[NMON * NMON] = {0}, bz[NMON] = {0}, zz = 0.0, hK = 0.0;
+    /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
+     * and x^i y^j z (i + j <= 3), x, y in units of H */
+    double S[NPOW] = {0}, T[NPOW] = {0}, zz = 0.0, r2K = 0.0;
     size_t m = 0;
     cand_fit cf[2][NCAND];
     memset(cf, 0, sizeof cf);
     int c = 0;
     for (size_t i = 0; i < nmax && c < nc; i++) {
         const double *q = nbr + 3 * i;
-        double v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        double x = v[0] * fr[0] + v[1] * fr[1] + v[2] * fr[2];
-        double y = v[0] * fr[3] + v[1] * fr[4] + v[2] * fr[5];
-        double z = v[0] * fr[6] + v[1] * fr[7] + v[2] * fr[8];
+        double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
+        double x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
+        double y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
+        double z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
         if (isfinite(x) && isfinite(y) && isfinite(z)) {
-            double r = hypot(x, y);
-            if (r > hK) hK = r;
-            x /= H;
-            y /= H;
-            double mon[NMON] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y,
-                                y * y * y};
-            for (int a = 0; a < NMON; a++) {
-                for (int b = 0; b <= a; b++) G[a * NMON + b] += mon[a] * mon[b];
-                bz[a] += mon[a] * z;
+            double r2 = x * x + y * y;
+            if (r2 > r2K) r2K = r2;
+            double xp[7], yp[7];
+            xp[0] = yp[0] = 1.0;
+            for (int e = 1; e <= 6; e++) {
+                xp[e] = xp[e - 1] * x;
+                yp[e] = yp[e - 1] * y;
+            }
+            /* pidx order: degree t, then j = 0..t */
+            int at = 0;
+            for (int t = 0; t <= 6; t++)
+                for (int j = 0; j <= t; j++) S[at++] += xp[t - j] * yp[j];
+            at = 0;
+            for (int t = 0; t <= 3; t++) {
+                double zt = z * xp[t];
+                for (int j = 0; j <= t; j++, at++) T[at] += (j ? xp[t - j] * yp[j] * z : zt);
             }
             zz += z * z;
             m++;
         }
         if (i + 1 != ks[c]) continue;
-        for (int d = 0; d < 2; d++) {
-            int nd = d ? 10 : 6;
-            if (m >= (size_t)nd + 4 && hK > 0.0)
-                solve_k(G, bz, zz, m, nd, H, hK, fr, &cf[d][c]);
+        double hK = sqrt(r2K) * H;
+        if (hK > 0.0) {
+            cand_fit two[2] = {{0}, {0}};
+            solve_k(S, T, zz, m, H, hK, fr, two);
+            cf[0][c] = two[0];
+            cf[1][c] = two[1];
         }
         c++;
     }

@@ -8,7 +8,8 @@
  *    KD_LEAF points are leaves.  An inner node keeps the largest coordinate
  *    of its left half and the smallest of its right half along its axis
  *    (as nanoflann does), so the gap between the halves prunes too.
- *  - query: depth first, nearer child first; a bounded max-heap of
+ *  - query: depth first, nearer child first; a bounded max-heap (or, for
+ *    k up to 512, a 2k buffer cut back to k by quickselect) of
  *    (d2, position in tree order) pairs lives in the caller's buffers,
  *    positions turned into original indices at the end (and, for the
  *    pipeline, the points' coordinates copied from the tree's storage:
@@ -36,6 +37,11 @@
                                in random query order at 1M points)     */
 #define KD_STACK_KEYS 1024  /* d2 scratch on the stack when d2 == NULL    */
 #define KD_SORTED_MAX 48    /* k up to this: sorted array, else heap      */
+#define KD_BUF_MAX 1024     /* 2k up to this: buffer and quickselect      */
+#define KD_PROBE_MIN 8      /* k >= 8 x this: a k/8 probe bounds the search */
+#ifndef KD_PROBE_GROW
+#define KD_PROBE_GROW 1.5   /* squared-radius margin of the probe's bound  */
+#endif
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
 
 typedef struct {
@@ -282,7 +288,7 @@ typedef struct {
     double *hd;       /* heap keys: squared distances                     */
     uint32_t *hp;     /* heap values: positions in tree order             */
     size_t cap, cnt;
-    int sorted;       /* small k: a sorted array instead of the heap     */
+    int sorted;       /* 1: sorted array (small k); 2: buffer (buf_push); 0: heap */
     double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
     uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
     jf__kd_scan *scan; /* when not NULL: the leaves read, the cells passed */
@@ -351,6 +357,132 @@ static void sorted_push(kd_query *s, double d, uint32_t pos)
     }
 }
 
+/* Larger k: candidates appended to a buffer of 2k; when it fills, a
+ * quickselect keeps the k least and the k-th becomes the worst (O(1)
+ * amortised per candidate, against the heap's log k sifts, which
+ * dominated knn:256).  The (d2, index) order is total, so the k kept and
+ * their final order are the heap's. */
+static void buf_swap(double *hd, uint32_t *hp, size_t a, size_t b)
+{
+    double td = hd[a];
+    uint32_t tp = hp[a];
+    hd[a] = hd[b];
+    hp[a] = hp[b];
+    hd[b] = td;
+    hp[b] = tp;
+}
+
+/* Quickselect (median of three, Hoare partition) on (d2, index): [lo, nth)
+ * before nth, (nth, hi) after it.  Keys are distinct. */
+static void buf_select(const uint32_t *id, double *hd, uint32_t *hp, size_t lo, size_t hi,
+                       size_t nth)
+{
+    while (hi - lo > 2) {
+        size_t mid = lo + (hi - lo) / 2, last = hi - 1;
+        if (KD_LESS(id, hd[mid], hp[mid], hd[lo], hp[lo])) buf_swap(hd, hp, mid, lo);
+        if (KD_LESS(id, hd[last], hp[last], hd[lo], hp[lo])) buf_swap(hd, hp, last, lo);
+        if (KD_LESS(id, hd[last], hp[last], hd[mid], hp[mid])) buf_swap(hd, hp, last, mid);
+        const double pd = hd[mid];
+        const uint32_t pp = hp[mid];
+        size_t i = lo, j = last;
+        for (;;) {
+            while (KD_LESS(id, hd[i], hp[i], pd, pp)) i++;
+            while (KD_LESS(id, pd, pp, hd[j], hp[j])) j--;
+            if (i >= j) break;
+            buf_swap(hd, hp, i, j);
+            i++;
+            j--;
+        }
+        if (nth <= j) hi = j + 1;
+        else lo = j + 1;
+    }
+    if (hi - lo == 2 && KD_LESS(id, hd[lo + 1], hp[lo + 1], hd[lo], hp[lo]))
+        buf_swap(hd, hp, lo, lo + 1);
+}
+
+/* Sorts [lo, hi) by (d2, index): quicksort, insertion sort below 16. */
+static void buf_sort(const uint32_t *id, double *hd, uint32_t *hp, size_t lo, size_t hi)
+{
+    while (hi - lo > 16) {
+        size_t mid = lo + (hi - lo) / 2;
+        buf_select(id, hd, hp, lo, hi, mid); /* [lo, mid) <= mid <= (mid, hi) */
+        if (mid - lo < hi - mid - 1) {
+            buf_sort(id, hd, hp, lo, mid);
+            lo = mid + 1;
+        } else {
+            buf_sort(id, hd, hp, mid + 1, hi);
+            hi = mid;
+        }
+    }
+    for (size_t i = lo + 1; i < hi; i++) {
+        double d = hd[i];
+        uint32_t p = hp[i];
+        size_t j = i;
+        while (j > lo && KD_LESS(id, d, p, hd[j - 1], hp[j - 1])) {
+            hd[j] = hd[j - 1];
+            hp[j] = hp[j - 1];
+            j--;
+        }
+        hd[j] = d;
+        hp[j] = p;
+    }
+}
+
+/* The k least of the buffer's cnt candidates, nearest first: a counting
+ * sort into cnt buckets of equal width in d2 (about as many points per
+ * bucket on a surface, where d2 grows with the area), each bucket then
+ * sorted by (d2, index) -- the bucket of a key is monotone in it, so the
+ * order is exactly the heap's, in O(cnt) instead of a comparison sort's
+ * unpredictable branches.  tmp: 2 cnt slots. */
+static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt, size_t k,
+                       double *td, uint32_t *tp)
+{
+    double mx = 0.0;
+    for (size_t i = 0; i < cnt; i++)
+        if (hd[i] > mx) mx = hd[i];
+    if (!(mx > 0.0) || !isfinite(mx) || cnt > KD_BUF_MAX) { /* all ties: compare */
+        if (cnt > k) buf_select(id, hd, hp, 0, cnt, k - 1);
+        buf_sort(id, hd, hp, 0, cnt < k ? cnt : k);
+        return;
+    }
+    uint32_t start[KD_BUF_MAX + 1];
+    const double scale = (double)cnt / mx;
+    memset(start, 0, (cnt + 1) * sizeof *start);
+    for (size_t i = 0; i < cnt; i++) {
+        size_t b = (size_t)(hd[i] * scale);
+        start[(b < cnt ? b : cnt - 1) + 1]++;
+    }
+    for (size_t b = 0; b < cnt; b++) start[b + 1] += start[b];
+    for (size_t i = 0; i < cnt; i++) {
+        size_t b = (size_t)(hd[i] * scale);
+        uint32_t at = start[b < cnt ? b : cnt - 1]++;
+        td[at] = hd[i];
+        tp[at] = hp[i];
+    }
+    /* start[b] is now the end of bucket b */
+    size_t out = 0, lo = 0;
+    for (size_t b = 0; b < cnt && out < k; b++) {
+        size_t hi = start[b];
+        if (hi - lo > 1) buf_sort(id, td, tp, lo, hi);
+        for (size_t i = lo; i < hi && out < k; i++, out++) {
+            hd[out] = td[i];
+            hp[out] = tp[i];
+        }
+        lo = hi;
+    }
+}
+
+static void buf_push(kd_query *s, double d, uint32_t pos)
+{
+    s->hd[s->cnt] = d;
+    s->hp[s->cnt++] = pos;
+    if (s->cnt < 2 * s->cap) return;
+    buf_select(s->ix->id, s->hd, s->hp, 0, s->cnt, s->cap - 1);
+    s->cnt = s->cap;
+    s->worst_d = s->hd[s->cap - 1];
+    s->worst_p = s->hp[s->cap - 1];
+}
+
 static void scan_leaf(kd_query *s, const kd_node *nd)
 {
     const uint32_t first = nd->first, cnt = nd->dim >> 2;
@@ -368,7 +500,8 @@ static void scan_leaf(kd_query *s, const kd_node *nd)
         if (d > s->worst_d) continue; /* the common case, decided fast */
         /* on a tie, the smaller index wins; no worst yet: any index */
         if (d < s->worst_d || s->worst_p == UINT32_MAX || id[first + j] < id[s->worst_p]) {
-            if (s->sorted) sorted_push(s, d, first + j);
+            if (s->sorted == 1) sorted_push(s, d, first + j);
+            else if (s->sorted == 2) buf_push(s, d, first + j);
             else heap_push(s, d, first + j);
         }
     }
@@ -450,7 +583,14 @@ static void run_query(kd_query *s)
     double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (bound <= s->worst_d) search(s, g);
     else if (s->scan) s->scan->rc2 = bound;
-    if (s->sorted) return;
+    if (s->sorted == 1) return;
+    if (s->sorted == 2) {
+        double td[KD_BUF_MAX];
+        uint32_t tp[KD_BUF_MAX];
+        buf_finish(ix->id, s->hd, s->hp, s->cnt, s->cap, td, tp);
+        if (s->cnt > s->cap) s->cnt = s->cap;
+        return;
+    }
     /* heap sort: repeatedly move the worst to the end */
     for (size_t end = s->cnt; end > 1; end--) {
         double td = s->hd[0];
@@ -475,15 +615,48 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     if (k > ix->m) k = ix->m;
     double stack_keys[KD_STACK_KEYS];
     double *keys = d2;
-    if (!keys) {
+    /* the 2k buffer of buf_push, on the stack */
+    int mode = k <= KD_SORTED_MAX ? 1 : 2 * k <= KD_BUF_MAX ? 2 : 0;
+    double buf_keys[KD_BUF_MAX];
+    uint32_t buf_pos[KD_BUF_MAX];
+    if (mode == 2) keys = buf_keys;
+    else if (!keys) {
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
     /* idx holds positions during the search, indices after */
-    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  idx,
-                  k,     0, k <= KD_SORTED_MAX, bound, UINT32_MAX, scan};
+    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode == 2 ? buf_pos : idx,
+                  k,     0, mode, bound, UINT32_MAX, scan};
     if (scan) scan->n = 0, scan->rc2 = INFINITY;
-    run_query(&s);
+    if (mode == 2 && !scan && bound == INFINITY && k >= 8 * KD_PROBE_MIN) {
+        /* Probe: the k/8 nearest give a radius that, grown as on a surface
+         * (r ~ sqrt k) with a margin, bounds the k-th nearest; the bounded
+         * search then reads little beyond that ball.  Exact either way:
+         * fewer than k inside the bound and the search runs unbounded. */
+        size_t k1 = k / 8 < KD_SORTED_MAX ? k / 8 : KD_SORTED_MAX;
+        double pd[KD_SORTED_MAX];
+        uint32_t pp[KD_SORTED_MAX];
+        kd_query s1 = {ix, {q[0], q[1], q[2]}, pd, pp, k1, 0, 1, INFINITY, UINT32_MAX, NULL};
+        run_query(&s1);
+        if (s1.cnt == k1) {
+            double r2 = pd[k1 - 1] * ((double)k / (double)k1) * KD_PROBE_GROW;
+            s.worst_d = r2;
+            run_query(&s);
+            if (s.cnt < k) { /* the bound was too tight: unbounded */
+                s.cnt = 0;
+                s.worst_d = INFINITY;
+                s.worst_p = UINT32_MAX;
+                run_query(&s);
+            }
+        } else
+            run_query(&s);
+    } else
+        run_query(&s);
+    if (mode == 2) {
+        if (d2) memcpy(d2, buf_keys, s.cnt * sizeof *d2);
+        memcpy(idx, buf_pos, s.cnt * sizeof *idx);
+        keys = d2;
+    }
     if (scan && scan->n > JF_KD_SCAN_LEAVES) scan->rc2 = 0; /* not all kept */
     if (keys != d2 && keys != stack_keys) free(keys);
     for (size_t j = 0; ids && j < s.cnt; j++) {
