@@ -39,6 +39,7 @@
 #include "robust_internal.h"
 
 #define NMON 10        /* monomials of a cubic                         */
+typedef double v2d __attribute__((vector_size(16)));
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND 10
@@ -73,17 +74,21 @@ typedef struct {
     double h;      /* radius (farthest planar distance)              */
 } cand_fit;
 
+/* The power sums of one candidate K (step 1) and what its fit needs. */
+typedef struct {
+    double S[28], T[NMON], zz;
+    size_t m;     /* finite points among the K                      */
+    double hmean; /* their mean planar distance (the jet's h, §2.3)  */
+} mom;
+
 /* Exponents of monomial j (order 1, x, y, x^2, xy, y^2, x^3, ...). */
 static const int mex[NMON] = {0, 1, 0, 2, 1, 0, 3, 2, 1, 0};
 static const int mey[NMON] = {0, 0, 1, 0, 1, 2, 0, 1, 2, 3};
 
-/* Position of the power sum x^i y^j (i + j <= 6) in the moment vector. */
+/* Position of the power sum x^i y^j (i + j <= 6) in the moment vector:
+ * by degree t = i + j, then j. */
 #define NPOW 28
-static int pidx(int i, int j)
-{
-    int t = i + j;
-    return t * (t + 1) / 2 + j;
-}
+#define PIDX(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j))
 
 /* The normal of a jet whose slope, in units of x / hK, is (a1, a2), and
  * the sd^2 of its angle per unit noise variance from the slope's variance
@@ -120,13 +125,25 @@ static int put_fit(double a1, double a2, double var, double rss, size_t m, int n
 static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
                     const double fr[9], cand_fit out[2])
 {
-    double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON];
+    /* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
+    static const unsigned char gpos[NMON][NMON] = {
+        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
+        {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
+        {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
+        {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
+        {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
+        {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
+        {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
+        {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
+        {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
+        {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
+    double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
     double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
     int nd = m >= NMON + 4 ? NMON : m >= 6 + 4 ? 6 : 0;
     for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
     for (int i = 0; i < nd; i++)
         for (int j = 0; j <= i; j++)
-            L[i * NMON + j] = S[pidx(mex[i] + mex[j], mey[i] + mey[j])] * D[i] * D[j];
+            L[i * NMON + j] = S[gpos[i][j]] * D[i] * D[j];
     /* Cholesky, lower triangle in place; nd drops to 6 if the cubic's
      * trailing block is singular */
     for (int j = 0; j < nd; j++) {
@@ -137,7 +154,7 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
             break;
         }
         L[j * NMON + j] = sqrt(sum);
-        double inv = 1.0 / L[j * NMON + j];
+        double inv = idg[j] = 1.0 / L[j * NMON + j];
         for (int i = j + 1; i < nd; i++) {
             double t = L[i * NMON + j];
             for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
@@ -145,9 +162,9 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
         }
     }
     for (int i = 0; i < nd; i++) { /* L y = D M^T z */
-        double t = T[pidx(mex[i], mey[i])] * D[i];
+        double t = T[PIDX(mex[i], mey[i])] * D[i];
         for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
-        y[i] = t / L[i * NMON + i];
+        y[i] = t * idg[i];
     }
     for (int c = 1; c <= 2; c++) { /* L u = e_c */
         double *z = u[c - 1];
@@ -156,7 +173,7 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
         for (int i = c; i < nd; i++) {
             double t = i == c ? 1.0 : 0.0;
             for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
-            z[i] = t / L[i * NMON + i];
+            z[i] = t * idg[i];
         }
     }
     double a1 = 0.0, a2 = 0.0, var = 0.0, rss = zz;
@@ -208,6 +225,194 @@ static jf_status final_fit(const jf_params *pr, int d, const double p[3], const 
     return JF_OK;
 }
 
+/* The power sums of the first k neighbours in the frame fr (as step 1's,
+ * x, y in units of H; up to degree 2 deg), their count and mean planar
+ * distance (length units). */
+static void moments(const double p[3], const double *nbr, size_t k, const double fr[9], double H,
+                    int deg, mom *mo)
+{
+    const double iH = 1.0 / H;
+    const int top = 2 * deg, ntop = (top + 1) * (top + 2) / 2, nt = (deg + 1) * (deg + 2) / 2;
+    v2d SA[NPOW], TA[NMON], ZA = {0.0, 0.0}, RA = {0.0, 0.0}, MA = {0.0, 0.0};
+    memset(SA, 0, sizeof SA);
+    memset(TA, 0, sizeof TA);
+    for (size_t i = 0; i < k; i += 2) {
+        v2d x, y, z, w;
+        for (int l = 0; l < 2; l++) {
+            double xl = 0.0, yl = 0.0, zl = 0.0, wl = 0.0;
+            if (i + (size_t)l < k) {
+                const double *q = nbr + 3 * (i + (size_t)l);
+                double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
+                xl = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
+                yl = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
+                zl = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
+                wl = isfinite(xl) && isfinite(yl) && isfinite(zl);
+                if (!wl) xl = yl = zl = 0.0;
+            }
+            x[l] = xl;
+            y[l] = yl;
+            z[l] = zl;
+            w[l] = wl;
+        }
+        v2d xp[7], yp[7];
+        xp[0] = w;
+        yp[0] = (v2d){1.0, 1.0};
+        for (int e = 1; e <= top; e++) {
+            xp[e] = xp[e - 1] * x;
+            yp[e] = yp[e - 1] * y;
+        }
+        int at = 0;
+        for (int t = 0; t <= top; t++)
+            for (int j = 0; j <= t; j++) SA[at++] += xp[t - j] * yp[j];
+        at = 0;
+        for (int t = 0; t <= deg; t++)
+            for (int j = 0; j <= t; j++) TA[at++] += xp[t - j] * yp[j] * z;
+        ZA += w * z * z;
+        MA += w;
+        v2d r2 = x * x + y * y;
+        RA += (v2d){sqrt(r2[0]), sqrt(r2[1])};
+    }
+    for (int j = 0; j < ntop; j++) mo->S[j] = SA[j][0] + SA[j][1];
+    for (int j = 0; j < nt; j++) mo->T[j] = TA[j][0] + TA[j][1];
+    mo->zz = ZA[0] + ZA[1];
+    mo->m = (size_t)(MA[0] + MA[1]);
+    mo->hmean = mo->m ? (RA[0] + RA[1]) / (double)mo->m * H : 0.0;
+}
+
+/* The chosen jet straight from its power sums (mo) in the frame fr: the
+ * least-squares jet of degree d on those K points, as jf_fit_point would
+ * fit it but in the frame of the 32 nearest (no second fit: step 5).
+ * Its steps mirror the jet's (§2, §5.2; jet.c): monomials of x / h with h
+ * the mean planar distance (§2.3), the condition number of that scaled
+ * Vandermonde matrix sqrt(lambda_max / lambda_min) of G', the degree
+ * lowered while G' is singular or too ill-conditioned (params.max_cond,
+ * flags LOWERED_RANK / LOWERED_COND), A_ij = Y_ij / h^(i+j), then the
+ * quantities (monge.c).  Interpolation, or no degree left: jf_fit_point
+ * on the same points (final_fit). */
+static jf_status direct_fit(const jf_params *pr, const double p[3], const double *nbr, size_t k,
+                            const mom *mo0, double H, const double fr0[9], int d, double sigma,
+                            jf_result *out)
+{
+    if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) return final_fit(pr, d, p, nbr, k, sigma, out);
+    /* the frame of the K points (the jet's, §5.2): their covariance from
+     * step 1's sums, turned from fr's axes to the world's */
+    double pca_ev[3], fk[9];
+    {
+        const double *S = mo0->S, *T = mo0->T, n1 = (double)mo0->m;
+        double mx = S[PIDX(1, 0)] * H / n1, my = S[PIDX(0, 1)] * H / n1, mz = T[0] / n1;
+        double c[9], cw[9], evec[9];
+        c[0] = S[PIDX(2, 0)] * H * H / n1 - mx * mx;
+        c[1] = c[3] = S[PIDX(1, 1)] * H * H / n1 - mx * my;
+        c[2] = c[6] = T[PIDX(1, 0)] * H / n1 - mx * mz;
+        c[4] = S[PIDX(0, 2)] * H * H / n1 - my * my;
+        c[5] = c[7] = T[PIDX(0, 1)] * H / n1 - my * mz;
+        c[8] = mo0->zz / n1 - mz * mz;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double t = 0.0;
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) t += fr0[3 * a + i] * c[3 * a + b] * fr0[3 * b + j];
+                cw[3 * i + j] = t;
+            }
+        jf__eig3(cw, pca_ev, evec);
+        jf__frame_axes(evec, pr->frame, fk);
+    }
+    const double *fr = fk;
+    mom mk;
+    moments(p, nbr, k, fr, H, d, &mk);
+    const mom *mo = &mk;
+    if (!(mo->hmean > 0.0)) return final_fit(pr, d, p, nbr, k, sigma, out);
+    static const unsigned char gpos[NMON][NMON] = {
+        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
+        {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
+        {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
+        {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
+        {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
+        {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
+        {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
+        {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
+        {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
+        {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
+    const double h = mo->hmean, sc = H / h, sp[4] = {1.0, sc, sc * sc, sc * sc * sc};
+    const size_t m = mo->m;
+    unsigned flags = 0;
+    double L[NMON * NMON], Y[NMON], cond = NAN, rss = mo->zz;
+    int deg = d;
+    for (; deg >= 1; deg--) {
+        int nd = (deg + 1) * (deg + 2) / 2;
+        if (m < (size_t)nd) {
+            flags |= JF_PT_LOWERED_FEW;
+            continue;
+        }
+        double E[NMON * NMON], ev[NMON], wk[NMON];
+        for (int i = 0; i < nd; i++)
+            for (int j = 0; j < nd; j++)
+                E[i * nd + j] = L[i * NMON + j] =
+                    mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
+        if (jf__sym_eigvals(E, (size_t)nd, ev, wk) != 0) {
+            flags |= JF_PT_LOWERED_RANK;
+            continue;
+        }
+        double lo = ev[0], hi = ev[0];
+        for (int i = 1; i < nd; i++) {
+            if (ev[i] < lo) lo = ev[i];
+            if (ev[i] > hi) hi = ev[i];
+        }
+        cond = lo > 0.0 ? sqrt(hi / lo) : INFINITY;
+        int okc = 1;
+        for (int j = 0; j < nd && okc; j++) { /* Cholesky of G' */
+            double sum = L[j * NMON + j];
+            for (int q = 0; q < j; q++) sum -= L[j * NMON + q] * L[j * NMON + q];
+            if (!(sum > 0.0)) {
+                okc = 0;
+                break;
+            }
+            L[j * NMON + j] = sqrt(sum);
+            for (int i = j + 1; i < nd; i++) {
+                double t = L[i * NMON + j];
+                for (int q = 0; q < j; q++) t -= L[i * NMON + q] * L[j * NMON + q];
+                L[i * NMON + j] = t / L[j * NMON + j];
+            }
+        }
+        if (!okc || !isfinite(cond)) {
+            flags |= JF_PT_LOWERED_RANK;
+            continue;
+        }
+        if (cond > pr->max_cond) {
+            flags |= JF_PT_LOWERED_COND;
+            continue;
+        }
+        double y[NMON];
+        rss = mo->zz;
+        for (int i = 0; i < nd; i++) { /* L y = D M^T z */
+            double t = mo->T[PIDX(mex[i], mey[i])] * sp[mdeg[i]];
+            for (int q = 0; q < i; q++) t -= L[i * NMON + q] * y[q];
+            y[i] = t / L[i * NMON + i];
+            rss -= y[i] * y[i];
+        }
+        for (int i = nd - 1; i >= 0; i--) { /* L^T Y = y */
+            double t = y[i];
+            for (int q = i + 1; q < nd; q++) t -= L[q * NMON + i] * Y[q];
+            Y[i] = t / L[i * NMON + i];
+        }
+        break;
+    }
+    if (deg < 1) return final_fit(pr, d, p, nbr, k, sigma, out);
+    memset(out, 0, sizeof *out);
+    out->status = flags | JF_PT_AUTO;
+    out->degree = deg;
+    out->n_used = (int)m;
+    out->cond = cond;
+    out->residual = sqrt((rss > 0.0 ? rss : 0.0) / (double)m);
+    out->sigma = sigma;
+    memcpy(out->pca_eval, pca_ev, sizeof pca_ev);
+    double A[NMON], hk = 1.0;
+    for (int t = 0, j = 0; t <= deg; t++, hk *= h)
+        for (int q = 0; q <= t; q++, j++) A[j] = Y[j] / hk;
+    jf__quantities(A, deg, pr->monge_degree, fr, h, out);
+    return JF_OK;
+}
+
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out)
 {
@@ -235,12 +440,9 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     }
     double ev[3], evec[9], fr[9];
     jf__eig3(cov, ev, evec);
-    /* rows t1 (largest variance), t2 = nf x t1, nf (smallest) */
-    memcpy(fr, evec + 6, 3 * sizeof(double));
-    memcpy(fr + 6, evec, 3 * sizeof(double));
-    fr[3] = fr[7] * fr[2] - fr[8] * fr[1];
-    fr[4] = fr[8] * fr[0] - fr[6] * fr[2];
-    fr[5] = fr[6] * fr[1] - fr[7] * fr[0];
+    /* rows t1 (largest variance), t2 = nf x t1, nf (smallest), as the
+     * jet's own frame (or the world axis nearest nf: params.frame) */
+    jf__frame_axes(evec, pr->frame, fr);
 
     /* H: a scale for the power sums (the farthest neighbour's distance,
      * >= every planar distance), so that x / H, y / H <= 1 */
@@ -260,45 +462,72 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     for (int c = 0; c < NCAND && cand[c] <= nmax; c++) ks[nc++] = cand[c];
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
 
-    /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
-     * and x^i y^j z (i + j <= 3), x, y in units of H */
-    double S[NPOW] = {0}, T[NPOW] = {0}, zz = 0.0, r2K = 0.0;
-    size_t m = 0;
-    cand_fit cf[2][NCAND];
-    memset(cf, 0, sizeof cf);
-    int c = 0;
-    for (size_t i = 0; i < nmax && c < nc; i++) {
+    /* the neighbours in the frame (x, y in units of H); a non-finite one
+     * weighs 0; prefix counts and largest planar r^2 */
+    double px[JF_NB_AUTO_KMAX + 1], py[JF_NB_AUTO_KMAX + 1], pz[JF_NB_AUTO_KMAX + 1],
+        pw[JF_NB_AUTO_KMAX + 1], r2p[JF_NB_AUTO_KMAX];
+    size_t cntp[JF_NB_AUTO_KMAX], m = 0;
+    double r2K = 0.0, rs = 0.0, rsum[JF_NB_AUTO_KMAX];
+    for (size_t i = 0; i < nmax; i++) {
         const double *q = nbr + 3 * i;
         double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
         double x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
         double y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
         double z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
-        if (isfinite(x) && isfinite(y) && isfinite(z)) {
-            double r2 = x * x + y * y;
-            if (r2 > r2K) r2K = r2;
-            double xp[7], yp[7];
-            xp[0] = yp[0] = 1.0;
-            for (int e = 1; e <= 6; e++) {
-                xp[e] = xp[e - 1] * x;
-                yp[e] = yp[e - 1] * y;
-            }
-            /* pidx order: degree t, then j = 0..t */
-            int at = 0;
-            for (int t = 0; t <= 6; t++)
-                for (int j = 0; j <= t; j++) S[at++] += xp[t - j] * yp[j];
-            at = 0;
-            for (int t = 0; t <= 3; t++) {
-                double zt = z * xp[t];
-                for (int j = 0; j <= t; j++, at++) T[at] += (j ? xp[t - j] * yp[j] * z : zt);
-            }
-            zz += z * z;
-            m++;
+        int ok = isfinite(x) && isfinite(y) && isfinite(z);
+        px[i] = ok ? x : 0.0;
+        py[i] = ok ? y : 0.0;
+        pz[i] = ok ? z : 0.0;
+        pw[i] = ok;
+        m += (size_t)ok;
+        double r2 = ok ? x * x + y * y : 0.0;
+        if (r2 > r2K) r2K = r2;
+        r2p[i] = r2K;
+        cntp[i] = m;
+        rs += sqrt(r2);
+        rsum[i] = rs;
+    }
+    px[nmax] = py[nmax] = pz[nmax] = pw[nmax] = 0.0; /* pads an odd count */
+
+    /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
+     * and x^i y^j z (i + j <= 3, with z'z), two neighbours at a time (SIMD
+     * lanes; every candidate K but a short list's last is even) */
+    v2d SA[NPOW], TA[NMON], ZA = {0.0, 0.0};
+    memset(SA, 0, sizeof SA);
+    memset(TA, 0, sizeof TA);
+    cand_fit cf[2][NCAND];
+    memset(cf, 0, sizeof cf);
+    mom mo[NCAND];
+    int c = 0;
+    for (size_t i = 0; i < nmax && c < nc; i += 2) {
+        v2d x = {px[i], px[i + 1]}, y = {py[i], py[i + 1]}, z = {pz[i], pz[i + 1]};
+        v2d xp[7], yp[7];
+        xp[0] = (v2d){pw[i], pw[i + 1]};
+        yp[0] = (v2d){1.0, 1.0};
+        for (int e = 1; e <= 6; e++) {
+            xp[e] = xp[e - 1] * x;
+            yp[e] = yp[e - 1] * y;
         }
-        if (i + 1 != ks[c]) continue;
-        double hK = sqrt(r2K) * H;
+        int at = 0; /* PIDX order: degree t, then j = 0..t */
+        for (int t = 0; t <= 6; t++)
+            for (int j = 0; j <= t; j++) SA[at++] += xp[t - j] * yp[j];
+        at = 0;
+        for (int t = 0; t <= 3; t++)
+            for (int j = 0; j <= t; j++) TA[at++] += xp[t - j] * yp[j] * z;
+        ZA += xp[0] * z * z;
+        if (i + 2 < ks[c]) continue;
+        size_t K = ks[c];
+        mom *mc = &mo[c];
+        double *S = mc->S, *T = mc->T;
+        mc->zz = ZA[0] + ZA[1];
+        for (int j = 0; j < NPOW; j++) S[j] = SA[j][0] + SA[j][1];
+        for (int j = 0; j < NMON; j++) T[j] = TA[j][0] + TA[j][1];
+        mc->m = cntp[K - 1];
+        mc->hmean = mc->m ? rsum[K - 1] / (double)mc->m * H : 0.0;
+        double hK = sqrt(r2p[K - 1]) * H;
         if (hK > 0.0) {
             cand_fit two[2] = {{0}, {0}};
-            solve_k(S, T, zz, m, H, hK, fr, two);
+            solve_k(S, T, mc->zz, mc->m, H, hK, fr, two);
             cf[0][c] = two[0];
             cf[1][c] = two[1];
         }
@@ -352,7 +581,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                 }
             }
         if (bc < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-        return final_fit(pr, bd ? 3 : 2, p, nbr, ks[bc], sigma, out);
+        return direct_fit(pr, p, nbr, ks[bc], &mo[bc], H, fr, bd ? 3 : 2, sigma, out);
     }
     /* step 3: Lepski per degree */
     double tau = jf__auto_tau;
@@ -377,5 +606,5 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         }
     }
     if (ci < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-    return final_fit(pr, d, p, nbr, ks[ci], sigma, out);
+    return direct_fit(pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
 }

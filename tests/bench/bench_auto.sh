@@ -1,0 +1,48 @@
+#!/bin/sh
+# bench_auto.sh -- issue 27's cost target: `--neighbors auto` against the
+# default knn:32 degree 2 on the same cloud, in the same run.
+#
+#   sh tests/bench/bench_auto.sh [BUILD] [N] [ROUNDS]
+#
+# BUILD (default: build) holds the jetfit command; N (default 100000) is
+# the point count of a `jetfit generate torus --density gradient --noise
+# 0.003` cloud (binary PLY); ROUNDS (default 5) rounds each run knn:32 then
+# auto, one thread, binary PLY out.  The machine may be shared: each
+# setting's time is its least CPU time (user + system) over the rounds,
+# the two alternating so that both see the same load.  Prints per setting
+# that time, points/s and peak RSS, then the ratios auto / knn:32 (goal:
+# time <= 3, memory <= 1.5).  Needs GNU time (/usr/bin/time).
+set -eu
+B=${1:-build}
+N=${2:-100000}
+R=${3:-5}
+J=$B/jetfit
+[ -x "$J" ] || { echo "bench_auto: $J not built" >&2; exit 1; }
+[ -x /usr/bin/time ] || { echo "bench_auto: needs GNU time (/usr/bin/time)" >&2; exit 1; }
+W=$(mktemp -d)
+trap 'rm -rf "$W"' EXIT INT TERM
+
+"$J" generate torus -o "$W/in.ply" --n "$N" --noise 0.003 --density gradient --seed 27 >/dev/null
+echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); $N points, $R rounds, 1 thread"
+
+one() { # one NB -> "cpu_seconds peak_kb"
+    /usr/bin/time -f "%U %S %M" -o "$W/t" "$J" estimate "$W/in.ply" -o "$W/out.ply" \
+        --neighbors "$1" --threads 1 --quiet
+    awk '{ printf "%.3f %d\n", $1 + $2, $3 }' "$W/t"
+}
+
+: >"$W/runs"
+i=0
+while [ "$i" -lt "$R" ]; do
+    for nb in knn:32 auto; do echo "$nb $(one $nb)" >>"$W/runs"; done
+    i=$((i + 1))
+done
+awk -v n="$N" '
+{ if (!($1 in t) || $2 < t[$1]) t[$1] = $2; if ($3 > m[$1]) m[$1] = $3 }
+END {
+    printf "| setting | CPU s (least of rounds) | points/s | peak RSS (MB) |\n|---|---|---|---|\n"
+    split("knn:32 auto", s, " ")
+    for (i = 1; i <= 2; i++)
+        printf "| %s | %.3f | %.0f | %.1f |\n", s[i], t[s[i]], n / t[s[i]], m[s[i]] / 1024
+    printf "auto / knn:32: time %.2fx, memory %.2fx\n", t["auto"] / t["knn:32"], m["auto"] / m["knn:32"]
+}' "$W/runs"
