@@ -40,7 +40,7 @@
 #define KD_BUF_MAX 1024     /* 2k up to this: buffer and quickselect      */
 #define KD_PROBE_MIN 8      /* k >= 8 x this: a k/8 probe bounds the search */
 #ifndef KD_PROBE_GROW
-#define KD_PROBE_GROW 1.5   /* squared-radius margin of the probe's bound  */
+#define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
 #endif
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
 
