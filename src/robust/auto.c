@@ -225,6 +225,52 @@ static jf_status final_fit(const jf_params *pr, int d, const double p[3], const 
     return JF_OK;
 }
 
+/* Power sums in SIMD lanes (two neighbours a step). */
+typedef long long v2l __attribute__((vector_size(16)));
+typedef struct {
+    v2d S[NPOW], T[NMON], zz, m, rmax2, rsum;
+} acc2;
+
+/* Adds neighbours q0, q1 (q1 NULL: none) to A: their frame coordinates x,
+ * y (units of H: scaled by iH), z; x^i y^j for i + j <= top, x^i y^j z for
+ * i + j <= deg, z^2, the count, the largest x^2 + y^2 and (rs) the sum of
+ * sqrt(x^2 + y^2).  A non-finite neighbour weighs 0. */
+static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const double p[3],
+                            const double fr[9], double iH, int top, int deg, int rs)
+{
+    const v2d zero = {0.0, 0.0}, one = {1.0, 1.0};
+    v2d v0 = {q0[0] - p[0], q1 ? q1[0] - p[0] : 0.0};
+    v2d v1 = {q0[1] - p[1], q1 ? q1[1] - p[1] : 0.0};
+    v2d v2 = {q0[2] - p[2], q1 ? q1[2] - p[2] : 0.0};
+    v2d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
+    v2d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
+    v2d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
+    /* finite: t - t == 0 (NaN for an infinity or a NaN) */
+    v2l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero);
+    if (!q1) ok[1] = 0;
+    x = (v2d)((v2l)x & ok);
+    y = (v2d)((v2l)y & ok);
+    z = (v2d)((v2l)z & ok);
+    v2d w = (v2d)((v2l)one & ok), xp[7], yp[7];
+    xp[0] = w;
+    yp[0] = one;
+    for (int e = 1; e <= top; e++) {
+        xp[e] = xp[e - 1] * x;
+        yp[e] = yp[e - 1] * y;
+    }
+    int at = 0; /* PIDX order: degree t, then j = 0..t */
+    for (int t = 0; t <= top; t++)
+        for (int j = 0; j <= t; j++) A->S[at++] += xp[t - j] * yp[j];
+    at = 0;
+    for (int t = 0; t <= deg; t++)
+        for (int j = 0; j <= t; j++) A->T[at++] += xp[t - j] * yp[j] * z;
+    A->zz += w * z * z;
+    A->m += w;
+    v2d r2 = x * x + y * y;
+    A->rmax2 = (v2d)(((v2l)r2 & (v2l)(r2 > A->rmax2)) | ((v2l)A->rmax2 & ~(v2l)(r2 > A->rmax2)));
+    if (rs) A->rsum += (v2d){sqrt(r2[0]), sqrt(r2[1])};
+}
+
 /* The power sums of the first k neighbours in the frame fr (as step 1's,
  * x, y in units of H; up to degree 2 deg), their count and mean planar
  * distance (length units). */
@@ -233,45 +279,15 @@ static void moments(const double p[3], const double *nbr, size_t k, const double
 {
     const double iH = 1.0 / H;
     const int top = 2 * deg, ntop = (top + 1) * (top + 2) / 2, nt = (deg + 1) * (deg + 2) / 2;
-    v2d SA[NPOW], TA[NMON], ZA = {0.0, 0.0}, RA = {0.0, 0.0}, MA = {0.0, 0.0};
-    memset(SA, 0, sizeof SA);
-    memset(TA, 0, sizeof TA);
-    for (size_t i = 0; i < k; i += 2) {
-        v2d x, y, z, w;
-        for (int l = 0; l < 2; l++) {
-            double xl = 0.0, yl = 0.0, zl = 0.0, wl = 0.0;
-            if (i + (size_t)l < k) {
-                const double *q = nbr + 3 * (i + (size_t)l);
-                double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
-                xl = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
-                yl = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
-                zl = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
-                wl = isfinite(xl) && isfinite(yl) && isfinite(zl);
-                if (!wl) xl = yl = zl = 0.0;
-            }
-            x[l] = xl;
-            y[l] = yl;
-            z[l] = zl;
-            w[l] = wl;
-        }
-        v2d xp[7], yp[7];
-        xp[0] = w;
-        yp[0] = (v2d){1.0, 1.0};
-        for (int e = 1; e <= top; e++) {
-            xp[e] = xp[e - 1] * x;
-            yp[e] = yp[e - 1] * y;
-        }
-        int at = 0;
-        for (int t = 0; t <= top; t++)
-            for (int j = 0; j <= t; j++) SA[at++] += xp[t - j] * yp[j];
-        at = 0;
-        for (int t = 0; t <= deg; t++)
-            for (int j = 0; j <= t; j++) TA[at++] += xp[t - j] * yp[j] * z;
-        ZA += w * z * z;
-        MA += w;
-        v2d r2 = x * x + y * y;
-        RA += (v2d){sqrt(r2[0]), sqrt(r2[1])};
-    }
+    acc2 A;
+    memset(&A, 0, sizeof A);
+    size_t i = 0;
+    if (deg == 2)
+        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, 4, 2, 1);
+    else
+        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, top, deg, 1);
+    if (i < k) acc_pair(&A, nbr + 3 * i, NULL, p, fr, iH, top, deg, 1);
+    v2d *SA = A.S, *TA = A.T, ZA = A.zz, MA = A.m, RA = A.rsum;
     for (int j = 0; j < ntop; j++) mo->S[j] = SA[j][0] + SA[j][1];
     for (int j = 0; j < nt; j++) mo->T[j] = TA[j][0] + TA[j][1];
     mo->zz = ZA[0] + ZA[1];
@@ -444,14 +460,18 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
      * jet's own frame (or the world axis nearest nf: params.frame) */
     jf__frame_axes(evec, pr->frame, fr);
 
-    /* H: a scale for the power sums (the farthest neighbour's distance,
-     * >= every planar distance), so that x / H, y / H <= 1 */
+    /* H: a scale for the power sums, the distance of the last finite
+     * neighbour (the farthest, nearest first), so that |x| / H, |y| / H
+     * <= 1 (only a scale: any order of the list stays exact) */
     double H2 = 0.0;
-    for (size_t i = 0; i < nmax; i++) {
+    for (size_t i = nmax; i-- > 0;) {
         const double *q = nbr + 3 * i;
         double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
         double r2 = v0 * v0 + v1 * v1 + v2 * v2;
-        if (r2 > H2 && isfinite(r2)) H2 = r2;
+        if (isfinite(r2)) {
+            H2 = r2;
+            break;
+        }
     }
     double H = sqrt(H2), iH = 1.0 / H;
     if (!(H > 0.0) || !isfinite(iH)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
@@ -462,69 +482,26 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     for (int c = 0; c < NCAND && cand[c] <= nmax; c++) ks[nc++] = cand[c];
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
 
-    /* the neighbours in the frame (x, y in units of H); a non-finite one
-     * weighs 0; prefix counts and largest planar r^2 */
-    double px[JF_NB_AUTO_KMAX + 1], py[JF_NB_AUTO_KMAX + 1], pz[JF_NB_AUTO_KMAX + 1],
-        pw[JF_NB_AUTO_KMAX + 1], r2p[JF_NB_AUTO_KMAX];
-    size_t cntp[JF_NB_AUTO_KMAX], m = 0;
-    double r2K = 0.0, rs = 0.0, rsum[JF_NB_AUTO_KMAX];
-    for (size_t i = 0; i < nmax; i++) {
-        const double *q = nbr + 3 * i;
-        double v0 = q[0] - p[0], v1 = q[1] - p[1], v2 = q[2] - p[2];
-        double x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
-        double y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
-        double z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
-        int ok = isfinite(x) && isfinite(y) && isfinite(z);
-        px[i] = ok ? x : 0.0;
-        py[i] = ok ? y : 0.0;
-        pz[i] = ok ? z : 0.0;
-        pw[i] = ok;
-        m += (size_t)ok;
-        double r2 = ok ? x * x + y * y : 0.0;
-        if (r2 > r2K) r2K = r2;
-        r2p[i] = r2K;
-        cntp[i] = m;
-        rs += sqrt(r2);
-        rsum[i] = rs;
-    }
-    px[nmax] = py[nmax] = pz[nmax] = pw[nmax] = 0.0; /* pads an odd count */
-
     /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
      * and x^i y^j z (i + j <= 3, with z'z), two neighbours at a time (SIMD
      * lanes; every candidate K but a short list's last is even) */
-    v2d SA[NPOW], TA[NMON], ZA = {0.0, 0.0};
-    memset(SA, 0, sizeof SA);
-    memset(TA, 0, sizeof TA);
+    acc2 A;
+    memset(&A, 0, sizeof A);
     cand_fit cf[2][NCAND];
     memset(cf, 0, sizeof cf);
     mom mo[NCAND];
     int c = 0;
     for (size_t i = 0; i < nmax && c < nc; i += 2) {
-        v2d x = {px[i], px[i + 1]}, y = {py[i], py[i + 1]}, z = {pz[i], pz[i + 1]};
-        v2d xp[7], yp[7];
-        xp[0] = (v2d){pw[i], pw[i + 1]};
-        yp[0] = (v2d){1.0, 1.0};
-        for (int e = 1; e <= 6; e++) {
-            xp[e] = xp[e - 1] * x;
-            yp[e] = yp[e - 1] * y;
-        }
-        int at = 0; /* PIDX order: degree t, then j = 0..t */
-        for (int t = 0; t <= 6; t++)
-            for (int j = 0; j <= t; j++) SA[at++] += xp[t - j] * yp[j];
-        at = 0;
-        for (int t = 0; t <= 3; t++)
-            for (int j = 0; j <= t; j++) TA[at++] += xp[t - j] * yp[j] * z;
-        ZA += xp[0] * z * z;
+        acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 6, 3, 0);
         if (i + 2 < ks[c]) continue;
-        size_t K = ks[c];
         mom *mc = &mo[c];
         double *S = mc->S, *T = mc->T;
-        mc->zz = ZA[0] + ZA[1];
-        for (int j = 0; j < NPOW; j++) S[j] = SA[j][0] + SA[j][1];
-        for (int j = 0; j < NMON; j++) T[j] = TA[j][0] + TA[j][1];
-        mc->m = cntp[K - 1];
-        mc->hmean = mc->m ? rsum[K - 1] / (double)mc->m * H : 0.0;
-        double hK = sqrt(r2p[K - 1]) * H;
+        mc->zz = A.zz[0] + A.zz[1];
+        for (int j = 0; j < NPOW; j++) S[j] = A.S[j][0] + A.S[j][1];
+        for (int j = 0; j < NMON; j++) T[j] = A.T[j][0] + A.T[j][1];
+        mc->m = (size_t)(A.m[0] + A.m[1]);
+        mc->hmean = 0.0; /* unused: the reported jet has its own sums */
+        double hK = sqrt(A.rmax2[0] > A.rmax2[1] ? A.rmax2[0] : A.rmax2[1]) * H;
         if (hK > 0.0) {
             cand_fit two[2] = {{0}, {0}};
             solve_k(S, T, mc->zz, mc->m, H, hK, fr, two);
