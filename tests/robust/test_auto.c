@@ -125,6 +125,63 @@ START_TEST(test_auto_threads)
 }
 END_TEST
 
+/* The reported jet is fitted from power sums (auto.c, direct_fit), not by
+ * jf_fit_point: it must be the least-squares jet of its degree on its K
+ * nearest, as jf_fit_point computes it on the same points (same frame,
+ * the PCA of the K points; same preconditioning h, so the same cond) --
+ * up to rounding, on every point. */
+START_TEST(test_auto_is_the_jet)
+{
+    surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
+    jf_result *ra = run(&c, "auto", 2);
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
+    jf_fitter *fit[4] = {NULL, NULL, NULL, NULL};
+    for (int d = 1; d <= 3; d++) {
+        jf_params p;
+        jf_params_init(&p);
+        p.degree = d;
+        p.max_neighbors = JF_NB_AUTO_KMAX;
+        ck_assert_int_eq(jf_fitter_create(&p, &fit[d]), JF_OK);
+    }
+    uint32_t idx[JF_NB_AUTO_KMAX];
+    double nb[3 * JF_NB_AUTO_KMAX];
+    size_t nd[4] = {0};
+    for (size_t i = 0; i < c.s.n; i++) {
+        const jf_result *a = &ra[i];
+        ck_assert(a->degree >= 1 && a->degree <= 3);
+        size_t k = (size_t)a->n_used, got;
+        ck_assert_int_eq(jf_index_knn(ix, c.s.xyz + 3 * i, k, idx, NULL, &got), JF_OK);
+        ck_assert_uint_eq(got, k);
+        for (size_t j = 0; j < k; j++)
+            memcpy(nb + 3 * j, c.s.xyz + 3 * (size_t)idx[j], 3 * sizeof(double));
+        jf_result r;
+        ck_assert_int_eq(jf_fit_point(fit[a->degree], c.s.xyz + 3 * i, nb, k, &r), JF_OK);
+        ck_assert_int_eq(r.degree, a->degree);
+        double dot = r.normal[0] * a->normal[0] + r.normal[1] * a->normal[1] +
+                     r.normal[2] * a->normal[2];
+        ck_assert_msg(dot > 1.0 - 1e-12, "point %zu: normals differ (dot %.17g)", i, dot);
+        double ks = fabs(r.k1) + fabs(r.k2) + 1e-300;
+        ck_assert_msg(fabs(r.k1 - a->k1) <= 1e-7 * ks && fabs(r.k2 - a->k2) <= 1e-7 * ks,
+                      "point %zu: k1 %.17g / %.17g, k2 %.17g / %.17g", i, a->k1, r.k1, a->k2,
+                      r.k2);
+        ck_assert_msg(fabs(r.cond - a->cond) <= 1e-7 * r.cond, "point %zu: cond %.17g / %.17g",
+                      i, a->cond, r.cond);
+        ck_assert_msg(fabs(r.residual - a->residual) <= 1e-6 * r.residual,
+                      "point %zu: residual %.17g / %.17g", i, a->residual, r.residual);
+        for (int e = 0; e < 3; e++)
+            ck_assert(fabs(r.pca_eval[e] - a->pca_eval[e]) <= 1e-9 * r.pca_eval[0]);
+        nd[a->degree]++;
+    }
+    ck_assert_uint_gt(nd[2], 0); /* both degrees met */
+    ck_assert_uint_gt(nd[3], 0);
+    for (int d = 1; d <= 3; d++) jf_fitter_free(fit[d]);
+    jf_index_free(ix);
+    free(ra);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
 typedef struct {
     jf_result *r;
     size_t n, got;
@@ -202,6 +259,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_ellipsoid);
     tcase_add_test(tc, test_auto_torus_gradient);
     tcase_add_test(tc, test_auto_threads);
+    tcase_add_test(tc, test_auto_is_the_jet);
     tcase_add_test(tc, test_auto_parts);
     suite_add_tcase(s, tc);
     return s;
