@@ -447,6 +447,11 @@ static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt,
     }
     uint32_t start[KD_BUF_MAX + 1];
     const double scale = (double)cnt / mx;
+    if (!isfinite(scale)) { /* mx subnormal: the buckets would overflow */
+        if (cnt > k) buf_select(id, hd, hp, 0, cnt, k - 1);
+        buf_sort(id, hd, hp, 0, cnt < k ? cnt : k);
+        return;
+    }
     memset(start, 0, (cnt + 1) * sizeof *start);
     for (size_t i = 0; i < cnt; i++) {
         size_t b = (size_t)(hd[i] * scale);
