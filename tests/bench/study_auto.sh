@@ -41,13 +41,31 @@ if [ -n "$P" ]; then
     "$B/tests/bench_pcpnet" "$P" --no-fixed --auto --sweep "" --cgal-ks 18,32,64,128,256 \
         --cgal-jet2 >"$W/pcpnet.txt"
     awk '
+    /^# auto chose/ { # K/degree:points pairs of the next auto row
+        n = small = big = cub = 0
+        for (i = 5; i <= NF; i++) {
+            if (split($i, a, "[/:;]") < 3) continue
+            c = a[3] + 0; n += c
+            if (a[1] <= 64) small += c
+            if (a[1] == 256) big += c
+            if (a[2] == 3) cub += c
+        }
+        ch = sprintf("K<=64 %.0f%%, K=256 %.0f%%, cubic %.0f%%", 100 * small / n, 100 * big / n, 100 * cub / n)
+        next }
     /^#/ { next }
-    $2 == "jetfit" && $3 == "auto" { auto[$1] = $6; t[$1] = $7; lv[++nl] = $1 }
-    $2 == "CGAL" { k = $4; r = $6; if (!($1 in best) || r < best[$1]) { best[$1] = r; bk[$1] = k } }
+    $2 == "jetfit" && $3 == "auto" { auto[$1] = $6; chose[$1] = ch; lv[++nl] = $1 }
+    $2 == "CGAL" { k = $4; r = $6; cg[$1, k] = r; if (!(k in seen)) { seen[k] = 1; ks[++nk] = k }
+                   if (!($1 in best) || r < best[$1]) { best[$1] = r; bk[$1] = k } }
     END {
-        printf "| noise (x diag) | auto | CGAL best k | CGAL best | auto / best |\n|---|---|---|---|---|\n"
+        printf "| noise (x diag) | auto | auto chose (share of the 5000 points) |"
+        for (j = 1; j <= nk; j++) printf " CGAL k=%s |", ks[j]
+        printf " CGAL best (k) | auto / best |\n|---|---|---|"
+        for (j = 1; j <= nk; j++) printf "---|"
+        printf "---|---|\n"
         for (i = 1; i <= nl; i++) { l = lv[i]
-            printf "| %s | %.3f | %d | %.3f | %.3f |\n", l, auto[l], bk[l], best[l], auto[l] / best[l] }
+            printf "| %s | %.3f | %s |", l, auto[l], chose[l]
+            for (j = 1; j <= nk; j++) printf " %.3f |", cg[l, ks[j]]
+            printf " %.3f (%d) | %.3f |\n", best[l], bk[l], auto[l] / best[l] }
     }' "$W/pcpnet.txt"
     grep "auto chose" "$W/pcpnet.txt" | sed 's/^# /  /'
 fi
