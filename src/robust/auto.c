@@ -4,12 +4,13 @@
  *
  * design:
  *  1. One frame per point: the PCA of its 32 nearest (§5.2).  In it every
- *     neighbour, nearest first, adds its monomials x^i y^j (i + j <= 3) to
- *     a Gram matrix G = M^T M and to M^T z, so that the least-squares jets
- *     of degree 2 and 3 at every candidate K (nested: the first K of the
- *     list) cost one small Cholesky solve each, not a fit (the normal
- *     equations of §2; each K's matrix is rescaled by its own radius, the
- *     preconditioning of §2.3, before the solve).
+ *     neighbour, nearest first, adds its power sums x^i y^j (i + j <= 6)
+ *     and x^i y^j z (i + j <= 3), two at a time (SIMD lanes): the Gram
+ *     matrix M^T M of the cubic on the first K points is read from their
+ *     sums, so every candidate K (nested: the first K of the list) costs
+ *     one small Cholesky solve, not a fit (the normal equations of §2,
+ *     rescaled by K's own radius as in §2.3), and serves both degrees
+ *     (the quadric's M^T M is the cubic's leading block).
  *  2. Noise: the unbiased residual variance of the cubic at K = 32 (22
  *     degrees of freedom), where truncation error (O(h^4), Theorem 3) is
  *     least and the noise is still well sampled; the next larger K where
@@ -28,8 +29,10 @@
  *     of their radius): the cubic's choice, unless the quadric at the largest K of
  *     its chain where it agrees with the cubic at the same K (within tau
  *     sd of the cubic) has the smaller sd.
- *  5. The reported fit is the ordinary jet (jf_fit_point) of the chosen
- *     degree on the chosen K points: the same numbers as knn:K --degree d,
+ *  5. The reported fit: the least-squares jet of the chosen degree on the
+ *     chosen K points in their own PCA frame (the jet's, §5.2), from a
+ *     second pass of power sums (direct_fit) -- the numbers of knn:K
+ *     --degree d up to rounding (test_auto), without a second fit;
  *     flagged JF_PT_AUTO.
  */
 #include <math.h>
