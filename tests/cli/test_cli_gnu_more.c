@@ -1,9 +1,11 @@
-/* test_cli_study_gnu.c -- `jetfit study` takes the command-line habits of
- * the other commands (issue 31): '-' as INPUT (standard input, with
- * --input-format), and inside --flags sets the GNU spellings estimate
- * takes (--opt=VALUE, unique prefixes), ambiguous and unknown ones refused
- * with one line.  Each spelling is checked against the plain one: the
- * same study.csv (every measured column) and the same study.def. */
+/* test_cli_gnu_more.c -- `jetfit study` and `jetfit view` take the
+ * command-line habits of the other commands (issue 31; test_cli_gnu.c
+ * covers estimate, generate, render, eval, convergence): study's '-' as
+ * INPUT (standard input, with --input-format), inside --flags sets the
+ * GNU spellings estimate takes (--opt=VALUE, unique prefixes), ambiguous
+ * and unknown ones refused with one line; view's -oFILE, --opt=V,
+ * prefixes, '--'.  Each spelling is checked against the plain one: the
+ * same study.csv (every measured column) and study.def, the same page. */
 #include <check.h>
 
 #include "jf_test.h"
@@ -229,13 +231,69 @@ START_TEST(flag_sets_take_gnu_spellings)
 }
 END_TEST
 
+/* 1 if the two files hold the same bytes (and at least one byte). */
+static int same_bytes(const char *a, const char *b)
+{
+    char *x = slurp(a), *y = slurp(b);
+    int same = x && y && *x && !strcmp(x, y);
+    free(x), free(y);
+    return same;
+}
+
+START_TEST(view_takes_gnu_spellings)
+{
+    cli_setup();
+    char cloud[512], res[512], a[512], b[512], c[512];
+    snprintf(cloud, sizeof cloud, "%s/s.xyz", cli_dir);
+    snprintf(res, sizeof res, "%s/r.ply", cli_dir);
+    snprintf(a, sizeof a, "%s/a.html", cli_dir);
+    snprintf(b, sizeof b, "%s/b.html", cli_dir);
+    snprintf(c, sizeof c, "%s/c.html", cli_dir);
+    ck_assert_int_eq(cli_run("generate", "sphere", "--n", "1500", "-o", cloud, NULL), 0);
+    ck_assert_int_eq(cli_run("estimate", cloud, "-o", res, "-q", NULL), 0);
+    ck_assert_int_eq(cli_run("view", res, "-o", a, "--quiet", "--color", "k2", "--max-points",
+                             "700", "--title", "T", NULL), 0);
+    char ob[600];
+    snprintf(ob, sizeof ob, "-qo%s", b);
+    ck_assert_int_eq(cli_run("view", "--colo=k2", ob, "--max-p=700", "--tit", "T", "--", res,
+                             NULL), 0);
+    ck_assert_str_eq(cli_err, "");
+    ck_assert(same_bytes(a, b));
+    /* another colour: another page (the comparison can fail) */
+    ck_assert_int_eq(cli_run("view", res, "-o", c, "-q", "--color", "k1", "--max-points", "700",
+                             "--title", "T", NULL), 0);
+    ck_assert(!same_bytes(a, c));
+    /* with --estimate, estimate's options in the same spellings */
+    unlink(c);
+    ck_assert_int_eq(cli_run("view", "--est", cloud, "-q", "--neighb=knn:16", "--degree=3",
+                             "--keep", "none", "-o", c, NULL), 0);
+    ck_assert(cli_exists(c));
+    struct {
+        const char *o1, *o2, *says;
+    } cases[] = {
+        {"--col", "k2", "'--col' is ambiguous; possibilities: '--color' '--columns'"},
+        {"--degree", "3", "--degree is an estimate option: it applies with --estimate"},
+        {"--bogus", NULL, "unknown option '--bogus'"},
+        {"--all-columns=1", NULL, "takes no value"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        unlink(c);
+        ck_assert_int_eq(cli_run("view", res, "-o", c, cases[k].o1, cases[k].o2, NULL), 2);
+        ck_assert_msg(strstr(cli_err, cases[k].says), "%s: %s", cases[k].o1, cli_err);
+        ck_assert(!cli_exists(c));
+    }
+    cli_teardown();
+}
+END_TEST
+
 int main(void)
 {
-    Suite *s = suite_create("cli_study_gnu");
-    TCase *t = tcase_create("study_gnu");
+    Suite *s = suite_create("cli_gnu_more");
+    TCase *t = tcase_create("gnu_more");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, standard_input_is_the_file);
     tcase_add_test(t, flag_sets_take_gnu_spellings);
+    tcase_add_test(t, view_takes_gnu_spellings);
     suite_add_tcase(s, t);
     return jf_test_run(s);
 }
