@@ -173,6 +173,7 @@ done:
 typedef struct {
     const double *xyz, *nrm, *k1, *k2, *d1, *d2, *b, *c, *cond, *res;
     const int32_t *deg, *nb, *st;
+    const double *sigma; /* NULL: no sigma column */
 } cols_src;
 
 static const void *data_of(PyObject *r, const char *name)
@@ -202,6 +203,7 @@ static size_t make_row(const cols_src *s, size_t i, int monge, double *v)
     v[n++] = s->nb[i];
     v[n++] = s->cond[i];
     v[n++] = s->res[i];
+    if (s->sigma) v[n++] = s->sigma[i]; /* jf_result_columns' order */
     v[n++] = (double)(uint32_t)s->st[i];
     return n;
 }
@@ -262,7 +264,8 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
                   data_of(result, "k2"), data_of(result, "d1"), data_of(result, "d2"),
                   data_of(result, "b"), data_of(result, "c"), data_of(result, "cond"),
                   data_of(result, "residual"), data_of(result, "degree"),
-                  data_of(result, "neighbors"), data_of(result, "status")};
+                  data_of(result, "neighbors"), data_of(result, "status"),
+                  jf_py_result_sigma(result) ? data_of(result, "sigma") : NULL};
     if (PyErr_Occurred()) goto out;
     jf_column cols[JF_RESULT_MAX_COLS];
     size_t ncols = jf_py_result_columns(result, cols);

@@ -77,8 +77,9 @@ int jf_py_opts_finish(jf_py_opts *po);
 /* result.c */
 extern PyTypeObject jf_py_ResultType;
 /* A Result of n rows for Monge degree `monge` with its arrays allocated
- * (b, c None below 3, 4); keeps points and faces (may be NULL). */
-PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *faces);
+ * (b, c None below 3, 4); sigma: the output table has the sigma column
+ * (neighbors="auto"); keeps points and faces (may be NULL). */
+PyObject *jf_py_result_new(size_t n, int monge, int sigma, PyObject *points, PyObject *faces);
 /* Copies res[0..n-1] into the Result's arrays on `threads` OpenMP threads
  * (<= 0: all cores); no Python calls. */
 void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads);
@@ -89,6 +90,9 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 /* The output file's columns and rows, as the command writes them. */
 size_t jf_py_result_columns(PyObject *result, jf_column *cols);
 int jf_py_result_monge(PyObject *result);
+int jf_py_result_sigma(PyObject *result);
+/* Rows whose status has a flag of mask. */
+size_t jf_py_result_count(PyObject *result, unsigned mask);
 
 /* estimate.c, files.c, fitjet.c: module functions */
 PyObject *jf_py_estimate(PyObject *self, PyObject *args, PyObject *kw);
