@@ -43,3 +43,18 @@ if(JF_PY3)
            ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR})
   set_tests_properties(check_commands PROPERTIES LABELS docs TIMEOUT 1800)
 endif()
+# Every command's options come from its option table (issue 31): --help,
+# the man page and docs/cli.md name each of them and nothing else, and
+# state the same defaults; _planted plants three discrepancies and passes
+# only if exactly they are reported (the check can fail).
+if(JF_PY3)
+  set(JF_OPT_MPI "")
+  if(TARGET jetfit-mpi)
+    set(JF_OPT_MPI $<TARGET_FILE:jetfit-mpi>)
+  endif()
+  add_test(NAME check_options COMMAND ${JF_PY3} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_options.py
+           ${PROJECT_SOURCE_DIR} $<TARGET_FILE:jetfit> ${JF_OPT_MPI})
+  add_test(NAME check_options_planted COMMAND ${JF_PY3} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_options.py
+           ${PROJECT_SOURCE_DIR} $<TARGET_FILE:jetfit> ${JF_OPT_MPI} --plant)
+  set_tests_properties(check_options check_options_planted PROPERTIES LABELS docs)
+endif()

@@ -41,6 +41,7 @@ static void usage(FILE *out)
         "  --estimate      INPUT is a raw cloud: run `jetfit estimate` on it first;\n"
         "                  other options go to the estimate (jetfit estimate --help)\n"
         "  -q, --quiet     no summary line\n"
+        "  -h, --help      this text\n"
         "  --memory SIZE, --keep all|none, --input-format FMT: as estimate's, with\n"
         "                  --estimate (INPUT '-': standard input)\n");
 }

@@ -58,9 +58,11 @@ static void usage(FILE *f)
         "  --resume              keep the finished cells of DIR/study.csv, run the rest\n"
         "                        (refused when DIR/study.def: input, truth, options, differ)\n"
         "  -q, --quiet           no progress line, no summary\n"
+        "  -h, --help            this text\n"
         "  any other estimate option (e.g. --orient, --columns, --robust) applies\n"
         "  to every cell, before the cell's flag set.  Every option, in a --flags\n"
-        "  set too, may be written --opt=VALUE or as a unique prefix (--robust-n).\n"
+        "  set too, may be written NAME=VALUE (--robust=huber) or as a unique\n"
+        "  prefix (--robust-norm).\n"
         "\n"
         "Errors: normal angle in degrees; k1, k2: |k - k_t| / max(|k_t|, 1), eval's\n"
         "k1_rel/k2_rel.  A cell that fails is recorded as failed; the rest go on.\n",
