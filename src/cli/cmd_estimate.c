@@ -48,7 +48,7 @@ static void usage(FILE *f)
         "  --frame MODE          pca | axis (default pca)\n"
         "  --max-cond X          lower the degree while cond > X (default %g)\n"
         "  --orient MODE         none | input | viewpoint:X,Y,Z | scanner | mst[:K]\n"
-        "                        (default: scanner for a PTX INPUT (its scanner\n"
+        "                        (default: scanner for a PTX or E57 INPUT (its scanner\n"
         "                        positions), else input if INPUT has normals,\n"
         "                        else none;\n"
         "                        mst uses K nearest neighbours, default 8)\n"
