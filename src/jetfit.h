@@ -1188,8 +1188,36 @@ typedef struct {
     void *cancel_user;
 } jf_estimate_opts;
 
-/* Fills defaults.  Never fails. */
+/* Fills defaults (params.monge_degree 0: from the degree, see
+ * jf_monge_degree_of).  Never fails. */
 void jf_estimate_opts_init(jf_estimate_opts *o);
+
+/* The options as text, by parameter name (src/estimate/options.c): the
+ * one parser the command, jetfit-mpi, jetfit study and the Python module
+ * share, so a value means the same in each.  Names: neighbors (as
+ * jf_nb_parse), degree (1..9), monge_degree (2..4), fit (approx|interp),
+ * frame (pca|axis), max_cond (>= 1), orient (none|input|scanner|mst[:K]|
+ * viewpoint:X,Y,Z), normal (auto|poles|mincirc|pca|jet|input), robust
+ * (none|huber|tukey), scales (K1,K2,... ascending, >= 3, at most 8),
+ * degree_select (1..9), dist_weight (> 0), threads (1..4096), and
+ * robust_normals (a preset: degree_select 1, dist_weight 0.55; value
+ * ignored).  JF_OK, or JF_ERR_INVALID with *why (static English, naming
+ * parameters, never flags) and o's field unchanged.  Thread-safe. */
+jf_status jf_estimate_opts_set(jf_estimate_opts *o, const char *name, const char *value,
+                               const char **why);
+/* After the last set: the Monge degree from the degree where it is 0
+ * (jf_monge_degree_of; a larger one given is refused), params.max_neighbors
+ * raised to the largest neighbourhood (K, N, the scales, auto's 256), and
+ * every rule of the parameters checked (jf_params_validate).  JF_OK, or
+ * JF_ERR_INVALID with *param (the parameter at fault) and *why. */
+jf_status jf_estimate_opts_finish(jf_estimate_opts *o, const char **param, const char **why);
+/* The Monge degree an estimate of this jet degree uses by default:
+ * min(max(degree, 2), 4) (degree 1 has no curvature: its columns are NaN). */
+int jf_monge_degree_of(int degree);
+/* The reading options as text: columns ("x,y,z" or six 0-based column
+ * numbers) and bad_rows (error|skip).  As jf_estimate_opts_set. */
+jf_status jf_read_opts_set(jf_read_opts *o, const char *name, const char *value,
+                           const char **why);
 
 /* Fits every point of c (out has c->n entries, caller-owned; out[i]
  * belongs to point i): builds what the neighbourhood needs (k-d tree,
