@@ -310,14 +310,15 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *    truncation error on clean data, costs variance under noise.  The
  *    command's --robust-normals is degree_select 1 with dist_weight 0.55
  *    (docs/robustness.md: below CGAL's jet in every PCPNet cell on the same points).
- * The degree-selection fitters of lower degrees are created once per thread
- * (on first use; recreated only when the parameters change) and freed at
- * thread exit.  Defaults (off) and constants: docs/robustness.md, bench_pcpnet.
- * With none set it is exactly jf_fit_point.  Returns what jf_fit_point
- * returns, or JF_ERR_NOMEM (n > 512 with robust or dist_weight: a
- * per-thread buffer is allocated once, grown when a larger n is first
- * seen, freed at thread exit; or a lower-degree fitter could not be
- * created).  Not thread-safe on one fitter, as jf_fit_point. */
+ * The degree-selection fitters of lower degrees are kept in f (made on
+ * first use; remade only when the parameters change) and freed with it:
+ * the library keeps no state outside the caller's fitter.  Defaults (off)
+ * and constants: docs/robustness.md, bench_pcpnet.  With none set it is
+ * exactly jf_fit_point.  Returns what jf_fit_point returns, or
+ * JF_ERR_NOMEM (n > 512 with robust or dist_weight: a buffer in f is
+ * allocated once, grown when a larger n is first seen; or a lower-degree
+ * fitter could not be created).  Not thread-safe on one fitter, as
+ * jf_fit_point. */
 jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
                             const double *nbr, size_t n, jf_result *out);
 
