@@ -25,10 +25,8 @@ if(Python3_EXECUTABLE)
 endif()
 # Every default quoted in the documents is the code's (issue 31):
 # print_defaults prints them from the code, check_defaults.py compares.
-add_executable(print_defaults ${CMAKE_CURRENT_SOURCE_DIR}/docs/print_defaults.c
-               ${PROJECT_SOURCE_DIR}/src/cli/opts.c ${PROJECT_SOURCE_DIR}/src/cli/args.c)
-target_include_directories(print_defaults PRIVATE ${PROJECT_SOURCE_DIR}/src/cli ${JF_INTERNAL_INCLUDES})
-target_link_libraries(print_defaults PRIVATE jetfit_lib)
+add_executable(print_defaults ${CMAKE_CURRENT_SOURCE_DIR}/docs/print_defaults.c)
+target_link_libraries(print_defaults PRIVATE jetfit_cmdline jetfit_lib)
 set_target_properties(print_defaults PROPERTIES LINKER_LANGUAGE CXX)
 if(JF_PY3)
   add_test(NAME check_defaults COMMAND ${JF_DOC_PY} ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_defaults.py

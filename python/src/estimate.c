@@ -84,7 +84,7 @@ static int nothing_fitted(const jf_cloud *c, PyObject *result)
 /* Runs the estimate on cloud c with options o into a new Result. */
 static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *faces)
 {
-    jf_estimate_opts *o = &po->e.o;
+    jf_estimate_opts *o = &po->o;
     if (o->orient == JF_ORIENT_SCANNER && !c->scanner) {
         PyErr_SetString(PyExc_ValueError,
                         "orient='scanner' needs scanners=: the (N, 3) position of the scanner "
@@ -99,7 +99,8 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
                      o->orient == JF_ORIENT_INPUT ? "orient" : "normal");
         return NULL;
     }
-    PyObject *result = jf_py_result_new(c->n, po->e.monge, o->nb.kind == JF_NB_AUTO, points, faces);
+    PyObject *result = jf_py_result_new(c->n, po->o.params.monge_degree, o->nb.kind == JF_NB_AUTO,
+                                        points, faces);
     if (!result) return NULL;
     /* mst orients after every normal is known: jf_estimate_blocks would
      * fit twice, so that one keeps the n results and copies them */
@@ -242,7 +243,7 @@ PyObject *jf_py_estimate_mesh(PyObject *self, PyObject *args, PyObject *kw)
             return PyErr_Format(PyExc_TypeError, "rings: expected an int, got %s",
                                 Py_TYPE(rings)->tp_name);
         if (!spec) return NULL;
-        int bad = jf_py_opt(&po, "--neighbors", "rings", spec, JF_PY_STR);
+        int bad = jf_py_opt(&po, "neighbors", "rings", spec, JF_PY_STR);
         Py_DECREF(spec);
         if (bad) return NULL;
     } else if (rings && rings != Py_None) {

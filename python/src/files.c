@@ -107,10 +107,9 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
         return NULL;
     const char *path = PyBytes_AS_STRING(pathobj);
     jf_py_opts po;
-    jf_cli_est_init(&po.e);
-    po.used = 0;
-    if (jf_py_opt(&po, "--columns", "columns", columns, JF_PY_LIST) ||
-        jf_py_opt(&po, "--bad-rows", "bad_rows", bad_rows, JF_PY_STR)) {
+    jf_py_opts_init(&po);
+    if (jf_py_opt(&po, "columns", "columns", columns, JF_PY_LIST) ||
+        jf_py_opt(&po, "bad_rows", "bad_rows", bad_rows, JF_PY_STR)) {
         Py_DECREF(pathobj);
         return NULL;
     }
@@ -118,7 +117,7 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
     jf_error err = {{0}};
     jf_status st;
     Py_BEGIN_ALLOW_THREADS
-    st = jf_cloud_read(path, &po.e.ro, &c, &err);
+    st = jf_cloud_read(path, &po.ro, &c, &err);
     Py_END_ALLOW_THREADS
     if (st != JF_OK) {
         file_error(st, &err, path);
@@ -222,10 +221,9 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
     PyArrayObject *pa = NULL;
     jf_cloud fc = {0};
     jf_py_opts po;
-    jf_cli_est_init(&po.e);
-    po.used = 0;
-    if (jf_py_opt(&po, "--threads", "threads", threads, JF_PY_INT)) goto out;
-    int nthreads = po.e.o.threads;
+    jf_py_opts_init(&po);
+    if (jf_py_opt(&po, "threads", "threads", threads, JF_PY_INT)) goto out;
+    int nthreads = po.o.threads;
     if (!points || points == Py_None) points = PyObject_GetAttrString(result, "points");
     else Py_INCREF(points);
     if (!points) goto out;

@@ -289,7 +289,7 @@ int jf_cmd_estimate(int argc, char **argv)
     int quiet = cmd.quiet, ascii = cmd.ascii, keep = cmd.keep;
     unsigned long long memory = cmd.memory; /* --memory; 0: MemAvailable */
     jf_estimate_opts o = e.o;
-    int monge = e.monge;
+    int monge = e.o.params.monge_degree;
     jf_error err = {{0}};
 
     double t0 = now_s();

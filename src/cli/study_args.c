@@ -205,13 +205,13 @@ static int make_settings(jf_study_args *c)
             for (int f = 0; f < s->nflags; f++) {
                 jf_cli_est e = c->base;
                 jf_cli_bad bad;
-                e.nbspec = s->strategy[a];
                 e.o.params.degree = s->degree[d];
                 char set[1024];
                 snprintf(set, sizeof set, "%s", s->flags[f]);
                 int rc = apply_flags(&e, set, s->flags[f]);
                 if (rc) return rc;
-                if (jf_cli_est_finish(&e, &bad)) {
+                if (jf_cli_est_option(&e, "--neighbors", s->strategy[a], &bad) ||
+                    jf_cli_est_finish(&e, &bad)) {
                     char why[300];
                     snprintf(why, sizeof why, "%s '%s': %s (degree %d, flags '%s')", bad.opt,
                              bad.val, bad.why, s->degree[d], s->flags[f]);

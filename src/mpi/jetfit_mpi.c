@@ -1,7 +1,7 @@
 /* jetfit_mpi.c -- `mpirun -np N jetfit-mpi estimate INPUT -o OUTPUT [options]`:
  * the estimate of `jetfit estimate`, over MPI, byte for byte the same file.
  *
- * design: the options are parsed by the command's own code (src/cli/opts.c)
+ * design: the options are parsed by the command's own code (src/cmdline/opts.c)
  * and the rows made by it (jf_result_row); mpi_dist.c gives each rank its
  * part of the cloud and the part's exact halo; the fit is the pipeline's
  * (jf__estimate_masked: the halo points are neighbours, not fitted); each
@@ -375,7 +375,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         return refuse(m, "%s: invalid parameters", in);
 
     jf_column cols[JF_RESULT_MAX_COLS];
-    size_t ncols = jf_result_columns(cmd.e.monge, o.nb.kind == JF_NB_AUTO, cols);
+    size_t ncols = jf_result_columns(cmd.e.o.params.monge_degree, o.nb.kind == JF_NB_AUTO, cols);
     outputs w;
     memset(&w, 0, sizeof w);
     /* open the output first: a missing folder fails before the work */
@@ -421,7 +421,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     }
     double t2 = MPI_Wtime();
     if (!failed) {
-        write_rows(m, &w, out, &c, res, cols, ncols, cmd.e.monge, o.threads);
+        write_rows(m, &w, out, &c, res, cols, ncols, cmd.e.o.params.monge_degree, o.threads);
         failed = jf_mpi_check(m);
     }
     free(res);

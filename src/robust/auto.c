@@ -155,10 +155,10 @@ static int lepski(const cand_fit *c, int nc, double s2, double tau)
     return best;
 }
 
-static jf_status final_fit(const jf_params *pr, int d, const double p[3], const double *nbr,
+static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
                            size_t k, double sigma, jf_result *out)
 {
-    jf_fitter *g = jf__tl_fitter(pr, d);
+    jf_fitter *g = jf__ws_fitter(f, pr, d);
     if (!g) return JF_ERR_NOMEM;
     jf_status st = jf_fit_point(g, p, nbr, k, out);
     if (st != JF_OK) return st;
@@ -186,7 +186,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         for (int k = 0; k < 3; k++) mean[k] += q[k] - p[k];
         kf++;
     }
-    if (kf < 16) return final_fit(pr, 2, p, nbr, nmax, NAN, out); /* too few to choose */
+    if (kf < 16) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out); /* too few to choose */
     for (int k = 0; k < 3; k++) mean[k] /= (double)kf;
     size_t seen = 0;
     for (size_t i = 0; i < nmax && seen < kf; i++) {
@@ -215,7 +215,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         double r = hypot(x, y);
         if (isfinite(r) && r > H) H = r;
     }
-    if (!(H > 0.0)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
+    if (!(H > 0.0)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
 
     /* the candidates (the last one: the whole list when it is shorter) */
     size_t ks[NCAND];
@@ -265,7 +265,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             s2 = cf[1][i].s2;
             if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
-    if (!isfinite(s2)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
+    if (!isfinite(s2)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
     double sigma = sqrt(s2);
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small
@@ -303,8 +303,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                     bc = i;
                 }
             }
-        if (bc < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-        return final_fit(pr, bd ? 3 : 2, p, nbr, ks[bc], sigma, out);
+        if (bc < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
+        return final_fit(f, pr, bd ? 3 : 2, p, nbr, ks[bc], sigma, out);
     }
     /* step 3: Lepski per degree */
     double tau = jf__auto_tau;
@@ -328,6 +328,6 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             break;
         }
     }
-    if (ci < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-    return final_fit(pr, d, p, nbr, ks[ci], sigma, out);
+    if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
+    return final_fit(f, pr, d, p, nbr, ks[ci], sigma, out);
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """check_options.py -- every command's options come from one place (issue
 31): the option tables its command line is scanned with (the
-`jf_cli_optdef` rows of src/cli/*.c, args.h).  For each command of
+`jf_cli_optdef` rows of src/cli/*.c and src/cmdline/*.c, args.h).  For each command of
 src/cli/main.c and for jetfit-mpi:
   1. its `--help` names every option of its tables (an alias may be left
      out; estimate's options may be covered by a stated reference, such as
@@ -25,10 +25,10 @@ import subprocess
 import sys
 
 # Each command: the file whose `tables[] = {...}` lists its tables.
-SOURCES = {"estimate": "src/cli/opts.c", "generate": "src/cli/cmd_generate.c",
+SOURCES = {"estimate": "src/cmdline/opts.c", "generate": "src/cli/cmd_generate.c",
            "convergence": "src/cli/cmd_convergence.c", "render": "src/cli/cmd_render.c",
            "eval": "src/cli/cmd_eval.c", "study": "src/cli/study_args.c",
-           "view": "src/cli/cmd_view.c", "jetfit-mpi": "src/cli/opts.c"}
+           "view": "src/cli/cmd_view.c", "jetfit-mpi": "src/cmdline/opts.c"}
 # Documents that cover estimate's options by reference: (command, the
 # words that must be there).
 BY_REFERENCE = {"study": "estimate option", "view": "jetfit estimate --help",
@@ -45,8 +45,8 @@ def tables_of(src):
     """{command: {long name: (short or None, alias_of or None)}} and the
     estimate options' table (the one every estimating command shares)."""
     defs = {}  # (file, table name) -> rows
-    files = [os.path.join("src/cli", f) for f in os.listdir(os.path.join(src, "src/cli"))
-             if f.endswith(".c")]
+    files = [os.path.join(d, f) for d in ("src/cli", "src/cmdline")
+             for f in os.listdir(os.path.join(src, d)) if f.endswith(".c")]
     for f in files:
         text = open(os.path.join(src, f), encoding="utf-8").read()
         for m in re.finditer(r"jf_cli_optdef (\w+)\[\] = \{(.*?)\};", text, re.S):
@@ -55,7 +55,7 @@ def tables_of(src):
                 rows[r.group(1)] = (r.group(3)[1] if r.group(3) != "0" else None,
                                     None if r.group(4) == "NULL" else r.group(4).strip('"'))
             defs[(f, m.group(1))] = rows
-    est = defs[("src/cli/opts.c", "jf_cli_est_optdefs")]
+    est = defs[("src/cmdline/opts.c", "jf_cli_est_optdefs")]
     out = {}
     for cmd, f in SOURCES.items():
         text = open(os.path.join(src, f), encoding="utf-8").read()
