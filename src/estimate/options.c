@@ -68,7 +68,9 @@ static jf_status set_orient(jf_estimate_opts *o, const char *v, const char **why
 {
     int k;
     if (!strncmp(v, "viewpoint:", 10)) {
-        if (list_of(v + 10, o->viewpoint, 3) != 3) return no(why, "expected viewpoint:X,Y,Z");
+        double at[3];
+        if (list_of(v + 10, at, 3) != 3) return no(why, "expected viewpoint:X,Y,Z");
+        memcpy(o->viewpoint, at, sizeof at);
         o->orient = JF_ORIENT_VIEWPOINT;
     } else if (!strncmp(v, "mst:", 4)) {
         if (int_of(v + 4, 1, 256, &k)) return no(why, "expected mst:K with K in 1..256");
@@ -94,8 +96,8 @@ static jf_status set_scales(jf_params *p, const char *v, const char **why)
         if (list[j] < 3 || list[j] > 100000 || list[j] != floor(list[j]) ||
             (j && list[j] <= list[j - 1]))
             return no(why, "expected ascending integers >= 3");
-        p->scales[j] = (size_t)list[j];
     }
+    for (int j = 0; j < m; j++) p->scales[j] = (size_t)list[j];
     p->nscales = m;
     return JF_OK;
 }

@@ -40,6 +40,26 @@ static inline int jf_test_run_tool(Suite *s, const char *tool, int have, const c
     return jf_test_run(s);
 }
 
+/* The whole file at path, malloc'd and NUL-ended (*len, when len is not
+ * NULL: its size); NULL if it cannot be read. */
+static inline void *jf_test_slurp(const char *path, size_t *len)
+{
+    if (len) *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    char *b = n >= 0 && fseek(f, 0, SEEK_SET) == 0 ? (char *)malloc((size_t)n + 1) : NULL;
+    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
+        free(b);
+        b = NULL;
+    }
+    fclose(f);
+    if (!b) return NULL;
+    b[n] = '\0';
+    if (len) *len = (size_t)n;
+    return b;
+}
+
 /* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */
 static inline uint64_t jf_splitmix64(uint64_t *state)
 {
