@@ -172,6 +172,7 @@ int jf_cmd_view(int argc, char **argv)
     free(pass);
     char msg[4600];
     if (!o.title && estimate) o.title = strrchr(in, '/') ? strrchr(in, '/') + 1 : in;
+    if (estimate) o.name = in; /* the page names the cloud, not the temporary */
     rc = jf_view_write(estimate ? tmp : in, out, &o, quiet, msg, sizeof msg);
     if (estimate) unlink(tmp);
     if (rc) fprintf(stderr, "jetfit view: %s\n", msg);

@@ -218,6 +218,25 @@ START_TEST(subsample_estimate_and_size)
 }
 END_TEST
 
+/* view --estimate names the INPUT, not its temporary: two runs give the
+ * same page byte for byte. */
+START_TEST(estimate_page_names_the_input)
+{
+    ck_assert_int_eq(cli_run("generate", "sphere", "-o", cli_path("cloud.ply"), "--n", "500", NULL), 0);
+    for (int k = 0; k < 2; k++)
+        ck_assert_int_eq(cli_run("view", "--estimate", cli_path("cloud.ply"), "-o",
+                                 cli_path(k ? "b.html" : "a.html"), "--threads", "1", "--quiet", NULL), 0);
+    size_t na, nb;
+    char *a = jf_test_slurp(cli_path("a.html"), &na), *b = jf_test_slurp(cli_path("b.html"), &nb);
+    ck_assert(a && b);
+    ck_assert_ptr_nonnull(strstr(a, "{\"file\":\"cloud.ply\""));
+    ck_assert_ptr_null(strstr(a, "jetfit-view-"));
+    ck_assert(na == nb && !memcmp(a, b, na));
+    free(a);
+    free(b);
+}
+END_TEST
+
 START_TEST(study_report_links_the_best_result)
 {
     ck_assert_int_eq(cli_run("study", "sphere", "-o", cli_path("st"), "--n", "600", "--degree", "2,3",
@@ -269,6 +288,7 @@ int main(void)
     tcase_add_test(th, errors_name_the_file_and_write_nothing);
     tcase_add_test(th, subsample_estimate_and_size);
     tcase_add_test(th, study_report_links_the_best_result);
+    tcase_add_test(th, estimate_page_names_the_input);
     suite_add_tcase(s, th);
     return jf_test_run_tool(s, "three", have_three, "three.js not found (Debian: libjs-three)");
 }
