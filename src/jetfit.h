@@ -310,14 +310,15 @@ const jf_params *jf_fitter_params(const jf_fitter *f);
  *    truncation error on clean data, costs variance under noise.  The
  *    command's --robust-normals is degree_select 1 with dist_weight 0.55
  *    (docs/robustness.md: below CGAL's jet in every PCPNet cell on the same points).
- * The degree-selection fitters of lower degrees are created once per thread
- * (on first use; recreated only when the parameters change) and freed at
- * thread exit.  Defaults (off) and constants: docs/robustness.md, bench_pcpnet.
- * With none set it is exactly jf_fit_point.  Returns what jf_fit_point
- * returns, or JF_ERR_NOMEM (n > 512 with robust or dist_weight: a
- * per-thread buffer is allocated once, grown when a larger n is first
- * seen, freed at thread exit; or a lower-degree fitter could not be
- * created).  Not thread-safe on one fitter, as jf_fit_point. */
+ * The degree-selection fitters of lower degrees are kept in f (made on
+ * first use; remade only when the parameters change) and freed with it:
+ * the library keeps no state outside the caller's fitter.  Defaults (off)
+ * and constants: docs/robustness.md, bench_pcpnet.  With none set it is
+ * exactly jf_fit_point.  Returns what jf_fit_point returns, or
+ * JF_ERR_NOMEM (n > 512 with robust or dist_weight: a buffer in f is
+ * allocated once, grown when a larger n is first seen; or a lower-degree
+ * fitter could not be created).  Not thread-safe on one fitter, as
+ * jf_fit_point. */
 jf_status jf_fit_point_full(jf_fitter *f, const double p[3],
                             const double *nbr, size_t n, jf_result *out);
 
@@ -1188,8 +1189,36 @@ typedef struct {
     void *cancel_user;
 } jf_estimate_opts;
 
-/* Fills defaults.  Never fails. */
+/* Fills defaults (params.monge_degree 0: from the degree, see
+ * jf_monge_degree_of).  Never fails. */
 void jf_estimate_opts_init(jf_estimate_opts *o);
+
+/* The options as text, by parameter name (src/estimate/options.c): the
+ * one parser the command, jetfit-mpi, jetfit study and the Python module
+ * share, so a value means the same in each.  Names: neighbors (as
+ * jf_nb_parse), degree (1..9), monge_degree (2..4), fit (approx|interp),
+ * frame (pca|axis), max_cond (>= 1), orient (none|input|scanner|mst[:K]|
+ * viewpoint:X,Y,Z), normal (auto|poles|mincirc|pca|jet|input), robust
+ * (none|huber|tukey), scales (K1,K2,... ascending, >= 3, at most 8),
+ * degree_select (1..9), dist_weight (> 0), threads (1..4096), and
+ * robust_normals (a preset: degree_select 1, dist_weight 0.55; value
+ * ignored).  JF_OK, or JF_ERR_INVALID with *why (static English, naming
+ * parameters, never flags) and o's field unchanged.  Thread-safe. */
+jf_status jf_estimate_opts_set(jf_estimate_opts *o, const char *name, const char *value,
+                               const char **why);
+/* After the last set: the Monge degree from the degree where it is 0
+ * (jf_monge_degree_of; a larger one given is refused), params.max_neighbors
+ * raised to the largest neighbourhood (K, N, the scales, auto's 256), and
+ * every rule of the parameters checked (jf_params_validate).  JF_OK, or
+ * JF_ERR_INVALID with *param (the parameter at fault) and *why. */
+jf_status jf_estimate_opts_finish(jf_estimate_opts *o, const char **param, const char **why);
+/* The Monge degree an estimate of this jet degree uses by default:
+ * min(max(degree, 2), 4) (degree 1 has no curvature: its columns are NaN). */
+int jf_monge_degree_of(int degree);
+/* The reading options as text: columns ("x,y,z" or six 0-based column
+ * numbers) and bad_rows (error|skip).  As jf_estimate_opts_set. */
+jf_status jf_read_opts_set(jf_read_opts *o, const char *name, const char *value,
+                           const char **why);
 
 /* Fits every point of c (out has c->n entries, caller-owned; out[i]
  * belongs to point i): builds what the neighbourhood needs (k-d tree,

@@ -38,3 +38,5 @@ foreach(t test_cli_pictures test_cli_fulldisk)
     set_tests_properties(${t} PROPERTIES SKIP_RETURN_CODE 77)
   endif()
 endforeach()
+# the study report in Chromium: a test of its own, skipped (77) without it
+jf_tool_case(test_cli_study chromium)

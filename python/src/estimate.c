@@ -18,6 +18,8 @@
  * Memory: the library's own (k-d tree ~40 B/point; with mst 216 B/point
  * of jf_result) plus the Result's arrays (116-188 B/point); no copy of
  * the points when they are float64 C-contiguous. */
+#include <math.h>
+
 #include "jfpy.h"
 
 /* jf_cancel_fn: read on the estimate's threads; set by jf_py_off_thread
@@ -50,10 +52,39 @@ static void est_work(void *p)
     }
 }
 
+/* No point fitted: ValueError; most points unfitted: RuntimeWarning --
+ * the command's rule and words (cmd_estimate.c, issues 31, 33.12).
+ * -1 with the exception set (result released). */
+static int nothing_fitted(const jf_cloud *c, PyObject *result)
+{
+    size_t unfit = jf_py_result_count(result, JF_PT_FAILED | JF_PT_NONFINITE);
+    size_t nonfin = jf_py_result_count(result, JF_PT_NONFINITE);
+    if (c->n && unfit == c->n) {
+        double big = 0;
+        for (size_t i = 0; i < 3 * c->n; i++)
+            if (isfinite(c->xyz[i]) && fabs(c->xyz[i]) > big) big = fabs(c->xyz[i]);
+        PyErr_Format(PyExc_ValueError, "no point could be fitted (%zu non-finite, %zu failed)%s",
+                     nonfin, c->n - nonfin,
+                     big > 1e150 ? ": coordinates near 1e150 or beyond overflow the fit "
+                                   "(rescale the cloud)"
+                     : nonfin < c->n ? ": too few or collinear neighbours (K must be at least 3)"
+                                     : ": every point is NaN or infinite");
+        Py_DECREF(result);
+        return -1;
+    }
+    if (unfit > c->n / 2 &&
+        PyErr_WarnFormat(PyExc_RuntimeWarning, 1, "%zu of %zu points could not be fitted "
+                         "(status failed or nonfinite)", unfit, c->n) < 0) {
+        Py_DECREF(result); /* warnings made errors */
+        return -1;
+    }
+    return 0;
+}
+
 /* Runs the estimate on cloud c with options o into a new Result. */
 static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *faces)
 {
-    jf_estimate_opts *o = &po->e.o;
+    jf_estimate_opts *o = &po->o;
     if (o->orient == JF_ORIENT_SCANNER && !c->scanner) {
         PyErr_SetString(PyExc_ValueError,
                         "orient='scanner' needs scanners=: the (N, 3) position of the scanner "
@@ -68,7 +99,8 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
                      o->orient == JF_ORIENT_INPUT ? "orient" : "normal");
         return NULL;
     }
-    PyObject *result = jf_py_result_new(c->n, po->e.monge, points, faces);
+    PyObject *result = jf_py_result_new(c->n, po->o.params.monge_degree, o->nb.kind == JF_NB_AUTO,
+                                        points, faces);
     if (!result) return NULL;
     /* mst orients after every normal is known: jf_estimate_blocks would
      * fit twice, so that one keeps the n results and copies them */
@@ -89,7 +121,7 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
         Py_DECREF(result);
         return jf_py_status_error(st, j.err.msg);
     }
-    return result;
+    return nothing_fitted(c, result) ? NULL : result;
 }
 
 #define EST_KW "neighbors", "degree", "monge_degree", "fit", "frame", "max_cond", "orient", \
@@ -211,7 +243,7 @@ PyObject *jf_py_estimate_mesh(PyObject *self, PyObject *args, PyObject *kw)
             return PyErr_Format(PyExc_TypeError, "rings: expected an int, got %s",
                                 Py_TYPE(rings)->tp_name);
         if (!spec) return NULL;
-        int bad = jf_py_opt(&po, "--neighbors", "rings", spec, JF_PY_STR);
+        int bad = jf_py_opt(&po, "neighbors", "rings", spec, JF_PY_STR);
         Py_DECREF(spec);
         if (bad) return NULL;
     } else if (rings && rings != Py_None) {

@@ -107,10 +107,9 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
         return NULL;
     const char *path = PyBytes_AS_STRING(pathobj);
     jf_py_opts po;
-    jf_cli_est_init(&po.e);
-    po.used = 0;
-    if (jf_py_opt(&po, "--columns", "columns", columns, JF_PY_LIST) ||
-        jf_py_opt(&po, "--bad-rows", "bad_rows", bad_rows, JF_PY_STR)) {
+    jf_py_opts_init(&po);
+    if (jf_py_opt(&po, "columns", "columns", columns, JF_PY_LIST) ||
+        jf_py_opt(&po, "bad_rows", "bad_rows", bad_rows, JF_PY_STR)) {
         Py_DECREF(pathobj);
         return NULL;
     }
@@ -118,7 +117,7 @@ PyObject *jf_py_read(PyObject *self, PyObject *args, PyObject *kw)
     jf_error err = {{0}};
     jf_status st;
     Py_BEGIN_ALLOW_THREADS
-    st = jf_cloud_read(path, &po.e.ro, &c, &err);
+    st = jf_cloud_read(path, &po.ro, &c, &err);
     Py_END_ALLOW_THREADS
     if (st != JF_OK) {
         file_error(st, &err, path);
@@ -173,6 +172,7 @@ done:
 typedef struct {
     const double *xyz, *nrm, *k1, *k2, *d1, *d2, *b, *c, *cond, *res;
     const int32_t *deg, *nb, *st;
+    const double *sigma; /* NULL: no sigma column */
 } cols_src;
 
 static const void *data_of(PyObject *r, const char *name)
@@ -202,6 +202,7 @@ static size_t make_row(const cols_src *s, size_t i, int monge, double *v)
     v[n++] = s->nb[i];
     v[n++] = s->cond[i];
     v[n++] = s->res[i];
+    if (s->sigma) v[n++] = s->sigma[i]; /* jf_result_columns' order */
     v[n++] = (double)(uint32_t)s->st[i];
     return n;
 }
@@ -220,10 +221,9 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
     PyArrayObject *pa = NULL;
     jf_cloud fc = {0};
     jf_py_opts po;
-    jf_cli_est_init(&po.e);
-    po.used = 0;
-    if (jf_py_opt(&po, "--threads", "threads", threads, JF_PY_INT)) goto out;
-    int nthreads = po.e.o.threads;
+    jf_py_opts_init(&po);
+    if (jf_py_opt(&po, "threads", "threads", threads, JF_PY_INT)) goto out;
+    int nthreads = po.o.threads;
     if (!points || points == Py_None) points = PyObject_GetAttrString(result, "points");
     else Py_INCREF(points);
     if (!points) goto out;
@@ -262,7 +262,8 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
                   data_of(result, "k2"), data_of(result, "d1"), data_of(result, "d2"),
                   data_of(result, "b"), data_of(result, "c"), data_of(result, "cond"),
                   data_of(result, "residual"), data_of(result, "degree"),
-                  data_of(result, "neighbors"), data_of(result, "status")};
+                  data_of(result, "neighbors"), data_of(result, "status"),
+                  jf_py_result_sigma(result) ? data_of(result, "sigma") : NULL};
     if (PyErr_Occurred()) goto out;
     jf_column cols[JF_RESULT_MAX_COLS];
     size_t ncols = jf_py_result_columns(result, cols);

@@ -81,13 +81,12 @@ PyObject *jf_py_fit_jet(PyObject *self, PyObject *args, PyObject *kw)
                                      &fit, &frame, &max_cond, &point, &weights))
         return NULL;
     jf_py_opts po;
-    jf_cli_est_init(&po.e);
-    po.used = 0;
-    if (jf_py_opt(&po, "--degree", "degree", degree, JF_PY_INT) ||
-        jf_py_opt(&po, "--monge-degree", "monge_degree", monge, JF_PY_INT) ||
-        jf_py_opt(&po, "--fit", "fit", fit, JF_PY_STR) ||
-        jf_py_opt(&po, "--frame", "frame", frame, JF_PY_STR) ||
-        jf_py_opt(&po, "--max-cond", "max_cond", max_cond, JF_PY_FLOAT) ||
+    jf_py_opts_init(&po);
+    if (jf_py_opt(&po, "degree", "degree", degree, JF_PY_INT) ||
+        jf_py_opt(&po, "monge_degree", "monge_degree", monge, JF_PY_INT) ||
+        jf_py_opt(&po, "fit", "fit", fit, JF_PY_STR) ||
+        jf_py_opt(&po, "frame", "frame", frame, JF_PY_STR) ||
+        jf_py_opt(&po, "max_cond", "max_cond", max_cond, JF_PY_FLOAT) ||
         jf_py_opts_finish(&po))
         return NULL;
     PyArrayObject *nb = jf_py_points(nbobj, "neighbors"), *pa = NULL, *wa = NULL;
@@ -119,7 +118,7 @@ PyObject *jf_py_fit_jet(PyObject *self, PyObject *args, PyObject *kw)
             goto out;
         }
     }
-    jf_params prm = po.e.o.params;
+    jf_params prm = po.o.params;
     if (n > prm.max_neighbors) prm.max_neighbors = n;
     jf_status st = jf_fitter_create(&prm, &f);
     jf_result r;

@@ -1,9 +1,9 @@
 /* jfpy.h -- shared declarations of the Python module's C files (python/src):
  *   module.c   the module: functions table, STATUS, FileError, __version__
  *   arrays.c   numpy in (points, normals, faces) and out
- *   options.c  keyword arguments -> jf_estimate_opts through the command's
- *              own option parser (src/cli/opts.c), so values are accepted
- *              and rejected with the command's words
+ *   options.c  keyword arguments -> jf_estimate_opts through the library's
+ *              parser (jf_estimate_opts_set), the command's too, so values
+ *              are accepted and rejected with the same words
  *   estimate.c estimate(), estimate_mesh(): GIL released, Ctrl-C polled
  *   offthread.c the OpenMP work of a call on a thread of its own
  *   result.c   the Result type and as_structured()
@@ -24,7 +24,6 @@
 #include <numpy/arrayobject.h>
 
 #include "jetfit.h"
-#include "opts.h"
 
 /* module.c */
 extern PyObject *jf_py_FileError;
@@ -57,11 +56,18 @@ PyArrayObject *jf_py_empty(int nd, npy_intp d0, npy_intp d1, int type);
 void jf_py_off_thread(void (*fn)(void *), void *arg, volatile int *stop);
 
 /* options.c */
+#define JF_PY_MAX_GIVEN 16
 typedef struct {
-    jf_cli_est e;   /* the command's option set                        */
-    char buf[512];  /* the option values as text (e points into it)    */
+    jf_estimate_opts o;
+    jf_read_opts ro;  /* columns, bad_rows                              */
+    char buf[512];    /* the keywords' values as text, for messages     */
     size_t used;
+    struct {
+        const char *param, *text;
+    } given[JF_PY_MAX_GIVEN];
+    int ngiven;
 } jf_py_opts;
+void jf_py_opts_init(jf_py_opts *po);
 /* The keywords of estimate()/estimate_mesh() (neighbors as given). */
 int jf_py_opts_parse(jf_py_opts *po, PyObject *neighbors, PyObject *degree,
                      PyObject *monge_degree, PyObject *fit, PyObject *frame,
@@ -69,16 +75,18 @@ int jf_py_opts_parse(jf_py_opts *po, PyObject *neighbors, PyObject *degree,
                      PyObject *robust, PyObject *scales, PyObject *degree_select,
                      PyObject *dist_weight, PyObject *robust_normals, PyObject *threads);
 /* One option from a Python value: None skips it; int, float, str or a
- * sequence of numbers ("a,b,c") as the command would see it. */
-int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int kind);
+ * sequence of numbers ("a,b,c") as text, to the library's parser of
+ * parameter `param` (keyword kw in messages). */
+int jf_py_opt(jf_py_opts *po, const char *param, const char *kw, PyObject *v, int kind);
 enum { JF_PY_INT, JF_PY_FLOAT, JF_PY_STR, JF_PY_LIST };
 int jf_py_opts_finish(jf_py_opts *po);
 
 /* result.c */
 extern PyTypeObject jf_py_ResultType;
 /* A Result of n rows for Monge degree `monge` with its arrays allocated
- * (b, c None below 3, 4); keeps points and faces (may be NULL). */
-PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *faces);
+ * (b, c None below 3, 4); sigma: the output table has the sigma column
+ * (neighbors="auto"); keeps points and faces (may be NULL). */
+PyObject *jf_py_result_new(size_t n, int monge, int sigma, PyObject *points, PyObject *faces);
 /* Copies res[0..n-1] into the Result's arrays on `threads` OpenMP threads
  * (<= 0: all cores); no Python calls. */
 void jf_py_result_fill(PyObject *result, const jf_result *res, size_t n, int threads);
@@ -89,6 +97,9 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 /* The output file's columns and rows, as the command writes them. */
 size_t jf_py_result_columns(PyObject *result, jf_column *cols);
 int jf_py_result_monge(PyObject *result);
+int jf_py_result_sigma(PyObject *result);
+/* Rows whose status has a flag of mask. */
+size_t jf_py_result_count(PyObject *result, unsigned mask);
 
 /* estimate.c, files.c, fitjet.c: module functions */
 PyObject *jf_py_estimate(PyObject *self, PyObject *args, PyObject *kw);

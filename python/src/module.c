@@ -46,7 +46,7 @@ static PyObject *status_dict(void)
 }
 
 /* The keywords of estimate and estimate_mesh (docs/python.md has the
- * long form; the defaults are the command's, src/cli/opts.c). */
+ * long form; the defaults are the library's, jf_estimate_opts_init). */
 #define JF_PY_EST_PARAMS \
 "  neighbors : str, default 'knn:32': knn:K | radius:R | knn:K,radius:R |\n" \
 "      rings[:N] (meshes) | natural[:N] (K and N count the point)\n" \

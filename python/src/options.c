@@ -1,43 +1,23 @@
 /* options.c -- keyword arguments -> jf_estimate_opts.
  *
- * Each keyword is written as the text the command line would carry
- * (degree=3 -> "--degree 3", scales=[8, 16] -> "--scales 8,16") and handed
- * to the command's own parser (src/cli/opts.c): the same values are
+ * Each keyword is written as text (degree=3 -> "3", scales=[8, 16] ->
+ * "8,16") and handed to the library's parser of that parameter
+ * (jf_estimate_opts_set, the command's too): the same values are
  * accepted, the same defaults follow (Monge degree, max_neighbors, orient
  * input when normals are given), and a bad value raises ValueError with
- * the command's words, its flags spelt as keywords ("degree=12: expected
- * an integer 1..9").  A value
- * of the wrong Python type raises TypeError naming the keyword. */
+ * the library's words, which name parameters ("degree=12: expected an
+ * integer 1..9").  A value of the wrong Python type raises TypeError
+ * naming the keyword. */
 #include <math.h>
 
 #include "jfpy.h"
 
-/* The command's words with its flags as keywords: "--degree-select" ->
- * "degree_select" (a Python user never typed the flag). */
-static void as_keywords(const char *in, char *out, size_t len)
+static int bad(const char *kw, const char *val, const char *why)
 {
-    size_t u = 0;
-    for (const char *p = in; *p && u + 1 < len; p++) {
-        if (p[0] == '-' && p[1] == '-' && p[2] >= 'a' && p[2] <= 'z' && (p == in || p[-1] == ' ')) {
-            for (p += 2; *p && u + 1 < len && ((*p >= 'a' && *p <= 'z') || *p == '-'); p++)
-                out[u++] = *p == '-' ? '_' : *p;
-            p--;
-        } else {
-            out[u++] = *p;
-        }
-    }
-    out[u] = '\0';
-}
-
-static int bad(const jf_cli_bad *b)
-{
-    char opt[64], why[256];
-    as_keywords(b->opt ? b->opt : "", opt, sizeof opt);
-    as_keywords(b->why, why, sizeof why);
-    if (b->val && *b->val)
-        PyErr_Format(PyExc_ValueError, "%s=%s: %s", opt, b->val, why);
+    if (val && *val)
+        PyErr_Format(PyExc_ValueError, "%s=%s: %s", kw, val, why ? why : "invalid value");
     else
-        PyErr_Format(PyExc_ValueError, "%s: %s", opt, why);
+        PyErr_Format(PyExc_ValueError, "%s: %s", kw, why ? why : "invalid value");
     return -1;
 }
 
@@ -78,7 +58,7 @@ static int number_text(PyObject *v, int kind, const char *kw, char *buf, size_t 
     return float_text(d, buf, len);
 }
 
-int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int kind)
+int jf_py_opt(jf_py_opts *po, const char *param, const char *kw, PyObject *v, int kind)
 {
     if (!v || v == Py_None) return 0;
     char text[256];
@@ -104,7 +84,7 @@ int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int
         snprintf(text, sizeof text, "%s", s);
     } else if (kind == JF_PY_LIST) {
         /* scales: a sequence of ints, or one int */
-        if (PyLong_Check(v)) return jf_py_opt(po, flag, kw, v, JF_PY_INT);
+        if (PyLong_Check(v)) return jf_py_opt(po, param, kw, v, JF_PY_INT);
         PyObject *seq = PySequence_Fast(v, "");
         if (!seq) {
             PyErr_Format(PyExc_TypeError, "%s: expected a sequence of ints, got %s", kw,
@@ -127,22 +107,38 @@ int jf_py_opt(jf_py_opts *po, const char *flag, const char *kw, PyObject *v, int
     } else if (number_text(v, kind, kw, text, sizeof text)) {
         return -1;
     }
-    /* the parser keeps pointers to the values: store them in po */
+    /* kept for a message of jf_py_opts_finish (the parameter's value) */
     size_t len = strlen(text) + 1;
-    if (po->used + len > sizeof po->buf) {
+    if (po->used + len > sizeof po->buf || po->ngiven == JF_PY_MAX_GIVEN) {
         PyErr_Format(PyExc_ValueError, "%s: value too long", kw);
         return -1;
     }
-    char *val = memcpy(po->buf + po->used, text, len);
+    po->given[po->ngiven].param = param;
+    po->given[po->ngiven++].text = memcpy(po->buf + po->used, text, len);
     po->used += len;
-    jf_cli_bad b;
-    return jf_cli_est_option(&po->e, flag, val, &b) ? bad(&b) : 0;
+    const char *why = NULL;
+    jf_status st = !strcmp(param, "columns") || !strcmp(param, "bad_rows")
+                       ? jf_read_opts_set(&po->ro, param, text, &why)
+                       : jf_estimate_opts_set(&po->o, param, text, &why);
+    return st == JF_OK ? 0 : bad(kw, text, why);
+}
+
+void jf_py_opts_init(jf_py_opts *po)
+{
+    jf_estimate_opts_init(&po->o);
+    jf_read_opts_init(&po->ro);
+    po->used = 0;
+    po->ngiven = 0;
 }
 
 int jf_py_opts_finish(jf_py_opts *po)
 {
-    jf_cli_bad b;
-    return jf_cli_est_finish(&po->e, &b) ? bad(&b) : 0;
+    const char *param = NULL, *why = NULL;
+    if (jf_estimate_opts_finish(&po->o, &param, &why) == JF_OK) return 0;
+    const char *val = "";
+    for (int i = 0; param && i < po->ngiven; i++)
+        if (!strcmp(po->given[i].param, param)) val = po->given[i].text;
+    return bad(param ? param : "options", val, why);
 }
 
 int jf_py_opts_parse(jf_py_opts *po, PyObject *neighbors, PyObject *degree,
@@ -151,29 +147,29 @@ int jf_py_opts_parse(jf_py_opts *po, PyObject *neighbors, PyObject *degree,
                      PyObject *robust, PyObject *scales, PyObject *degree_select,
                      PyObject *dist_weight, PyObject *robust_normals, PyObject *threads)
 {
-    jf_cli_est_init(&po->e);
-    po->used = 0;
-    /* the command's order of precedence: --robust-normals is a preset that
-     * later flags override, so it goes first */
+    jf_py_opts_init(po);
+    /* --robust-normals is a preset that later keywords override, so it
+     * goes first (the command's order of precedence) */
     if (robust_normals && robust_normals != Py_None) {
         int on = PyObject_IsTrue(robust_normals);
         if (on < 0) return -1;
-        jf_cli_bad b;
-        if (on && jf_cli_est_option(&po->e, "--robust-normals", NULL, &b)) return bad(&b);
+        const char *why = NULL;
+        if (on && jf_estimate_opts_set(&po->o, "robust_normals", NULL, &why) != JF_OK)
+            return bad("robust_normals", "", why);
     }
-    if (jf_py_opt(po, "--neighbors", "neighbors", neighbors, JF_PY_STR) ||
-        jf_py_opt(po, "--degree", "degree", degree, JF_PY_INT) ||
-        jf_py_opt(po, "--monge-degree", "monge_degree", monge_degree, JF_PY_INT) ||
-        jf_py_opt(po, "--fit", "fit", fit, JF_PY_STR) ||
-        jf_py_opt(po, "--frame", "frame", frame, JF_PY_STR) ||
-        jf_py_opt(po, "--max-cond", "max_cond", max_cond, JF_PY_FLOAT) ||
-        jf_py_opt(po, "--orient", "orient", orient, JF_PY_STR) ||
-        jf_py_opt(po, "--normal", "normal", normal, JF_PY_STR) ||
-        jf_py_opt(po, "--robust", "robust", robust, JF_PY_STR) ||
-        jf_py_opt(po, "--scales", "scales", scales, JF_PY_LIST) ||
-        jf_py_opt(po, "--degree-select", "degree_select", degree_select, JF_PY_INT) ||
-        jf_py_opt(po, "--dist-weight", "dist_weight", dist_weight, JF_PY_FLOAT) ||
-        jf_py_opt(po, "--threads", "threads", threads, JF_PY_INT))
+    if (jf_py_opt(po, "neighbors", "neighbors", neighbors, JF_PY_STR) ||
+        jf_py_opt(po, "degree", "degree", degree, JF_PY_INT) ||
+        jf_py_opt(po, "monge_degree", "monge_degree", monge_degree, JF_PY_INT) ||
+        jf_py_opt(po, "fit", "fit", fit, JF_PY_STR) ||
+        jf_py_opt(po, "frame", "frame", frame, JF_PY_STR) ||
+        jf_py_opt(po, "max_cond", "max_cond", max_cond, JF_PY_FLOAT) ||
+        jf_py_opt(po, "orient", "orient", orient, JF_PY_STR) ||
+        jf_py_opt(po, "normal", "normal", normal, JF_PY_STR) ||
+        jf_py_opt(po, "robust", "robust", robust, JF_PY_STR) ||
+        jf_py_opt(po, "scales", "scales", scales, JF_PY_LIST) ||
+        jf_py_opt(po, "degree_select", "degree_select", degree_select, JF_PY_INT) ||
+        jf_py_opt(po, "dist_weight", "dist_weight", dist_weight, JF_PY_FLOAT) ||
+        jf_py_opt(po, "threads", "threads", threads, JF_PY_INT))
         return -1;
     return 0;
 }

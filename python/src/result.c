@@ -16,6 +16,7 @@ typedef struct {
     PyObject *points, *faces; /* as given (points converted on demand) */
     Py_ssize_t n;
     int monge;
+    int with_sigma; /* neighbors="auto": sigma is an output column */
 } Result;
 
 #define ARR(o) ((PyArrayObject *)(o))
@@ -40,13 +41,14 @@ static void result_dealloc(Result *r)
     Py_TYPE(r)->tp_free((PyObject *)r);
 }
 
-PyObject *jf_py_result_new(size_t n, int monge, PyObject *points, PyObject *faces)
+PyObject *jf_py_result_new(size_t n, int monge, int sigma, PyObject *points, PyObject *faces)
 {
     Result *r = PyObject_New(Result, &jf_py_ResultType);
     if (!r) return NULL;
     npy_intp N = (npy_intp)n;
     r->n = (Py_ssize_t)n;
     r->monge = monge;
+    r->with_sigma = sigma != 0;
     r->normal = (PyObject *)jf_py_empty(2, N, 3, NPY_DOUBLE);
     r->k1 = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
     r->k2 = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
@@ -125,11 +127,22 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 
 int jf_py_result_monge(PyObject *result) { return ((Result *)result)->monge; }
 
+int jf_py_result_sigma(PyObject *result) { return ((Result *)result)->with_sigma; }
+
+size_t jf_py_result_count(PyObject *result, unsigned mask)
+{
+    Result *r = (Result *)result;
+    const int32_t *st = PyArray_DATA(ARR(r->status));
+    size_t n = 0;
+    for (Py_ssize_t i = 0; i < r->n; i++) n += ((uint32_t)st[i] & mask) != 0;
+    return n;
+}
+
 /* ---- the output file's columns: the library's one list ------------------ */
 
 size_t jf_py_result_columns(PyObject *result, jf_column *cols)
 {
-    return jf_result_columns(((Result *)result)->monge, 0, cols);
+    return jf_result_columns(((Result *)result)->monge, ((Result *)result)->with_sigma, cols);
 }
 
 /* The source array of column j and its component, in file order. */
@@ -164,8 +177,9 @@ static void column_source(Result *r, PyArrayObject *pts, size_t j, PyArrayObject
         }
         j -= 5;
     }
-    PyObject *tail[] = {r->degree, r->neighbors, r->cond, r->residual, r->status};
-    *a = ARR(tail[j]);
+    /* jf_result_columns' order: sigma (when there) before status */
+    PyObject *tail[] = {r->degree, r->neighbors, r->cond, r->residual, r->sigma, r->status};
+    *a = ARR(tail[j == 4 && !r->with_sigma ? 5 : j]);
 }
 
 /* Result.as_structured(points=None): one structured array, fields named and

@@ -48,7 +48,7 @@ static void usage(FILE *f)
         "  --frame MODE          pca | axis (default pca)\n"
         "  --max-cond X          lower the degree while cond > X (default %g)\n"
         "  --orient MODE         none | input | viewpoint:X,Y,Z | scanner | mst[:K]\n"
-        "                        (default: scanner for a PTX INPUT (its scanner\n"
+        "                        (default: scanner for a PTX or E57 INPUT (its scanner\n"
         "                        positions), else input if INPUT has normals,\n"
         "                        else none;\n"
         "                        mst uses K nearest neighbours, default 8)\n"
@@ -94,8 +94,8 @@ static void usage(FILE *f)
         "                        outlier makes it coarse (docs/formats.md)\n"
         "  -q, --quiet           no progress line, no summary\n"
         "  -h, --help            this text\n"
-        "Options follow GNU conventions: --opt=V or --opt V, -oFILE, unique\n"
-        "abbreviations (--deg 3), '--' ends the options.\n"
+        "Options follow GNU conventions: --degree=3 or --degree 3, -oFILE, unique\n"
+        "abbreviations (--neighb knn:16), '--' ends the options.\n"
         "\n"
         "Columns: x y z nx ny nz k1 k2 d1x d1y d1z d2x d2y d2z [b0..b3] [c0..c4]\n"
         "         degree neighbors cond residual [sigma] status\n"
@@ -289,7 +289,7 @@ int jf_cmd_estimate(int argc, char **argv)
     int quiet = cmd.quiet, ascii = cmd.ascii, keep = cmd.keep;
     unsigned long long memory = cmd.memory; /* --memory; 0: MemAvailable */
     jf_estimate_opts o = e.o;
-    int monge = e.monge;
+    int monge = e.o.params.monge_degree;
     jf_error err = {{0}};
 
     double t0 = now_s();

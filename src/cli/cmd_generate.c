@@ -75,7 +75,8 @@ static void usage(FILE *out)
         "                   x y z is the noise-free point (an outlier: itself);\n"
         "                   d1, d2 are written for\n"
         "                   every surface but the sphere and are NaN at umbilics)\n"
-        "  --ascii          ascii PLY\n",
+        "  --ascii          ascii PLY\n"
+        "  -h, --help       this text\n",
         DEFAULT_N);
 }
 

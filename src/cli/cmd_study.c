@@ -30,6 +30,7 @@
 #include "cmd.h"
 #include "eval_errors.h"
 #include "jetfit.h"
+#include "pipes.h"
 #include "study_args.h"
 #include "view.h"
 
@@ -244,7 +245,17 @@ static int load_input(jf_study_args *c)
     jf_error e = {{0}};
     char msg[4200];
     size_t nt = 0;
-    jf_status st = jf_cloud_read(s->input, &c->base.ro, &c->cloud, &e);
+    /* '-' (standard input) or --input-format: through a private file
+     * (pipes.c), read once and hashed for study.def, then removed: the
+     * cells work on the cloud in memory */
+    jf_cli_in in;
+    jf_status st = jf_cli_in_begin(&in, s->input, c->in_fmt, &e);
+    if (st == JF_OK) st = jf_cloud_read(in.path, &c->base.ro, &c->cloud, &e);
+    if (st == JF_OK &&
+        jf_study_def_identity(in.path, c->input_id, sizeof c->input_id, e.msg, sizeof e.msg))
+        st = JF_ERR_IO;
+    if (in.dir[0]) s->input = in.shown; /* messages and the report name what was given */
+    jf_cli_in_end(&in, st == JF_OK ? NULL : &e);
     if (st != JF_OK) {
         fprintf(stderr, "jetfit: %s\n", e.msg[0] ? e.msg : jf_strerror(st));
         return 1;

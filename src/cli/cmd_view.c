@@ -27,7 +27,8 @@ static void usage(FILE *out)
         "                  .txt .las): columns x y z, and any of nx..nz k1 k2\n"
         "                  d1x..d2z degree neighbors cond residual status and the\n"
         "                  input's attributes\n"
-        "  -o FILE.html    the page: one file, opens from disk, no network (three.js\n"
+        "  -o, --output FILE.html\n"
+        "                  the page: one file, opens from disk, no network (three.js\n"
         "                  inlined from Debian's libjs-three)\n"
         "  --color COLUMN  the column coloured first (default k1; mean and gauss are\n"
         "                  (k1+k2)/2 and k1 k2; rgb: the input's red green blue);\n"
@@ -39,7 +40,10 @@ static void usage(FILE *out)
         "  --all-columns   also the Monge coefficients b0..b3 c0..c4\n"
         "  --estimate      INPUT is a raw cloud: run `jetfit estimate` on it first;\n"
         "                  other options go to the estimate (jetfit estimate --help)\n"
-        "  --quiet         no summary line\n");
+        "  -q, --quiet     no summary line\n"
+        "  -h, --help      this text\n"
+        "  --memory SIZE, --keep all|none, --input-format FMT: as estimate's, with\n"
+        "                  --estimate (INPUT '-': standard input)\n");
 }
 
 static int bad(const char *fmt, const char *arg)
@@ -64,51 +68,73 @@ static int count_arg(const char *a, const char *v, size_t lo, size_t *out)
     return 0;
 }
 
+/* view's own options; with --estimate, estimate's (opts.h) and those of
+ * its own that make sense here are passed on.  Scanned by args.c, as
+ * every command's line is. */
+static const jf_cli_optdef view_optdefs[] = {
+    {"--output", 1, 'o', NULL},
+    {"--help", 0, 'h', NULL},
+    {"--quiet", 0, 'q', NULL},
+    {"--color", 1, 0, NULL},
+    {"--max-points", 1, 0, NULL},
+    {"--glyphs", 1, 0, NULL},
+    {"--title", 1, 0, NULL},
+    {"--all-columns", 0, 0, NULL},
+    {"--estimate", 0, 0, NULL},
+    {"--memory", 1, 0, NULL},
+    {"--keep", 1, 0, NULL},
+    {"--input-format", 1, 0, NULL},
+    {NULL, 0, 0, NULL}};
+
 int jf_cmd_view(int argc, char **argv)
 {
     jf_view_opts o;
     jf_view_opts_init(&o);
     const char *in = NULL, *out = NULL;
     int estimate = 0, quiet = 0;
-    char **pass = calloc((size_t)argc + 8, sizeof *pass); /* estimate's argv */
+    char **pass = calloc(2 * (size_t)argc + 8, sizeof *pass); /* estimate's argv */
     if (!pass) return bad("%s", "out of memory");
     int npass = 1, rc;
     pass[0] = "estimate";
-    for (int i = 1; i < argc; i++)
-        if (!strcmp(argv[i], "--estimate")) estimate = 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+    const jf_cli_optdef *const tables[] = {view_optdefs, jf_cli_est_optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, argc, argv, tables);
+    const char *first_est = NULL; /* an estimate option, refused without --estimate */
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        const char *a = args.name, *v = args.val;
+        if (k == JF_CLI_ERROR) {
+            free(pass);
+            return bad("%s", args.err);
+        }
+        if (k == JF_CLI_OPERAND) {
+            if (in) { free(pass); return bad("unexpected argument '%s'", v); }
+            in = v;
+            continue;
+        }
+        if (!strcmp(a, "--help")) {
             usage(stdout);
             free(pass);
             return 0;
         }
-        if (!strcmp(a, "--estimate")) continue;
-        if (!strcmp(a, "--all-columns")) { o.all_columns = 1; continue; }
-        if (!strcmp(a, "--quiet")) { quiet = 1; pass[npass++] = argv[i]; continue; }
-        if (a[0] != '-' || !a[1]) {
-            if (in) { free(pass); return bad("unexpected argument '%s'", a); }
-            in = a;
-            continue;
-        }
-        int ours = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--color") ||
-                   !strcmp(a, "--max-points") || !strcmp(a, "--glyphs") || !strcmp(a, "--title");
-        if (!ours) {
-            if (!estimate) { free(pass); return bad("unknown option '%s'", a); }
-            /* the estimate's option, with its value when it takes one */
-            pass[npass++] = argv[i];
-            if (i + 1 < argc && !strchr(a, '=') &&
-                (jf_cli_est_takes_value(a) == 1 || !strcmp(a, "--memory") || !strcmp(a, "--keep")))
-                pass[npass++] = argv[++i];
-            continue;
-        }
-        if (i + 1 >= argc) { free(pass); return bad("%s needs a value", a); }
-        const char *v = argv[++i];
-        if (!strcmp(a, "-o") || !strcmp(a, "--output")) out = v;
+        if (!strcmp(a, "--estimate")) estimate = 1;
+        else if (!strcmp(a, "--all-columns")) o.all_columns = 1;
+        else if (!strcmp(a, "--quiet")) quiet = 1, pass[npass++] = "--quiet";
+        else if (!strcmp(a, "--output")) out = v;
         else if (!strcmp(a, "--color")) o.color = v;
         else if (!strcmp(a, "--title")) o.title = v;
-        else if (!strcmp(a, "--max-points")) { if (count_arg(a, v, 1, &o.max_points)) { free(pass); return 2; } }
-        else if (count_arg(a, v, 0, &o.glyphs)) { free(pass); return 2; }
+        else if (!strcmp(a, "--max-points")) {
+            if (count_arg(a, v, 1, &o.max_points)) { free(pass); return 2; }
+        } else if (!strcmp(a, "--glyphs")) {
+            if (count_arg(a, v, 0, &o.glyphs)) { free(pass); return 2; }
+        } else { /* the estimate's: its long name, then its value */
+            if (!first_est) first_est = a;
+            pass[npass++] = (char *)a;
+            if (v) pass[npass++] = (char *)v;
+        }
+    }
+    if (first_est && !estimate) {
+        free(pass);
+        return bad("%s is an estimate option: it applies with --estimate", first_est);
     }
     if (!in) { free(pass); return bad("%s", estimate ? "which INPUT cloud?" : "which RESULT file?"); }
     if (!out) { free(pass); return bad("%s", "-o FILE.html is required"); }
@@ -131,9 +157,10 @@ int jf_cmd_view(int argc, char **argv)
             return 1;
         }
         close(fd);
-        pass[npass++] = (char *)in;
         pass[npass++] = "-o";
         pass[npass++] = tmp;
+        pass[npass++] = "--"; /* INPUT may start with '-' */
+        pass[npass++] = (char *)in;
         pass[npass] = NULL;
         rc = jf_cmd_estimate(npass, pass);
         if (rc) {
@@ -145,6 +172,7 @@ int jf_cmd_view(int argc, char **argv)
     free(pass);
     char msg[4600];
     if (!o.title && estimate) o.title = strrchr(in, '/') ? strrchr(in, '/') + 1 : in;
+    if (estimate) o.name = in; /* the page names the cloud, not the temporary */
     rc = jf_view_write(estimate ? tmp : in, out, &o, quiet, msg, sizeof msg);
     if (estimate) unlink(tmp);
     if (rc) fprintf(stderr, "jetfit view: %s\n", msg);

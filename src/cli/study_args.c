@@ -25,6 +25,7 @@ static void usage(FILE *f)
         "  INPUT, --truth TRUTH  a cloud and its truth: a `generate` truth file,\n"
         "                  PCPNet .normals (with .curv beside it when present),\n"
         "                  or a reference result (e.g. estimated on a cleaner scan)\n"
+        "                  ('-': standard input, with --input-format FMT)\n"
         "  SURFACE         exp, paraboloid, revolution, sphere, ellipsoid, cylinder,\n"
         "                  torus:\n"
         "                  `jetfit generate SURFACE --n N --seed S+r` with exact truth\n"
@@ -48,6 +49,8 @@ static void usage(FILE *f)
         "  --mesh                SURFACE: a perturbed triangulated grid of about N\n"
         "                        vertices, as generate --mesh (rings need it)\n"
         "  --subset IDX          only these 0-based rows count (as eval --subset)\n"
+        "  --input-format FMT    read INPUT as FMT (ply xyz txt pts csv off las ptx):\n"
+        "                        needed when INPUT is '-' (standard input)\n"
         "  --metrics LIST        best.csv's metrics (default all): normal_rms,\n"
         "                        normal_median, normal_p95, k1_median, k1_p95,\n"
         "                        k2_median, k2_p95\n"
@@ -55,8 +58,11 @@ static void usage(FILE *f)
         "  --resume              keep the finished cells of DIR/study.csv, run the rest\n"
         "                        (refused when DIR/study.def: input, truth, options, differ)\n"
         "  -q, --quiet           no progress line, no summary\n"
+        "  -h, --help            this text\n"
         "  any other estimate option (e.g. --orient, --columns, --robust) applies\n"
-        "  to every cell, before the cell's flag set.\n"
+        "  to every cell, before the cell's flag set.  Every option, in a --flags\n"
+        "  set too, may be written NAME=VALUE (--robust=huber) or as a unique\n"
+        "  prefix (--robust-norm).\n"
         "\n"
         "Errors: normal angle in degrees; k1, k2: |k - k_t| / max(|k_t|, 1), eval's\n"
         "k1_rel/k2_rel.  A cell that fails is recorded as failed; the rest go on.\n",
@@ -143,31 +149,41 @@ void jf_study_args_free(jf_study_args *c)
     free(c->sel);
 }
 
-/* Tokens of one flag set, applied to e; the study's own axes refused. */
-
+/* Tokens of one flag set, applied to e; the study's own axes refused.
+ * A set is scanned as estimate's command line is (args.c: --opt=V,
+ * unique prefixes, "--"), so an option is spelt the same in both. */
 static int apply_flags(jf_cli_est *e, char *set, const char *text)
 {
-    char *tok[64];
-    int n = 0;
-    for (char *p = strtok(set, " \t"); p && n < 64; p = strtok(NULL, " \t")) tok[n++] = p;
+    char *tok[66];
+    int n = 1;
+    tok[0] = "--flags"; /* the scanner's argv[0] */
+    for (char *p = strtok(set, " \t"); p; p = strtok(NULL, " \t")) {
+        if (n == 65) return bad_opt("--flags", text, "a set holds more than 64 words");
+        tok[n++] = p;
+    }
+    tok[n] = NULL;
+    const jf_cli_optdef *const tables[] = {jf_cli_est_optdefs, NULL};
+    jf_cli_args args;
+    jf_cli_args_init(&args, n, tok, tables);
     jf_cli_bad bad;
-    for (int i = 0; i < n; i++) {
-        char *a = tok[i], *val = NULL, *eq = strchr(a, '=');
-        if (eq) *eq = '\0';
-        int tv = jf_cli_est_takes_value(a);
-        if (tv < 0) return bad_opt("--flags", text, "an option set holds a word that is not an estimate option");
-        if (!strcmp(a, "--neighbors") || !strcmp(a, "--neighbours") || !strcmp(a, "--degree") ||
-            !strcmp(a, "--threads") || !strcmp(a, "--columns"))
-            return bad_opt("--flags", text, "--neighbors, --degree, --threads and --columns are the study's own options");
-        if (tv == 1) {
-            if (eq) val = eq + 1;
-            else if (i + 1 < n) val = tok[++i];
-            else return bad_opt("--flags", text, "an option in a set needs its value");
-        } else if (eq) {
-            return bad_opt("--flags", text, "--robust-normals takes no value");
+    for (int k; (k = jf_cli_args_next(&args)) != JF_CLI_END;) {
+        char why[700];
+        if (k == JF_CLI_ERROR) {
+            snprintf(why, sizeof why, "%s%s", args.err,
+                     strncmp(args.err, "unknown", 7) ? "" : " (not an estimate option)");
+            return bad_opt("--flags", text, why);
         }
-        if (jf_cli_est_option(e, a, val, &bad)) {
-            char why[256];
+        if (k == JF_CLI_OPERAND) {
+            snprintf(why, sizeof why, "'%s' is not an estimate option", args.val);
+            return bad_opt("--flags", text, why);
+        }
+        const char *a = args.name; /* the long name, aliases resolved */
+        if (!strcmp(a, "--neighbors") || !strcmp(a, "--degree") || !strcmp(a, "--threads") ||
+            !strcmp(a, "--columns") || !strcmp(a, "--bad-rows"))
+            return bad_opt("--flags", text, "--neighbors, --degree, --threads, --columns and "
+                                            "--bad-rows are the study's own options (give "
+                                            "them outside --flags)");
+        if (jf_cli_est_option(e, a, args.val, &bad)) {
             snprintf(why, sizeof why, "%s '%s': %s", bad.opt, bad.val, bad.why);
             return bad_opt("--flags", text, why);
         }
@@ -189,13 +205,13 @@ static int make_settings(jf_study_args *c)
             for (int f = 0; f < s->nflags; f++) {
                 jf_cli_est e = c->base;
                 jf_cli_bad bad;
-                e.nbspec = s->strategy[a];
                 e.o.params.degree = s->degree[d];
                 char set[1024];
                 snprintf(set, sizeof set, "%s", s->flags[f]);
                 int rc = apply_flags(&e, set, s->flags[f]);
                 if (rc) return rc;
-                if (jf_cli_est_finish(&e, &bad)) {
+                if (jf_cli_est_option(&e, "--neighbors", s->strategy[a], &bad) ||
+                    jf_cli_est_finish(&e, &bad)) {
                     char why[300];
                     snprintf(why, sizeof why, "%s '%s': %s (degree %d, flags '%s')", bad.opt,
                              bad.val, bad.why, s->degree[d], s->flags[f]);
@@ -268,6 +284,7 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
         {"--repeat", 1, 0, NULL},
         {"--seed", 1, 0, NULL},
         {"--n", 1, 0, NULL},
+        {"--input-format", 1, 0, NULL},
         {NULL, 0, 0, NULL}};
     /* --neighbors and --degree are the study's axes (lists), from estimate's table */
     const jf_cli_optdef *const tables[] = {optdefs, jf_cli_est_optdefs, NULL};
@@ -317,6 +334,7 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
         else if (!strcmp(name, "--noise-uniform")) noise_u = val;
         else if (!strcmp(name, "--outliers")) outl = val;
         else if (!strcmp(name, "--metrics")) c->metrics_text = val;
+        else if (!strcmp(name, "--input-format")) c->in_fmt = val;
         else if (!strcmp(name, "--repeat")) {
             if (jf_cli_parse_int(val, 1, 100000, &iv)) return bad_opt(name, val, "expected a positive integer");
             s->repeat = iv;
@@ -345,7 +363,12 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv)
         if (!c->npoints) c->npoints = JF_STUDY_DEFAULT_N;
     } else if (c->npoints || c->mesh) {
         return bad_opt(c->mesh ? "--mesh" : "--n", "", "applies to a SURFACE, not to INPUT --truth");
+    } else if (!strcmp(s->truth, "-") || (s->subset && !strcmp(s->subset, "-"))) {
+        return bad_opt(!strcmp(s->truth, "-") ? "--truth" : "--subset", "-",
+                       "a named file (standard input can only carry INPUT)");
     }
+    if (c->in_fmt && c->is_surface)
+        return bad_opt("--input-format", c->in_fmt, "applies to INPUT, not to a SURFACE");
     /* the lists */
     int ns = split_list(c->nb_text, ";", &c->strat_block);
     if (ns < 0) return bad_opt("--neighbors", c->nb_text, "out of memory");

@@ -14,6 +14,9 @@
 typedef struct {
     jf_study s;
     const char *dir, *nb_text, *deg_text, *flags_text, *metrics_text;
+    const char *in_fmt;          /* --input-format (INPUT '-' needs it) */
+    char input_id[160];          /* INPUT's identity for study.def, taken
+                                    while it is read (study_def.c)      */
     char **strat_block, **flags_block;
     jf_surface surf;
     int is_surface, mesh, quiet, resume;
@@ -41,6 +44,8 @@ int jf_study_args_parse(jf_study_args *c, int argc, char **argv);
  * write: onto DIR/study.def (atomic); check: 0 if DIR/study.def says the
  * same, else -1 with one line naming what differs (or that it is
  * missing). */
+/* "SIZE bytes, fnv1a64 HASH" of the file at path into out; -1 with msg. */
+int jf_study_def_identity(const char *path, char *out, size_t len, char *msg, size_t mlen);
 int jf_study_def_make(const jf_study_args *c, char *def, size_t len, char *msg, size_t mlen);
 int jf_study_def_write(const char *dir, const char *def, char *msg, size_t len);
 int jf_study_def_check(const char *dir, const char *def, char *msg, size_t len);

@@ -15,8 +15,7 @@
 
 #include "study_args.h"
 
-/* "SIZE bytes, fnv1a64 HASH" of a file's content; -1 with msg. */
-static int identity(const char *path, char *out, size_t len, char *msg, size_t mlen)
+int jf_study_def_identity(const char *path, char *out, size_t len, char *msg, size_t mlen)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
@@ -50,15 +49,17 @@ int jf_study_def_make(const jf_study_args *c, char *def, size_t len, char *msg, 
         u += (size_t)snprintf(def + u, len - u, "surface: %s\nn: %zu\nmesh: %s\n", s->input,
                               c->npoints, c->mesh ? "yes" : "no");
     } else {
-        if (identity(s->input, id, sizeof id, msg, mlen)) return -1;
-        u += (size_t)snprintf(def + u, len - u, "input: %s\n", id);
+        /* taken by cmd_study.c while INPUT was read (standard input is
+         * read once): the content, so a file and the same bytes piped in
+         * are one study */
+        u += (size_t)snprintf(def + u, len - u, "input: %s\n", c->input_id);
         if (s->truth) {
-            if (identity(s->truth, id, sizeof id, msg, mlen)) return -1;
+            if (jf_study_def_identity(s->truth, id, sizeof id, msg, mlen)) return -1;
             u += (size_t)snprintf(def + u, len - u, "truth: %s\n", id);
         }
     }
     if (s->subset) {
-        if (u >= len || identity(s->subset, id, sizeof id, msg, mlen)) return -1;
+        if (u >= len || jf_study_def_identity(s->subset, id, sizeof id, msg, mlen)) return -1;
         u += (size_t)snprintf(def + u, len - u, "subset: %s\n", id);
     }
     if (u >= len) return -1;

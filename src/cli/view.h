@@ -93,6 +93,8 @@ typedef struct {
     const char *color;  /* the column coloured at first (NULL: k1, else
                            the first non-position column)             */
     const char *title;  /* NULL: the file's name                      */
+    const char *name;   /* the file the page names (NULL: `in`; view
+                           --estimate: the INPUT, not its temporary)  */
     int all_columns;    /* also b0..b3, c0..c4                         */
 } jf_view_opts;
 

@@ -206,7 +206,7 @@ int jf_view_write(const char *in, const char *out, const jf_view_opts *o, int qu
         jf_view_three_free(&th);
         return 1;
     }
-    page pg = {.t = &t, .in = in, .max_points = o->max_points, .glyphs = o->glyphs};
+    page pg = {.t = &t, .in = o->name ? o->name : in, .max_points = o->max_points, .glyphs = o->glyphs};
     int rc = 1, cx = jf_eval_table_col(&t, "x");
     size_t *idx = NULL;
     if (cx < 0 || jf_eval_table_col(&t, "y") != cx + 1 || jf_eval_table_col(&t, "z") != cx + 2) {

@@ -43,6 +43,11 @@ struct jf_fitter {
     size_t last_n;    /* n of the last surface fit (residuals)         */
     int have_last;
     double last_p[3]; /* its origin (the point fitted)                 */
+    /* the robust layer's state of this fitter (robust.c: scratch, the
+     * lower-degree fitters, tuning), made on its first use and freed with
+     * the fitter; core never looks inside, so it calls nothing up */
+    void *ext;
+    void (*ext_free)(void *);
 };
 
 /* RMS of z - J(x, y) of n other points (world coordinates) in the last

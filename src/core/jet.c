@@ -32,6 +32,7 @@ void jf__gsl_init(void) { pthread_once(&gsl_once, gsl_init_once); }
 void jf_fitter_free(jf_fitter *f)
 {
     if (!f) return;
+    if (f->ext_free) f->ext_free(f->ext);
     free(f->loc);
     free(f->w);
     free(f->dist);

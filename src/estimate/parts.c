@@ -45,6 +45,7 @@ jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q)
     if (!o || !q) return JF_ERR_INVALID;
     jf_estimate_opts oa = *o;
     jf__nb_auto_opts(&oa); /* auto is knn:JF_NB_AUTO_KMAX, as in jf_estimate */
+    if (oa.params.monge_degree == 0) oa.params.monge_degree = jf_monge_degree_of(oa.params.degree);
     o = &oa;
     if (jf_params_validate(&o->params, NULL) != JF_OK) return JF_ERR_INVALID;
     if (o->nb.kind > JF_NB_KNN_RADIUS) return JF_ERR_UNSUPPORTED;

@@ -45,6 +45,7 @@ void jf_estimate_opts_init(jf_estimate_opts *o)
     if (!o) return;
     memset(o, 0, sizeof *o);
     jf_params_init(&o->params);
+    o->params.monge_degree = 0; /* from the degree: jf_monge_degree_of */
     o->nb.kind = JF_NB_KNN;
     o->nb.k = JF_ESTIMATE_DEFAULT_K;
     o->normal = JF_NORMAL_AUTO;
@@ -690,6 +691,7 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
 {
     const char *bad = NULL;
     *use = *o;
+    if (use->params.monge_degree == 0) use->params.monge_degree = jf_monge_degree_of(use->params.degree);
     jf__nb_auto_opts(use); /* auto: knn:JF_NB_AUTO_KMAX and the fit's choice */
     use->orient = jf_orient_resolve(o->orient, c->nrm != NULL,
                                     c->scan && c->scanner && c->nscans);
@@ -709,7 +711,7 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
         set_err(err, "invalid parameter 'orient'");
         return JF_ERR_INVALID;
     }
-    if (jf_params_validate(&o->params, &bad) != JF_OK) {
+    if (jf_params_validate(&use->params, &bad) != JF_OK) {
         char m[128];
         snprintf(m, sizeof m, "invalid parameter '%s'", bad ? bad : "?");
         set_err(err, m);

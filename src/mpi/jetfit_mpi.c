@@ -1,7 +1,7 @@
 /* jetfit_mpi.c -- `mpirun -np N jetfit-mpi estimate INPUT -o OUTPUT [options]`:
  * the estimate of `jetfit estimate`, over MPI, byte for byte the same file.
  *
- * design: the options are parsed by the command's own code (src/cli/opts.c)
+ * design: the options are parsed by the command's own code (src/cmdline/opts.c)
  * and the rows made by it (jf_result_row); mpi_dist.c gives each rank its
  * part of the cloud and the part's exact halo; the fit is the pipeline's
  * (jf__estimate_masked: the halo points are neighbours, not fitted); each
@@ -267,6 +267,46 @@ static void convert_text(jf_mpi *m, outputs *o, const jf_column *cols, size_t nc
     free(vals);
 }
 
+/* No point fitted: an error, nothing written; most points unfitted: a
+ * warning -- jetfit estimate's rule and words (cmd_estimate.c, issues 31,
+ * 33.12), over every rank's own points.  1 if the run must stop. */
+static int nothing_fitted(jf_mpi *m, const char *in, const jf_mpi_cloud *c, const jf_result *res,
+                          uint64_t count)
+{
+    uint64_t mine[3] = {0, 0, 0}, all[3] = {0, 0, 0}; /* unfit, nonfinite, own */
+    double big = 0, bigall = 0;
+    for (size_t j = 0; j < c->n; j++) {
+        if (!c->own[j]) continue;
+        mine[2]++;
+        if (res[j].status & (JF_PT_FAILED | JF_PT_NONFINITE)) mine[0]++;
+        if (res[j].status & JF_PT_NONFINITE) mine[1]++;
+        for (int d = 0; d < 3; d++)
+            if (isfinite(c->xyz[3 * j + d]) && fabs(c->xyz[3 * j + d]) > big)
+                big = fabs(c->xyz[3 * j + d]);
+    }
+    MPI_Allreduce(mine, all, 3, MPI_UINT64_T, MPI_SUM, m->comm);
+    MPI_Allreduce(&big, &bigall, 1, MPI_DOUBLE, MPI_MAX, m->comm);
+    const uint64_t unfit = all[0], nonfin = all[1];
+    if (count && unfit == count) {
+        if (m->rank == 0)
+            jf_mpi_fail(m, "%s: no point could be fitted (%llu non-finite, %llu failed)%s; "
+                           "nothing written", in, (unsigned long long)nonfin,
+                        (unsigned long long)(count - nonfin),
+                        bigall > 1e150 ? ": coordinates near 1e150 or beyond overflow the fit "
+                                         "(rescale the cloud)"
+                        : nonfin < count ? ": too few or collinear neighbours (K must be at "
+                                           "least 3)"
+                                         : ": every point is NaN or infinite (a scale or "
+                                           "transform that overflows?)");
+        return 1;
+    }
+    if (unfit > count / 2 && m->rank == 0)
+        fprintf(stderr, "jetfit-mpi: %s: warning: %llu of %llu points could not be fitted "
+                        "(status failed or nonfinite)\n", in, (unsigned long long)unfit,
+                (unsigned long long)count);
+    return 0;
+}
+
 static int refuse(jf_mpi *m, const char *fmt, const char *what)
 {
     if (m->rank == 0) {
@@ -335,7 +375,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         return refuse(m, "%s: invalid parameters", in);
 
     jf_column cols[JF_RESULT_MAX_COLS];
-    size_t ncols = jf_result_columns(cmd.e.monge, o.nb.kind == JF_NB_AUTO, cols);
+    size_t ncols = jf_result_columns(cmd.e.o.params.monge_degree, o.nb.kind == JF_NB_AUTO, cols);
     outputs w;
     memset(&w, 0, sizeof w);
     /* open the output first: a missing folder fails before the work */
@@ -374,10 +414,14 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         if (inj && *inj && atoi(inj) == m->rank)
             jf_mpi_fail(m, "rank %d: injected failure (JETFIT_MPI_TEST_FAIL)", m->rank);
         failed = jf_mpi_check(m);
+        if (!failed) {
+            nothing_fitted(m, in, &c, res, lay.count);
+            failed = jf_mpi_check(m);
+        }
     }
     double t2 = MPI_Wtime();
     if (!failed) {
-        write_rows(m, &w, out, &c, res, cols, ncols, cmd.e.monge, o.threads);
+        write_rows(m, &w, out, &c, res, cols, ncols, cmd.e.o.params.monge_degree, o.threads);
         failed = jf_mpi_check(m);
     }
     free(res);

@@ -211,10 +211,10 @@ static int lepski(const cand_fit *c, int nc, double s2, double tau)
     return best;
 }
 
-static jf_status final_fit(const jf_params *pr, int d, const double p[3], const double *nbr,
+static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
                            size_t k, double sigma, jf_result *out)
 {
-    jf_fitter *g = jf__tl_fitter(pr, d);
+    jf_fitter *g = jf__ws_fitter(f, pr, d);
     if (!g) return JF_ERR_NOMEM;
     jf_status st = jf_fit_point(g, p, nbr, k, out);
     if (st != JF_OK) return st;
@@ -308,11 +308,11 @@ static void moments(const double p[3], const double *nbr, size_t k, const double
  * flags LOWERED_RANK / LOWERED_COND), A_ij = Y_ij / h^(i+j), then the
  * quantities (monge.c).  Interpolation, or no degree left: jf_fit_point
  * on the same points (final_fit). */
-static jf_status direct_fit(const jf_params *pr, const double p[3], const double *nbr, size_t k,
+static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr, size_t k,
                             const mom *mo0, double H, const double fr0[9], int d, double sigma,
                             jf_result *out)
 {
-    if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) return final_fit(pr, d, p, nbr, k, sigma, out);
+    if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
     /* the frame of the K points (the jet's, §5.2): their covariance from
      * step 1's sums, turned from fr's axes to the world's */
     double pca_ev[3], fk[9];
@@ -340,7 +340,7 @@ static jf_status direct_fit(const jf_params *pr, const double p[3], const double
     mom mk;
     moments(p, nbr, k, fr, H, d, &mk);
     const mom *mo = &mk;
-    if (!(mo->hmean > 0.0)) return final_fit(pr, d, p, nbr, k, sigma, out);
+    if (!(mo->hmean > 0.0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
     static const unsigned char gpos[NMON][NMON] = {
         {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
         {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
@@ -416,7 +416,7 @@ static jf_status direct_fit(const jf_params *pr, const double p[3], const double
         }
         break;
     }
-    if (deg < 1) return final_fit(pr, d, p, nbr, k, sigma, out);
+    if (deg < 1) return final_fit(f, pr, d, p, nbr, k, sigma, out);
     memset(out, 0, sizeof *out);
     out->status = flags | JF_PT_AUTO;
     out->degree = deg;
@@ -435,7 +435,6 @@ static jf_status direct_fit(const jf_params *pr, const double p[3], const double
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out)
 {
-    (void)f;
     size_t nmax = n < JF_NB_AUTO_KMAX ? n : JF_NB_AUTO_KMAX;
     /* step 1: the frame, PCA of the FRAME_K nearest finite points */
     double mean[3] = {0, 0, 0}, cov[9] = {0};
@@ -446,7 +445,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         for (int k = 0; k < 3; k++) mean[k] += q[k] - p[k];
         kf++;
     }
-    if (kf < 16) return final_fit(pr, 2, p, nbr, nmax, NAN, out); /* too few to choose */
+    if (kf < 16) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out); /* too few to choose */
     for (int k = 0; k < 3; k++) mean[k] /= (double)kf;
     size_t seen = 0;
     for (size_t i = 0; i < nmax && seen < kf; i++) {
@@ -477,7 +476,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         }
     }
     double H = sqrt(H2), iH = 1.0 / H;
-    if (!(H > 0.0) || !isfinite(iH)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
+    if (!(H > 0.0) || !isfinite(iH)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
 
     /* the candidates (the last one: the whole list when it is shorter) */
     size_t ks[NCAND];
@@ -522,7 +521,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             s2 = cf[1][i].s2;
             if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
-    if (!isfinite(s2)) return final_fit(pr, 2, p, nbr, nmax, NAN, out);
+    if (!isfinite(s2)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
     double sigma = sqrt(s2);
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small
@@ -560,8 +559,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                     bc = i;
                 }
             }
-        if (bc < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-        return direct_fit(pr, p, nbr, ks[bc], &mo[bc], H, fr, bd ? 3 : 2, sigma, out);
+        if (bc < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
+        return direct_fit(f, pr, p, nbr, ks[bc], &mo[bc], H, fr, bd ? 3 : 2, sigma, out);
     }
     /* step 3: Lepski per degree */
     double tau = jf__auto_tau;
@@ -585,6 +584,6 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             break;
         }
     }
-    if (ci < 0) return final_fit(pr, 2, p, nbr, nmax, sigma, out);
-    return direct_fit(pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
+    if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
+    return direct_fit(f, pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
 }

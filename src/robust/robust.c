@@ -1,5 +1,5 @@
 /* robust.c -- robust reweighting (params.robust) of one jet fit, and the
- * per-thread state shared by the selection rules (select.c, scale.c).
+ * fitter's state shared by the selection rules (select.c, scale.c).
  *
  * Iteratively reweighted least squares on the height residuals of the
  * fit.  Scale s = 1.4826 * median|r| (the MAD, consistent for Gaussian
@@ -13,13 +13,14 @@
  * on the distance to p, combined with the IRLS weights.
  *
  * No allocation per point: buffers live on the caller's stack up to
- * JF_STACK_N neighbours; above that, one heap buffer per thread (C11 tss,
- * freed at thread exit) grown only when a larger n is first seen. */
+ * JF_STACK_N neighbours; above that, one heap buffer per fitter (the
+ * caller's workspace: a fitter per thread) grown only when a larger n is
+ * first seen, freed with the fitter. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <threads.h>
 
+#include "fitter_internal.h"
 #include "order_stat.h"
 #include "robust_internal.h"
 
@@ -79,24 +80,20 @@ int jf__robust_tune(const char *name, double v)
     return 0;
 }
 
-/* ---- per-thread state: fallback buffer for n > JF_STACK_N, and the fitters
- * of the lower degrees tried by degree selection (created on first use,
- * kept for the thread's life; recreated only if the caller's parameters
- * other than the degree change) ---- */
+/* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
+ * the fitters of the lower degrees tried by degree selection (created on
+ * first use, kept with the fitter; recreated only if the caller's
+ * parameters other than the degree change) ---- */
 typedef struct {
     double *buf;
     size_t cap;
     jf_fitter *fit[JF_MAX_DEGREE + 1]; /* fit[d]: a fitter of degree d */
     jf_params key;                     /* the parameters they were made from */
-} tl_state;
+} ws_state;
 
-static tss_t tl_key;
-static once_flag tl_once = ONCE_FLAG_INIT;
-static int tl_ok;
-
-static void tl_free(void *p)
+static void ws_free(void *p)
 {
-    tl_state *b = p;
+    ws_state *b = p;
     if (b) {
         free(b->buf);
         for (int d = 0; d <= JF_MAX_DEGREE; d++) jf_fitter_free(b->fit[d]);
@@ -104,26 +101,18 @@ static void tl_free(void *p)
     free(b);
 }
 
-static void tl_init(void) { tl_ok = tss_create(&tl_key, tl_free) == thrd_success; }
-
-static tl_state *tl_state_get(void)
+static ws_state *ws_get(jf_fitter *f)
 {
-    call_once(&tl_once, tl_init);
-    if (!tl_ok) return NULL;
-    tl_state *b = tss_get(tl_key);
-    if (!b) {
-        if (!(b = calloc(1, sizeof *b))) return NULL;
-        if (tss_set(tl_key, b) != thrd_success) {
-            free(b);
-            return NULL;
-        }
+    if (!f->ext) {
+        if (!(f->ext = calloc(1, sizeof(ws_state)))) return NULL;
+        f->ext_free = ws_free;
     }
-    return b;
+    return f->ext;
 }
 
-double *jf__tl_buf(size_t need)
+double *jf__ws_buf(jf_fitter *f, size_t need)
 {
-    tl_state *b = tl_state_get();
+    ws_state *b = ws_get(f);
     if (!b) return NULL;
     if (b->cap < need) {
         double *nb = realloc(b->buf, need * sizeof *nb);
@@ -136,9 +125,9 @@ double *jf__tl_buf(size_t need)
 
 /* A fitter of degree d with pr's other fitting parameters (frame, mode,
  * max_cond, max_neighbors; monge_degree clamped to what d allows). */
-jf_fitter *jf__tl_fitter(const jf_params *pr, int d)
+jf_fitter *jf__ws_fitter(jf_fitter *f, const jf_params *pr, int d)
 {
-    tl_state *b = tl_state_get();
+    ws_state *b = ws_get(f);
     if (!b) return NULL;
     const jf_params *k = &b->key;
     if (k->fit != pr->fit || k->frame != pr->frame || k->max_cond != pr->max_cond ||

@@ -1,4 +1,4 @@
-/* robust_internal.h -- shared by robust.c (IRLS, per-thread state),
+/* robust_internal.h -- shared by robust.c (IRLS, the fitter's state),
  * select.c (a normal's uncertainty, degree selection) and scale.c (scale
  * selection, jf_fit_point_full).  Not part of the public API. */
 #ifndef JF_ROBUST_INTERNAL_H
@@ -9,7 +9,7 @@
 #include "jetfit.h"
 
 /* Neighbourhoods up to this size use the caller's stack for the 4n
- * doubles of residuals and weights; larger ones a per-thread buffer. */
+ * doubles of residuals and weights; larger ones the fitter's buffer. */
 #define JF_STACK_N 512
 
 /* Tuning constants of the selection rules (defaults in robust.c). */
@@ -30,10 +30,11 @@ int jf__robust_tune(const char *name, double v);
 /* Neither failed nor non-finite: the fit's quantities can be used. */
 int jf__usable(const jf_result *r);
 
-/* This thread's scratch of at least `need` doubles (NULL: out of memory),
- * and its fitter of degree d with pr's other fitting parameters. */
-double *jf__tl_buf(size_t need);
-jf_fitter *jf__tl_fitter(const jf_params *pr, int d);
+/* Fitter f's scratch of at least `need` doubles (NULL: out of memory),
+ * and its companion fitter of degree d with pr's other fitting parameters:
+ * both live with f (the caller's workspace) and are freed with it. */
+double *jf__ws_buf(jf_fitter *f, size_t need);
+jf_fitter *jf__ws_fitter(jf_fitter *f, const jf_params *pr, int d);
 
 /* One fit of the first n neighbours, distance-weighted when dist_c > 0
  * and reweighted when pr->robust asks.  buf: 4n doubles.  *sigma: noise

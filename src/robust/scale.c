@@ -52,7 +52,7 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
     double stackbuf[4 * JF_STACK_N];
     double *buf = stackbuf;
     if (n > JF_STACK_N && (pr->robust != JF_ROBUST_NONE || pr->dist_weight > 0.0) &&
-        !(buf = jf__tl_buf(4 * n)))
+        !(buf = jf__ws_buf(f, 4 * n)))
         return JF_ERR_NOMEM;
 
     double sigma;
@@ -81,7 +81,7 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
             continue;
         }
         double b2 = 0.0;
-        jf_fitter *g = r.degree < JF_MAX_DEGREE ? jf__tl_fitter(pr, r.degree + 1) : NULL;
+        jf_fitter *g = r.degree < JF_MAX_DEGREE ? jf__ws_fitter(f, pr, r.degree + 1) : NULL;
         if (r.degree < JF_MAX_DEGREE && !g) return JF_ERR_NOMEM;
         if (g) {
             st = jf__fit_robust(g, pr, p, nbr, ks[i], buf, 0.0, &ref, &sg_ref, &neff);

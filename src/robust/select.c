@@ -163,7 +163,7 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
     if (!isfinite(s2) || top.degree <= pr->degree_select) return JF_OK;
     if (!(sd_top >= jf__knob.degree_sdmin)) return JF_OK; /* precise enough: keep D */
     for (int d = top.degree - 1; d >= pr->degree_select; d--) {
-        jf_fitter *g = jf__tl_fitter(pr, d);
+        jf_fitter *g = jf__ws_fitter(f, pr, d);
         if (!g) return JF_ERR_NOMEM;
         jf_result r;
         if ((st = jf__fit_robust(g, pr, p, nbr, n, buf, 0.0, &r, &sg, &neff)) != JF_OK) return st;

@@ -43,23 +43,10 @@ static void write_colour_ply(const char *path)
     fclose(f);
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    *len = (size_t)ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc(*len ? *len : 1);
-    ck_assert_uint_eq(fread(b, 1, *len, f), *len);
-    fclose(f);
-    return b;
-}
-
 static void same_bytes(const char *a, const char *b)
 {
     size_t la, lb;
-    unsigned char *x = slurp(a, &la), *y = slurp(b, &lb);
+    unsigned char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
     ck_assert_msg(la == lb && !memcmp(x, y, la), "%s and %s differ (%zu, %zu bytes)", a, b, la,
                   lb);
     free(x);
@@ -147,7 +134,7 @@ START_TEST(keep_none_is_todays_bytes)
     /* --keep all (the default) keeps the input's format 3 records */
     ck_assert_int_eq(cli_run("estimate", las, "-o", cli_path("s3.las"), "--quiet", NULL), 0);
     size_t len;
-    unsigned char *b = slurp(cli_path("s3.las"), &len);
+    unsigned char *b = jf_test_slurp(cli_path("s3.las"), &len);
     ck_assert_int_eq(b[104], 3);
     free(b);
     /* which reads back with jetfit's columns: eval of it against the CSV

@@ -20,20 +20,6 @@
 
 static char disk[300]; /* the tmpfs */
 
-static int whole_png(const char *path)
-{
-    /* ISO/IEC 15948 §5.2, §11.2.5: signature first, IEND chunk last */
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    unsigned char a[8], b[12];
-    int ok = fread(a, 1, 8, f) == 8 && fseek(f, -12, SEEK_END) == 0 && fread(b, 1, 12, f) == 12 &&
-             !memcmp(a, sig, 8) && !memcmp(b, iend, 12);
-    fclose(f);
-    return ok;
-}
-
 /* Fills the tmpfs, then frees `room` bytes: the next big write fails. */
 static void fill_leaving(size_t room)
 {
@@ -63,7 +49,7 @@ static int pngs_whole(const char *dir)
         ck_assert_msg(!(e->d_name[0] == '.' && l > 4 && !strcmp(e->d_name + l - 4, ".tmp")),
                       "temporary left: %s", e->d_name);
         if (l > 4 && !strcmp(e->d_name + l - 4, ".png")) {
-            ck_assert_msg(whole_png(p), "%s is cut off", p);
+            ck_assert_msg(cli_whole_png(p), "%s is cut off", p);
             n++;
         }
     }
@@ -101,7 +87,7 @@ START_TEST(render_full_disk)
     char png[400];
     snprintf(png, sizeof png, "%s/pic.png", disk);
     ck_assert_int_eq(cli_run("render", res, "-o", png, NULL), 0); /* room: a whole one */
-    ck_assert(whole_png(png));
+    ck_assert(cli_whole_png(png));
     struct stat old;
     ck_assert_int_eq(stat(png, &old), 0);
     ck_assert_uint_gt(old.st_size, 3 * 8192);
@@ -111,7 +97,7 @@ START_TEST(render_full_disk)
                   "not one line naming the file: %s", cli_err);
     struct stat now;
     ck_assert_int_eq(stat(png, &now), 0);
-    ck_assert(now.st_ino == old.st_ino && now.st_size == old.st_size && whole_png(png));
+    ck_assert(now.st_ino == old.st_ino && now.st_size == old.st_size && cli_whole_png(png));
     ck_assert_int_eq(pngs_whole(disk), 1);
 }
 END_TEST

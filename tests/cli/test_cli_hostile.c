@@ -23,21 +23,6 @@ static size_t file_size(const char *path)
     return stat(path, &sb) == 0 ? (size_t)sb.st_size : (size_t)-1;
 }
 
-/* Whole contents, malloc'd (NULL if unreadable). */
-static char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    rewind(f);
-    char *b = malloc((size_t)len + 1);
-    *n = fread(b, 1, (size_t)len, f);
-    b[*n] = '\0';
-    fclose(f);
-    return b;
-}
-
 /* Temporaries ("." NAME "." ... ".tmp") left in cli_dir. */
 static int temporaries(void)
 {
@@ -105,7 +90,7 @@ START_TEST(planted_link_not_followed)
     waitpid(pid, &st, 0);
     ck_assert(WIFEXITED(st) && WEXITSTATUS(st) == 0);
     size_t n;
-    char *v = slurp(victim, &n);
+    char *v = jf_test_slurp(victim, &n);
     ck_assert_str_eq(v, "precious\n");
     free(v);
     ck_assert(file_size(cli_path("out.xyz")) > 1000);
@@ -212,7 +197,7 @@ START_TEST(output_is_input)
 {
     const char *in = sphere(300);
     size_t n0 = 0, n1 = 0;
-    char *before = slurp(in, &n0);
+    char *before = jf_test_slurp(in, &n0);
     ck_assert_int_eq(symlink("sphere.ply", cli_path("sl.ply")), 0);
     ck_assert_int_eq(link(in, cli_path("hl.ply")), 0);
     const char *outs[] = {in, cli_path("sl.ply"), cli_path("hl.ply")};
@@ -220,7 +205,7 @@ START_TEST(output_is_input)
         ck_assert_int_eq(cli_run("estimate", in, "-o", outs[k], NULL), 1);
         ck_assert_ptr_nonnull(strstr(cli_err, "is the input file"));
     }
-    char *after = slurp(in, &n1);
+    char *after = jf_test_slurp(in, &n1);
     ck_assert(n0 == n1 && memcmp(before, after, n0) == 0);
     free(before), free(after);
     ck_assert_int_eq(temporaries(), 0);
@@ -271,7 +256,7 @@ START_TEST(render_failure_keeps_old)
     write_file(nan, "# x y z k1 k2\nnan nan nan 1 1\nnan nan nan 2 1\n");
     ck_assert_int_eq(cli_run("render", nan, "-o", png, NULL), 1);
     size_t n;
-    char *v = slurp(png, &n);
+    char *v = jf_test_slurp(png, &n);
     ck_assert_str_eq(v, "old picture");
     free(v);
     ck_assert_ptr_null(strchr(cli_err, '\n') ? strchr(strchr(cli_err, '\n') + 1, '\n') : NULL);

@@ -9,51 +9,8 @@
 
 #include "jf_test.h"
 #include "test_cli_util.h"
-#include "jf_test.h"
 
-/* Whole contents, malloc'd (NULL if unreadable). */
-static char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    rewind(f);
-    char *b = malloc((size_t)len + 1);
-    *n = fread(b, 1, (size_t)len, f);
-    b[*n] = '\0';
-    fclose(f);
-    return b;
-}
-
-/* rm -rf path (the test folder holds folders). */
-static void rm_rf(const char *path)
-{
-    fflush(NULL);
-    pid_t p = fork();
-    if (p == 0) {
-        execl("/bin/rm", "rm", "-rf", path, (char *)NULL);
-        _exit(127);
-    }
-    waitpid(p, NULL, 0);
-}
-
-static void teardown(void) { rm_rf(cli_dir); }
-
-/* 1 if path holds a whole PNG: the signature first and the IEND chunk last
- * (ISO/IEC 15948 §5.2, §11.2.5), read here independently of jetfit. */
-static int whole_png(const char *path)
-{
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    unsigned char a[8], b[12];
-    int ok = fread(a, 1, 8, f) == 8 && fseek(f, -12, SEEK_END) == 0 && fread(b, 1, 12, f) == 12 &&
-             !memcmp(a, sig, 8) && !memcmp(b, iend, 12);
-    fclose(f);
-    return ok;
-}
+static void teardown(void) { cli_rm_rf(cli_dir); }
 
 /* The swapper: a child that, until killed, replaces every ".*.tmp" entry
  * of dir with a symbolic link to victim (what any process with write
@@ -129,12 +86,12 @@ START_TEST(render_temporary_swapped)
         int rc = cli_run("render", res, "-o", png, NULL);
         stop(sw);
         size_t n;
-        char *v = slurp(victim, &n);
+        char *v = jf_test_slurp(victim, &n);
         ck_assert_msg(v && !strcmp(v, victim_text), "render %d wrote into the link's target", k);
         free(v);
         ck_assert_int_eq(links_in(out), 0);
         if (rc == 0) {
-            ck_assert(whole_png(png));
+            ck_assert(cli_whole_png(png));
         } else {
             ck_assert_int_eq(rc, 1);
             ck_assert_ptr_nonnull(strstr(cli_err, "replaced by another process"));
@@ -165,7 +122,7 @@ START_TEST(study_convergence_temporaries_swapped)
     int rcv = cli_run("convergence", "--out", cdir, "--quick", NULL);
     stop(sw);
     size_t n;
-    char *v = slurp(victim, &n);
+    char *v = jf_test_slurp(victim, &n);
     ck_assert_msg(v && !strcmp(v, victim_text), "a picture went into the link's target");
     free(v);
     ck_assert_int_eq(links_in(sdir), 0);
@@ -190,12 +147,12 @@ START_TEST(control_characters_in_names)
     const char *names[3] = {"normal.png", "curvature.png", "k.png"};
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/%s", sdir, names[k]);
-        ck_assert_msg(whole_png(path), "%s", names[k]);
+        ck_assert_msg(cli_whole_png(path), "%s", names[k]);
     }
     snprintf(cdir, sizeof cdir, "%s/con\nv", cli_dir);
     ck_assert_int_eq(cli_run("convergence", "--out", cdir, "--quick", NULL), 0);
     snprintf(path, sizeof path, "%s/degree_approx.png", cdir);
-    ck_assert(whole_png(path));
+    ck_assert(cli_whole_png(path));
 }
 END_TEST
 

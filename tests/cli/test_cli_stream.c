@@ -89,50 +89,20 @@ static void make_cloud(jf_cloud *c, size_t side)
     free(perm);
 }
 
-/* ---- the rows: the command's columns (cmd_estimate.c) ---------------- */
+/* ---- the rows: the command's columns, from the library's one list ---- */
 
-static const char *const names[] = {"x",  "y",  "z",  "nx", "ny", "nz", "k1", "k2",
-                                    "d1x", "d1y", "d1z", "d2x", "d2y", "d2z", "b0", "b1",
-                                    "b2", "b3", "c0", "c1", "c2", "c3", "c4"};
-
-static size_t columns(int monge, jf_column *cols)
-{
-    size_t n = 0;
-    size_t base = 14 + (monge >= 3 ? 4 : 0) + (monge >= 4 ? 5 : 0);
-    for (size_t j = 0; j < base; j++) cols[n++] = (jf_column){names[j], JF_COL_F64};
-    cols[n++] = (jf_column){"degree", JF_COL_I32};
-    cols[n++] = (jf_column){"neighbors", JF_COL_I32};
-    cols[n++] = (jf_column){"cond", JF_COL_F64};
-    cols[n++] = (jf_column){"residual", JF_COL_F64};
-    cols[n++] = (jf_column){"status", JF_COL_I32};
-    return n;
-}
+static size_t columns(int monge, jf_column *cols) { return jf_result_columns(monge, 0, cols); }
 
 static void row(const double *p, const jf_result *r, int monge, double *v)
 {
-    size_t n = 0;
-    for (int j = 0; j < 3; j++) v[n++] = p[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->normal[j];
-    v[n++] = r->k1;
-    v[n++] = r->k2;
-    for (int j = 0; j < 3; j++) v[n++] = r->d1[j];
-    for (int j = 0; j < 3; j++) v[n++] = r->d2[j];
-    if (monge >= 3)
-        for (int j = 0; j < 4; j++) v[n++] = r->b[j];
-    if (monge >= 4)
-        for (int j = 0; j < 5; j++) v[n++] = r->c[j];
-    v[n++] = r->degree;
-    v[n++] = r->n_used;
-    v[n++] = r->cond;
-    v[n++] = r->residual;
-    v[n++] = (double)r->status;
+    jf_result_row(p, r, monge, 0, v);
 }
 
 /* The whole-array path: every result, then rows in input order. */
 static void write_whole(const char *path, const jf_cloud *c, const jf_estimate_opts *o,
                         int ascii)
 {
-    jf_column cols[32];
+    jf_column cols[JF_RESULT_MAX_COLS];
     int monge = o->params.monge_degree;
     size_t nc = columns(monge, cols);
     jf_result *r = malloc(c->n * sizeof *r);
@@ -177,7 +147,7 @@ static jf_status sink(void *user, const uint32_t *idx, jf_result *res, size_t m)
 static jf_status write_blocks(const char *path, const jf_cloud *c, const jf_estimate_opts *o,
                               int ascii, size_t fail_after)
 {
-    jf_column cols[32];
+    jf_column cols[JF_RESULT_MAX_COLS];
     int monge = o->params.monge_degree;
     size_t nc = columns(monge, cols);
     jf_error err;
@@ -196,23 +166,10 @@ static jf_status write_blocks(const char *path, const jf_cloud *c, const jf_esti
     return jf_writer_commit(w, &err);
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    *len = (size_t)ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc(*len + 1);
-    ck_assert_uint_eq(fread(b, 1, *len, f), *len);
-    fclose(f);
-    return b;
-}
-
 static void assert_same_file(const char *a, const char *b, const char *what)
 {
     size_t la, lb;
-    char *x = slurp(a, &la), *y = slurp(b, &lb);
+    char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
     ck_assert_msg(la == lb && !memcmp(x, y, la), "%s: %s and %s differ (%zu, %zu bytes)", what,
                   a, b, la, lb);
     free(x);
@@ -325,7 +282,7 @@ END_TEST
 static jf_status write_parts(const char *path, const jf_cloud *c, const jf_estimate_opts *o,
                              int nparts)
 {
-    jf_column cols[32];
+    jf_column cols[JF_RESULT_MAX_COLS];
     int monge = o->params.monge_degree;
     size_t nc = columns(monge, cols);
     jf_error err;

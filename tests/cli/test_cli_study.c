@@ -563,11 +563,6 @@ static int chromium_flag(const char *page, const char *what, const char *out, co
 
 START_TEST(report_opens_in_chromium)
 {
-    if (access(CHROMIUM, X_OK) != 0) {
-        printf("SKIP report_opens_in_chromium: %s is not installed (Debian package chromium)\n",
-               CHROMIUM);
-        return;
-    }
     cli_setup();
     char dir[300]; /* not cli_path's rotating buffer: more paths follow */
     snprintf(dir, sizeof dir, "%s/st", cli_dir);
@@ -958,7 +953,6 @@ int main(void)
     tcase_add_test(t, study_of_an_input_equals_estimate_eval_subset);
     tcase_add_test(t, mesh_study_equals_generate_mesh);
     tcase_add_test(t, resume_after_kill_gives_the_same_files);
-    tcase_add_test(t, report_opens_in_chromium);
     tcase_add_test(t, natural_points_count_as_ok);
     tcase_add_test(t, bad_input_one_line_no_folder);
     tcase_add_test(t, failing_cell_recorded_study_goes_on);
@@ -967,5 +961,11 @@ int main(void)
     tcase_add_test(t, one_progress_line_with_eta);
     tcase_add_test(t, user_text_stays_text);
     suite_add_tcase(s, t);
-    return jf_test_run(s);
+    TCase *c = tcase_create("chromium"); /* its own ctest: test_cli_study_chromium */
+    tcase_set_timeout(c, 600);
+    tcase_set_tags(c, "chromium");
+    tcase_add_test(c, report_opens_in_chromium);
+    suite_add_tcase(s, c);
+    return jf_test_run_tool(s, "chromium", access(CHROMIUM, X_OK) == 0,
+                            CHROMIUM " is not installed (Debian package chromium)");
 }

@@ -50,6 +50,33 @@ static inline void cli_teardown(void)
     rmdir(cli_dir);
 }
 
+/* rm -rf path (a test folder holding folders). */
+static inline void cli_rm_rf(const char *path)
+{
+    fflush(NULL);
+    pid_t p = fork();
+    if (p == 0) {
+        execl("/bin/rm", "rm", "-rf", path, (char *)NULL);
+        _exit(127);
+    }
+    waitpid(p, NULL, 0);
+}
+
+/* 1 if path holds a whole PNG: the signature first and the IEND chunk last
+ * (ISO/IEC 15948 §5.2, §11.2.5), read independently of jetfit. */
+static inline int cli_whole_png(const char *path)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    unsigned char a[8], b[12];
+    int ok = fread(a, 1, 8, f) == 8 && fseek(f, -12, SEEK_END) == 0 && fread(b, 1, 12, f) == 12 &&
+             !memcmp(a, sig, 8) && !memcmp(b, iend, 12);
+    fclose(f);
+    return ok;
+}
+
 /* cli_dir "/" name, in a rotating static buffer (8 live paths). */
 static inline const char *cli_path(const char *name)
 {

@@ -11,7 +11,6 @@
 #include "view.h"
 #include "jf_test.h"
 
-static int have_three;
 
 /* IEEE 754 binary16 -> double, from the definition (not view_pack.c) */
 static double half_to_double(uint16_t h)
@@ -164,7 +163,6 @@ static long fsize(const char *p)
 
 START_TEST(errors_name_the_file_and_write_nothing)
 {
-    if (!have_three) return;
     cli_write_text(cli_path("abc.csv"), "a,b,c\n1,2,3\n");
     cli_write_text(cli_path("old.html"), "old");
     ck_assert_int_eq(cli_run("view", cli_path("nope.ply"), "-o", cli_path("old.html"), NULL), 1);
@@ -203,7 +201,6 @@ END_TEST
 
 START_TEST(subsample_estimate_and_size)
 {
-    if (!have_three) return;
     ck_assert_int_eq(cli_run("generate", "paraboloid", "-o", cli_path("raw.ply"), "--n", "4000", NULL), 0);
     ck_assert_int_eq(cli_run("view", "--estimate", cli_path("raw.ply"), "-o", cli_path("e.html"),
                              "--degree", "2", "--neighbors", "knn:20", "--threads", "1", "--quiet", NULL), 0);
@@ -221,9 +218,27 @@ START_TEST(subsample_estimate_and_size)
 }
 END_TEST
 
+/* view --estimate names the INPUT, not its temporary: two runs give the
+ * same page byte for byte. */
+START_TEST(estimate_page_names_the_input)
+{
+    ck_assert_int_eq(cli_run("generate", "sphere", "-o", cli_path("cloud.ply"), "--n", "500", NULL), 0);
+    for (int k = 0; k < 2; k++)
+        ck_assert_int_eq(cli_run("view", "--estimate", cli_path("cloud.ply"), "-o",
+                                 cli_path(k ? "b.html" : "a.html"), "--threads", "1", "--quiet", NULL), 0);
+    size_t na, nb;
+    char *a = jf_test_slurp(cli_path("a.html"), &na), *b = jf_test_slurp(cli_path("b.html"), &nb);
+    ck_assert(a && b);
+    ck_assert_ptr_nonnull(strstr(a, "{\"file\":\"cloud.ply\""));
+    ck_assert_ptr_null(strstr(a, "jetfit-view-"));
+    ck_assert(na == nb && !memcmp(a, b, na));
+    free(a);
+    free(b);
+}
+END_TEST
+
 START_TEST(study_report_links_the_best_result)
 {
-    if (!have_three) return;
     ck_assert_int_eq(cli_run("study", "sphere", "-o", cli_path("st"), "--n", "600", "--degree", "2,3",
                              "--quiet", NULL), 0);
     ck_assert_int_eq(meta_num(cli_path("st/view.html"), "ndrawn"), 600);
@@ -254,9 +269,7 @@ int main(void)
     size_t n = p ? fread(v, 1, sizeof v - 1, p) : 0;
     v[n] = 0;
     if (p) pclose(p);
-    have_three = strstr(v, "view: three.js r") != NULL;
-    if (!have_three)
-        printf("SKIP (part): three.js not found (Debian: libjs-three); the command's runs are skipped\n");
+    int have_three = strstr(v, "view: three.js r") != NULL;
     Suite *s = suite_create("cli_view");
     TCase *tc = tcase_create("view");
     tcase_set_timeout(tc, 120);
@@ -265,11 +278,17 @@ int main(void)
     tcase_add_test(tc, base64_round_trips);
     tcase_add_test(tc, names_and_scripts_are_escaped);
     tcase_add_test(tc, spread_order_is_an_even_permutation);
-    tcase_add_test(tc, errors_name_the_file_and_write_nothing);
     tcase_add_test(tc, no_three_is_one_clear_line);
-    tcase_add_test(tc, subsample_estimate_and_size);
-    tcase_add_test(tc, study_report_links_the_best_result);
     suite_add_tcase(s, tc);
-    int rc = jf_test_run(s);
-    return rc ? rc : !have_three ? 77 : 0;
+    /* the command's pages need three.js: their own ctest, test_cli_view_three */
+    TCase *th = tcase_create("three");
+    tcase_set_timeout(th, 120);
+    tcase_set_tags(th, "three");
+    tcase_add_checked_fixture(th, cli_setup, cli_teardown);
+    tcase_add_test(th, errors_name_the_file_and_write_nothing);
+    tcase_add_test(th, subsample_estimate_and_size);
+    tcase_add_test(th, study_report_links_the_best_result);
+    tcase_add_test(th, estimate_page_names_the_input);
+    suite_add_tcase(s, th);
+    return jf_test_run_tool(s, "three", have_three, "three.js not found (Debian: libjs-three)");
 }

@@ -7,6 +7,9 @@
 
 #include <check.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* Runs every case of s (Check's normal output, its summary line); the
  * process's exit status: 0 if all passed, else 1. */
@@ -17,6 +20,44 @@ static inline int jf_test_run(Suite *s)
     int failed = srunner_ntests_failed(sr);
     srunner_free(sr);
     return failed ? 1 : 0;
+}
+
+/* Runs s, whose cases tagged `tool` (tcase_set_tags) need an optional
+ * tool (have: 1 when it is here).  ctest runs those cases as a test of
+ * their own (CK_INCLUDE_TAGS=tool, see jf_tool_case in
+ * tests/CMakeLists.txt) and the rest without them (CK_EXCLUDE_TAGS), so a
+ * missing tool is a reported skip (the reason, exit status 77) of that
+ * test, never a pass; run by hand, the suite says SKIP and leaves them
+ * out. */
+static inline int jf_test_run_tool(Suite *s, const char *tool, int have, const char *reason)
+{
+    const char *only = getenv("CK_INCLUDE_TAGS");
+    if (!have) {
+        printf("SKIP cases tagged %s: %s\n", tool, reason);
+        if (only && !strcmp(only, tool)) return 77; /* s: freed by the exit */
+        setenv("CK_EXCLUDE_TAGS", tool, 1);
+    }
+    return jf_test_run(s);
+}
+
+/* The whole file at path, malloc'd and NUL-ended (*len, when len is not
+ * NULL: its size); NULL if it cannot be read. */
+static inline void *jf_test_slurp(const char *path, size_t *len)
+{
+    if (len) *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    char *b = n >= 0 && fseek(f, 0, SEEK_SET) == 0 ? (char *)malloc((size_t)n + 1) : NULL;
+    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
+        free(b);
+        b = NULL;
+    }
+    fclose(f);
+    if (!b) return NULL;
+    b[n] = '\0';
+    if (len) *len = (size_t)n;
+    return b;
 }
 
 /* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */

@@ -30,19 +30,6 @@ static char *path_of(const char *name)
     return p[k];
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    *len = (size_t)ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc(*len ? *len : 1);
-    ck_assert_uint_eq(fread(b, 1, *len, f), *len);
-    fclose(f);
-    return b;
-}
-
 /* Writes a table of x y z [+ extra double columns] with c's attributes. */
 static void write_table(const char *path, const jf_cloud *c, int ascii, size_t nextra,
                         const char *const *extra)
@@ -262,7 +249,7 @@ START_TEST(rename_clash)
     static const char *const extra[] = {"nx", "k1"};
     write_table(path_of("o.csv"), &c, 0, 2, extra);
     size_t len;
-    unsigned char *b = slurp(path_of("o.csv"), &len);
+    unsigned char *b = jf_test_slurp(path_of("o.csv"), &len);
     const char *head = "x,y,z,in_nx,in_in_nx,in_k1,q,nx,k1\n1,2,3,4,5,6,7,0,-1\n";
     ck_assert_msg(len > strlen(head) && !memcmp(b, head, strlen(head)), "%.*s", (int)len, b);
     free(b);
@@ -404,7 +391,7 @@ START_TEST(las_records_kept)
         }
         write_table(path_of("out.las"), &c, 0, 2, extra);
         size_t len;
-        unsigned char *b = slurp(path_of("out.las"), &len);
+        unsigned char *b = jf_test_slurp(path_of("out.las"), &len);
         unsigned hs = g16(in + 94), rl = g16(in + 105);
         uint32_t doff = g32(b + 96), idoff = g32(in + 96);
         ck_assert_int_eq(b[25], 4);
@@ -533,7 +520,7 @@ START_TEST(las_13_short_header)
     ck_assert_ptr_null(c.attrs.las_evlr);
     write_table(path_of("s.out.las"), &c, 0, 0, NULL);
     size_t len;
-    unsigned char *b = slurp(path_of("s.out.las"), &len);
+    unsigned char *b = jf_test_slurp(path_of("s.out.las"), &len);
     unsigned rl = g16(in + 105);
     uint32_t doff = g32(b + 96), idoff = g32(in + 96);
     ck_assert_uint_eq(g16(b + 105), rl);

@@ -32,28 +32,12 @@
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_e57_XXXXXX"); }
 
-/* The whole file (*n bytes) or NULL. */
-static unsigned char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    long L = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)L + 1);
-    ck_assert_uint_eq(fread(b, 1, (size_t)L, f), (size_t)L);
-    fclose(f);
-    b[L] = 0;
-    *n = (size_t)L;
-    return b;
-}
-
 /* The XML section, found by the header's offset and length, NUL
  * terminated (checksums dropped here, not by the reader). */
 static char *logical(const char *path, size_t *n)
 {
     size_t len;
-    unsigned char *b = slurp(path, &len);
+    unsigned char *b = jf_test_slurp(path, &len);
     char *o = malloc(len + 1);
     size_t k = 0;
     for (size_t p = 0; p < len; p += 1024) {
@@ -75,7 +59,7 @@ static char *logical(const char *path, size_t *n)
 static unsigned char *image(const char *path)
 {
     size_t len;
-    unsigned char *b = slurp(path, &len), *o = malloc(len);
+    unsigned char *b = jf_test_slurp(path, &len), *o = malloc(len);
     for (size_t p = 0, k = 0; p < len; p += 1024, k += 1020) memcpy(o + k, b + p, 1020);
     free(b);
     return o;
@@ -475,7 +459,7 @@ START_TEST(command_exit_status)
     char ep[300];
     snprintf(ep, sizeof ep, "%s/err.txt", tmpdir);
     size_t n;
-    unsigned char *t = slurp(ep, &n);
+    unsigned char *t = jf_test_slurp(ep, &n);
     ck_assert_msg(strstr((char *)t, "jetfit: " DATA "bad-crc.e57: page 0") == (char *)t, "%s", t);
     ck_assert(n > 0 && t[n - 1] == '\n' && !memchr(t, '\n', n - 1));
     free(t);

@@ -12,6 +12,8 @@ count) have their boundaries in dense regions:
   tiny.ply      2 finite points and 2 NaN rows (a 3-rank run has an empty
                 part; K above every part's count)
   ten.ply       10 points (knn:8 with 3 ranks: K above each part's count)
+  few.ply       4 finite points and 5 NaN rows: most points cannot be
+                fitted (a warning), and a 5-rank run has an empty part
 Deterministic (own LCG, no random module state)."""
 import math
 import struct
@@ -63,6 +65,9 @@ def main(d):
     nan = float("nan")
     write(d + "/tiny.ply", [(0.0, 0.0, 0.0), (nan, 0.0, 0.0), (1.0, 0.5, 0.0), (0.0, nan, nan)])
     write(d + "/ten.ply", [(rnd(), rnd(), 0.1 * rnd()) for _ in range(10)])
+    write(d + "/few.ply", [(0.0, 0.0, 0.0), (nan, 0.0, 0.0), (1.0, 0.0, 0.1), (nan, nan, nan),
+                           (0.0, 1.0, 0.05), (nan, 1.0, 1.0), (1.0, 1.0, 0.2), (2.0, nan, 0.0),
+                           (5.0, 5.0, nan)])
 
 
 if __name__ == "__main__":

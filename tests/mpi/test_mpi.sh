@@ -61,9 +61,19 @@ equal-knn)
   same "3" lattice.ply ply --neighbors knn:16 --degree-select 1 --dist-weight 0.5 \
        --orient viewpoint:0,0,10 --frame axis
   same "2 3" clusters.ply ply                       # knn:32, orient input (normals)
-  # tiny.ply (2 finite points: a 3-rank run has an empty part) is no longer
-  # compared: jetfit estimate now refuses a cloud where no point can be
-  # fitted (issue 33.12), and jetfit-mpi does not apply that rule yet
+  # tiny.ply (no point can be fitted) is refused as jetfit estimate refuses
+  # it (errors mode); few.ply: most points unfitted, jetfit's bytes and its
+  # warning, and an empty part on 5 ranks (issues 31, 33.12)
+  same "1 3 5" few.ply ply --neighbors knn:4 --degree 1
+  "$jetfit" estimate "$d/few.ply" -o "$d/ref.ply" --quiet --keep none --neighbors knn:4 \
+    --degree 1 2>"$d/want"
+  for np in 1 5; do
+    mpi "$np" estimate "$d/few.ply" -o "$d/got.ply" --quiet --neighbors knn:4 --degree 1 2>"$d/stderr"
+    if [ "$(sed 's/^jetfit[^:]*: //' "$d/want")" = "$(sed 's/^jetfit[^:]*: //' "$d/stderr")" ] &&
+       grep -q "5 of 9 points could not be fitted" "$d/stderr"; then
+      echo "ok   np $np few.ply: $(cat "$d/stderr")"
+    else bad "np $np few.ply: jetfit-mpi's warning '$(cat "$d/stderr")', jetfit's '$(cat "$d/want")'"; fi
+  done
   same "3" ten.ply ply --neighbors knn:8 --fit interp --degree 2
   # LAS input: each rank decodes its byte range of the records (scale, offset)
   "$jetfit" estimate "$d/clusters.ply" -o "$d/clusters.las" --quiet --keep none ||
@@ -98,7 +108,7 @@ errors)
   printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n' >"$d/xonly.ply"
   head -c 24 /dev/zero >>"$d/xonly.ply"
   printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$d/empty.ply"
-  for f in xonly.ply empty.ply; do
+  for f in xonly.ply empty.ply tiny.ply; do
     "$jetfit" estimate "$d/$f" -o "$d/err.ply" --quiet 2>"$d/want"; rc=$?
     want=$(sed 's/^jetfit[^:]*: //' "$d/want")
     [ $rc -eq 1 ] && [ -n "$want" ] || bad "jetfit estimate $f: exit $rc, '$want'"

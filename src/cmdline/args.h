@@ -1,4 +1,4 @@
-/* args.h -- GNU-style command lines for every command (src/cli/args.c):
+/* args.h -- GNU-style command lines for every command (src/cmdline/args.c):
  * what getopt_long(3) accepts, from tables of option names, so each
  * command's parser is a loop over (option, value) pairs and operands. */
 #ifndef JF_CLI_ARGS_H

@@ -1,8 +1,8 @@
-/* opts.h -- the estimation options shared by `jetfit estimate` and
- * `jetfit study` (src/cli/opts.c): strict number parsing, one option at a
- * time into a jf_estimate_opts, and the checks that need them all.  Study
- * parses each of its --flags sets with the same code, so an option means
- * the same in both commands. */
+/* opts.h -- the estimate's command line (src/cmdline/opts.c), shared by
+ * `jetfit estimate`, `jetfit study` and `jetfit-mpi estimate`: one flag at
+ * a time into a jf_estimate_opts through the library's jf_estimate_opts_set,
+ * then jf_estimate_opts_finish.  Study parses each of its --flags sets
+ * with the same code, so an option means the same in every command. */
 #ifndef JF_CLI_OPTS_H
 #define JF_CLI_OPTS_H
 
@@ -20,19 +20,19 @@ int jf_cli_parse_list(const char *s, double *v, int max);
 /* One set of estimation options as the command line gives them. */
 typedef struct {
     jf_estimate_opts o;
-    const char *dsel_s;    /* --degree-select text, for _finish's message */
-    jf_read_opts ro;       /* --columns                                  */
-    const char *nbspec;    /* --neighbors text (parsed by _finish)       */
-    int monge;             /* --monge-degree, -1 = from the degree       */
-    const char *monge_s;
+    jf_read_opts ro;         /* --columns, --bad-rows                    */
+    const char *given[17];   /* each flag's text as given (for messages) */
+    char flag[48];           /* a message's flag made from a parameter   */
 } jf_cli_est;
+
+/* The default neighbourhood as the help says it (the library's default:
+ * opts.c checks that they agree). */
+#define JF_CLI_DEFAULT_NEIGHBORS "knn:32"
 
 /* What was wrong: option, its value, why (static or argv strings). */
 typedef struct {
     const char *opt, *val, *why;
 } jf_cli_bad;
-
-#define JF_CLI_DEFAULT_NEIGHBORS "knn:32"
 
 void jf_cli_est_init(jf_cli_est *e);
 
@@ -46,8 +46,8 @@ int jf_cli_est_takes_value(const char *name);
 /* Applies option NAME (with VAL, NULL for a flag).  0, or -1 with *bad. */
 int jf_cli_est_option(jf_cli_est *e, const char *name, const char *val, jf_cli_bad *bad);
 
-/* After all options: parses the neighbourhood, settles the Monge degree
- * and max_neighbors, validates.  0, or -1 with *bad. */
+/* After all options: jf_estimate_opts_finish (the Monge degree,
+ * max_neighbors, the checks).  0, or -1 with *bad. */
 int jf_cli_est_finish(jf_cli_est *e, jf_cli_bad *bad);
 
 /* The whole `jetfit estimate` (and `jetfit-mpi estimate`) command line. */
