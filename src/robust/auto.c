@@ -14,7 +14,7 @@
  *  2. Noise: the unbiased residual variance of the cubic at K = 32 (22
  *     degrees of freedom), where truncation error (O(h^4), Theorem 3) is
  *     least and the noise is still well sampled; the next larger K where
- *     that exceeds jf__auto_blob x the radius (a blob of noise, whose cubic
+ *     that exceeds auto_blob x the radius (a blob of noise, whose cubic
  *     follows it).  It is what `sigma` reports.
  *  3. Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
  *     intersection of confidence intervals of Katkovnik 1999; the K that
@@ -51,20 +51,8 @@ typedef double v2d __attribute__((vector_size(16)));
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
 
-/* Lepski's threshold, in sd (chosen on tests/bench/study_auto.sh's data) */
-double jf__auto_tau = 2.0;
-/* A residual above this fraction of the radius is a blob of noise whose
- * cubic follows the noise (and whose residual understates it): the noise
- * is then read at a larger K. */
-double jf__auto_blob = 0.2;
-/* A normal whose sd exceeds this (rad) is noise: it does not stop K. */
-double jf__auto_sdmax = 0.3;
-/* Noise below this fraction of the radius: cubics on 16-24 points allowed. */
-double jf__auto_clean = 0.05;
-/* 1: Goldenshluger-Lepski over every (K, degree) instead (bench --auto-gl
- * 1; worse, docs/robustness.md "Neighbourhood auto") */
-int jf__auto_gl = 0;
-double jf__auto_varw = 1.0;
+/* The thresholds (Lepski's tau, blob, sdmax, clean, varw, gl) are the
+ * fitter's knobs: jf__knob_defaults in robust.c says what each means. */
 
 /* total degree of monomial j (order 1, x, y, x^2, xy, y^2, x^3, ...) */
 static const int mdeg[NMON] = {0, 1, 1, 2, 2, 2, 3, 3, 3, 3};
@@ -192,7 +180,7 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
 
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
  * agrees with every smaller accepted K's.  Returns its index or -1. */
-static int lepski(const cand_fit *c, int nc, double s2, double tau)
+static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax)
 {
     int acc[NCAND], na = 0, best = -1;
     for (int i = 0; i < nc; i++) {
@@ -201,7 +189,7 @@ static int lepski(const cand_fit *c, int nc, double s2, double tau)
         int okk = 1;
         for (int j = 0; j < na && okk; j++) {
             double sdj = sqrt(s2 * c[acc[j]].tr);
-            if (!(sdj < jf__auto_sdmax)) continue; /* a normal of noise bounds nothing */
+            if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
             okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <= tau * (sdi + sdj);
         }
         if (!okk) break;
@@ -436,6 +424,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                        size_t n, jf_result *out)
 {
     size_t nmax = n < JF_NB_AUTO_KMAX ? n : JF_NB_AUTO_KMAX;
+    const jf__knobs *kn = jf__knobs_of(f);
     /* step 1: the frame, PCA of the FRAME_K nearest finite points */
     double mean[3] = {0, 0, 0}, cov[9] = {0};
     size_t kf = 0;
@@ -517,7 +506,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     double s2 = NAN;
     for (int i = 0; i < nc; i++)
         if (cf[1][i].ok) {
-            double hb = jf__auto_blob * cf[1][i].h;
+            double hb = kn->auto_blob * cf[1][i].h;
             s2 = cf[1][i].s2;
             if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
@@ -527,11 +516,11 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
      * is a small fraction of its radius (clean data, where the small
      * cubic is the least biased choice) */
     for (int i = 0; i < nc; i++) {
-        double hc = jf__auto_clean * cf[1][i].h;
+        double hc = kn->auto_clean * cf[1][i].h;
         if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= hc * hc)) cf[1][i].ok = 0;
     }
 
-    if (jf__auto_gl) {
+    if (kn->auto_gl) {
         /* Goldenshluger-Lepski over every (K, degree): the squared bias of a
          * candidate is its largest excess move against each less biased
          * one (smaller K, or the cubic at the same K), less what noise of
@@ -548,11 +537,11 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                         const cand_fit *b = &cf[e][j];
                         if (!b->ok || (j == i && e <= d)) continue;
                         double vb = s2 * b->tr;
-                        if (!(vb < jf__auto_sdmax * jf__auto_sdmax)) continue;
-                        double x = jf__angle(a->nrm, b->nrm) - jf__auto_tau * sqrt(fabs(vb - va));
+                        if (!(vb < kn->auto_sdmax * kn->auto_sdmax)) continue;
+                        double x = jf__angle(a->nrm, b->nrm) - kn->auto_tau * sqrt(fabs(vb - va));
                         if (x > 0.0 && x * x > b2) b2 = x * x;
                     }
-                double cost = b2 + jf__auto_varw * va;
+                double cost = b2 + kn->auto_varw * va;
                 if (cost < bcost) {
                     bcost = cost;
                     bd = d;
@@ -563,8 +552,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         return direct_fit(f, pr, p, nbr, ks[bc], &mo[bc], H, fr, bd ? 3 : 2, sigma, out);
     }
     /* step 3: Lepski per degree */
-    double tau = jf__auto_tau;
-    int c2 = lepski(cf[0], nc, s2, tau), c3 = lepski(cf[1], nc, s2, tau);
+    double tau = kn->auto_tau;
+    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax), c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax);
     /* step 4: the degree */
     int d = 3, ci = c3;
     if (c3 < 0) {

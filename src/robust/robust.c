@@ -56,29 +56,16 @@
 #define JF_DEGREE_FLOOR_N 50.0
 #endif
 
-jf__knobs jf__knob = {JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN,
-                      JF_DEGREE_FLOOR_N};
-
-/* Bench-only setter of the knobs (tests/bench/bench_pcpnet.cpp measures them);
- * not in jetfit.h, not thread-safe: call before fitting.  name: a field
- * of jf__knobs.  Returns 0, or -1 for an unknown name. */
-int jf__robust_tune(const char *name, double v)
-{
-    if (!strcmp(name, "scale_varw")) jf__knob.scale_varw = v;
-    else if (!strcmp(name, "scale_target")) jf__knob.scale_target = v;
-    else if (!strcmp(name, "scale_floor")) jf__knob.scale_floor = v;
-    else if (!strcmp(name, "degree_tau")) jf__knob.degree_tau = v;
-    else if (!strcmp(name, "degree_sdmin")) jf__knob.degree_sdmin = v;
-    else if (!strcmp(name, "degree_floor_n")) jf__knob.degree_floor_n = v;
-    else if (!strcmp(name, "auto_tau")) jf__auto_tau = v;
-    else if (!strcmp(name, "auto_blob")) jf__auto_blob = v;
-    else if (!strcmp(name, "auto_sdmax")) jf__auto_sdmax = v;
-    else if (!strcmp(name, "auto_varw")) jf__auto_varw = v;
-    else if (!strcmp(name, "auto_clean")) jf__auto_clean = v;
-    else if (!strcmp(name, "auto_gl")) jf__auto_gl = (int)v;
-    else return -1;
-    return 0;
-}
+/* neighbors auto (auto.c): Lepski's threshold in sd (chosen on
+ * tests/bench/study_auto.sh's data); a residual above auto_blob x the
+ * radius is a blob of noise whose cubic follows the noise (the noise is
+ * then read at a larger K); a normal whose sd exceeds auto_sdmax (rad) is
+ * noise and stops no K; noise below auto_clean x the radius allows cubics
+ * on 16-24 points; auto_gl 1 = Goldenshluger-Lepski over every (K, degree)
+ * (worse: docs/robustness.md "Neighbourhood auto"). */
+const jf__knobs jf__knob_defaults = {
+    JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
+    2.0, 0.2, 0.3, 0.05, 1.0, 0};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -89,6 +76,7 @@ typedef struct {
     size_t cap;
     jf_fitter *fit[JF_MAX_DEGREE + 1]; /* fit[d]: a fitter of degree d */
     jf_params key;                     /* the parameters they were made from */
+    jf__knobs knob;                    /* the selection rules' tuning */
 } ws_state;
 
 static void ws_free(void *p)
@@ -104,10 +92,42 @@ static void ws_free(void *p)
 static ws_state *ws_get(jf_fitter *f)
 {
     if (!f->ext) {
-        if (!(f->ext = calloc(1, sizeof(ws_state)))) return NULL;
+        ws_state *b = calloc(1, sizeof *b);
+        if (!b) return NULL;
+        b->knob = jf__knob_defaults;
+        f->ext = b;
         f->ext_free = ws_free;
     }
     return f->ext;
+}
+
+const jf__knobs *jf__knobs_of(jf_fitter *f)
+{
+    ws_state *b = ws_get(f);
+    return b ? &b->knob : &jf__knob_defaults;
+}
+
+/* Bench- and test-only (tests/bench/bench_pcpnet.cpp measures them): not
+ * in jetfit.h. */
+int jf__robust_tune(jf_fitter *f, const char *name, double v)
+{
+    ws_state *b = ws_get(f);
+    if (!b) return -1;
+    jf__knobs *k = &b->knob;
+    if (!strcmp(name, "scale_varw")) k->scale_varw = v;
+    else if (!strcmp(name, "scale_target")) k->scale_target = v;
+    else if (!strcmp(name, "scale_floor")) k->scale_floor = v;
+    else if (!strcmp(name, "degree_tau")) k->degree_tau = v;
+    else if (!strcmp(name, "degree_sdmin")) k->degree_sdmin = v;
+    else if (!strcmp(name, "degree_floor_n")) k->degree_floor_n = v;
+    else if (!strcmp(name, "auto_tau")) k->auto_tau = v;
+    else if (!strcmp(name, "auto_blob")) k->auto_blob = v;
+    else if (!strcmp(name, "auto_sdmax")) k->auto_sdmax = v;
+    else if (!strcmp(name, "auto_varw")) k->auto_varw = v;
+    else if (!strcmp(name, "auto_clean")) k->auto_clean = v;
+    else if (!strcmp(name, "auto_gl")) k->auto_gl = (int)v;
+    else return -1;
+    return 0;
 }
 
 double *jf__ws_buf(jf_fitter *f, size_t need)

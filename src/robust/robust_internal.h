@@ -12,7 +12,10 @@
  * doubles of residuals and weights; larger ones the fitter's buffer. */
 #define JF_STACK_N 512
 
-/* Tuning constants of the selection rules (defaults in robust.c). */
+/* Tuning constants of the selection rules and of neighbors auto
+ * (defaults and reasons in robust.c and auto.c).  Each fitter carries its
+ * own copy (the defaults until jf__robust_tune changes them): the library
+ * keeps no mutable global. */
 typedef struct {
     double scale_varw;   /* scale selection: weight of the variance */
     double scale_target; /* scale selection: stop once sd is below (rad) */
@@ -21,11 +24,16 @@ typedef struct {
     double degree_sdmin; /* degree selection: keep the top degree below */
     double degree_floor_n; /* degree selection: the blob floor shrinks as
                               sqrt(degree_floor_n / n) above this n */
+    double auto_tau, auto_blob, auto_sdmax, auto_clean, auto_varw; /* auto.c */
+    int auto_gl;
 } jf__knobs;
-extern jf__knobs jf__knob;
+extern const jf__knobs jf__knob_defaults;
 
-/* Bench-only setter of a jf__knob field by name; 0, or -1 if unknown. */
-int jf__robust_tune(const char *name, double v);
+/* Fitter f's tuning (the defaults when its state cannot be made). */
+const jf__knobs *jf__knobs_of(jf_fitter *f);
+/* Bench- and test-only setter of one of f's knobs by name (a field of
+ * jf__knobs); 0, or -1 if unknown or out of memory. */
+int jf__robust_tune(jf_fitter *f, const char *name, double v);
 
 /* Neither failed nor non-finite: the fit's quantities can be used. */
 int jf__usable(const jf_result *r);
@@ -45,7 +53,7 @@ jf_status jf__fit_robust(jf_fitter *f, const jf_params *pr, const double p[3],
 
 /* Standard deviation (radians) of the normal of fit r of n points with
  * noise variance s2; INFINITY when undefined. */
-double jf__normal_sd(const jf_result *r, double s2, const double p[3], const double *nbr,
+double jf__normal_sd(const jf__knobs *k, const jf_result *r, double s2, const double p[3], const double *nbr,
                      size_t n);
 /* Unbiased residual variance of r from its residual scale sigma. */
 double jf__unbiased_var(const jf_result *r, double sigma, size_t n);
@@ -62,8 +70,4 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
  * (nearest first) and the degree; fills out->sigma. */
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out);
-/* auto.c's Lepski threshold (bench-only knob) */
-extern double jf__auto_tau, jf__auto_blob, jf__auto_sdmax, jf__auto_varw, jf__auto_clean;
-extern int jf__auto_gl;
-
 #endif

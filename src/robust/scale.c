@@ -34,7 +34,7 @@ static double bias2(const jf_result *r, double sd_r, const jf_result *ref, doubl
  * larger of bias2() against the higher degree and, for a bias no
  * polynomial sees (a crease, a neighbourhood across a thin part), the
  * normal's excess move against each smaller K; the cost is that plus
- * varw * sd^2 (jf__knob.scale_varw = 2: the bias estimates are noisy and
+ * varw * sd^2 (scale_varw = 2: the bias estimates are noisy and
  * clipped at 0, so the minimum favours lucky draws; weighting the variance
  * up counters it).  The least cost wins.  Noise makes sd fall with K
  * (large K on flat, noisy regions); curvature makes the bias grow as h^2
@@ -57,6 +57,7 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
 
     double sigma;
     if (pr->nscales <= 0) return jf__fit_select(f, pr, p, nbr, n, buf, out, &sigma);
+    const jf__knobs *kn = jf__knobs_of(f);
 
     /* Candidate sizes: scales[] clamped to n, ascending, distinct. */
     size_t ks[8];
@@ -100,11 +101,11 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
             s2 = have_ref && ks[i] >= nref + 8 ? jf__unbiased_var(&ref, sg_ref, ks[i])
                                                : jf__unbiased_var(&r, sigma, ks[i]);
         }
-        double sd = jf__normal_sd(&r, s2, p, nbr, ks[i]);
+        double sd = jf__normal_sd(kn, &r, s2, p, nbr, ks[i]);
         /* ...from the smallest K whose normal is not noise: a blob's
          * residual underestimates the noise (its frame follows it) */
         if (!isfinite(s2n) && sd < SD_MEANINGFUL) s2n = s2;
-        if (have_ref) b2 = bias2(&r, sd, &ref, jf__normal_sd(&ref, s2, p, nbr, ks[i]));
+        if (have_ref) b2 = bias2(&r, sd, &ref, jf__normal_sd(kn, &ref, s2, p, nbr, ks[i]));
         /* Bias that a polynomial of any degree misses (a crease, a
          * neighbourhood reaching across a thin part) moves the normal with
          * K instead: the same estimate against each smaller K, whose
@@ -121,13 +122,13 @@ jf_status jf_fit_point_full(jf_fitter *f, const double p[3], const double *nbr,
         /* A noise-dominated normal's sd (a linearisation) understates its
          * error: such K win only when no K is better than noise, and
          * then the largest does. */
-        double cost = sd < SD_MEANINGFUL ? b2 + jf__knob.scale_varw * sd * sd : INFINITY;
+        double cost = sd < SD_MEANINGFUL ? b2 + kn->scale_varw * sd * sd : INFINITY;
         if (best < 0 || cost < best_cost || (!isfinite(best_cost) && !isfinite(cost))) {
             best_cost = cost;
             *out = r;
             best = i;
         }
-        if (sd <= jf__knob.scale_target) break; /* precise enough: stop growing */
+        if (sd <= kn->scale_target) break; /* precise enough: stop growing */
     }
     if (best >= 0 && best != nk - 1) out->status |= JF_PT_SCALE_SELECTED;
     return JF_OK;

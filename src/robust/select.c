@@ -15,7 +15,7 @@
  * by h (§2.3), and inverted by Cholesky.  s2: the noise variance, e.g. the
  * unbiased residual variance (unbiased_var()).  INFINITY when undefined. */
 #define SD_MAXN 15 /* degree <= 4: N_4 = 15; higher degrees use degree 4 */
-static double normal_sd(const jf_result *r, double s2, const double p[3], const double *nbr,
+static double normal_sd(const jf__knobs *kn, const jf_result *r, double s2, const double p[3], const double *nbr,
                         size_t n, double floor_n)
 {
     int d = r->degree < 4 ? r->degree : 4;
@@ -76,20 +76,20 @@ static double normal_sd(const jf_result *r, double s2, const double p[3], const 
      * to the plane, whose bias there exceeds the quadric's. */
     double sd = sqrt(s2 * var) / h, fl = sqrt(s2) / h, f2 = fl;
     if (floor_n > 0.0 && (double)n > floor_n) f2 = fl * sqrt(floor_n / (double)n);
-    return fl > jf__knob.scale_floor && f2 > sd ? f2 : sd;
+    return fl > kn->scale_floor && f2 > sd ? f2 : sd;
 }
 
-double jf__normal_sd(const jf_result *r, double s2, const double p[3], const double *nbr,
+double jf__normal_sd(const jf__knobs *kn, const jf_result *r, double s2, const double p[3], const double *nbr,
                      size_t n)
 {
-    return normal_sd(r, s2, p, nbr, n, 0.0);
+    return normal_sd(kn, r, s2, p, nbr, n, 0.0);
 }
 
 /* The sd used by degree selection: the floor shrinks with n. */
-static double select_sd(const jf_result *r, double s2, const double p[3], const double *nbr,
+static double select_sd(const jf__knobs *kn, const jf_result *r, double s2, const double p[3], const double *nbr,
                         size_t n)
 {
-    return normal_sd(r, s2, p, nbr, n, jf__knob.degree_floor_n);
+    return normal_sd(kn, r, s2, p, nbr, n, kn->degree_floor_n);
 }
 
 /* Unbiased residual variance of a fit of r->degree to n points whose RMS
@@ -129,6 +129,7 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
         return jf__fit_robust(f, pr, p, nbr, n, buf, dw, out, sigma, &neff);
     /* The chain, least bias first: [distance-weighted degree D,] degree D,
      * D - 1, ..., degree_select. */
+    const jf__knobs *kn = jf__knobs_of(f);
     jf_result top;
     double sg;
     jf_status st = jf__fit_robust(f, pr, p, nbr, n, buf, 0.0, &top, &sg, &neff);
@@ -140,7 +141,7 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
     double s2 = jf__unbiased_var(&top, sg, n);
     double nrm[JF_MAX_DEGREE + 2][3], sd[JF_MAX_DEGREE + 2];
     int acc = 0;
-    double sd_top = select_sd(&top, s2, p, nbr, n);
+    double sd_top = select_sd(kn, &top, s2, p, nbr, n);
     if (dw > 0.0) {
         jf_result rw;
         double sgw;
@@ -151,8 +152,8 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
             sd[acc++] = sd_top * sqrt((double)n / (neff > 1.0 ? neff : 1.0));
             *out = rw;
             *sigma = sgw;
-            if (!(sd_top >= jf__knob.degree_sdmin)) return JF_OK; /* precise enough */
-            if (!isfinite(s2) || !(jf__angle(top.normal, rw.normal) <= jf__knob.degree_tau * (sd[0] + sd_top)))
+            if (!(sd_top >= kn->degree_sdmin)) return JF_OK; /* precise enough */
+            if (!isfinite(s2) || !(jf__angle(top.normal, rw.normal) <= kn->degree_tau * (sd[0] + sd_top)))
                 return JF_OK;
         }
     }
@@ -161,16 +162,16 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
     *out = top;
     *sigma = sg;
     if (!isfinite(s2) || top.degree <= pr->degree_select) return JF_OK;
-    if (!(sd_top >= jf__knob.degree_sdmin)) return JF_OK; /* precise enough: keep D */
+    if (!(sd_top >= kn->degree_sdmin)) return JF_OK; /* precise enough: keep D */
     for (int d = top.degree - 1; d >= pr->degree_select; d--) {
         jf_fitter *g = jf__ws_fitter(f, pr, d);
         if (!g) return JF_ERR_NOMEM;
         jf_result r;
         if ((st = jf__fit_robust(g, pr, p, nbr, n, buf, 0.0, &r, &sg, &neff)) != JF_OK) return st;
         if (!jf__usable(&r)) break;
-        double s = select_sd(&r, s2, p, nbr, n);
+        double s = select_sd(kn, &r, s2, p, nbr, n);
         int ok = 1;
-        for (int j = 0; j < acc && ok; j++) ok = jf__angle(r.normal, nrm[j]) <= jf__knob.degree_tau * (s + sd[j]);
+        for (int j = 0; j < acc && ok; j++) ok = jf__angle(r.normal, nrm[j]) <= kn->degree_tau * (s + sd[j]);
         if (!ok) break;
         memcpy(nrm[acc], r.normal, sizeof nrm[acc]);
         sd[acc++] = s;

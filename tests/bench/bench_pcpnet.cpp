@@ -49,7 +49,10 @@
 
 // src/robust/robust.c's bench-only setter of its tuning constants (scale_varw,
 // scale_target, scale_floor, degree_tau, degree_sdmin, degree_floor_n).
-extern "C" int jf__robust_tune(const char *name, double v);
+extern "C" int jf__robust_tune(jf_fitter *f, const char *name, double v);
+// the knobs given on the command line, applied to every fitter made
+static std::vector<std::pair<std::string, double>> tunes;
+static void tune(const char *name, double v) { tunes.emplace_back(name, v); }
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 typedef Kernel::Point_3 Point;
@@ -144,6 +147,7 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
         std::fprintf(stderr, "bench_pcpnet: bad params (%s)\n", bad ? bad : "?");
         return NAN;
     }
+    for (auto &t : tunes) jf__robust_tune(f, t.first.c_str(), t.second);
     std::vector<uint32_t> idx(c.k);
     std::vector<double> nbr(3 * c.k), nrm(3 * s.pidx.size());
     std::map<std::pair<int, int>, size_t> chosen;
@@ -215,22 +219,22 @@ int main(int argc, char **argv)
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
         else if (!std::strcmp(argv[i], "--no-fixed")) no_fixed = true;
-        else if (!std::strcmp(argv[i], "--varw") && i + 1 < argc) jf__robust_tune("scale_varw", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) jf__robust_tune("scale_target", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) jf__robust_tune("scale_floor", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--dtau") && i + 1 < argc) jf__robust_tune("degree_tau", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--dsdmin") && i + 1 < argc) jf__robust_tune("degree_sdmin", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--dfloorn") && i + 1 < argc) jf__robust_tune("degree_floor_n", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--varw") && i + 1 < argc) tune("scale_varw", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--target") && i + 1 < argc) tune("scale_target", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) tune("scale_floor", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dtau") && i + 1 < argc) tune("degree_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dsdmin") && i + 1 < argc) tune("degree_sdmin", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--dfloorn") && i + 1 < argc) tune("degree_floor_n", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--distw") && i + 1 < argc) g_distw = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--same-points")) same_points = true;
         else if (!std::strcmp(argv[i], "--auto")) with_auto = true;
         else if (!std::strcmp(argv[i], "--cgal-jet2")) cgal_jet2 = true;
-        else if (!std::strcmp(argv[i], "--auto-tau") && i + 1 < argc) jf__robust_tune("auto_tau", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--auto-blob") && i + 1 < argc) jf__robust_tune("auto_blob", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--auto-sdmax") && i + 1 < argc) jf__robust_tune("auto_sdmax", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--auto-varw") && i + 1 < argc) jf__robust_tune("auto_varw", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--auto-clean") && i + 1 < argc) jf__robust_tune("auto_clean", std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--auto-gl") && i + 1 < argc) jf__robust_tune("auto_gl", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-tau") && i + 1 < argc) tune("auto_tau", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-blob") && i + 1 < argc) tune("auto_blob", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-sdmax") && i + 1 < argc) tune("auto_sdmax", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-varw") && i + 1 < argc) tune("auto_varw", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-clean") && i + 1 < argc) tune("auto_clean", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-gl") && i + 1 < argc) tune("auto_gl", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--cgal-ks") && i + 1 < argc) cgal_ks = argv[++i];
         else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
         else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) only_levels = argv[++i];

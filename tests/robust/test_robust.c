@@ -12,7 +12,9 @@
 #include "jf_test.h"
 
 /* src/robust/robust.c's bench-only setter of the selection constants */
-int jf__robust_tune(const char *name, double v);
+int jf__robust_tune(jf_fitter *f, const char *name, double v);
+/* degree_floor_n of roof_err's fitters (the library's default: 50) */
+static double roof_floor_n = 50.0;
 
 /* ---- the surface and its exact quantities ---- */
 static double fz(double u, double v) { return 0.1 * exp(2 * u + v - v * v); }
@@ -560,6 +562,7 @@ static double roof_err(double a, double sigma, size_t K, const jf_params *p, siz
         }
     jf_fitter *f;
     ck_assert_int_eq(jf_fitter_create(p, &f), JF_OK);
+    ck_assert_int_eq(jf__robust_tune(f, "degree_floor_n", roof_floor_n), 0);
     double *nbr = malloc(3 * K * sizeof *nbr), *d2 = malloc(K * sizeof *d2);
     size_t *idx = malloc(K * sizeof *idx);
     double *e = malloc(c.n * sizeof *e);
@@ -634,9 +637,9 @@ START_TEST(robust_normals_preset)
     size_t low_new, low_old, npts, l;
     p.degree = 2;
     double en = roof_err(1.0, 0.05, 256, &p, &low_new, &npts);
-    jf__robust_tune("degree_floor_n", 0.0);
+    roof_floor_n = 0.0;
     double eo = roof_err(1.0, 0.05, 256, &p, &low_old, &npts);
-    jf__robust_tune("degree_floor_n", 50.0);
+    roof_floor_n = 50.0;
     p.degree_select = 0;
     p.dist_weight = 0.0;
     double eq = roof_err(1.0, 0.05, 256, &p, &l, &npts);
