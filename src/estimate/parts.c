@@ -392,3 +392,67 @@ out:
     free(moff);
     return st;
 }
+
+/* ------------------------------------------- partition from a sample */
+
+typedef struct {
+    uint64_t key;
+    uint32_t id;
+} keyed;
+
+static int keyed_cmp(const void *a, const void *b)
+{
+    const keyed *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+/* Rank of (key, id) among the sorted cuts: how many are <= it. */
+static int32_t cut_rank(const keyed *cut, int ncut, uint64_t key, uint32_t id)
+{
+    int lo = 0, hi = ncut;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (cut[mid].key < key || (cut[mid].key == key && cut[mid].id <= id)) lo = mid + 1;
+        else hi = mid;
+    }
+    return (int32_t)lo;
+}
+
+jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
+                                  int32_t *part)
+{
+    if ((n && (!xyz || !part)) || nparts < 1 || nparts > JF_PARTS_MAX) return JF_ERR_INVALID;
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    if (!n) return JF_OK;
+    double box[6];
+    const size_t nf = jf__parts_bbox(xyz, n, box);
+    const double scale = jf__morton_scale(box);
+    /* every stride-th finite point, in input order: about JF_PARTS_SAMPLE */
+    const size_t stride = nf > JF_PARTS_SAMPLE ? nf / JF_PARTS_SAMPLE : 1;
+    size_t ns = nf ? (nf + stride - 1) / stride : 0, got = 0, seen = 0;
+    keyed *s = malloc((ns ? ns : 1) * sizeof *s);
+    keyed *cut = malloc((size_t)nparts * sizeof *cut);
+    if (!s || !cut) {
+        free(s);
+        free(cut);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n && got < ns; i++) {
+        if (!finite3(xyz + 3 * i)) continue;
+        if (seen++ % stride == 0) s[got++] = (keyed){jf__morton_key(xyz + 3 * i, box, scale), (uint32_t)i};
+    }
+    qsort(s, got, sizeof *s, keyed_cmp);
+    /* cut r (1..P-1) is the sample's r/P quantile: part r starts there */
+    int ncut = 0;
+    for (int r = 1; r < nparts && got; r++) cut[ncut++] = s[(size_t)r * got / (size_t)nparts];
+    free(s);
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
+#pragma omp parallel for num_threads(nt) schedule(static, 65536)
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        part[i] = finite3(p) ? cut_rank(cut, ncut, jf__morton_key(p, box, scale), (uint32_t)i) : -1;
+    }
+    free(cut);
+    return JF_OK;
+}

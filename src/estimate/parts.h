@@ -61,6 +61,17 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
 #define JF_PARTS_MAX 65536
 jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part);
 
+/* Step 1 without sorting the cloud (the bounded-memory estimate): the
+ * (Morton key, index) order's quantiles of a sample of about
+ * JF_PARTS_SAMPLE finite points (every stride-th in input order) cut it
+ * into nparts runs; part[i] as jf__parts_split's, -1 for non-finite
+ * points.  Parts are near equal, not exactly (the sample's error, about
+ * sqrt(P / JF_PARTS_SAMPLE) of a part); memory: 16 bytes per sampled
+ * point, not 12+ per point as the sort.  Same errors as jf__parts_split. */
+#define JF_PARTS_SAMPLE ((size_t)1 << 16)
+jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
+                                  int32_t *part);
+
 /* Squared distance from q to the box, a lower bound of the distance to
  * every point inside computed by the same rounded operations (never
  * larger: a part is skipped only if none of its points can qualify).
