@@ -13,6 +13,7 @@
 
 #include "cmd.h"
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
+#include "estimate/parts.h"  /* --memory: the plan (jf__parts_plan) */
 #include "jetfit.h"
 #include "opts.h"
 #include "pipes.h"
@@ -113,6 +114,15 @@ static unsigned long long mem_available(void)
         if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
     if (f) fclose(f);
     return kb * 1024ULL;
+}
+
+/* A byte count as --memory takes it, rounded up: K below 64M, else M. */
+static const char *size_str(unsigned long long b, char out[32])
+{
+    if (b % (1ULL << 20) == 0 && b) snprintf(out, 32, "%lluM", b >> 20);
+    else if (b < (64ULL << 20)) snprintf(out, 32, "%lluK", (b + 1023) >> 10);
+    else snprintf(out, 32, "%lluM", (b + (1ULL << 20) - 1) >> 20);
+    return out;
 }
 
 static int bad_option(const char *opt, const char *val, const char *why)
@@ -330,6 +340,35 @@ int jf_cmd_estimate(int argc, char **argv)
     jf_column cols[JF_RESULT_MAX_COLS];
     const int with_sigma = o.nb.kind == JF_NB_AUTO; /* auto: its noise estimate */
     size_t ncols = jf_result_columns(monge, with_sigma, cols);
+    /* --memory SIZE bounds the whole process (docs/scale.md): the cloud,
+     * the summary's values, the output's spool and buffers, then the
+     * whole cloud's tree or one part at a time; too small: said now */
+    int plan = 1;
+    {
+        const int pt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
+        size_t held = c.n * (24 + (c.nrm ? 24 : 0) + (c.scan ? 4 : 0) + (quiet ? 0 : 8)) +
+                      (c.attrs.rec ? c.n * c.attrs.stride : 0) + c.nfaces * 20;
+        size_t need_whole = 0, need_min = 0;
+        const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
+                       o.orient != JF_ORIENT_MST;
+        plan = jf__parts_plan(c.n, held, ncols, pt, memory ? memory : mem_available(), &need_whole,
+                              &need_min);
+        if (plan != 1 && !kd) {
+            if (!quiet)
+                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
+                                "natural and mst need the whole cloud: fitting it whole\n",
+                        c.n, (memory ? memory : mem_available()) >> 20);
+            plan = 1;
+        } else if (plan == 0 && memory) {
+            char given[32], least[32], cloud[32];
+            fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
+                            "works is --memory %s (the cloud and the summary's values: %s)\n", in,
+                    size_str(memory, given), c.n, size_str(need_min, least), size_str(held, cloud));
+            jf_cloud_free(&c);
+            return 1;
+        } else if (plan == 0)
+            plan = 1; /* MemAvailable too small: try the whole cloud */
+    }
     jf_writer *w = NULL;
     jf_cli_out po; /* "-o -" and --output-format: through a private file */
     st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
@@ -418,22 +457,7 @@ int jf_cmd_estimate(int argc, char **argv)
         o.progress = progress;
         o.progress_user = &ps;
     }
-    /* --memory: parts when the points and their tree (about 64 bytes per
-     * point) would not fit; then each part's tree and halo take about
-     * half of it (docs/scale.md) */
-    if (!memory) memory = mem_available();
-    int nparts = 1;
-    if (memory && 64.0 * (double)c.n > (double)memory) {
-        double p = ceil(128.0 * (double)c.n / (double)memory);
-        nparts = p > 65536 ? 65536 : (int)p;
-        if (o.nb.kind == JF_NB_RINGS || o.nb.kind == JF_NB_NATURAL || o.orient == JF_ORIENT_MST) {
-            if (!quiet)
-                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
-                                "natural and mst need the whole cloud: fitting it whole\n",
-                        c.n, memory >> 20);
-            nparts = 1;
-        }
-    }
+    int nparts = plan > 1 ? plan : 1;
     st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
                     : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
     free(sk.rows);

@@ -31,6 +31,7 @@
 #include <omp.h>
 
 #include "index_internal.h"
+#include "io_internal.h"
 #include "parts.h"
 
 static int finite3(const double *p)
@@ -455,4 +456,48 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
     }
     free(cut);
     return JF_OK;
+}
+
+/* --------------------------------------------------------- memory plan */
+
+size_t jf__parts_grid_bits(size_t n)
+{
+    size_t b = n < ((size_t)1 << 22) ? 16 * n : (size_t)1 << 26;
+    return b < 4096 ? 4096 : b;
+}
+
+/* What a part of at most m own points holds at its peak: own + halo
+ * points (the halo at most JF_PLAN_HALO of m) at JF_PLAN_PART_PT each. */
+static double part_bytes(size_t n, int P)
+{
+    double m = ceil((double)n / P) * JF_PLAN_HALO + 64;
+    return m * JF_PLAN_PART_PT;
+}
+
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
+                   size_t *need_min)
+{
+    /* the writer: its file buffer (1 MiB), the sink's rows (a block per
+     * thread) and jf_writer_rows' formatting (4096 rows of up to 32
+     * bytes a column per thread) */
+    const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
+                          (double)nt * 4096.0 * 32.0 * (double)ncols;
+    const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
+    const double whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
+    const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
+                         2.0 * (double)(jf__parts_grid_bits(n) / 8) +
+                         (double)sizeof(uint64_t[2]) * (double)(n < JF_PARTS_SAMPLE ? n : JF_PARTS_SAMPLE);
+    const double least = fixed + part_bytes(n, JF_PLAN_PARTS_MAX);
+    if (need_whole) *need_whole = (size_t)whole;
+    if (need_min) *need_min = (size_t)(least < whole ? least : whole);
+    if ((double)budget >= whole || n < 2) return 1;
+    if ((double)budget < least) return 0;
+    /* the fewest parts that fit: each costs a scan of the cloud */
+    int lo = 2, hi = JF_PLAN_PARTS_MAX;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (fixed + part_bytes(n, mid) <= (double)budget) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
 }

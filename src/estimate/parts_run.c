@@ -172,7 +172,6 @@ typedef struct {
     uint64_t *bits;
 } occgrid;
 
-#define OCC_BITS ((size_t)1 << 26) /* 8 MiB */
 #define OCC_PROBE 4096             /* more cells in a ball: just ask   */
 /* (skipping a query: at most 64 cells probed, a query costs less) */
 
@@ -183,7 +182,7 @@ static size_t cell1(double v, double lo, double s, size_t dim)
     return t >= (double)dim ? dim - 1 : (size_t)t;
 }
 
-static void occ_setup(occgrid *g, const double box[6])
+static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
 {
     double ext = 0;
     for (int d = 0; d < 3; d++) ext = box[3 + d] - box[d] > ext ? box[3 + d] - box[d] : ext;
@@ -191,7 +190,7 @@ static void occ_setup(occgrid *g, const double box[6])
     for (;;) {
         double cells = 1;
         for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1;
-        if (cells <= (double)OCC_BITS) break;
+        if (cells <= (double)maxbits) break;
         g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
     }
     for (int d = 0; d < 3; d++) {
@@ -244,7 +243,6 @@ static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t
 static size_t dbg_q;
 #define FAR_FINITE 16           /* finite-bound requests answered by a scan */
 #define FAR_RATIO 64.0          /* ... when their bound exceeds 64 x median */
-#define GRID_BITS ((size_t)1 << 26) /* cells of the marked grid: 8 MiB    */
 #define REQ_CHUNK 4096          /* own points per task of the request pass */
 
 /* Step 2 for part a: the halo (input indices, ascending, distinct) of
@@ -269,7 +267,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     const size_t scratch = (q->cap > q->min_count ? q->cap : q->min_count) + 1;
     const size_t n = c->n;
     const int knn = q->nb.kind == JF_NB_KNN;
-    uint32_t *ord = malloc((m ? m : 1) * sizeof *ord);
     rvec *trq = calloc((size_t)nt, sizeof *trq);
     uvec *th = calloc((size_t)nt, sizeof *th);
     request *rq = NULL, *far = NULL;
@@ -277,9 +274,12 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     size_t *hn = NULL;
     uint64_t *bits = NULL;
     size_t nrq = 0, nfar = 0, kmax = 0;
-    jf_status st = ord && trq && th ? JF_OK : JF_ERR_NOMEM;
+    jf_status st = trq && th ? JF_OK : JF_ERR_NOMEM;
     double H0 = omp_get_wtime();
-    if (st == JF_OK) st = jf_spatial_order(xyz, m, ord);
+    /* the own index's leaf order: spatially coherent, as a Morton order */
+    const double *lp = NULL;
+    const uint32_t *lid = NULL;
+    if (jf__index_points(own, &lp, &lid) != m) st = JF_ERR_INVALID;
     double H1 = omp_get_wtime();
     /* 1. the requests that reach another part's box */
     if (st == JF_OK) {
@@ -296,8 +296,8 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
                 double last[4] = {0, 0, 0, INFINITY};
                 const size_t end = (ch + 1) * REQ_CHUNK < m ? (ch + 1) * REQ_CHUNK : m;
                 for (size_t jj = ch * REQ_CHUNK; ok && jj < end; jj++) {
-                    const size_t j = ord[jj];
-                    const double *p = xyz + 3 * j;
+                    const size_t j = lid[jj];
+                    const double *p = lp + 3 * jj;
                     jf_halo_req r[2];
                     if (knn && last[3] < INFINITY) {
                         /* own k-th distance <= last's + |p - last|
@@ -343,8 +343,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     for (int t = 0; t < nt; t++) free(trq[t].r);
     free(trq);
     trq = NULL;
-    free(ord);
-    ord = NULL;
     double H2 = omp_get_wtime();
     /* 2. the balls too large for the grid: infinite bounds, and the
      * largest finite ones beyond FAR_RATIO x the median (FAR_FINITE at
@@ -399,7 +397,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
         for (;;) {
             double cells = 1;
             for (int d = 0; d < 3; d++) cells *= floor((ghi[d] - glo[d]) / h) + 1;
-            if (cells <= (double)GRID_BITS) break;
+            if (cells <= (double)jf__parts_grid_bits(n)) break;
             h *= 1.25992104989487316; /* cube root of 2: half the cells */
         }
         for (int d = 0; d < 3; d++) dim[d] = (size_t)floor((ghi[d] - glo[d]) / h) + 1;
@@ -616,7 +614,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     {
         double gb[6];
         jf__parts_bbox(c->xyz, n, gb);
-        occ_setup(&occ, gb);
+        occ_setup(&occ, gb, jf__parts_grid_bits(n));
         occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
         if (!occ.bits) {
             st = JF_ERR_NOMEM;
