@@ -487,13 +487,16 @@ int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, s
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
                          (double)sizeof(uint64_t[2]) * (double)(n < JF_PARTS_SAMPLE ? n : JF_PARTS_SAMPLE);
-    const double least = fixed + part_bytes(n, JF_PLAN_PARTS_MAX);
+    /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
+    size_t pmax = n / JF_PLAN_PART_MIN;
+    pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;
+    const double least = fixed + part_bytes(n, (int)pmax);
     if (need_whole) *need_whole = (size_t)whole;
     if (need_min) *need_min = (size_t)(least < whole ? least : whole);
     if ((double)budget >= whole || n < 2) return 1;
     if ((double)budget < least) return 0;
     /* the fewest parts that fit: each costs a scan of the cloud */
-    int lo = 2, hi = JF_PLAN_PARTS_MAX;
+    int lo = 2, hi = (int)pmax;
     while (lo < hi) {
         int mid = lo + (hi - lo) / 2;
         if (fixed + part_bytes(n, mid) <= (double)budget) hi = mid;

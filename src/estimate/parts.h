@@ -83,13 +83,15 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
  * and one part at a time: own and halo points with their coordinates,
  * input index, mask and index (the own index during the halo, the fit's
  * after).  Returns 1 (whole), P >= 2 parts, or 0 when even
- * JF_PLAN_PARTS_MAX parts do not fit; *need_whole, *need_min: the least
+ * min(JF_PLAN_PARTS_MAX, n / JF_PLAN_PART_MIN) parts (2 at least) do not fit; *need_whole, *need_min: the least
  * budget for the whole cloud and for any plan. */
 #define JF_PLAN_WHOLE_PT 36
 #define JF_PLAN_PART_PT 68
 #define JF_PLAN_SPLIT_PT 4
 #define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
-#define JF_PLAN_PARTS_MAX 1024 /* each part scans the cloud twice       */
+#define JF_PLAN_PARTS_MAX 1024 /* each part scans the cloud three times */
+#define JF_PLAN_PART_MIN 4096  /* points: a part's fixed costs (threads,
+                                  workspaces, grids) stay small          */
 int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
                    size_t *need_min);
 

@@ -240,7 +240,6 @@ static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t
     }
 }
 
-static size_t dbg_q;
 #define FAR_FINITE 16           /* finite-bound requests answered by a scan */
 #define FAR_RATIO 64.0          /* ... when their bound exceeds 64 x median */
 #define REQ_CHUNK 4096          /* own points per task of the request pass */
@@ -275,12 +274,10 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     uint64_t *bits = NULL;
     size_t nrq = 0, nfar = 0, kmax = 0;
     jf_status st = trq && th ? JF_OK : JF_ERR_NOMEM;
-    double H0 = omp_get_wtime();
     /* the own index's leaf order: spatially coherent, as a Morton order */
     const double *lp = NULL;
     const uint32_t *lid = NULL;
     if (jf__index_points(own, &lp, &lid) != m) st = JF_ERR_INVALID;
-    double H1 = omp_get_wtime();
     /* 1. the requests that reach another part's box */
     if (st == JF_OK) {
         const size_t nchunk = (m + REQ_CHUNK - 1) / REQ_CHUNK;
@@ -308,7 +305,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
                         if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64)) continue;
                     }
                     int nr = jf__halo_requests(own, q, p, idx, d2, r);
-                    if (getenv("JF_DBG")) __atomic_fetch_add(&dbg_q, 1, __ATOMIC_RELAXED);
                     if (knn && nr == 1) {
                         memcpy(last, p, sizeof(double[3]));
                         last[3] = sqrt(r[0].bound);
@@ -343,7 +339,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     for (int t = 0; t < nt; t++) free(trq[t].r);
     free(trq);
     trq = NULL;
-    double H2 = omp_get_wtime();
     /* 2. the balls too large for the grid: infinite bounds, and the
      * largest finite ones beyond FAR_RATIO x the median (FAR_FINITE at
      * most) */
@@ -471,7 +466,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     free(hn);
     heaps = NULL;
     hn = NULL;
-    double H3 = omp_get_wtime();
     /* 5. the scan: points of other parts in a marked cell or a far ball */
     if (st == JF_OK && (nrq || nfar)) {
         int fail = 0;
@@ -511,7 +505,6 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     }
     free(bits);
     free(far);
-    if (getenv("JF_DBG")) fprintf(stderr, "   q %zu order %.3f req %.3f (%zu) grid+far %.3f (%zu far) scan %.3f\n", dbg_q, H1-H0, H2-H1, nrq, H3-H2, nfar, omp_get_wtime()-H3);
     /* the threads' lists are in ascending order, one range each */
     uint32_t *hv = NULL;
     size_t nh = 0;
@@ -572,9 +565,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         st = JF_ERR_NOMEM;
         goto out;
     }
-    double S0 = omp_get_wtime();
     if ((st = jf__parts_split_sampled(c->xyz, n, P, nt, part)) != JF_OK) goto out;
-    if (getenv("JF_DBG")) fprintf(stderr, "split %.3f\n", omp_get_wtime()-S0);
     for (int b = 0; b < P; b++)
         for (int k = 0; k < 3; k++) box[6 * b + k] = INFINITY, box[6 * b + 3 + k] = -INFINITY;
     for (size_t i = 0; i < n; i++) {
@@ -637,16 +628,11 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
             goto out;
         }
         /* step 2: own index, requests, halo */
-        double T0 = omp_get_wtime();
         size_t m = gather(c, part, a, ids, sxyz), nh = 0;
-        double T1 = omp_get_wtime();
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        double T2 = omp_get_wtime();
         occ_mark(&occ, c, part, a, nt);
         st = halo_of(c, part, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
-        double T3 = omp_get_wtime();
-        if (getenv("JF_DBG")) fprintf(stderr, "part %d m %zu halo %zu gather %.3f own %.3f halo %.3f\n", a, m, nh, T1-T0, T2-T1, T3-T2);
         jf_index_free(own);
         if (st != JF_OK) break;
         /* step 3: own + halo in input order */
@@ -689,9 +675,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         sc.scanner = c->scanner;
         sc.nscans = c->nscans;
         relay rl = {sid, sink, user};
-        double T4 = omp_get_wtime();
         st = jf__estimate_blocks_masked(&sc, &po, mask, relay_block, &rl, err);
-        if (getenv("JF_DBG")) fprintf(stderr, "  prep %.3f fit %.3f\n", T4-T3, omp_get_wtime()-T4);
         free(sid);
         free(snrm);
         free(sscan);
