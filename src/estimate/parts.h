@@ -89,7 +89,7 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
 #define JF_PLAN_PART_PT 68
 #define JF_PLAN_SPLIT_PT 4
 #define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
-#define JF_PLAN_PARTS_MAX 1024 /* each part scans the cloud three times */
+#define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 4096  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */
 int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,

@@ -1,23 +1,27 @@
 /* parts_run.c -- jf_estimate_parts: the cloud cut into parts processed one
  * at a time, each with an exact halo, so that only one part's index is
- * held at once (`jetfit estimate --memory`, issue 12.1).  The same results
- * as jf_estimate_blocks, bit for bit.
+ * held at once (`jetfit estimate --memory`, issues 12.1, 28).  The same
+ * results as jf_estimate_blocks, bit for bit.
  *
- * design (the parts and requests are parts.c's, shared with jetfit-mpi):
- *  1. Parts: the finite points in (Morton key, index) order cut into P runs
- *     of equal count (jf__parts_split); their bounding boxes.
- *  2. For part a: index its own points; each own point turns its
- *     neighbourhood into at most two requests "the k nearest within
- *     squared distance <= bound", bound its own k-th distance
- *     (jf__halo_requests; in space order, knn points whose own k-th
- *     distance is bounded below every other box's distance by the
- *     previous query's skip theirs: jf__halo_requests_near).  Every
- *     other part b whose box is within a request's bound is indexed in
- *     turn (one at a time) and answers with
- *     its k nearest within the bound; the answers' union is the halo: it
- *     holds every remote point of every own point's neighbourhood over the
- *     whole cloud (a point of b in that neighbourhood is among b's k
- *     nearest within the bound).
+ * design (the requests are parts.c's, shared with jetfit-mpi):
+ *  1. Parts: the finite points cut along the (Morton key, index) order at
+ *     the quantiles of a sample (jf__parts_split_sampled: no sort of the
+ *     cloud, 16 bytes per sampled point).
+ *  2. For part a: index its own points; walking the index's leaf order
+ *     (spatially coherent) on the threads, each own point whose own k-th
+ *     distance may reach a cell holding another part's point (an
+ *     occupancy grid over the cloud's box, rebuilt per part by one scan)
+ *     turns its neighbourhood into at most two requests "the k nearest
+ *     within squared distance <= bound" (jf__halo_requests); in space
+ *     order a knn point whose own k-th distance is bounded by the previous
+ *     query's plus the step (triangle inequality) and meets no such cell
+ *     is not even queried.  Every remote neighbour of an own point lies
+ *     within its request's bound (parts.c), so the halo is taken from one
+ *     scan of the cloud: the points of other parts in a grid cell touched
+ *     by a request's ball, and for the few balls too large for the grid
+ *     (an isolated point, a part of fewer than k points) those within its
+ *     k-th distance over the other parts (halo_of).  A superset of the
+ *     exact halo; no other part is indexed.
  *  3. The part's own points and its halo, in input-index order (so the
  *     k-d tree's tie rule, smaller position first, is the input index's),
  *     form a small cloud; jf_estimate_blocks on it fits the own points only
@@ -25,8 +29,8 @@
  *     that contains all of it gives the same k nearest, the same order,
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
- *  handed over first.  Index builds: at most P per part (P^2 in all, each
- *  of n/P points).
+ *  handed over first.  Every step runs on the threads; per part: two index
+ *  builds (own, own + halo) and three scans of the coordinates.
  */
 #include <math.h>
 #include <stdio.h>
