@@ -174,6 +174,8 @@ typedef struct {
     double lo[3], s;
     size_t dim[3];
     uint64_t *bits;
+    double reach;      /* only parts within reach of a's box are marked  */
+    uint8_t *near;     /* near[b]: b's box within reach of a's (per part) */
 } occgrid;
 
 #define OCC_PROBE 4096             /* more cells in a ball: just ask   */
@@ -220,7 +222,7 @@ static int occ_free(const occgrid *g, const double p[3], double r, double probe)
         hi[d] = cell1(p[d] + r, g->lo[d], g->s, g->dim[d]);
         cells *= (double)(hi[d] - lo[d] + 1);
     }
-    if (!(r < INFINITY) || cells > probe) return 0;
+    if (!(r <= g->reach) || cells > probe) return 0; /* beyond: unmarked parts */
     for (size_t z = lo[2]; z <= hi[2]; z++)
         for (size_t y = lo[1]; y <= hi[1]; y++)
             for (size_t x = lo[0]; x <= hi[0]; x++) {
@@ -230,13 +232,25 @@ static int occ_free(const occgrid *g, const double p[3], double r, double probe)
     return 1;
 }
 
-/* Marks the cells of the finite points not in part a. */
-static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t a, int nt)
+/* Marks the cells of the finite points of the parts near part a: those
+ * whose box comes within reach of a's (reach: 16 cells); a ball wider
+ * than that is never called free, so the parts left out cannot matter. */
+static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t a,
+                     const double *box, int P, int nt)
 {
+    g->reach = 16 * g->s;
+    const double *ba = box + 6 * a;
+    for (int b = 0; b < P; b++) {
+        const double *bb = box + 6 * b;
+        int near = b != a && bb[0] <= bb[3];
+        for (int d = 0; d < 3 && near; d++)
+            near = bb[d] <= ba[3 + d] + g->reach && bb[3 + d] >= ba[d] - g->reach;
+        g->near[b] = (uint8_t)near;
+    }
     memset(g->bits, 0, (g->dim[0] * g->dim[1] * g->dim[2] + 63) / 64 * sizeof *g->bits);
 #pragma omp parallel for num_threads(nt) schedule(static, 65536)
     for (size_t i = 0; i < c->n; i++) {
-        if (part[i] < 0 || part[i] == a) continue;
+        if (part[i] < 0 || !g->near[part[i]]) continue;
         size_t cix = occ_cell(g, c->xyz + 3 * i);
         uint64_t bit = (uint64_t)1 << (cix % 64);
         if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
@@ -262,7 +276,8 @@ static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t
  * the k smallest distances in the scan, and a second scan takes the
  * points within its k-th: a superset too.  Cost: two index-free passes
  * over the cloud's coordinates, no other part indexed. */
-static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *occ, int32_t a,
+static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *box, int P,
+                         const occgrid *occ, int32_t a,
                          const jf_index *own,
                          const double *xyz, size_t m, const jf_part_query *q, int nt,
                          uint32_t **halo, size_t *nhalo)
@@ -470,7 +485,16 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     free(hn);
     heaps = NULL;
     hn = NULL;
-    /* 5. the scan: points of other parts in a marked cell or a far ball */
+    /* 5. the scan: points of other parts in a marked cell or a far ball
+     * (without far balls, only parts whose box meets the grid's) */
+    uint8_t *scan = NULL;
+    if (st == JF_OK && (nrq || nfar) && !(scan = malloc((size_t)P))) st = JF_ERR_NOMEM;
+    for (int b = 0; st == JF_OK && scan && b < P; b++) {
+        const double *bb = box + 6 * b;
+        int in = b != a && bb[0] <= bb[3];
+        for (int d = 0; in && !nfar && d < 3; d++) in = bb[d] <= ghi[d] && bb[3 + d] >= glo[d];
+        scan[b] = (uint8_t)in;
+    }
     if (st == JF_OK && (nrq || nfar)) {
         int fail = 0;
 #pragma omp parallel num_threads(nt)
@@ -479,7 +503,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
             int ok = 1;
 #pragma omp for schedule(static, 65536)
             for (size_t i = 0; i < n; i++) {
-                if (!ok || part[i] < 0 || part[i] == a) continue;
+                if (!ok || part[i] < 0 || !scan[part[i]]) continue;
                 const double *x = c->xyz + 3 * i;
                 int keep = 0;
                 if (nrq && x[0] >= glo[0] && x[0] <= ghi[0] && x[1] >= glo[1] && x[1] <= ghi[1] &&
@@ -509,6 +533,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const occgrid *
     }
     free(bits);
     free(far);
+    free(scan);
     /* the threads' lists are in ascending order, one range each */
     uint32_t *hv = NULL;
     size_t nh = 0;
@@ -564,7 +589,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     double *sxyz = NULL, *snrm = NULL;
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
-    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL};
+    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, NULL};
     if (!part || !count || !box) {
         st = JF_ERR_NOMEM;
         goto out;
@@ -611,7 +636,8 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         jf__parts_bbox(c->xyz, n, gb);
         occ_setup(&occ, gb, jf__parts_grid_bits(n));
         occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
-        if (!occ.bits) {
+        occ.near = malloc((size_t)P);
+        if (!occ.bits || !occ.near) {
             st = JF_ERR_NOMEM;
             goto out;
         }
@@ -635,8 +661,8 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         size_t m = gather(c, part, a, ids, sxyz), nh = 0;
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        occ_mark(&occ, c, part, a, nt);
-        st = halo_of(c, part, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
+        occ_mark(&occ, c, part, a, box, P, nt);
+        st = halo_of(c, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
         jf_index_free(own);
         if (st != JF_OK) break;
         /* step 3: own + halo in input order */
@@ -703,5 +729,6 @@ out:
     free(sscan);
     free(mask);
     free(occ.bits);
+    free(occ.near);
     return st;
 }
