@@ -521,6 +521,8 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     if (!quiet) summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+    if (!quiet && nparts > 1) /* --memory: the cloud was fitted in parts */
+        fprintf(stderr, "  parts: %d, one at a time, within --memory\n", nparts);
     free(sk.tl);
     free(sk.cond);
     jf_cloud_free(&c);

@@ -408,6 +408,12 @@ static int keyed_cmp(const void *a, const void *b)
     return (x->id > y->id) - (x->id < y->id);
 }
 
+size_t jf__parts_sample_size(size_t nf)
+{
+    size_t s = nf / 16 > 256 ? nf / 16 : 256;
+    return s < JF_PARTS_SAMPLE ? s : JF_PARTS_SAMPLE;
+}
+
 /* Rank of (key, id) among the sorted cuts: how many are <= it. */
 static int32_t cut_rank(const keyed *cut, int ncut, uint64_t key, uint32_t id)
 {
@@ -430,7 +436,7 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
     const size_t nf = jf__parts_bbox(xyz, n, box);
     const double scale = jf__morton_scale(box);
     /* every stride-th finite point, in input order: about JF_PARTS_SAMPLE */
-    const size_t stride = nf > JF_PARTS_SAMPLE ? nf / JF_PARTS_SAMPLE : 1;
+    const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
     size_t ns = nf ? (nf + stride - 1) / stride : 0, got = 0, seen = 0;
     keyed *s = malloc((ns ? ns : 1) * sizeof *s);
     keyed *cut = malloc((size_t)nparts * sizeof *cut);
@@ -486,7 +492,7 @@ int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, s
     const double whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
-                         (double)sizeof(uint64_t[2]) * (double)(n < JF_PARTS_SAMPLE ? n : JF_PARTS_SAMPLE);
+                         (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);
     /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
     size_t pmax = n / JF_PLAN_PART_MIN;
     pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;

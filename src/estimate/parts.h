@@ -63,12 +63,14 @@ jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part
 
 /* Step 1 without sorting the cloud (the bounded-memory estimate): the
  * (Morton key, index) order's quantiles of a sample of about
- * JF_PARTS_SAMPLE finite points (every stride-th in input order) cut it
+ * jf__parts_sample_size finite points (every stride-th in input order) cut it
  * into nparts runs; part[i] as jf__parts_split's, -1 for non-finite
  * points.  Parts are near equal, not exactly (the sample's error, about
  * sqrt(P / JF_PARTS_SAMPLE) of a part); memory: 16 bytes per sampled
  * point, not 12+ per point as the sort.  Same errors as jf__parts_split. */
 #define JF_PARTS_SAMPLE ((size_t)1 << 16)
+/* The sample's size for nf finite points: nf / 16, in 256..2^16. */
+size_t jf__parts_sample_size(size_t nf);
 jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
                                   int32_t *part);
 
@@ -90,7 +92,7 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
 #define JF_PLAN_SPLIT_PT 4
 #define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
-#define JF_PLAN_PART_MIN 4096  /* points: a part's fixed costs (threads,
+#define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */
 int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
                    size_t *need_min);

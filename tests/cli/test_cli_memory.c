@@ -44,7 +44,7 @@ static int run_budget(const char *out, const char *nb, unsigned long long bytes)
     char mem[32];
     snprintf(mem, sizeof mem, "%lluK", bytes >> 10);
     return cli_run("estimate", cli_path("in.ply"), "-o", cli_path(out), "--neighbors", nb,
-                   "--threads", "2", "--quiet", "--memory", mem, NULL);
+                   "--threads", "2", "--memory", mem, NULL);
 }
 
 START_TEST(too_small_is_refused_with_the_least)
@@ -73,6 +73,7 @@ START_TEST(too_small_is_refused_with_the_least)
     ck_assert_int_eq(run_budget("p.ply", "knn:16", least - 1024), 1);
     ck_assert_uint_eq(least_named(), least);
     ck_assert_int_eq(run_budget("p.ply", "knn:16", least), 0);
+    ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
     same_bytes(cli_path("w.ply"), cli_path("p.ply"));
 }
 END_TEST
@@ -81,7 +82,7 @@ END_TEST
  * every k-d tree neighbourhood, binary PLY and CSV (through the spool). */
 START_TEST(small_budgets_same_bytes)
 {
-    ck_assert_int_eq(cli_run("generate", "exp", "--n", "10000", "--seed", "4", "-o",
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "20000", "--seed", "4", "-o",
                              cli_path("in.ply"), NULL),
                      0);
     static const struct {
@@ -99,6 +100,7 @@ START_TEST(small_budgets_same_bytes)
         ck_assert_msg(least > 0, "%s", cli_err);
         for (unsigned long long extra = 0; extra <= (256ULL << 10); extra += 256ULL << 10) {
             ck_assert_int_eq(run_budget(p, runs[k].nb, least + extra), 0);
+            ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
             same_bytes(cli_path(w), cli_path(p));
         }
     }
