@@ -73,16 +73,31 @@ static int cmp_u32(const void *a, const void *b)
 
 /* The points of part a (input order) and their coordinates. */
 static size_t gather(const jf_cloud *c, const int32_t *part, int32_t a, uint32_t *ids,
-                     double *xyz)
+                     double *xyz, int nt)
 {
-    size_t m = 0;
-    for (size_t i = 0; i < c->n; i++)
-        if (part[i] == a) {
-            ids[m] = (uint32_t)i;
-            memcpy(xyz + 3 * m, c->xyz + 3 * i, sizeof(double[3]));
-            m++;
-        }
-    return m;
+    /* on the threads, in input order: count per slice, then fill from
+     * each slice's offset */
+    enum { SLICES = 64 };
+    size_t cnt[SLICES + 1] = {0};
+    const size_t n = c->n, per = (n + SLICES - 1) / SLICES;
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
+    for (int t = 0; t < SLICES; t++) {
+        size_t k = 0, end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
+        for (size_t i = (size_t)t * per; i < end; i++) k += part[i] == a;
+        cnt[t + 1] = k;
+    }
+    for (int t = 0; t < SLICES; t++) cnt[t + 1] += cnt[t];
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
+    for (int t = 0; t < SLICES; t++) {
+        size_t m = cnt[t], end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
+        for (size_t i = (size_t)t * per; i < end; i++)
+            if (part[i] == a) {
+                ids[m] = (uint32_t)i;
+                memcpy(xyz + 3 * m, c->xyz + 3 * i, sizeof(double[3]));
+                m++;
+            }
+    }
+    return cnt[SLICES];
 }
 
 typedef struct {
@@ -658,7 +673,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
             goto out;
         }
         /* step 2: own index, requests, halo */
-        size_t m = gather(c, part, a, ids, sxyz), nh = 0;
+        size_t m = gather(c, part, a, ids, sxyz, nt), nh = 0;
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
         occ_mark(&occ, c, part, a, box, P, nt);
