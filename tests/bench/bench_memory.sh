@@ -12,7 +12,7 @@
 #   1. in memory: wall, user+sys CPU, peak RSS (GNU time);
 #   2. --memory SIZE, SIZE = a third of (1)'s peak, or, when the command
 #      refuses it, the least that works (its message names it); at 10^8
-#      also --memory 2G (MEM100M overrides);
+#      also --memory 2G (MEM100M overrides); EXTRA="400M 1G": these too;
 #   3. the ratios (time, CPU, peak), "budget ok" when peak <= SIZE + 64 MiB,
 #      and the outputs' SHA-256 compared (identical required).
 # The load average is printed before and after: the machine is shared.
@@ -55,7 +55,7 @@ for n in "$@"; do
     printf '%-11s %-10s %9s %9s %9s %8d %8s %8s %s\n' "$n" memory - "$wall" "$cpu" $((peak_kb / 1024)) \
         1 1 -
     third=$((w_peak / 3 / 1024))
-    sizes="${third}M"
+    sizes="${third}M ${EXTRA:-}"
     [ "$n" -ge 100000000 ] && sizes="$sizes ${MEM100M:-2G}"
     for size in $sizes; do
         label="--memory"
