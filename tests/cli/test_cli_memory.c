@@ -56,7 +56,7 @@ START_TEST(too_small_is_refused_with_the_least)
                              "knn:16", "--threads", "2", "--quiet", NULL),
                      0);
     ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--neighbors",
-                             "knn:16", "--threads", "2", "--quiet", "--memory", "1K", NULL),
+                             "knn:16", "--threads", "2", "--memory", "1K", NULL),
                      1);
     /* one line, the file and the figures in it, nothing written */
     char want[600];
