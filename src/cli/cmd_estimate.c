@@ -14,6 +14,7 @@
 #include "cmd.h"
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
 #include "estimate/parts.h"  /* --memory: the plan (jf__parts_plan) */
+#include "io/io_internal.h"   /* --memory: a PLY or LAS header's point count */
 #include "jetfit.h"
 #include "opts.h"
 #include "pipes.h"
@@ -118,10 +119,12 @@ static unsigned long long mem_available(void)
     return kb * 1024ULL;
 }
 
-/* A byte count as --memory takes it, rounded up: K below 64M, else M. */
+/* A byte count as --memory takes it, rounded up: K below 64M, else M
+ * (G, M when exact). */
 static const char *size_str(unsigned long long b, char out[32])
 {
-    if (b % (1ULL << 20) == 0 && b) snprintf(out, 32, "%lluM", b >> 20);
+    if (b % (1ULL << 30) == 0 && b) snprintf(out, 32, "%lluG", b >> 30);
+    else if (b % (1ULL << 20) == 0 && b) snprintf(out, 32, "%lluM", b >> 20);
     else if (b < (64ULL << 20)) snprintf(out, 32, "%lluK", (b + 1023) >> 10);
     else snprintf(out, 32, "%lluM", (b + (1ULL << 20) - 1) >> 20);
     return out;
@@ -287,6 +290,37 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
 
 /* ---- the command ---------------------------------------------------------- */
 
+/* --memory too small for the points a binary PLY or LAS header announces
+ * (their coordinates, normals and the summary's values at least): said
+ * before reading them.  1 when refused (message printed). */
+static int memory_precheck(const char *in, const char *fmt, unsigned long long memory, int quiet,
+                           size_t ncols, int threads, int kd)
+{
+    size_t len = strlen(in);
+    int ply = len >= 4 && !strcasecmp(in + len - 4, ".ply"),
+        las = len >= 4 && !strcasecmp(in + len - 4, ".las");
+    if (!memory || fmt || !kd || !(ply || las)) return 0;
+    FILE *f = fopen(in, "rb");
+    if (!f) return 0; /* the reader says why */
+    static char buf[1 << 16];
+    size_t got = fread(buf, 1, sizeof buf, f);
+    long long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    fclose(f);
+    jf_row_layout l;
+    jf_error e = {{0}};
+    if (size < 0 || (ply ? jf__ply_layout(buf, got, (uint64_t)size, in, &l, &e)
+                         : jf__las_layout(buf, got, (uint64_t)size, in, &l, &e)) != JF_OK)
+        return 0;
+    size_t n = (size_t)l.count, need_min = 0;
+    size_t held = n * (24 + (l.has_normals ? 24 : 0) + (quiet ? 0 : 8));
+    if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
+    char given[32], least[32], cloud[32];
+    fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that works "
+                    "is --memory %s (the cloud and the summary's values: %s)\n", in,
+            size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+    return 1;
+}
+
 int jf_cmd_estimate(int argc, char **argv)
 {
     jf_cli_estimate_cmd cmd;
@@ -312,6 +346,15 @@ int jf_cmd_estimate(int argc, char **argv)
         fprintf(stderr, "jetfit: %s: is the input file (%s); write the result to another file\n",
                 out, in);
         return 1;
+    }
+    {
+        jf_column pc[JF_RESULT_MAX_COLS];
+        const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
+                       o.orient != JF_ORIENT_MST;
+        if (memory_precheck(in, cmd.in_fmt, memory, quiet,
+                            jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
+                            o.threads > 0 ? o.threads : jf_default_threads(NULL), kd))
+            return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
     if (o.threads > 0)
