@@ -1271,19 +1271,20 @@ jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o,
                              jf_block_fn sink, void *user, jf_error *err);
 
 /* jf_estimate_blocks in bounded memory: the finite points are cut into
- * nparts parts of equal count along the Morton order, and the parts are
- * processed one at a time, each with an exact halo (the points of other
- * parts that can be among its points' neighbours, found by queries to one
- * other part's index at a time), so that the index is never built over
- * the whole cloud: about (n / nparts) x 64 bytes besides c at a time.
+ * nparts parts of near-equal count along the Morton order, and the parts
+ * are processed one at a time on all threads, each with an exact halo
+ * (the points of other parts that can be among its points' neighbours,
+ * found by scans of c's coordinates), so that the index is never built
+ * over the whole cloud: about 4 bytes per point, two grids of <= 8 MiB,
+ * and (n / nparts) x 88 bytes besides c at a time.
  * The same results, bit for bit, as jf_estimate_blocks (neighbourhoods
  * over own points + halo in input order break ties by input index as the
  * whole cloud's do); the blocks come part after part, non-finite points
  * first.  knn, radius, knn+radius only, and orientation none, input,
  * viewpoint or scanner: JF_ERR_UNSUPPORTED otherwise (rings, natural and
  * mst need the whole cloud).  nparts == 1 is jf_estimate_blocks.  The
- * progress hook is called once, at the end.  Costs more index builds
- * (up to nparts per part).  Errors as jf_estimate_blocks. */
+ * progress hook is called once, at the end.  Costs two index builds and
+ * three scans of the coordinates per part.  Errors as jf_estimate_blocks. */
 jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int nparts,
                             jf_block_fn sink, void *user, jf_error *err);
 

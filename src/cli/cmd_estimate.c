@@ -13,6 +13,8 @@
 
 #include "cmd.h"
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
+#include "estimate/parts.h"  /* --memory: the plan (jf__parts_plan) */
+#include "io/io_internal.h"   /* --memory: a PLY or LAS header's point count */
 #include "jetfit.h"
 #include "opts.h"
 #include "pipes.h"
@@ -77,11 +79,13 @@ static void usage(FILE *f)
         "                        nonfinite, so rows stay aligned with the input)\n"
         "  --threads N           OpenMP threads (default: all cores, here %d)\n"
         "  --ascii               ascii PLY output (default binary little endian)\n"
-        "  --memory SIZE         memory for the points and their k-d tree, e.g. 8G,\n"
-        "                        256M (K, M, G, T: powers of 1024; default: the\n"
-        "                        available memory, MemAvailable); when ~64 bytes per\n"
-        "                        point would not fit, the cloud is fitted in parts\n"
-        "                        with exact halos, one at a time (same output)\n"
+        "  --memory SIZE         memory budget of the whole run, e.g. 8G, 256M (K, M,\n"
+        "                        G, T: powers of 1024; default: the available memory,\n"
+        "                        MemAvailable); when the whole cloud's k-d tree would\n"
+        "                        not fit, the cloud is fitted in parts with exact\n"
+        "                        halos, one at a time (same output); a SIZE too small\n"
+        "                        for the points themselves is refused, naming the least\n"
+        "                        that works\n"
         "  --keep MODE           all (default): the input's other per-point values\n"
         "                        (PLY properties, named CSV columns, LAS dimensions;\n"
         "                        a LAS output keeps the LAS records) go to the output\n"
@@ -113,6 +117,17 @@ static unsigned long long mem_available(void)
         if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
     if (f) fclose(f);
     return kb * 1024ULL;
+}
+
+/* A byte count as --memory takes it, rounded up: K below 64M, else M
+ * (G, M when exact). */
+static const char *size_str(unsigned long long b, char out[32])
+{
+    if (b % (1ULL << 30) == 0 && b) snprintf(out, 32, "%lluG", b >> 30);
+    else if (b % (1ULL << 20) == 0 && b) snprintf(out, 32, "%lluM", b >> 20);
+    else if (b < (64ULL << 20)) snprintf(out, 32, "%lluK", (b + 1023) >> 10);
+    else snprintf(out, 32, "%lluM", (b + (1ULL << 20) - 1) >> 20);
+    return out;
 }
 
 static int bad_option(const char *opt, const char *val, const char *why)
@@ -275,6 +290,37 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
 
 /* ---- the command ---------------------------------------------------------- */
 
+/* --memory too small for the points a binary PLY or LAS header announces
+ * (their coordinates, normals and the summary's values at least): said
+ * before reading them.  1 when refused (message printed). */
+static int memory_precheck(const char *in, const char *fmt, unsigned long long memory, int quiet,
+                           size_t ncols, int threads, int kd)
+{
+    size_t len = strlen(in);
+    int ply = len >= 4 && !strcasecmp(in + len - 4, ".ply"),
+        las = len >= 4 && !strcasecmp(in + len - 4, ".las");
+    if (!memory || fmt || !kd || !(ply || las)) return 0;
+    FILE *f = fopen(in, "rb");
+    if (!f) return 0; /* the reader says why */
+    static char buf[1 << 16];
+    size_t got = fread(buf, 1, sizeof buf, f);
+    long long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    fclose(f);
+    jf_row_layout l;
+    jf_error e = {{0}};
+    if (size < 0 || (ply ? jf__ply_layout(buf, got, (uint64_t)size, in, &l, &e)
+                         : jf__las_layout(buf, got, (uint64_t)size, in, &l, &e)) != JF_OK)
+        return 0;
+    size_t n = (size_t)l.count, need_min = 0;
+    size_t held = n * (24 + (l.has_normals ? 24 : 0) + (quiet ? 0 : 8));
+    if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
+    char given[32], least[32], cloud[32];
+    fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that works "
+                    "is --memory %s (the cloud and the summary's values: %s)\n", in,
+            size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+    return 1;
+}
+
 int jf_cmd_estimate(int argc, char **argv)
 {
     jf_cli_estimate_cmd cmd;
@@ -300,6 +346,15 @@ int jf_cmd_estimate(int argc, char **argv)
         fprintf(stderr, "jetfit: %s: is the input file (%s); write the result to another file\n",
                 out, in);
         return 1;
+    }
+    {
+        jf_column pc[JF_RESULT_MAX_COLS];
+        const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
+                       o.orient != JF_ORIENT_MST;
+        if (memory_precheck(in, cmd.in_fmt, memory, quiet,
+                            jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
+                            o.threads > 0 ? o.threads : jf_default_threads(NULL), kd))
+            return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
     if (o.threads > 0)
@@ -330,6 +385,35 @@ int jf_cmd_estimate(int argc, char **argv)
     jf_column cols[JF_RESULT_MAX_COLS];
     const int with_sigma = o.nb.kind == JF_NB_AUTO; /* auto: its noise estimate */
     size_t ncols = jf_result_columns(monge, with_sigma, cols);
+    /* --memory SIZE bounds the whole process (docs/scale.md): the cloud,
+     * the summary's values, the output's spool and buffers, then the
+     * whole cloud's tree or one part at a time; too small: said now */
+    int plan = 1;
+    {
+        const int pt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
+        size_t held = c.n * (24 + (c.nrm ? 24 : 0) + (c.scan ? 4 : 0) + (quiet ? 0 : 8)) +
+                      (c.attrs.rec ? c.n * c.attrs.stride : 0) + c.nfaces * 20;
+        size_t need_whole = 0, need_min = 0;
+        const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
+                       o.orient != JF_ORIENT_MST;
+        plan = jf__parts_plan(c.n, held, ncols, pt, memory ? memory : mem_available(), &need_whole,
+                              &need_min);
+        if (plan != 1 && !kd) {
+            if (!quiet)
+                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
+                                "natural and mst need the whole cloud: fitting it whole\n",
+                        c.n, (memory ? memory : mem_available()) >> 20);
+            plan = 1;
+        } else if (plan == 0 && memory) {
+            char given[32], least[32], cloud[32];
+            fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
+                            "works is --memory %s (the cloud and the summary's values: %s)\n", in,
+                    size_str(memory, given), c.n, size_str(need_min, least), size_str(held, cloud));
+            jf_cloud_free(&c);
+            return 1;
+        } else if (plan == 0)
+            plan = 1; /* MemAvailable too small: try the whole cloud */
+    }
     jf_writer *w = NULL;
     jf_cli_out po; /* "-o -" and --output-format: through a private file */
     st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
@@ -418,22 +502,7 @@ int jf_cmd_estimate(int argc, char **argv)
         o.progress = progress;
         o.progress_user = &ps;
     }
-    /* --memory: parts when the points and their tree (about 64 bytes per
-     * point) would not fit; then each part's tree and halo take about
-     * half of it (docs/scale.md) */
-    if (!memory) memory = mem_available();
-    int nparts = 1;
-    if (memory && 64.0 * (double)c.n > (double)memory) {
-        double p = ceil(128.0 * (double)c.n / (double)memory);
-        nparts = p > 65536 ? 65536 : (int)p;
-        if (o.nb.kind == JF_NB_RINGS || o.nb.kind == JF_NB_NATURAL || o.orient == JF_ORIENT_MST) {
-            if (!quiet)
-                fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
-                                "natural and mst need the whole cloud: fitting it whole\n",
-                        c.n, memory >> 20);
-            nparts = 1;
-        }
-    }
+    int nparts = plan > 1 ? plan : 1;
     st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
                     : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
     free(sk.rows);
@@ -495,6 +564,8 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     if (!quiet) summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+    if (!quiet && nparts > 1) /* --memory: the cloud was fitted in parts */
+        fprintf(stderr, "  parts: %d, one at a time, within --memory\n", nparts);
     free(sk.tl);
     free(sk.cond);
     jf_cloud_free(&c);

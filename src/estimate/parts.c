@@ -31,6 +31,7 @@
 #include <omp.h>
 
 #include "index_internal.h"
+#include "io_internal.h"
 #include "parts.h"
 
 static int finite3(const double *p)
@@ -392,4 +393,121 @@ out:
     free(mem);
     free(moff);
     return st;
+}
+
+/* ------------------------------------------- partition from a sample */
+
+typedef struct {
+    uint64_t key;
+    uint32_t id;
+} keyed;
+
+static int keyed_cmp(const void *a, const void *b)
+{
+    const keyed *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+size_t jf__parts_sample_size(size_t nf)
+{
+    size_t s = nf / 16 > 256 ? nf / 16 : 256;
+    return s < JF_PARTS_SAMPLE ? s : JF_PARTS_SAMPLE;
+}
+
+/* Rank of (key, id) among the sorted cuts: how many are <= it. */
+static int32_t cut_rank(const keyed *cut, int ncut, uint64_t key, uint32_t id)
+{
+    int lo = 0, hi = ncut;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (cut[mid].key < key || (cut[mid].key == key && cut[mid].id <= id)) lo = mid + 1;
+        else hi = mid;
+    }
+    return (int32_t)lo;
+}
+
+jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
+                                  int32_t *part)
+{
+    if ((n && (!xyz || !part)) || nparts < 1 || nparts > JF_PARTS_MAX) return JF_ERR_INVALID;
+    if (n >= UINT32_MAX) return JF_ERR_TOO_LARGE;
+    if (!n) return JF_OK;
+    double box[6];
+    const size_t nf = jf__parts_bbox(xyz, n, box);
+    const double scale = jf__morton_scale(box);
+    /* every stride-th finite point, in input order: about JF_PARTS_SAMPLE */
+    const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
+    size_t ns = nf ? (nf + stride - 1) / stride : 0, got = 0, seen = 0;
+    keyed *s = malloc((ns ? ns : 1) * sizeof *s);
+    keyed *cut = malloc((size_t)nparts * sizeof *cut);
+    if (!s || !cut) {
+        free(s);
+        free(cut);
+        return JF_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n && got < ns; i++) {
+        if (!finite3(xyz + 3 * i)) continue;
+        if (seen++ % stride == 0) s[got++] = (keyed){jf__morton_key(xyz + 3 * i, box, scale), (uint32_t)i};
+    }
+    qsort(s, got, sizeof *s, keyed_cmp);
+    /* cut r (1..P-1) is the sample's r/P quantile: part r starts there */
+    int ncut = 0;
+    for (int r = 1; r < nparts && got; r++) cut[ncut++] = s[(size_t)r * got / (size_t)nparts];
+    free(s);
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
+#pragma omp parallel for num_threads(nt) schedule(static, 65536)
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        part[i] = finite3(p) ? cut_rank(cut, ncut, jf__morton_key(p, box, scale), (uint32_t)i) : -1;
+    }
+    free(cut);
+    return JF_OK;
+}
+
+/* --------------------------------------------------------- memory plan */
+
+size_t jf__parts_grid_bits(size_t n)
+{
+    size_t b = n < ((size_t)1 << 22) ? 16 * n : (size_t)1 << 26;
+    return b < 4096 ? 4096 : b;
+}
+
+/* What a part of at most m own points holds at its peak: own + halo
+ * points (the halo at most JF_PLAN_HALO of m) at JF_PLAN_PART_PT each. */
+static double part_bytes(size_t n, int P)
+{
+    double m = ceil((double)n / P) * JF_PLAN_HALO + 64;
+    return m * JF_PLAN_PART_PT;
+}
+
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
+                   size_t *need_min)
+{
+    /* the writer: its file buffer (1 MiB), the sink's rows (a block per
+     * thread) and jf_writer_rows' formatting (4096 rows of up to 32
+     * bytes a column per thread) */
+    const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
+                          (double)nt * 4096.0 * 32.0 * (double)ncols;
+    const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
+    const double whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
+    const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
+                         2.0 * (double)(jf__parts_grid_bits(n) / 8) +
+                         (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);
+    /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
+    size_t pmax = n / JF_PLAN_PART_MIN;
+    pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;
+    const double least = fixed + part_bytes(n, (int)pmax);
+    if (need_whole) *need_whole = (size_t)whole;
+    if (need_min) *need_min = (size_t)(least < whole ? least : whole);
+    if ((double)budget >= whole || n < 2) return 1;
+    if ((double)budget < least) return 0;
+    /* the fewest parts that fit: each costs a scan of the cloud */
+    int lo = 2, hi = (int)pmax;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (fixed + part_bytes(n, mid) <= (double)budget) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
 }

@@ -25,7 +25,7 @@
 #include <stdint.h>
 
 #include "jetfit.h"
-#include "order_internal.h"
+#include "spatial/order_internal.h"
 
 /* The neighbourhood query jf_estimate makes for a kind the k-d tree
  * answers (knn, radius, knn+radius), with the pipeline's sizes. */
@@ -60,6 +60,45 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
  * JF_ERR_TOO_LARGE (n >= 2^32 - 1). */
 #define JF_PARTS_MAX 65536
 jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part);
+
+/* Step 1 without sorting the cloud (the bounded-memory estimate): the
+ * (Morton key, index) order's quantiles of a sample of about
+ * jf__parts_sample_size finite points (every stride-th in input order) cut it
+ * into nparts runs; part[i] as jf__parts_split's, -1 for non-finite
+ * points.  Parts are near equal, not exactly (the sample's error, about
+ * sqrt(P / JF_PARTS_SAMPLE) of a part); memory: 16 bytes per sampled
+ * point, not 12+ per point as the sort.  Same errors as jf__parts_split. */
+#define JF_PARTS_SAMPLE ((size_t)1 << 16)
+/* The sample's size for nf finite points: nf / 16, in 256..2^16. */
+size_t jf__parts_sample_size(size_t nf);
+jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
+                                  int32_t *part);
+
+/* The memory plan of `jetfit estimate --memory SIZE` (docs/scale.md):
+ * bytes per point measured with massif (tests/bench/bench_memory.sh).
+ * held: what the caller holds whatever the plan (the cloud, the
+ * summary's values); the plan adds the output's row spool
+ * (jf__spool_bytes: nrows = n, ncols) and the writer's buffers for nt
+ * threads.  The whole-cloud estimate
+ * adds its k-d tree (copy of the points, indices, nodes); the parts add
+ * part[] per point, two grids (jf__parts_grid_bits each), the sample,
+ * and one part at a time: own and halo points with their coordinates,
+ * input index, mask and index (the own index during the halo, the fit's
+ * after).  Returns 1 (whole), P >= 2 parts, or 0 when even
+ * min(JF_PLAN_PARTS_MAX, n / JF_PLAN_PART_MIN) parts (2 at least) do not fit; *need_whole, *need_min: the least
+ * budget for the whole cloud and for any plan. */
+#define JF_PLAN_WHOLE_PT 36
+#define JF_PLAN_PART_PT 68
+#define JF_PLAN_SPLIT_PT 4
+#define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
+#define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
+#define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
+                                  workspaces, grids) stay small          */
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
+                   size_t *need_min);
+
+/* Bits of the parts' occupancy and halo grids for n points (<= 2^26). */
+size_t jf__parts_grid_bits(size_t n);
 
 /* Squared distance from q to the box, a lower bound of the distance to
  * every point inside computed by the same rounded operations (never

@@ -1,23 +1,27 @@
 /* parts_run.c -- jf_estimate_parts: the cloud cut into parts processed one
  * at a time, each with an exact halo, so that only one part's index is
- * held at once (`jetfit estimate --memory`, issue 12.1).  The same results
- * as jf_estimate_blocks, bit for bit.
+ * held at once (`jetfit estimate --memory`, issues 12.1, 28).  The same
+ * results as jf_estimate_blocks, bit for bit.
  *
- * design (the parts and requests are parts.c's, shared with jetfit-mpi):
- *  1. Parts: the finite points in (Morton key, index) order cut into P runs
- *     of equal count (jf__parts_split); their bounding boxes.
- *  2. For part a: index its own points; each own point turns its
- *     neighbourhood into at most two requests "the k nearest within
- *     squared distance <= bound", bound its own k-th distance
- *     (jf__halo_requests; in space order, knn points whose own k-th
- *     distance is bounded below every other box's distance by the
- *     previous query's skip theirs: jf__halo_requests_near).  Every
- *     other part b whose box is within a request's bound is indexed in
- *     turn (one at a time) and answers with
- *     its k nearest within the bound; the answers' union is the halo: it
- *     holds every remote point of every own point's neighbourhood over the
- *     whole cloud (a point of b in that neighbourhood is among b's k
- *     nearest within the bound).
+ * design (the requests are parts.c's, shared with jetfit-mpi):
+ *  1. Parts: the finite points cut along the (Morton key, index) order at
+ *     the quantiles of a sample (jf__parts_split_sampled: no sort of the
+ *     cloud, 16 bytes per sampled point).
+ *  2. For part a: index its own points; walking the index's leaf order
+ *     (spatially coherent) on the threads, each own point whose own k-th
+ *     distance may reach a cell holding another part's point (an
+ *     occupancy grid over the cloud's box, rebuilt per part by one scan)
+ *     turns its neighbourhood into at most two requests "the k nearest
+ *     within squared distance <= bound" (jf__halo_requests); in space
+ *     order a knn point whose own k-th distance is bounded by the previous
+ *     query's plus the step (triangle inequality) and meets no such cell
+ *     is not even queried.  Every remote neighbour of an own point lies
+ *     within its request's bound (parts.c), so the halo is taken from one
+ *     scan of the cloud: the points of other parts in a grid cell touched
+ *     by a request's ball, and for the few balls too large for the grid
+ *     (an isolated point, a part of fewer than k points) those within its
+ *     k-th distance over the other parts (halo_of).  A superset of the
+ *     exact halo; no other part is indexed.
  *  3. The part's own points and its halo, in input-index order (so the
  *     k-d tree's tie rule, smaller position first, is the input index's),
  *     form a small cloud; jf_estimate_blocks on it fits the own points only
@@ -25,8 +29,8 @@
  *     that contains all of it gives the same k nearest, the same order,
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
- *  handed over first.  Index builds: at most P per part (P^2 in all, each
- *  of n/P points).
+ *  handed over first.  Every step runs on the threads; per part: two index
+ *  builds (own, own + halo) and three scans of the coordinates.
  */
 #include <math.h>
 #include <stdio.h>
@@ -69,16 +73,31 @@ static int cmp_u32(const void *a, const void *b)
 
 /* The points of part a (input order) and their coordinates. */
 static size_t gather(const jf_cloud *c, const int32_t *part, int32_t a, uint32_t *ids,
-                     double *xyz)
+                     double *xyz, int nt)
 {
-    size_t m = 0;
-    for (size_t i = 0; i < c->n; i++)
-        if (part[i] == a) {
-            ids[m] = (uint32_t)i;
-            memcpy(xyz + 3 * m, c->xyz + 3 * i, sizeof(double[3]));
-            m++;
-        }
-    return m;
+    /* on the threads, in input order: count per slice, then fill from
+     * each slice's offset */
+    enum { SLICES = 64 };
+    size_t cnt[SLICES + 1] = {0};
+    const size_t n = c->n, per = (n + SLICES - 1) / SLICES;
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
+    for (int t = 0; t < SLICES; t++) {
+        size_t k = 0, end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
+        for (size_t i = (size_t)t * per; i < end; i++) k += part[i] == a;
+        cnt[t + 1] = k;
+    }
+    for (int t = 0; t < SLICES; t++) cnt[t + 1] += cnt[t];
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
+    for (int t = 0; t < SLICES; t++) {
+        size_t m = cnt[t], end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
+        for (size_t i = (size_t)t * per; i < end; i++)
+            if (part[i] == a) {
+                ids[m] = (uint32_t)i;
+                memcpy(xyz + 3 * m, c->xyz + 3 * i, sizeof(double[3]));
+                m++;
+            }
+    }
+    return cnt[SLICES];
 }
 
 typedef struct {
@@ -86,95 +105,470 @@ typedef struct {
     jf_halo_req req;
 } request;
 
+/* A growable array of requests or of input indices (one per thread). */
+typedef struct {
+    request *r;
+    size_t n, cap;
+} rvec;
+
+static int rvec_push(rvec *v, request x)
+{
+    if (v->n == v->cap) {
+        size_t nc = v->cap ? 2 * v->cap : 1024;
+        request *nr = realloc(v->r, nc * sizeof *nr);
+        if (!nr) return 0;
+        v->r = nr;
+        v->cap = nc;
+    }
+    v->r[v->n++] = x;
+    return 1;
+}
+
+typedef struct {
+    uint32_t *v;
+    size_t n, cap;
+} uvec;
+
+static int uvec_push(uvec *a, uint32_t x)
+{
+    if (a->n == a->cap) {
+        size_t nc = a->cap ? 2 * a->cap : 1024;
+        uint32_t *nv = realloc(a->v, nc * sizeof *nv);
+        if (!nv) return 0;
+        a->v = nv;
+        a->cap = nc;
+    }
+    a->v[a->n++] = x;
+    return 1;
+}
+
+static int cmp_f64(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Max-heap of the k smallest squared distances (a far request's). */
+static void heap_push(double *h, size_t *n, size_t k, double d)
+{
+    if (*n < k) {
+        size_t i = (*n)++;
+        while (i && h[(i - 1) / 2] < d) {
+            h[i] = h[(i - 1) / 2];
+            i = (i - 1) / 2;
+        }
+        h[i] = d;
+        return;
+    }
+    if (!(d < h[0])) return;
+    size_t i = 0;
+    for (;;) {
+        size_t l = 2 * i + 1, r = l + 1, b = i;
+        double vb = d;
+        if (l < *n && h[l] > vb) b = l, vb = h[l];
+        if (r < *n && h[r] > vb) b = r;
+        if (b == i) break;
+        h[i] = h[b];
+        i = b;
+    }
+    h[i] = d;
+}
+
+/* A ball's half side, inflated so that every point the k-d tree finds
+ * within squared distance b (its rounded sum) lies inside the box: the
+ * relative margin covers the roundings, the absolute one squares that
+ * underflow to 0. */
+static double ball_r(double b) { return sqrt(b) * (1 + 1e-9) + 1e-140; }
+
+/* Cells of a grid over the cloud's box that hold a point of another
+ * part (the foreign points of part a): a ball over no such cell holds no
+ * foreign point, so its point needs no halo (boxes of Z-curve runs
+ * overlap too much to tell).  cell(v) = floor((v - lo) / s), clamped, is
+ * monotone in v, so a point inside a box is in one of the box's cells. */
+typedef struct {
+    double lo[3], s;
+    size_t dim[3];
+    uint64_t *bits;
+    double reach;      /* only parts within reach of a's box are marked  */
+    uint8_t *near;     /* near[b]: b's box within reach of a's (per part) */
+} occgrid;
+
+#define OCC_PROBE 4096             /* more cells in a ball: just ask   */
+/* (skipping a query: at most 64 cells probed, a query costs less) */
+
+static size_t cell1(double v, double lo, double s, size_t dim)
+{
+    double t = floor((v - lo) / s);
+    if (!(t > 0)) return 0;
+    return t >= (double)dim ? dim - 1 : (size_t)t;
+}
+
+static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
+{
+    double ext = 0;
+    for (int d = 0; d < 3; d++) ext = box[3 + d] - box[d] > ext ? box[3 + d] - box[d] : ext;
+    g->s = ext > 0 && isfinite(ext) ? ext / 4096 : 1;
+    for (;;) {
+        double cells = 1;
+        for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1;
+        if (cells <= (double)maxbits) break;
+        g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
+    }
+    for (int d = 0; d < 3; d++) {
+        g->lo[d] = box[d];
+        g->dim[d] = (size_t)floor((box[3 + d] - box[d]) / g->s) + 1;
+    }
+}
+
+static size_t occ_cell(const occgrid *g, const double *x)
+{
+    return (cell1(x[2], g->lo[2], g->s, g->dim[2]) * g->dim[1] +
+            cell1(x[1], g->lo[1], g->s, g->dim[1])) * g->dim[0] +
+           cell1(x[0], g->lo[0], g->s, g->dim[0]);
+}
+
+/* 1 when no marked cell meets the box p +- r. */
+static int occ_free(const occgrid *g, const double p[3], double r, double probe)
+{
+    size_t lo[3], hi[3];
+    double cells = 1;
+    for (int d = 0; d < 3; d++) {
+        lo[d] = cell1(p[d] - r, g->lo[d], g->s, g->dim[d]);
+        hi[d] = cell1(p[d] + r, g->lo[d], g->s, g->dim[d]);
+        cells *= (double)(hi[d] - lo[d] + 1);
+    }
+    if (!(r <= g->reach) || cells > probe) return 0; /* beyond: unmarked parts */
+    for (size_t z = lo[2]; z <= hi[2]; z++)
+        for (size_t y = lo[1]; y <= hi[1]; y++)
+            for (size_t x = lo[0]; x <= hi[0]; x++) {
+                size_t c = (z * g->dim[1] + y) * g->dim[0] + x;
+                if ((g->bits[c / 64] >> (c % 64)) & 1) return 0;
+            }
+    return 1;
+}
+
+/* Marks the cells of the finite points of the parts near part a: those
+ * whose box comes within reach of a's (reach: 16 cells); a ball wider
+ * than that is never called free, so the parts left out cannot matter. */
+static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t a,
+                     const double *box, int P, int nt)
+{
+    g->reach = 16 * g->s;
+    const double *ba = box + 6 * a;
+    for (int b = 0; b < P; b++) {
+        const double *bb = box + 6 * b;
+        int near = b != a && bb[0] <= bb[3];
+        for (int d = 0; d < 3 && near; d++)
+            near = bb[d] <= ba[3 + d] + g->reach && bb[3 + d] >= ba[d] - g->reach;
+        g->near[b] = (uint8_t)near;
+    }
+    memset(g->bits, 0, (g->dim[0] * g->dim[1] * g->dim[2] + 63) / 64 * sizeof *g->bits);
+#pragma omp parallel for num_threads(nt) schedule(static, 65536)
+    for (size_t i = 0; i < c->n; i++) {
+        if (part[i] < 0 || !g->near[part[i]]) continue;
+        size_t cix = occ_cell(g, c->xyz + 3 * i);
+        uint64_t bit = (uint64_t)1 << (cix % 64);
+        if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
+            __atomic_fetch_or(&g->bits[cix / 64], bit, __ATOMIC_RELAXED);
+    }
+}
+
+#define FAR_FINITE 16           /* finite-bound requests answered by a scan */
+#define FAR_RATIO 64.0          /* ... when their bound exceeds 64 x median */
+#define REQ_CHUNK 4096          /* own points per task of the request pass */
+
 /* Step 2 for part a: the halo (input indices, ascending, distinct) of
- * its m own points (ids, xyz, indexed by own). */
-static jf_status halo_of(const jf_cloud *c, const int32_t *part, const size_t *count,
-                         const double *box, int P, int32_t a, const jf_index *own,
+ * its m own points (xyz, indexed by own).
+ * design: each own point's requests (k, bound) that reach another part's
+ * box (in space order, chunks of REQ_CHUNK on the threads) describe balls;
+ * a remote point within a ball's bound may be a neighbour, and one outside
+ * every ball is none (parts.c: the own k-th distance bounds the cloud's).
+ * So the balls' bounding boxes mark the cells of a grid (cell side the
+ * median ball radius), and one parallel scan of the cloud keeps the points
+ * of other parts in a marked cell: a superset of the halo, which the fit
+ * then narrows exactly.  Balls too large for the grid (an isolated point,
+ * a part with fewer than k points: bound up to inf) are few; each keeps
+ * the k smallest distances in the scan, and a second scan takes the
+ * points within its k-th: a superset too.  Cost: two index-free passes
+ * over the cloud's coordinates, no other part indexed. */
+static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *box, int P,
+                         const occgrid *occ, int32_t a,
+                         const jf_index *own,
                          const double *xyz, size_t m, const jf_part_query *q, int nt,
                          uint32_t **halo, size_t *nhalo)
 {
-    size_t scratch = (q->cap > q->min_count ? q->cap : q->min_count) + 1;
-    request *rq = NULL;
-    size_t nrq = 0, caprq = 0;
-    uint32_t *idx = malloc(scratch * sizeof *idx), *bids = NULL, *h = NULL;
-    double *d2 = malloc(scratch * sizeof *d2), *bxyz = NULL;
-    size_t nh = 0, caph = 0, bmax = 0;
-    uint32_t *ord = malloc((m ? m : 1) * sizeof *ord);
-    jf_status st = idx && d2 && ord ? JF_OK : JF_ERR_NOMEM;
-    if (st == JF_OK) st = jf_spatial_order(xyz, m, ord);
-    /* requests that reach another part's box (serial: in space order only
-     * the points near the part's rim query; kept compact, 32 bytes each) */
-    double last[4] = {0, 0, 0, INFINITY};
-    for (size_t jj = 0; st == JF_OK && jj < m; jj++) {
-        const size_t j = ord[jj];
-        jf_halo_req r[2];
-        int nr = jf__halo_requests_near(own, q, box, P, a, xyz + 3 * j, last, idx, d2, r);
-        for (int t = 0; t < nr; t++) {
-            int reach = 0;
-            for (int b = 0; b < P && !reach; b++)
-                reach = b != a && count[b] && jf__box_dist2(box + 6 * b, xyz + 3 * j) <= r[t].bound;
-            if (!reach) continue;
-            if (nrq == caprq) {
-                caprq = caprq ? 2 * caprq : 1024;
-                request *nq = realloc(rq, caprq * sizeof *nq);
-                if (!nq) {
-                    st = JF_ERR_NOMEM;
-                    break;
+    const size_t scratch = (q->cap > q->min_count ? q->cap : q->min_count) + 1;
+    const size_t n = c->n;
+    const int knn = q->nb.kind == JF_NB_KNN;
+    rvec *trq = calloc((size_t)nt, sizeof *trq);
+    uvec *th = calloc((size_t)nt, sizeof *th);
+    request *rq = NULL, *far = NULL;
+    double *bs = NULL, *heaps = NULL;
+    size_t *hn = NULL;
+    uint64_t *bits = NULL;
+    size_t nrq = 0, nfar = 0, kmax = 0;
+    jf_status st = trq && th ? JF_OK : JF_ERR_NOMEM;
+    /* the own index's leaf order: spatially coherent, as a Morton order */
+    const double *lp = NULL;
+    const uint32_t *lid = NULL;
+    if (jf__index_points(own, &lp, &lid) != m) st = JF_ERR_INVALID;
+    /* 1. the requests that reach another part's box */
+    if (st == JF_OK) {
+        const size_t nchunk = (m + REQ_CHUNK - 1) / REQ_CHUNK;
+        int fail = 0;
+#pragma omp parallel num_threads(nt)
+        {
+            rvec *mine = &trq[omp_get_thread_num()];
+            uint32_t *idx = malloc(scratch * sizeof *idx);
+            double *d2 = malloc(scratch * sizeof *d2);
+            int ok = idx && d2;
+#pragma omp for schedule(dynamic, 1)
+            for (size_t ch = 0; ch < nchunk; ch++) {
+                double last[4] = {0, 0, 0, INFINITY};
+                const size_t end = (ch + 1) * REQ_CHUNK < m ? (ch + 1) * REQ_CHUNK : m;
+                for (size_t jj = ch * REQ_CHUNK; ok && jj < end; jj++) {
+                    const size_t j = lid[jj];
+                    const double *p = lp + 3 * jj;
+                    jf_halo_req r[2];
+                    if (knn && last[3] < INFINITY) {
+                        /* own k-th distance <= last's + |p - last|
+                         * (triangle inequality): no foreign cell within
+                         * it, no request, no query */
+                        double dd = 0;
+                        for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
+                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64)) continue;
+                    }
+                    int nr = jf__halo_requests(own, q, p, idx, d2, r);
+                    if (knn && nr == 1) {
+                        memcpy(last, p, sizeof(double[3]));
+                        last[3] = sqrt(r[0].bound);
+                    }
+                    for (int t = 0; t < nr && ok; t++)
+                        if (!occ_free(occ, p, ball_r(r[t].bound), OCC_PROBE))
+                            ok = rvec_push(mine, (request){(uint32_t)j, r[t]});
                 }
-                rq = nq;
             }
-            rq[nrq++] = (request){(uint32_t)j, r[t]};
+            if (!ok) {
+#pragma omp atomic write
+                fail = 1;
+            }
+            free(idx);
+            free(d2);
         }
+        if (fail) st = JF_ERR_NOMEM;
     }
-    for (int b = 0; b < P; b++) bmax = count[b] > bmax ? count[b] : bmax;
+    for (int t = 0; st == JF_OK && t < nt; t++) nrq += trq[t].n;
     if (st == JF_OK && nrq) {
-        bids = malloc(bmax * sizeof *bids);
-        bxyz = malloc(3 * bmax * sizeof *bxyz);
-        if (!bids || !bxyz) st = JF_ERR_NOMEM;
+        rq = malloc(nrq * sizeof *rq);
+        bs = malloc(nrq * sizeof *bs);
+        if (!rq || !bs) st = JF_ERR_NOMEM;
     }
-    for (int b = 0; st == JF_OK && nrq && b < P; b++) {
-        if (b == a || !count[b]) continue;
-        int touched = 0;
-        for (size_t r = 0; r < nrq && !touched; r++)
-            touched = jf__box_dist2(box + 6 * b, xyz + 3 * (size_t)rq[r].pt) <= rq[r].req.bound;
-        if (!touched) continue;
-        size_t mb = gather(c, part, b, bids, bxyz);
-        jf_index *ix = NULL;
-        if ((st = jf__index_build_threads(bxyz, mb, nt, &ix)) != JF_OK) break;
-        for (size_t r = 0; st == JF_OK && r < nrq; r++) {
-            const double *p = xyz + 3 * (size_t)rq[r].pt;
-            if (!(jf__box_dist2(box + 6 * b, p) <= rq[r].req.bound)) continue;
-            size_t found = 0;
-            st = jf__index_query(ix, p, rq[r].req.k, rq[r].req.bound, idx, d2, NULL, &found);
-            if (st == JF_OK && nh + found > caph) {
-                caph = (nh + found) * 2;
-                uint32_t *nhp = realloc(h, caph * sizeof *nhp);
-                if (!nhp) st = JF_ERR_NOMEM;
-                else h = nhp;
-            }
-            for (size_t t = 0; st == JF_OK && t < found; t++) h[nh++] = bids[idx[t]];
+    if (st == JF_OK && nrq) {
+        size_t w = 0;
+        for (int t = 0; t < nt; t++) {
+            memcpy(rq + w, trq[t].r, trq[t].n * sizeof *rq);
+            w += trq[t].n;
         }
-        jf_index_free(ix);
-        /* keep the list short as it grows: sort, drop repeats */
-        if (st == JF_OK && nh) {
-            qsort(h, nh, sizeof *h, cmp_u32);
-            size_t u = 1;
-            for (size_t t = 1; t < nh; t++)
-                if (h[t] != h[u - 1]) h[u++] = h[t];
-            nh = u;
+    }
+    for (int t = 0; t < nt; t++) free(trq[t].r);
+    free(trq);
+    trq = NULL;
+    /* 2. the balls too large for the grid: infinite bounds, and the
+     * largest finite ones beyond FAR_RATIO x the median (FAR_FINITE at
+     * most) */
+    double cutb = INFINITY, h = 0;
+    if (st == JF_OK && nrq) {
+        size_t nfin = 0;
+        for (size_t r = 0; r < nrq; r++)
+            if (rq[r].req.bound < INFINITY) bs[nfin++] = rq[r].req.bound;
+        qsort(bs, nfin, sizeof *bs, cmp_f64);
+        if (nfin) {
+            const double med = bs[nfin / 2];
+            cutb = med * FAR_RATIO;
+            if (nfin > FAR_FINITE && bs[nfin - 1 - FAR_FINITE] > cutb) cutb = bs[nfin - 1 - FAR_FINITE];
+            h = sqrt(med);
+        }
+        /* far requests move to the end of rq */
+        size_t w = 0;
+        far = malloc(nrq * sizeof *far);
+        if (!far) st = JF_ERR_NOMEM;
+        for (size_t r = 0; st == JF_OK && r < nrq; r++) {
+            if (rq[r].req.bound > cutb) far[nfar++] = rq[r];
+            else rq[w++] = rq[r];
+        }
+        nrq = w;
+    }
+    free(bs);
+    bs = NULL;
+    /* 3. the grid over the near balls' boxes */
+    double glo[3] = {INFINITY, INFINITY, INFINITY}, ghi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t dim[3] = {0, 0, 0};
+    if (st == JF_OK && nrq) {
+        for (size_t r = 0; r < nrq; r++) {
+            const double *p = xyz + 3 * (size_t)rq[r].pt, rr = ball_r(rq[r].req.bound);
+            for (int d = 0; d < 3; d++) {
+                if (p[d] - rr < glo[d]) glo[d] = p[d] - rr;
+                if (p[d] + rr > ghi[d]) ghi[d] = p[d] + rr;
+            }
+        }
+        double ext = 0;
+        for (int d = 0; d < 3; d++) ext = ghi[d] - glo[d] > ext ? ghi[d] - glo[d] : ext;
+        if (!isfinite(ext)) { /* coordinates near the overflow: all scanned */
+            memcpy(far + nfar, rq, nrq * sizeof *rq);
+            nfar += nrq;
+            nrq = 0;
+        }
+    }
+    if (st == JF_OK && nrq) {
+        double ext = 0;
+        for (int d = 0; d < 3; d++) ext = ghi[d] - glo[d] > ext ? ghi[d] - glo[d] : ext;
+        if (!(h > 0) || !isfinite(h)) h = ext > 0 ? ext / 256 : 1;
+        for (;;) {
+            double cells = 1;
+            for (int d = 0; d < 3; d++) cells *= floor((ghi[d] - glo[d]) / h) + 1;
+            if (cells <= (double)jf__parts_grid_bits(n)) break;
+            h *= 1.25992104989487316; /* cube root of 2: half the cells */
+        }
+        for (int d = 0; d < 3; d++) dim[d] = (size_t)floor((ghi[d] - glo[d]) / h) + 1;
+        bits = calloc((dim[0] * dim[1] * dim[2] + 63) / 64, sizeof *bits);
+        if (!bits) st = JF_ERR_NOMEM;
+        for (size_t r = 0; st == JF_OK && r < nrq; r++) {
+            const double *p = xyz + 3 * (size_t)rq[r].pt, rr = ball_r(rq[r].req.bound);
+            size_t lo[3], hi[3];
+            for (int d = 0; d < 3; d++) {
+                /* floor((v - glo) / h) is monotone in v: every point of
+                 * the ball's box falls in [lo, hi] */
+                lo[d] = (size_t)floor((p[d] - rr - glo[d]) / h);
+                hi[d] = (size_t)floor((p[d] + rr - glo[d]) / h);
+                if (hi[d] >= dim[d]) hi[d] = dim[d] - 1;
+                if (lo[d] > hi[d]) lo[d] = hi[d];
+            }
+            for (size_t z = lo[2]; z <= hi[2]; z++)
+                for (size_t y = lo[1]; y <= hi[1]; y++)
+                    for (size_t x = lo[0]; x <= hi[0]; x++) {
+                        size_t cix = (z * dim[1] + y) * dim[0] + x;
+                        bits[cix / 64] |= (uint64_t)1 << (cix % 64);
+                    }
         }
     }
     free(rq);
-    free(ord);
-    free(idx);
-    free(d2);
-    free(bids);
-    free(bxyz);
+    rq = NULL;
+    /* 4. the far balls' k-th distance over the other parts (first scan) */
+    for (size_t f = 0; f < nfar; f++) kmax = far[f].req.k > kmax ? far[f].req.k : kmax;
+    if (st == JF_OK && nfar) {
+        heaps = malloc((size_t)nt * nfar * kmax * sizeof *heaps);
+        hn = calloc((size_t)nt * nfar, sizeof *hn);
+        if (!heaps || !hn) st = JF_ERR_NOMEM;
+    }
+    if (st == JF_OK && nfar) {
+#pragma omp parallel num_threads(nt)
+        {
+            const size_t t = (size_t)omp_get_thread_num();
+            double *hp = heaps + t * nfar * kmax;
+            size_t *hc = hn + t * nfar;
+#pragma omp for schedule(static, 65536)
+            for (size_t i = 0; i < n; i++) {
+                if (part[i] < 0 || part[i] == a) continue;
+                const double *x = c->xyz + 3 * i;
+                for (size_t f = 0; f < nfar; f++) {
+                    const double *p = xyz + 3 * (size_t)far[f].pt;
+                    const double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
+                    const double d = dx * dx + dy * dy + dz * dz;
+                    if (d <= far[f].req.bound) heap_push(hp + f * kmax, &hc[f], far[f].req.k, d);
+                }
+            }
+        }
+        /* threshold: the k-th smallest over the threads, inflated */
+        double *all = malloc((size_t)nt * kmax * sizeof *all);
+        if (!all) st = JF_ERR_NOMEM;
+        for (size_t f = 0; st == JF_OK && f < nfar; f++) {
+            size_t na = 0;
+            for (int t = 0; t < nt; t++) {
+                memcpy(all + na, heaps + ((size_t)t * nfar + f) * kmax, hn[(size_t)t * nfar + f] * sizeof *all);
+                na += hn[(size_t)t * nfar + f];
+            }
+            qsort(all, na, sizeof *all, cmp_f64);
+            if (na >= far[f].req.k) {
+                const double th2 = all[far[f].req.k - 1] * (1 + 1e-9) + 1e-280;
+                if (th2 < far[f].req.bound) far[f].req.bound = th2;
+            }
+            far[f].req.bound = far[f].req.bound * (1 + 1e-9) + 1e-280;
+        }
+        free(all);
+    }
+    free(heaps);
+    free(hn);
+    heaps = NULL;
+    hn = NULL;
+    /* 5. the scan: points of other parts in a marked cell or a far ball
+     * (without far balls, only parts whose box meets the grid's) */
+    uint8_t *scan = NULL;
+    if (st == JF_OK && (nrq || nfar) && !(scan = malloc((size_t)P))) st = JF_ERR_NOMEM;
+    for (int b = 0; st == JF_OK && scan && b < P; b++) {
+        const double *bb = box + 6 * b;
+        int in = b != a && bb[0] <= bb[3];
+        for (int d = 0; in && !nfar && d < 3; d++) in = bb[d] <= ghi[d] && bb[3 + d] >= glo[d];
+        scan[b] = (uint8_t)in;
+    }
+    if (st == JF_OK && (nrq || nfar)) {
+        int fail = 0;
+#pragma omp parallel num_threads(nt)
+        {
+            uvec *mine = &th[omp_get_thread_num()];
+            int ok = 1;
+#pragma omp for schedule(static, 65536)
+            for (size_t i = 0; i < n; i++) {
+                if (!ok || part[i] < 0 || !scan[part[i]]) continue;
+                const double *x = c->xyz + 3 * i;
+                int keep = 0;
+                if (nrq && x[0] >= glo[0] && x[0] <= ghi[0] && x[1] >= glo[1] && x[1] <= ghi[1] &&
+                    x[2] >= glo[2] && x[2] <= ghi[2]) {
+                    size_t cx = (size_t)floor((x[0] - glo[0]) / h),
+                           cy = (size_t)floor((x[1] - glo[1]) / h),
+                           cz = (size_t)floor((x[2] - glo[2]) / h);
+                    cx = cx < dim[0] ? cx : dim[0] - 1;
+                    cy = cy < dim[1] ? cy : dim[1] - 1;
+                    cz = cz < dim[2] ? cz : dim[2] - 1;
+                    size_t cix = (cz * dim[1] + cy) * dim[0] + cx;
+                    keep = (int)((bits[cix / 64] >> (cix % 64)) & 1);
+                }
+                for (size_t f = 0; !keep && f < nfar; f++) {
+                    const double *p = xyz + 3 * (size_t)far[f].pt;
+                    const double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
+                    keep = dx * dx + dy * dy + dz * dz <= far[f].req.bound;
+                }
+                if (keep) ok = uvec_push(mine, (uint32_t)i);
+            }
+            if (!ok) {
+#pragma omp atomic write
+                fail = 1;
+            }
+        }
+        if (fail) st = JF_ERR_NOMEM;
+    }
+    free(bits);
+    free(far);
+    free(scan);
+    /* the threads' lists are in ascending order, one range each */
+    uint32_t *hv = NULL;
+    size_t nh = 0;
+    for (int t = 0; st == JF_OK && t < nt; t++) nh += th[t].n;
+    if (st == JF_OK && !(hv = malloc((nh ? nh : 1) * sizeof *hv))) st = JF_ERR_NOMEM;
+    if (st == JF_OK) {
+        size_t w = 0;
+        for (int t = 0; t < nt; t++) {
+            if (th[t].n) memcpy(hv + w, th[t].v, th[t].n * sizeof *hv);
+            w += th[t].n;
+        }
+        qsort(hv, nh, sizeof *hv, cmp_u32); /* static schedule: already near sorted */
+    }
+    for (int t = 0; t < nt; t++) free(th[t].v);
+    free(th);
     if (st != JF_OK) {
-        free(h);
+        free(hv);
         return st;
     }
-    *halo = h;
+    *halo = hv;
     *nhalo = nh;
     return JF_OK;
 }
@@ -210,11 +604,12 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     double *sxyz = NULL, *snrm = NULL;
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
+    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, NULL};
     if (!part || !count || !box) {
         st = JF_ERR_NOMEM;
         goto out;
     }
-    if ((st = jf__parts_split(c->xyz, n, P, part)) != JF_OK) goto out;
+    if ((st = jf__parts_split_sampled(c->xyz, n, P, nt, part)) != JF_OK) goto out;
     for (int b = 0; b < P; b++)
         for (int k = 0; k < 3; k++) box[6 * b + k] = INFINITY, box[6 * b + 3 + k] = -INFINITY;
     for (size_t i = 0; i < n; i++) {
@@ -251,6 +646,17 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         if (st != JF_OK) goto out;
     }
     for (int b = 0; b < P; b++) cmax = count[b] > cmax ? count[b] : cmax;
+    {
+        double gb[6];
+        jf__parts_bbox(c->xyz, n, gb);
+        occ_setup(&occ, gb, jf__parts_grid_bits(n));
+        occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
+        occ.near = malloc((size_t)P);
+        if (!occ.bits || !occ.near) {
+            st = JF_ERR_NOMEM;
+            goto out;
+        }
+    }
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
     if (!ids || !sxyz) {
@@ -267,10 +673,11 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
             goto out;
         }
         /* step 2: own index, requests, halo */
-        size_t m = gather(c, part, a, ids, sxyz), nh = 0;
+        size_t m = gather(c, part, a, ids, sxyz, nt), nh = 0;
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        st = halo_of(c, part, count, box, P, a, own, sxyz, m, &q, nt, &halo, &nh);
+        occ_mark(&occ, c, part, a, box, P, nt);
+        st = halo_of(c, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
         jf_index_free(own);
         if (st != JF_OK) break;
         /* step 3: own + halo in input order */
@@ -336,5 +743,7 @@ out:
     free(snrm);
     free(sscan);
     free(mask);
+    free(occ.bits);
+    free(occ.near);
     return st;
 }

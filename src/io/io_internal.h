@@ -111,12 +111,16 @@ void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, 
 /* io_spool.c: rows put in any order from any thread, drained in row
  * order (the table writer's positioned rows).  open: a temporary beside
  * `final` for nrows rows of ncols doubles, buckets of bucket_bytes of
- * values (0: 32 MiB; small values are for tests).  put: thread-safe; JF_ERR_IO /
+ * values (0: jf__spool_bucket; small values are for tests).  put: thread-safe; JF_ERR_IO /
  * _INVALID (a row >= nrows, or more rows than a bucket holds) stick.
  * drain (once, one thread): every row must have been put exactly once;
- * emit gets the rows in order, a bucket (up to 32 MiB of values) at a
+ * emit gets the rows in order, a bucket (up to 128 MiB of values) at a
  * time; err "NAME: reason".  free: removes the temporary (NULL ok). */
 typedef struct jf_spool jf_spool;
+/* The bucket size jf__spool_open takes for bucket_bytes 0, and the most
+ * memory such a spool holds at once (staging or drain). */
+size_t jf__spool_bucket(size_t nrows, size_t ncols);
+size_t jf__spool_bytes(size_t nrows, size_t ncols);
 jf_status jf__spool_open(const char *final, size_t nrows, size_t ncols, size_t bucket_bytes,
                          jf_spool **s, jf_error *err);
 jf_status jf__spool_put(jf_spool *s, const uint32_t *rows, const double *vals, size_t m);

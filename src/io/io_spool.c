@@ -28,13 +28,14 @@
 #include "io_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#define BUCKET_BYTES ((size_t)32 << 20) /* values of one bucket at most   */
+#define BUCKET_BYTES ((size_t)32 << 20) /* values of one bucket: 4x at most */
 #define STAGE ((size_t)64 << 10)        /* staging bytes per bucket        */
 
 typedef struct {
@@ -79,6 +80,32 @@ static size_t rows_in(const jf_spool *s, size_t k)
     return s->nrows - lo < s->per ? s->nrows - lo : s->per;
 }
 
+/* Bucket size: staging (buckets x STAGE) and the drain's bucket cost
+ * about the same at sqrt(values x STAGE), their least sum: 11 MiB each at
+ * 10^7 rows of 24 columns, 112 MiB at 10^9; clamped to 1..BUCKET_BYTES
+ * MiB above that. */
+size_t jf__spool_bucket(size_t nrows, size_t ncols)
+{
+    double b = sqrt((double)nrows * (double)ncols * 8.0 * (double)STAGE);
+    if (b < (double)(1 << 20))
+        b = (double)(1 << 20);
+    if (b > (double)BUCKET_BYTES * 4)
+        b = (double)BUCKET_BYTES * 4;
+    return (size_t)b;
+}
+
+size_t jf__spool_bytes(size_t nrows, size_t ncols)
+{
+    size_t b = jf__spool_bucket(nrows, ncols), per = b / (8 * ncols) ? b / (8 * ncols) : 1;
+    size_t nb = nrows ? (nrows + per - 1) / per : 0, entry = 8 + 8 * ncols;
+    size_t stage = per * entry / 4 < STAGE ? per * entry / 4 : STAGE;
+    size_t rows = per < nrows ? per : nrows;
+    /* staging while rows come; at the drain one bucket's values, its
+     * 'seen' bytes and a read chunk (the writer's own buffers apart) */
+    size_t fill = nb * (stage + entry + sizeof(bucket)), drain = rows * (8 * ncols + 1) + 4096 * entry;
+    return fill > drain ? fill : drain;
+}
+
 jf_status jf__spool_open(const char *final, size_t nrows, size_t ncols, size_t bucket_bytes,
                          jf_spool **out, jf_error *err)
 {
@@ -90,7 +117,7 @@ jf_status jf__spool_open(const char *final, size_t nrows, size_t ncols, size_t b
     s->ncols = ncols;
     s->entry = 8 + 8 * ncols;
     if (!bucket_bytes)
-        bucket_bytes = BUCKET_BYTES;
+        bucket_bytes = jf__spool_bucket(nrows, ncols);
     s->per = bucket_bytes / (8 * ncols) ? bucket_bytes / (8 * ncols) : 1;
     /* a quarter of a bucket's region at most: small buckets flush too */
     size_t q = s->per * s->entry / 4;

@@ -95,8 +95,15 @@ START_TEST(auto_parts_threads)
     ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("w.ply"), "--neighbors",
                              "auto", "--threads", "2", "--quiet", NULL),
                      0);
+    /* --memory 16K is refused with the least that works: that runs in parts */
     ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
                              "auto", "--threads", "2", "--memory", "16K", "--quiet", NULL),
+                     1);
+    const char *lw = strstr(cli_err, "the least that works is --memory ");
+    char mem[32] = "";
+    ck_assert_msg(lw && sscanf(lw + 33, "%31s", mem) == 1, "%s", cli_err);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
+                             "auto", "--threads", "2", "--memory", mem, "--quiet", NULL),
                      0);
     same_bytes(cli_path("w.ply"), cli_path("p.ply"));
     ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("t.ply"), "--neighbors",

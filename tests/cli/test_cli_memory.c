@@ -1,0 +1,120 @@
+/* test_cli_memory.c -- `jetfit estimate --memory SIZE` as a budget for the
+ * whole process (docs/scale.md, "Memory budget"): a SIZE too small is
+ * refused at the start in one line naming the least that works, with no
+ * output made; that least is exact (1K less is refused, it runs), and runs
+ * in parts give the bytes of the unbounded run for every k-d tree
+ * neighbourhood and text or binary output. */
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "test_cli_util.h"
+#include "jf_test.h"
+
+static void same_bytes(const char *a, const char *b)
+{
+    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
+    ck_assert_msg(f && g, "%s or %s missing", a, b);
+    long at = 0;
+    int x, y;
+    do {
+        x = fgetc(f);
+        y = fgetc(g);
+        ck_assert_msg(x == y, "%s and %s differ at byte %ld", a, b, at);
+        at++;
+    } while (x != EOF);
+    fclose(f);
+    fclose(g);
+}
+
+/* The least SIZE the refusal names, in bytes (K or M), or 0. */
+static unsigned long long least_named(void)
+{
+    const char *p = strstr(cli_err, "the least that works is --memory ");
+    unsigned long long v = 0;
+    char unit = 0;
+    if (!p || sscanf(p + strlen("the least that works is --memory "), "%llu%c", &v, &unit) != 2)
+        return 0;
+    return unit == 'K' ? v << 10 : unit == 'M' ? v << 20 : 0;
+}
+
+static int run_budget(const char *out, const char *nb, unsigned long long bytes)
+{
+    char mem[32];
+    snprintf(mem, sizeof mem, "%lluK", bytes >> 10);
+    return cli_run("estimate", cli_path("in.ply"), "-o", cli_path(out), "--neighbors", nb,
+                   "--threads", "2", "--memory", mem, NULL);
+}
+
+START_TEST(too_small_is_refused_with_the_least)
+{
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "20000", "--seed", "3", "-o",
+                             cli_path("in.ply"), NULL),
+                     0);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("w.ply"), "--neighbors",
+                             "knn:16", "--threads", "2", "--quiet", NULL),
+                     0);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--neighbors",
+                             "knn:16", "--threads", "2", "--memory", "1K", NULL),
+                     1);
+    /* one line, the file and the figures in it, nothing written */
+    char want[600];
+    snprintf(want, sizeof want, "jetfit: %s: --memory 1K is too small for 20000 points: the least "
+                                "that works is --memory ", cli_path("in.ply"));
+    ck_assert_msg(!strncmp(cli_err, want, strlen(want)), "%s", cli_err);
+    ck_assert_msg(strchr(cli_err, '\n') == cli_err + strlen(cli_err) - 1, "one line: %s", cli_err);
+    ck_assert_int_eq(cli_exists(cli_path("p.ply")), 0);
+    ck_assert_int_eq(cli_count_files(), 2);
+    const unsigned long long least = least_named();
+    ck_assert_msg(least >= (20000ULL * 24), "the coordinates alone: %s", cli_err);
+    /* exact to the K: 1K less is refused, the least runs (in parts: the
+     * least is below the whole cloud's need) with the same bytes */
+    ck_assert_int_eq(run_budget("p.ply", "knn:16", least - 1024), 1);
+    ck_assert_uint_eq(least_named(), least);
+    ck_assert_int_eq(run_budget("p.ply", "knn:16", least), 0);
+    ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
+    same_bytes(cli_path("w.ply"), cli_path("p.ply"));
+}
+END_TEST
+
+/* Budgets between the least and the whole cloud's: a few to many parts,
+ * every k-d tree neighbourhood, binary PLY and CSV (through the spool). */
+START_TEST(small_budgets_same_bytes)
+{
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "20000", "--seed", "4", "-o",
+                             cli_path("in.ply"), NULL),
+                     0);
+    static const struct {
+        const char *nb, *ext;
+    } runs[] = {{"knn:16", "ply"}, {"radius:0.02", "csv"}, {"knn:12,radius:0.015", "ply"}};
+    for (size_t k = 0; k < sizeof runs / sizeof *runs; k++) {
+        char w[32], p[32];
+        snprintf(w, sizeof w, "w.%s", runs[k].ext);
+        snprintf(p, sizeof p, "p.%s", runs[k].ext);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(w), "--neighbors",
+                                 runs[k].nb, "--threads", "2", "--quiet", NULL),
+                         0);
+        ck_assert_int_eq(run_budget(p, runs[k].nb, 1024), 1);
+        const unsigned long long least = least_named();
+        ck_assert_msg(least > 0, "%s", cli_err);
+        for (unsigned long long extra = 0; extra <= (256ULL << 10); extra += 256ULL << 10) {
+            ck_assert_int_eq(run_budget(p, runs[k].nb, least + extra), 0);
+            ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
+            same_bytes(cli_path(w), cli_path(p));
+        }
+    }
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("cli_memory");
+    TCase *tc = tcase_create("memory budget");
+    tcase_add_checked_fixture(tc, cli_setup, cli_teardown);
+    tcase_set_timeout(tc, 900);
+    tcase_add_test(tc, too_small_is_refused_with_the_least);
+    tcase_add_test(tc, small_budgets_same_bytes);
+    suite_add_tcase(s, tc);
+    return jf_test_run(s);
+}
