@@ -620,6 +620,23 @@ typedef struct {
                             empty when jf_read_opts.no_attrs           */
 } jf_cloud;
 
+/* The phases of a run, as a progress hook (jf_phase_fn) names them. */
+typedef enum {
+    JF_PHASE_READ,   /* parsing the input (units: bytes of the file)     */
+    JF_PHASE_ORDER,  /* the spatial order (Morton) of the points          */
+    JF_PHASE_INDEX,  /* the k-d tree (its leaf order is the walk)         */
+    JF_PHASE_FIT,    /* fitting (points; 2n with mst in blocks)           */
+    JF_PHASE_WRITE   /* formatting and writing the rows (rows)            */
+} jf_phase;
+
+/* Progress of a phase: `done` of `total` units, non-decreasing within a
+ * phase, reported once with done == total when the phase ends (0 to
+ * total for a phase that is not split).  Called on the thread that called
+ * the library function only (never concurrently); it must not call back
+ * into the same object.  The library never prints: a command draws its
+ * progress line from these calls. */
+typedef void (*jf_phase_fn)(void *user, jf_phase phase, size_t done, size_t total);
+
 typedef struct {
     int columns[6];      /* .xyz/.pts/.txt/.csv: 0-based column of x,y,z
                             [,nx,ny,nz]; -1 = default.  Defaults: xyz/txt
@@ -639,6 +656,13 @@ typedef struct {
     int no_attrs;        /* 0 (default) read the attributes into
                             jf_cloud.attrs; 1 skip them (--keep none:
                             no memory spent on them)                   */
+    int threads;         /* text formats: rows parsed in blocks on this
+                            many OpenMP threads (<= 0, the default: all
+                            cores); the cloud and every message are the
+                            same for any count                          */
+    jf_phase_fn progress; /* may be NULL (default): JF_PHASE_READ, in
+                            bytes of the file                          */
+    void *progress_user;
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */

@@ -302,6 +302,7 @@ int jf_cmd_estimate(int argc, char **argv)
         return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
+    e.ro.threads = o.threads; /* text input parsed in blocks on them */
     if (o.threads > 0)
         omp_set_num_threads(o.threads); /* the LAZ reader decodes chunks on them */
     jf_status st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);

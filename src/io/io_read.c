@@ -35,6 +35,9 @@ void jf_read_opts_init(jf_read_opts *o)
         o->columns[i] = -1;
     o->bad_rows = 0;
     o->no_attrs = 0;
+    o->threads = 0;
+    o->progress = NULL;
+    o->progress_user = NULL;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -353,6 +356,8 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
                               "a NUL byte (binary data in a text file?)");
         }
     }
+    if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, 0, len);
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
@@ -385,6 +390,8 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
     if (st != JF_OK)
         jf_cloud_free(c);
+    else if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, len, len);
     return st;
 }
 
@@ -424,9 +431,13 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     }
     if (fmt == JF_FMT_PLY) {
         /* binary point clouds without a second copy (io_ply.c) */
+        if (o && o->progress)
+            o->progress(o->progress_user, JF_PHASE_READ, 0, len);
         jf_status cs = jf__read_ply_chunked(fd, len, path, o, c, err);
         if (cs != JF_ERR_UNSUPPORTED) {
             close(fd);
+            if (cs == JF_OK && o && o->progress)
+                o->progress(o->progress_user, JF_PHASE_READ, len, len);
             return cs;
         }
     }
