@@ -835,6 +835,12 @@ jf_status jf_writer_row(jf_writer *w, const double *vals);
 jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                          int threads);
 
+/* Progress of the rows' formatting and writing: fn(user,
+ * JF_PHASE_WRITE, rows written, nrows) after each round of
+ * jf_writer_rows (jf_writer_commit's, for positioned rows), on the
+ * calling thread.  fn may be NULL (none).  Call before the first row. */
+void jf_writer_progress(jf_writer *w, jf_phase_fn fn, void *user);
+
 /* Positioned rows, for results that arrive out of order
  * (jf_estimate_blocks): jf_writer_begin_put once, on one thread, after
  * jf_writer_las_frame / jf_writer_faces and instead of any
@@ -1210,6 +1216,11 @@ typedef struct {
     void *progress_user;
     jf_cancel_fn cancel;     /* may be NULL (jf_cancel_fn)              */
     void *cancel_user;
+    jf_phase_fn phase;       /* may be NULL: JF_PHASE_INDEX or _ORDER
+                                (0 then n), then JF_PHASE_FIT (as
+                                progress counts); jf_estimate_parts:
+                                per part, with the part's counts        */
+    void *phase_user;
 } jf_estimate_opts;
 
 /* Fills defaults.  Never fails. */

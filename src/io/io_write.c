@@ -43,6 +43,8 @@ struct jf_writer {
     int put_threads;                 /* for the drain's formatting       */
     jf_spool *spool;                 /* io_spool.c                       */
     char *warn;                      /* jf_writer_warnings' text         */
+    jf_phase_fn prog;                /* jf_writer_progress, or NULL      */
+    void *prog_user;
 };
 
 /* The attribute columns go after column 2 (x y z). */
@@ -480,12 +482,24 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
         }
         for (int t = 0; t < nt && f->st == JF_OK; t++)
             jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
+        if (w->prog && f->st == JF_OK) {
+            size_t r1 = r0 + (size_t)nt * blk;
+            w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + (r1 < nrows ? r1 : nrows), w->nrows);
+        }
     }
     free(scratch);
     free(len);
     if (f->st == JF_OK)
         w->rows += nrows;
     return f->st;
+}
+
+void jf_writer_progress(jf_writer *w, jf_phase_fn fn, void *user)
+{
+    if (!w)
+        return;
+    w->prog = fn;
+    w->prog_user = user;
 }
 
 /* ---- positioned rows --------------------------------------------------- */
