@@ -36,7 +36,7 @@ static void draw(jf_cli_progress *p, int ph, size_t done, size_t total, double s
     double eta = rate > 0 && total > done ? (double)(total - done) / rate : 0;
     double pct = total ? 100.0 * (double)done / (double)total : 100.0;
     if (ph == JF_PHASE_READ)
-        fprintf(stderr, "\r%s: %-8s %5.1f%%  %.0f/%.0f MB  %.0f MB/s  ETA %.0f s     ", p->who,
+        fprintf(stderr, "\r%s: %-8s %5.1f%%  %.1f/%.1f MB  %.1f MB/s  ETA %.0f s     ", p->who,
                 verb[ph], pct, (double)done / 1e6, (double)total / 1e6, rate / 1e6, eta);
     else
         fprintf(stderr, "\r%s: %-8s %5.1f%%  %zu/%zu points  %.0f points/s  ETA %.0f s     ",
@@ -82,6 +82,11 @@ void jf_cli_progress_fitted(jf_cli_progress *p, size_t m)
 void jf_cli_progress_end(jf_cli_progress *p)
 {
     if (p->cur >= 0) p->secs[p->cur] += p->lastcall - p->start;
+    if (p->draw && p->counted && p->fitted && !p->fit_final) {
+        /* the last block's redraw may have met another thread drawing */
+        draw(p, JF_PHASE_FIT, p->fitted, p->fit_total, 1e-9 * (double)p->fit_t0ns);
+        p->fit_final = 1;
+    }
     p->cur = -1;
     if (p->shown) {
         fputc('\n', stderr);

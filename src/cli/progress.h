@@ -21,6 +21,7 @@ typedef struct {
     int shown, busy;        /* a line is on screen; a thread draws        */
     uint64_t fit_t0ns;      /* first point counted (atomic)               */
     size_t fitted, fit_total; /* points counted (atomic), of              */
+    int fit_final;          /* the fit's 100% line was drawn by _end      */
 } jf_cli_progress;
 
 void jf_cli_progress_init(jf_cli_progress *p, const char *who, int draw);
