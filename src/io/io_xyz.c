@@ -738,13 +738,19 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
     /* a UTF-8 byte order mark (spreadsheet exports) is not data */
     if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
         buf += 3, len -= 3;
+    const int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     size_t lines = 1, crs = 0;
-    for (const char *q = buf, *e = buf + len;
-         (q = memchr(q, '\n', (size_t)(e - q))) != NULL; q++)
-        lines++;
-    for (const char *q = buf, *e = buf + len; /* lone-CR line ends too */
-         (q = memchr(q, '\r', (size_t)(e - q))) != NULL; q++)
-        crs++;
+    /* counted in nt slices on the threads (a pass over the whole text) */
+#pragma omp parallel for num_threads(nt) reduction(+ : lines, crs) schedule(static, 1)
+    for (int k = 0; k < nt; k++) {
+        const char *q = buf + len / (size_t)nt * (size_t)k,
+                   *e = k == nt - 1 ? buf + len : buf + len / (size_t)nt * (size_t)(k + 1);
+        for (const char *r = q; (r = memchr(r, '\n', (size_t)(e - r))) != NULL; r++)
+            lines++;
+        for (const char *r = q; /* lone-CR line ends too */
+             (r = memchr(r, '\r', (size_t)(e - r))) != NULL; r++)
+            crs++;
+    }
     lines += crs;
     /* no '\r' or '#' anywhere: the per-line searches for them are skipped */
     t.no_hash = !memchr(buf, '#', len);
@@ -753,7 +759,6 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
     int started = 0;
     xstate s = {0, 0, lines, 0, 0, 0, 0, 0, -1, 0, 0};
     const int skip = o->bad_rows == 1;
-    const int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     for (size_t r = 0;; r++) {
         /* the columns and width are known: the rest in parallel blocks */
         if (nt > 1 && s.nf0 >= 0 && (size_t)(tx.end - tx.p) > 2 * block_bytes)
