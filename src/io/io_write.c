@@ -462,33 +462,40 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                        : row_max >= ((size_t)8 << 20) ? 1 : ((size_t)8 << 20) / row_max,
                  slot = blk * row_max;
     char *scratch = malloc((size_t)nt * slot);
-    size_t *len = malloc((size_t)nt * sizeof *len);
-    if (!scratch || !len) {
-        free(scratch);
-        free(len);
+    if (!scratch)
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
-    }
-    /* each round: thread t formats the t-th block of blk rows into
-     * its slot, then the slots go out in order, unbuffered */
-    for (size_t r0 = 0; r0 < nrows && f->st == JF_OK;
-         r0 += (size_t)nt * blk) {
-#pragma omp parallel for num_threads(nt) schedule(static, 1)
-        for (int t = 0; t < nt; t++) {
-            size_t a = r0 + (size_t)t * blk, b = a + blk;
-            char *o = scratch + (size_t)t * slot;
-            len[t] = 0;
-            for (size_t r = a; r < b && r < nrows; r++)
-                len[t] += format_row(w, vals + r * w->ncols, w->rows + r, o + len[t]);
+    /* blocks of blk rows handed out one at a time: each thread formats
+     * its block into its slot, then waits for its turn (ordered) to
+     * write it, while the others format the next ones -- no round
+     * barrier, the file gets the blocks in row order */
+    const size_t nblk = (nrows + blk - 1) / blk;
+    int failed = f->st != JF_OK;
+#pragma omp parallel num_threads(nt)
+    {
+        const int tid = omp_get_thread_num();
+        char *o = scratch + (size_t)tid * slot;
+#pragma omp for schedule(dynamic, 1) ordered
+        for (size_t k = 0; k < nblk; k++) {
+            int halt;
+#pragma omp atomic read
+            halt = failed;
+            size_t a = k * blk, e = a + blk < nrows ? a + blk : nrows, l = 0;
+            for (size_t r = a; r < e && !halt; r++)
+                l += format_row(w, vals + r * w->ncols, w->rows + r, o + l);
+#pragma omp ordered
+            if (f->st == JF_OK) {
+                if (jf_wf_write(f, o, l) != JF_OK) {
+#pragma omp atomic write
+                    failed = 1;
+                } else if (tid == 0 && w->prog) { /* the calling thread */
+                    w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + e, w->nrows);
+                }
+            }
         }
-        for (int t = 0; t < nt && f->st == JF_OK; t++)
-            jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
-        if (w->prog && f->st == JF_OK) {
-            size_t r1 = r0 + (size_t)nt * blk;
-            w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + (r1 < nrows ? r1 : nrows), w->nrows);
-        }
     }
+    if (w->prog && f->st == JF_OK)
+        w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + nrows, w->nrows);
     free(scratch);
-    free(len);
     if (f->st == JF_OK)
         w->rows += nrows;
     return f->st;

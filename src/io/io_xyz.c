@@ -13,6 +13,7 @@
 #include "io_internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -675,41 +676,73 @@ static jf_status merge_block(const tab *t, xstate *s, const xblock *b, int skip,
     return JF_OK;
 }
 
-/* The text [p, end) in rounds of 4 blocks a thread: parsed on nt
- * threads, merged in order. */
+/* The text [p, end): blocks handed out one at a time, each parsed by a
+ * thread into its own rows, then merged in order (ordered) while the
+ * other threads parse the next ones; no round barrier. */
 static jf_status read_blocks(const tab *t, xstate *s, const char *p, const char *end, int nt,
                              int skip, jf_cloud *c, const jf_read_opts *o, const char *buf0,
                              size_t total)
 {
-    const int nb = 4 * nt, na = t->ta ? t->ta->na : 0;
-    xblock *bl = calloc((size_t)nb, sizeof *bl);
+    const int na = t->ta ? t->ta->na : 0;
+    size_t nblk = 0, cap = 0;
+    const char **cut = NULL;
+    for (const char *q = p; q < end; nblk++) { /* the blocks' ends, at line ends */
+        const char *e = (size_t)(end - q) > block_bytes ? q + block_bytes : end;
+        if (e < end) {
+            const char *nl = memchr(e - 1, '\n', (size_t)(end - e + 1));
+            e = nl ? nl + 1 : end;
+        }
+        if (nblk + 2 > cap) {
+            cap = cap ? 2 * cap : 256;
+            const char **g = realloc(cut, cap * sizeof *g);
+            if (!g) {
+                free(cut);
+                return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+            }
+            cut = g;
+        }
+        cut[nblk] = q;
+        q = e;
+        cut[nblk + 1] = e;
+    }
+    xblock *bl = calloc((size_t)nt, sizeof *bl);
     int ok = bl != NULL;
-    for (int i = 0; ok && i < nb; i++)
+    for (int i = 0; ok && i < nt; i++)
         ok = !na || (bl[i].text = malloc((size_t)na)) != NULL;
     jf_status st = ok ? JF_OK : jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
-    while (st == JF_OK && p < end) {
-        int m = 0;
-        for (; m < nb && p < end; m++) {
-            const char *e = (size_t)(end - p) > block_bytes ? p + block_bytes : end;
-            if (e < end) { /* to the end of the line */
-                const char *nl = memchr(e - 1, '\n', (size_t)(end - e + 1));
-                e = nl ? nl + 1 : end;
+    const xstate s0 = *s; /* what the parsers read; the merge changes s */
+    int stop = st != JF_OK;
+#pragma omp parallel num_threads(nt) if (ok)
+    {
+        const int tid = omp_get_thread_num();
+        xblock *b = ok ? &bl[tid] : NULL;
+#pragma omp for schedule(dynamic, 1) ordered
+        for (size_t i = 0; i < nblk; i++) {
+            int halt;
+#pragma omp atomic read
+            halt = stop;
+            if (!halt) {
+                b->s = cut[i];
+                b->e = cut[i + 1];
+                parse_block(t, &s0, b, skip);
             }
-            bl[m].s = p;
-            bl[m].e = e;
-            p = e;
+#pragma omp ordered
+            if (!halt && st == JF_OK) {
+                st = merge_block(t, s, b, skip, c);
+                if (st != JF_OK) {
+#pragma omp atomic write
+                    stop = 1;
+                } else if (tid == 0 && o->progress) { /* the calling thread */
+                    o->progress(o->progress_user, JF_PHASE_READ, (size_t)(cut[i + 1] - buf0),
+                                total);
+                }
+            }
         }
-#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
-        for (int i = 0; i < m; i++)
-            parse_block(t, s, &bl[i], skip);
-        for (int i = 0; i < m && st == JF_OK; i++)
-            st = merge_block(t, s, &bl[i], skip, c);
-        if (st == JF_OK && o->progress)
-            o->progress(o->progress_user, JF_PHASE_READ, (size_t)(p - buf0), total);
     }
-    for (int i = 0; bl && i < nb; i++)
+    for (int i = 0; bl && i < nt; i++)
         block_free(&bl[i]);
     free(bl);
+    free(cut);
     return st;
 }
 
