@@ -828,8 +828,10 @@ jf_status jf_writer_row(jf_writer *w, const double *vals);
 
 /* Appends nrows rows, vals[r * ncols + j] (row-major), exactly as nrows
  * calls of jf_writer_row would, formatting them on `threads` OpenMP
- * threads (<= 0: the OpenMP default) and writing them in order.  Writing
- * is otherwise serial: this is what keeps it off the critical path of a
+ * threads (<= 0: the OpenMP default) and writing them in order: blocks
+ * of rows handed out one at a time, each written when its turn comes
+ * while the other threads format the next ones.  Writing the file is
+ * otherwise serial: this is what keeps it off the critical path of a
  * parallel run (text output above all).  Allocates about threads x 4096
  * x (32 ncols + 2) bytes for the call.  Same errors as jf_writer_row. */
 jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
@@ -880,7 +882,8 @@ void jf_writer_abort(jf_writer *w);
  * element list uchar int vertex_indices), .xyz/.txt/.csv (vertices and
  * normals only; faces are not written), .las (LAS 1.4 format 0, the frame
  * of jf_writer_las_frame; normals as Extra Bytes nx ny nz; faces are not
- * written).  Thread-safe. */
+ * written).  The rows are formatted on the OpenMP threads
+ * (jf_writer_rows; the bytes do not depend on their count).  Thread-safe. */
 jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
                          jf_error *err);
 
