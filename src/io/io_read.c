@@ -447,17 +447,30 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
         return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
                           "out of memory reading %zu bytes", len);
     }
+    /* a large file in slices of at least 16 MiB on the threads: the
+     * kernel's copy into fresh pages is most of a text read's serial part */
+    int nt = o && o->threads > 0 ? o->threads : jf_default_threads(NULL);
+    if ((size_t)nt > len / ((size_t)16 << 20))
+        nt = (int)(len / ((size_t)16 << 20));
+    nt = nt < 1 ? 1 : nt;
+    const size_t slice = (len + (size_t)nt - 1) / (size_t)nt;
     size_t got = 0;
     int e = 0;
-    while (got < len) {
-        ssize_t r = read(fd, buf + got, len - got > (1u << 30) ? (1u << 30) : len - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0) {
-            e = r < 0 ? errno : 0;
-            break;
+#pragma omp parallel for num_threads(nt) reduction(+ : got) if (nt > 1)
+    for (int k = 0; k < nt; k++) {
+        size_t a = slice * (size_t)k, b = a + slice < len ? a + slice : len, g = a;
+        while (g < b) {
+            ssize_t r = pread(fd, buf + g, b - g > (1u << 30) ? (1u << 30) : b - g, (off_t)g);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                if (r < 0)
+                    __atomic_store_n(&e, errno, __ATOMIC_RELAXED);
+                break;
+            }
+            g += (size_t)r;
         }
-        got += (size_t)r;
+        got += g - a;
     }
     close(fd);
     if (got < len) {

@@ -18,6 +18,26 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* How many bytes of [p, p + n) are c: eight at a time (a byte of x ^ c
+ * is zero exactly where the byte is c: the carry-free test below leaves
+ * a 1 in that byte, and a multiply sums the eight bytes). */
+static size_t count_byte(const char *p, size_t n, char c)
+{
+    const uint64_t ones = 0x0101010101010101ULL, low7 = 0x7F7F7F7F7F7F7F7FULL;
+    const uint64_t cc = ones * (unsigned char)c;
+    size_t k = 0, i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t x;
+        memcpy(&x, p + i, 8);
+        x ^= cc;
+        uint64_t t = ((x & low7) + low7) | x; /* high bit set: byte non-zero */
+        k += (size_t)((((~t & ~low7) >> 7) * ones) >> 56); /* the bytes' sum */
+    }
+    for (; i < n; i++)
+        k += p[i] == c;
+    return k;
+}
+
 /* Whether the row's first field could be a count (jf_parse_size: '+'
  * and digits): a quick look that spares data rows the full test. */
 static int digits_first(const char *q, const char *le)
@@ -54,7 +74,9 @@ typedef struct {
     int col[6];     /* column of x y z nx ny nz, -1 = not read */
     int maxcol;     /* largest column needed */
     text_attrs *ta; /* NULL: attributes not wanted */
-    int no_hash;    /* no '#' in the whole text */
+    const char *hash; /* the first '#' at or after the last line looked
+                         at (tend: none), NULL before the first        */
+    const char *tend; /* the end of the text (of the block)            */
 } tab;
 
 /* Next field of a row; csv fields are trimmed and may be empty. */
@@ -111,17 +133,20 @@ static int fast_row(const char *p, const char *e, int w, double *v)
 }
 
 /* The row without a comment: [ls, *le) shortened; 0 if nothing is left. */
-static int strip_comment(const tab *t, const char *ls, const char **le)
+static int strip_comment(tab *t, const char *ls, const char **le)
 {
     const char *q = ls;
     while (q < *le && jf_is_space(*q))
         q++;
     if (q == *le || *q == '#' || (*le - q >= 2 && q[0] == '/' && q[1] == '/'))
         return 0;
-    if (!t->csv && !t->no_hash) {
-        const char *h = memchr(q, '#', (size_t)(*le - q));
-        if (h)
-            *le = h;
+    if (!t->csv) { /* one search for the next '#' serves every line before it */
+        if (!t->hash || t->hash < q) {
+            t->hash = memchr(q, '#', (size_t)(t->tend - q));
+            t->hash = t->hash ? t->hash : t->tend;
+        }
+        if (t->hash < *le)
+            *le = t->hash;
     }
     return 1;
 }
@@ -556,7 +581,8 @@ static int block_room(xblock *b, int have_nrm, int na)
 static void parse_block(const tab *t0, const xstate *s, xblock *b, int skip)
 {
     tab t = *t0;
-    t.no_hash = !memchr(b->s, '#', (size_t)(b->e - b->s));
+    t.hash = NULL;
+    t.tend = b->e;
     const int na = t.ta ? t.ta->na : 0;
     jf_text tx = {b->s, b->e, 0, !memchr(b->s, '\r', (size_t)(b->e - b->s))};
     const char *ls, *le;
@@ -750,7 +776,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                          const char *name, const jf_read_opts *o, jf_cloud *c,
                          jf_error *err, text_attrs *ta)
 {
-    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, 0};
+    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, NULL, NULL};
     int setx = 0, setn = 0;
     for (int k = 0; k < 6; k++) {
         if (o->columns[k] < -1 || o->columns[k] > 4095)
@@ -773,20 +799,18 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         buf += 3, len -= 3;
     const int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     size_t lines = 1, crs = 0;
-    /* counted in nt slices on the threads (a pass over the whole text) */
+    /* counted in nt slices on the threads (a pass over the whole text);
+     * lone-CR line ends too */
 #pragma omp parallel for num_threads(nt) reduction(+ : lines, crs) schedule(static, 1)
     for (int k = 0; k < nt; k++) {
         const char *q = buf + len / (size_t)nt * (size_t)k,
                    *e = k == nt - 1 ? buf + len : buf + len / (size_t)nt * (size_t)(k + 1);
-        for (const char *r = q; (r = memchr(r, '\n', (size_t)(e - r))) != NULL; r++)
-            lines++;
-        for (const char *r = q; /* lone-CR line ends too */
-             (r = memchr(r, '\r', (size_t)(e - r))) != NULL; r++)
-            crs++;
+        lines += count_byte(q, (size_t)(e - q), '\n');
+        crs += count_byte(q, (size_t)(e - q), '\r');
     }
     lines += crs;
-    /* no '\r' or '#' anywhere: the per-line searches for them are skipped */
-    t.no_hash = !memchr(buf, '#', len);
+    /* no '\r' anywhere: the per-line search for it is skipped */
+    t.tend = buf + len;
     jf_text tx = {buf, buf + len, 0, crs == 0};
     const char *ls, *le;
     int started = 0;
