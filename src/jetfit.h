@@ -621,6 +621,23 @@ typedef struct {
                             empty when jf_read_opts.no_attrs           */
 } jf_cloud;
 
+/* The phases of a run, as a progress hook (jf_phase_fn) names them. */
+typedef enum {
+    JF_PHASE_READ,   /* parsing the input (units: bytes of the file)     */
+    JF_PHASE_ORDER,  /* the spatial order (Morton) of the points          */
+    JF_PHASE_INDEX,  /* the k-d tree (its leaf order is the walk)         */
+    JF_PHASE_FIT,    /* fitting (points; 2n with mst in blocks)           */
+    JF_PHASE_WRITE   /* formatting and writing the rows (rows)            */
+} jf_phase;
+
+/* Progress of a phase: `done` of `total` units, non-decreasing within a
+ * phase, reported once with done == total when the phase ends (0 to
+ * total for a phase that is not split).  Called on the thread that called
+ * the library function only (never concurrently); it must not call back
+ * into the same object.  The library never prints: a command draws its
+ * progress line from these calls. */
+typedef void (*jf_phase_fn)(void *user, jf_phase phase, size_t done, size_t total);
+
 typedef struct {
     int columns[6];      /* .xyz/.pts/.txt/.csv: 0-based column of x,y,z
                             [,nx,ny,nz]; -1 = default.  Defaults: xyz/txt
@@ -640,6 +657,13 @@ typedef struct {
     int no_attrs;        /* 0 (default) read the attributes into
                             jf_cloud.attrs; 1 skip them (--keep none:
                             no memory spent on them)                   */
+    int threads;         /* text formats: rows parsed in blocks on this
+                            many OpenMP threads (<= 0, the default: all
+                            cores); the cloud and every message are the
+                            same for any count                          */
+    jf_phase_fn progress; /* may be NULL (default): JF_PHASE_READ, in
+                            bytes of the file                          */
+    void *progress_user;
 } jf_read_opts;
 
 /* Sets every column to -1 (the defaults above).  Never fails. */
@@ -805,12 +829,20 @@ jf_status jf_writer_row(jf_writer *w, const double *vals);
 
 /* Appends nrows rows, vals[r * ncols + j] (row-major), exactly as nrows
  * calls of jf_writer_row would, formatting them on `threads` OpenMP
- * threads (<= 0: the OpenMP default) and writing them in order.  Writing
- * is otherwise serial: this is what keeps it off the critical path of a
+ * threads (<= 0: the OpenMP default) and writing them in order: blocks
+ * of rows handed out one at a time, each written when its turn comes
+ * while the other threads format the next ones.  Writing the file is
+ * otherwise serial: this is what keeps it off the critical path of a
  * parallel run (text output above all).  Allocates about threads x 4096
  * x (32 ncols + 2) bytes for the call.  Same errors as jf_writer_row. */
 jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                          int threads);
+
+/* Progress of the rows' formatting and writing: fn(user,
+ * JF_PHASE_WRITE, rows written, nrows) after each round of
+ * jf_writer_rows (jf_writer_commit's, for positioned rows), on the
+ * calling thread.  fn may be NULL (none).  Call before the first row. */
+void jf_writer_progress(jf_writer *w, jf_phase_fn fn, void *user);
 
 /* Positioned rows, for results that arrive out of order
  * (jf_estimate_blocks): jf_writer_begin_put once, on one thread, after
@@ -851,7 +883,8 @@ void jf_writer_abort(jf_writer *w);
  * element list uchar int vertex_indices), .xyz/.txt/.csv (vertices and
  * normals only; faces are not written), .las (LAS 1.4 format 0, the frame
  * of jf_writer_las_frame; normals as Extra Bytes nx ny nz; faces are not
- * written).  Thread-safe. */
+ * written).  The rows are formatted on the OpenMP threads
+ * (jf_writer_rows; the bytes do not depend on their count).  Thread-safe. */
 jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
                          jf_error *err);
 
@@ -1187,6 +1220,11 @@ typedef struct {
     void *progress_user;
     jf_cancel_fn cancel;     /* may be NULL (jf_cancel_fn)              */
     void *cancel_user;
+    jf_phase_fn phase;       /* may be NULL: JF_PHASE_INDEX or _ORDER
+                                (0 then n), then JF_PHASE_FIT (as
+                                progress counts); jf_estimate_parts:
+                                per part, with the part's counts        */
+    void *phase_user;
 } jf_estimate_opts;
 
 /* Fills defaults (params.monge_degree 0: from the degree, see

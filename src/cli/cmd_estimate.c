@@ -18,6 +18,7 @@
 #include "jetfit.h"
 #include "opts.h"
 #include "pipes.h"
+#include "progress.h"
 
 #define DEFAULT_NEIGHBORS JF_CLI_DEFAULT_NEIGHBORS
 
@@ -150,27 +151,6 @@ static double now_s(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-typedef struct {
-    double t0, last;
-    int shown;
-} progress_state;
-
-/* Called by the library on the calling thread: redraw at most 4x/s. */
-static void progress(void *user, size_t done, size_t total)
-{
-    progress_state *ps = user;
-    double t = now_s();
-    if (done < total && t - ps->last < 0.25) return;
-    ps->last = t;
-    double el = t - ps->t0, rate = el > 0 ? (double)done / el : 0;
-    double eta = rate > 0 ? (double)(total - done) / rate : 0;
-    fprintf(stderr, "\rjetfit: %5.1f%%  %zu/%zu points  %.0f points/s  ETA %.0f s   ",
-            total ? 100.0 * (double)done / (double)total : 100.0, done, total, rate, eta);
-    if (done == total) fputc('\n', stderr);
-    fflush(stderr);
-    ps->shown = 1;
-}
-
 /* What the summary counts, per thread (the sink runs on the fit's
  * threads), padded so that threads do not share a cache line. */
 /* neighbors auto: the summary's bins of the chosen K (upper bounds) */
@@ -270,6 +250,7 @@ typedef struct {
     tally *tl;       /* nt                                              */
     double *cond;    /* n, or NULL (--quiet)                            */
     int wfail;       /* a jf_writer_put failed (atomic)                 */
+    jf_cli_progress *pg; /* counts the points fitted (parts too)        */
 } sinkctx;
 
 static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
@@ -285,6 +266,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     }
     jf_status st = jf_writer_put(s->w, idx, v, m);
     if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
+    if (s->pg) jf_cli_progress_fitted(s->pg, m);
     return st;
 }
 
@@ -357,13 +339,22 @@ int jf_cmd_estimate(int argc, char **argv)
             return 1;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
+    e.ro.threads = o.threads; /* text input parsed in blocks on them */
+    /* the progress line: reading, indexing (or ordering), fitting,
+     * writing; the phases' times go to the summary */
+    jf_cli_progress pg;
+    jf_cli_progress_init(&pg, "jetfit", !quiet && isatty(2));
+    e.ro.progress = jf_cli_progress_phase;
+    e.ro.progress_user = &pg;
     if (o.threads > 0)
         omp_set_num_threads(o.threads); /* the LAZ reader decodes chunks on them */
     jf_status st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);
     if (st != JF_OK) {
+        jf_cli_progress_end(&pg);
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
         return 1;
     }
+    jf_cli_progress_end(&pg); /* the line ends before any message */
     if (c.nbad) {
         /* --bad-rows skip: say which rows, so the user can look at them */
         char lines[160] = "";
@@ -481,7 +472,7 @@ int jf_cmd_estimate(int argc, char **argv)
     }
     const int nt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
     sinkctx sk = {w, c.xyz, monge, nt, with_sigma, ncols, malloc((size_t)nt * JF_BLOCK_MAX * ncols * sizeof(double)),
-                  calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0};
+                  calloc((size_t)nt, sizeof(tally)), quiet ? NULL : malloc((c.n ? c.n : 1) * sizeof(double)), 0, NULL};
     if (!sk.rows || !sk.tl || (!quiet && !sk.cond) || jf_writer_begin_put(w, o.threads) != JF_OK) {
         /* a failed begin is reported by commit's message below */
         if (!sk.rows || !sk.tl || (!quiet && !sk.cond))
@@ -497,15 +488,17 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    progress_state ps = {now_s(), 0, 0}; /* rate of the estimation itself */
-    if (!quiet && isatty(2)) {
-        o.progress = progress;
-        o.progress_user = &ps;
-    }
+    sk.pg = &pg;
+    pg.counted = 1; /* the sink counts: parts restart the library's counts */
+    pg.fit_total = c.n;
+    o.phase = jf_cli_progress_phase;
+    o.phase_user = &pg;
+    jf_writer_progress(w, jf_cli_progress_phase, &pg);
     int nparts = plan > 1 ? plan : 1;
     st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
                     : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
     free(sk.rows);
+    jf_cli_progress_end(&pg); /* the fit's line ends before any message */
     if (st != JF_OK) {
         /* a failed write: the writer's own message says which file and
          * why (commit fails on it, and removes the temporary) */
@@ -552,8 +545,11 @@ int jf_cmd_estimate(int argc, char **argv)
     if (unfit > c.n / 2)
         fprintf(stderr, "jetfit: %s: warning: %zu of %zu points could not be fitted (status "
                         "failed or nonfinite)\n", in, unfit, c.n);
-    /* commit reports a failed row too, and removes the temporary */
+    /* commit reports a failed row too, and removes the temporary; the
+     * rows are formatted and written there */
+    jf_cli_progress_phase(&pg, JF_PHASE_WRITE, 0, c.n);
     st = jf_writer_commit(w, &err);
+    jf_cli_progress_end(&pg);
     if (st == JF_OK) st = jf_cli_out_finish(&po, 1, &err); /* to standard output, or renamed */
     else jf_cli_out_msg(&po, &err), jf_cli_out_finish(&po, 0, NULL);
     if (st != JF_OK) {
@@ -563,9 +559,14 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    if (!quiet) summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
-    if (!quiet && nparts > 1) /* --memory: the cloud was fitted in parts */
-        fprintf(stderr, "  parts: %d, one at a time, within --memory\n", nparts);
+    if (!quiet) {
+        char ph[160];
+        summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+        if (nparts > 1) /* --memory: the cloud was fitted in parts */
+            fprintf(stderr, "  parts: %d, one at a time, within --memory\n", nparts);
+        jf_cli_progress_times(&pg, ph, sizeof ph);
+        fprintf(stderr, "  phases: %s\n", ph);
+    }
     free(sk.tl);
     free(sk.cond);
     jf_cloud_free(&c);

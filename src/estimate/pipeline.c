@@ -641,6 +641,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
              * a stop is seen by every thread before its next block */
             if (omp_get_thread_num() == 0) {
                 if (o->progress) o->progress(o->progress_user, now, R->total);
+                if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, now, R->total);
                 if (cancelled(o)) {
 #pragma omp atomic write
                     failed = JF_ERR_CANCELLED;
@@ -797,10 +798,12 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     int knn_cells = o->nb.kind == JF_NB_NATURAL && o->normal != JF_NORMAL_POLES &&
                     o->normal != JF_NORMAL_MINCIRC;
     int need_index = nb.kind <= JF_NB_KNN_RADIUS || knn_cells;
+    if (need_index && o->phase) o->phase(o->phase_user, JF_PHASE_INDEX, 0, n);
     if (need_index && (st = jf__index_build_threads(c->xyz, n, nt, &ix)) != JF_OK) {
         set_err(err, "building the k-d tree failed");
         goto out;
     }
+    if (need_index && o->phase) o->phase(o->phase_user, JF_PHASE_INDEX, n, n);
     x.ix = ix;
     if (cancelled(o)) {
         st = cancel_status(err);
@@ -848,10 +851,12 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             set_err(err, "out of memory (point order)");
             goto out;
         }
+        if (o->phase) o->phase(o->phase_user, JF_PHASE_ORDER, 0, n);
         if ((st = jf_spatial_order(c->xyz, n, order)) != JF_OK) {
             set_err(err, "spatial order failed");
             goto out;
         }
+        if (o->phase) o->phase(o->phase_user, JF_PHASE_ORDER, n, n);
         walk = order;
     }
 
@@ -896,6 +901,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     jf_index_free(ix); /* the orientation does not need it: lower peak */
     ix = NULL;
     if (o->progress) o->progress(o->progress_user, R.total, R.total);
+    if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, R.total, R.total);
     if (!out) goto out; /* blocks left oriented */
     if (o->orient != JF_ORIENT_NONE && cancelled(o)) {
         st = cancel_status(err);

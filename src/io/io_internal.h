@@ -42,6 +42,9 @@ jf_status jf_read_ply(const char *buf, size_t len, const char *name,
 jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
                       const char *name, const jf_read_opts *o, jf_cloud *c,
                       jf_error *err);
+/* io_xyz.c: bytes of text a parallel block takes (0: the default,
+ * 1 MiB); tests make blocks small to cut files of a few rows. */
+void jf__xyz_block_bytes(size_t bytes);
 jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,

@@ -35,6 +35,9 @@ void jf_read_opts_init(jf_read_opts *o)
         o->columns[i] = -1;
     o->bad_rows = 0;
     o->no_attrs = 0;
+    o->threads = 0;
+    o->progress = NULL;
+    o->progress_user = NULL;
 }
 
 void jf_cloud_free(jf_cloud *c)
@@ -353,6 +356,8 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
                               "a NUL byte (binary data in a text file?)");
         }
     }
+    if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, 0, len);
     jf_status st;
     switch (fmt) {
     case JF_FMT_PLY:
@@ -385,6 +390,8 @@ jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "no points in the file");
     if (st != JF_OK)
         jf_cloud_free(c);
+    else if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, len, len);
     return st;
 }
 
@@ -424,9 +431,13 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
     }
     if (fmt == JF_FMT_PLY) {
         /* binary point clouds without a second copy (io_ply.c) */
+        if (o && o->progress)
+            o->progress(o->progress_user, JF_PHASE_READ, 0, len);
         jf_status cs = jf__read_ply_chunked(fd, len, path, o, c, err);
         if (cs != JF_ERR_UNSUPPORTED) {
             close(fd);
+            if (cs == JF_OK && o && o->progress)
+                o->progress(o->progress_user, JF_PHASE_READ, len, len);
             return cs;
         }
     }
@@ -436,17 +447,30 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
         return jf_io_fail(err, JF_ERR_NOMEM, path, 0,
                           "out of memory reading %zu bytes", len);
     }
+    /* a large file in slices of at least 16 MiB on the threads: the
+     * kernel's copy into fresh pages is most of a text read's serial part */
+    int nt = o && o->threads > 0 ? o->threads : jf_default_threads(NULL);
+    if ((size_t)nt > len / ((size_t)16 << 20))
+        nt = (int)(len / ((size_t)16 << 20));
+    nt = nt < 1 ? 1 : nt;
+    const size_t slice = (len + (size_t)nt - 1) / (size_t)nt;
     size_t got = 0;
     int e = 0;
-    while (got < len) {
-        ssize_t r = read(fd, buf + got, len - got > (1u << 30) ? (1u << 30) : len - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0) {
-            e = r < 0 ? errno : 0;
-            break;
+#pragma omp parallel for num_threads(nt) reduction(+ : got) if (nt > 1)
+    for (int k = 0; k < nt; k++) {
+        size_t a = slice * (size_t)k, b = a + slice < len ? a + slice : len, g = a;
+        while (g < b) {
+            ssize_t r = pread(fd, buf + g, b - g > (1u << 30) ? (1u << 30) : b - g, (off_t)g);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                if (r < 0)
+                    __atomic_store_n(&e, errno, __ATOMIC_RELAXED);
+                break;
+            }
+            g += (size_t)r;
         }
-        got += (size_t)r;
+        got += g - a;
     }
     close(fd);
     if (got < len) {

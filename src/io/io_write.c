@@ -43,6 +43,8 @@ struct jf_writer {
     int put_threads;                 /* for the drain's formatting       */
     jf_spool *spool;                 /* io_spool.c                       */
     char *warn;                      /* jf_writer_warnings' text         */
+    jf_phase_fn prog;                /* jf_writer_progress, or NULL      */
+    void *prog_user;
 };
 
 /* The attribute columns go after column 2 (x y z). */
@@ -460,32 +462,51 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                        : row_max >= ((size_t)8 << 20) ? 1 : ((size_t)8 << 20) / row_max,
                  slot = blk * row_max;
     char *scratch = malloc((size_t)nt * slot);
-    size_t *len = malloc((size_t)nt * sizeof *len);
-    if (!scratch || !len) {
-        free(scratch);
-        free(len);
+    if (!scratch)
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
-    }
-    /* each round: thread t formats the t-th block of blk rows into
-     * its slot, then the slots go out in order, unbuffered */
-    for (size_t r0 = 0; r0 < nrows && f->st == JF_OK;
-         r0 += (size_t)nt * blk) {
-#pragma omp parallel for num_threads(nt) schedule(static, 1)
-        for (int t = 0; t < nt; t++) {
-            size_t a = r0 + (size_t)t * blk, b = a + blk;
-            char *o = scratch + (size_t)t * slot;
-            len[t] = 0;
-            for (size_t r = a; r < b && r < nrows; r++)
-                len[t] += format_row(w, vals + r * w->ncols, w->rows + r, o + len[t]);
+    /* blocks of blk rows handed out one at a time: each thread formats
+     * its block into its slot, then waits for its turn (ordered) to
+     * write it, while the others format the next ones -- no round
+     * barrier, the file gets the blocks in row order */
+    const size_t nblk = (nrows + blk - 1) / blk;
+    int failed = f->st != JF_OK;
+#pragma omp parallel num_threads(nt)
+    {
+        const int tid = omp_get_thread_num();
+        char *o = scratch + (size_t)tid * slot;
+#pragma omp for schedule(dynamic, 1) ordered
+        for (size_t k = 0; k < nblk; k++) {
+            int halt;
+#pragma omp atomic read
+            halt = failed;
+            size_t a = k * blk, e = a + blk < nrows ? a + blk : nrows, l = 0;
+            for (size_t r = a; r < e && !halt; r++)
+                l += format_row(w, vals + r * w->ncols, w->rows + r, o + l);
+#pragma omp ordered
+            if (f->st == JF_OK) {
+                if (jf_wf_write(f, o, l) != JF_OK) {
+#pragma omp atomic write
+                    failed = 1;
+                } else if (tid == 0 && w->prog) { /* the calling thread */
+                    w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + e, w->nrows);
+                }
+            }
         }
-        for (int t = 0; t < nt && f->st == JF_OK; t++)
-            jf_wf_write(f, scratch + (size_t)t * slot, len[t]);
     }
+    if (w->prog && f->st == JF_OK)
+        w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + nrows, w->nrows);
     free(scratch);
-    free(len);
     if (f->st == JF_OK)
         w->rows += nrows;
     return f->st;
+}
+
+void jf_writer_progress(jf_writer *w, jf_phase_fn fn, void *user)
+{
+    if (!w)
+        return;
+    w->prog = fn;
+    w->prog_user = user;
 }
 
 /* ---- positioned rows --------------------------------------------------- */
@@ -749,12 +770,23 @@ jf_status jf_cloud_write(const char *path, const jf_cloud *c, int ascii,
         return jf_io_fail(err, st, nm, 0, "a face has bad offsets or a vertex "
                                           "index out of range");
     }
-    for (size_t i = 0; i < c->n && st == JF_OK; i++) {
-        double v[6];
-        memcpy(v, c->xyz + 3 * i, 3 * sizeof(double));
-        if (c->nrm)
-            memcpy(v + 3, c->nrm + 3 * i, 3 * sizeof(double));
-        st = jf_writer_row(w, v);
+    /* rows gathered a slice at a time and formatted on the threads
+     * (jf_writer_rows: the bytes of row-by-row writes) */
+    const size_t slice = (size_t)1 << 16;
+    double *v = malloc((c->n < slice ? c->n : slice) * nc * sizeof *v + sizeof *v);
+    if (!v) {
+        jf_writer_abort(w);
+        return jf_io_fail(err, JF_ERR_NOMEM, nm, 0, "out of memory");
     }
+    for (size_t i0 = 0; i0 < c->n && st == JF_OK; i0 += slice) {
+        size_t k = c->n - i0 < slice ? c->n - i0 : slice;
+        for (size_t i = 0; i < k; i++) {
+            memcpy(v + nc * i, c->xyz + 3 * (i0 + i), 3 * sizeof(double));
+            if (c->nrm)
+                memcpy(v + nc * i + 3, c->nrm + 3 * (i0 + i), 3 * sizeof(double));
+        }
+        st = jf_writer_rows(w, v, k, 0);
+    }
+    free(v);
     return jf_writer_commit(w, err);
 }

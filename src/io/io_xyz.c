@@ -13,9 +13,30 @@
 #include "io_internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* How many bytes of [p, p + n) are c: eight at a time (a byte of x ^ c
+ * is zero exactly where the byte is c: the carry-free test below leaves
+ * a 1 in that byte, and a multiply sums the eight bytes). */
+static size_t count_byte(const char *p, size_t n, char c)
+{
+    const uint64_t ones = 0x0101010101010101ULL, low7 = 0x7F7F7F7F7F7F7F7FULL;
+    const uint64_t cc = ones * (unsigned char)c;
+    size_t k = 0, i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t x;
+        memcpy(&x, p + i, 8);
+        x ^= cc;
+        uint64_t t = ((x & low7) + low7) | x; /* high bit set: byte non-zero */
+        k += (size_t)((((~t & ~low7) >> 7) * ones) >> 56); /* the bytes' sum */
+    }
+    for (; i < n; i++)
+        k += p[i] == c;
+    return k;
+}
 
 /* Whether the row's first field could be a count (jf_parse_size: '+'
  * and digits): a quick look that spares data rows the full test. */
@@ -53,7 +74,9 @@ typedef struct {
     int col[6];     /* column of x y z nx ny nz, -1 = not read */
     int maxcol;     /* largest column needed */
     text_attrs *ta; /* NULL: attributes not wanted */
-    int no_hash;    /* no '#' in the whole text */
+    const char *hash; /* the first '#' at or after the last line looked
+                         at (tend: none), NULL before the first        */
+    const char *tend; /* the end of the text (of the block)            */
 } tab;
 
 /* Next field of a row; csv fields are trimmed and may be empty. */
@@ -110,17 +133,20 @@ static int fast_row(const char *p, const char *e, int w, double *v)
 }
 
 /* The row without a comment: [ls, *le) shortened; 0 if nothing is left. */
-static int strip_comment(const tab *t, const char *ls, const char **le)
+static int strip_comment(tab *t, const char *ls, const char **le)
 {
     const char *q = ls;
     while (q < *le && jf_is_space(*q))
         q++;
     if (q == *le || *q == '#' || (*le - q >= 2 && q[0] == '/' && q[1] == '/'))
         return 0;
-    if (!t->csv && !t->no_hash) {
-        const char *h = memchr(q, '#', (size_t)(*le - q));
-        if (h)
-            *le = h;
+    if (!t->csv) { /* one search for the next '#' serves every line before it */
+        if (!t->hash || t->hash < q) {
+            t->hash = memchr(q, '#', (size_t)(t->tend - q));
+            t->hash = t->hash ? t->hash : t->tend;
+        }
+        if (t->hash < *le)
+            *le = t->hash;
     }
     return 1;
 }
@@ -214,31 +240,48 @@ static jf_status csv_header(tab *t, const char *ls, const char *le,
     return JF_OK;
 }
 
-/* Attribute values of row n: fields [0, maxcol] of the line (NaN when the
- * row is bad or a field is empty; a field that is not a number marks its
- * column as text). */
-static int text_attrs_row(const tab *t, size_t n, const char *ls, const char *le, int bad)
+/* Attribute values of one row into v (na values) from fields [0, maxcol]
+ * of the line (NaN when the row is bad or a field is empty; a field that
+ * is not a number marks its column in text[]). */
+static void attrs_fill(const tab *t, double *v, unsigned char *text, const char *ls,
+                       const char *le, int bad)
 {
-    text_attrs *ta = t->ta;
-    if (n >= ta->rows_cap) {
-        size_t cap = ta->rows_cap ? 2 * ta->rows_cap : 1024;
-        double *q = realloc(ta->v, cap * (size_t)ta->na * sizeof *q);
-        if (!q)
-            return 0;
-        ta->v = q;
-        ta->rows_cap = cap;
-    }
-    double *v = ta->v + n * (size_t)ta->na;
+    const text_attrs *ta = t->ta;
     for (int k = 0; k < ta->na; k++)
         v[k] = NAN;
     if (bad)
-        return 1;
+        return;
     const char *p = ls, *fs, *fe;
     for (int j = 0; j <= ta->maxcol && next_field(t, &p, le, &fs, &fe); j++) {
         int k = ta->acol[j];
         if (k >= 0 && fs < fe && !jf_parse_double(fs, fe, &v[k]))
-            ta->text[k] = 1;
+            text[k] = 1;
     }
+}
+
+/* Room for `rows` rows of attribute values (grown by doubling). */
+static int attrs_room(text_attrs *ta, size_t rows)
+{
+    if (rows <= ta->rows_cap)
+        return 1;
+    size_t cap = ta->rows_cap ? ta->rows_cap : 1024;
+    while (cap < rows)
+        cap *= 2;
+    double *q = realloc(ta->v, cap * (size_t)ta->na * sizeof *q);
+    if (!q)
+        return 0;
+    ta->v = q;
+    ta->rows_cap = cap;
+    return 1;
+}
+
+/* Attribute values of row n (see attrs_fill). */
+static int text_attrs_row(const tab *t, size_t n, const char *ls, const char *le, int bad)
+{
+    text_attrs *ta = t->ta;
+    if (!attrs_room(ta, n + 1))
+        return 0;
+    attrs_fill(t, ta->v + n * (size_t)ta->na, ta->text, ls, le, bad);
     return 1;
 }
 
@@ -404,11 +447,336 @@ static int grow_rows(jf_cloud *c, size_t *cap, size_t lines, int have_nrm)
     return 1;
 }
 
+/* One data row [ls, le) into v (x y z nx ny nz as t->col says): 0, or
+ * the length of why, the reason the row is bad, without the "row N: "
+ * its caller puts first.  nf0: the first data row's width (-1: none yet);
+ * fast: its rows take fast_row; *nfp: the row's fields. */
+static int parse_row(const tab *t, const char *ls, const char *le, int nf0, int fast,
+                     double *v, char *why, size_t wl, int *nfp)
+{
+    if (fast && fast_row(ls, le, nf0, v)) {
+        *nfp = nf0;
+        return 0;
+    }
+    const char *p = ls, *fs, *fe;
+    int j = 0, bad = 0;
+    /* rows, like lines and columns, count from 1 (docs/formats.md) */
+    why[0] = '\0';
+    for (; j <= t->maxcol && next_field(t, &p, le, &fs, &fe); j++) {
+        for (int k = 0; k < 6 && !bad; k++) {
+            if (t->col[k] != j)
+                continue;
+            if (fs == fe)
+                bad = snprintf(why, wl, "empty field in column %d", j + 1);
+            else if (!jf_parse_double(fs, fe, &v[k]))
+                bad = snprintf(why, wl, "column %d: '%.*s' is not a number", j + 1,
+                               (int)(fe - fs > 40 ? 40 : fe - fs), fs);
+        }
+    }
+    int nf = j;
+    while (next_field(t, &p, le, &fs, &fe))
+        nf++;
+    *nfp = nf;
+    if (!bad && j <= t->maxcol)
+        bad = snprintf(why, wl, "expected %d numbers, found %d", t->maxcol + 1, nf);
+    /* a row of another width is a broken or shifted line, not data */
+    if (!bad && nf0 >= 0 && nf != nf0)
+        bad = !t->csv && decimal_commas(ls, le)
+                  ? snprintf(why, wl, "'%.*s' has decimal commas; jetfit "
+                             "reads '.' as the decimal point (sed 's/,/./g')",
+                             (int)(le - ls > 40 ? 40 : le - ls), ls)
+                  : snprintf(why, wl, "%d columns, the first data row has %d", nf, nf0);
+    return bad;
+}
+
+/* A line holding one integer that may be a point count (PTS): its value. */
+static int count_candidate(const tab *t, const char *ls, const char *le, uint64_t *cnt)
+{
+    const char *p = ls, *fs, *fe, *gs, *ge;
+    return !t->csv && digits_first(ls, le) && next_field(t, &p, le, &fs, &fe) &&
+           !next_field(t, &p, le, &gs, &ge) && jf_parse_size(fs, fe, UINT64_MAX, cnt);
+}
+
+/* The reader's running state, shared by the serial start and the merge
+ * of the parallel blocks. */
+typedef struct {
+    size_t n, cap;           /* rows stored, room in c->xyz (c->nrm)      */
+    size_t lines;            /* upper bound on rows: the file's lines     */
+    size_t since_count, last_count, count_line;
+    int counted;             /* a count line was seen                     */
+    int have_nrm, nf0, fast;
+    size_t line;             /* lines read                                */
+} xstate;
+
+/* ---- the parallel part ------------------------------------------------
+ * design: once the first data row has fixed the columns and the width,
+ * every later line is parsed on its own: the text is cut into blocks at
+ * line ends, each thread parses blocks into their own rows, and the
+ * blocks are merged in order on the calling thread.  What a line means
+ * beyond itself is an event the merge settles in order: a bad row (its
+ * row and line numbers, known only then; the error is the first in file
+ * order, its reason parsed again from the line) and a line of one
+ * integer, a PTS count line when exactly that many rows precede it since
+ * the last count, else a bad row.  The rows are the serial reader's, bit
+ * for bit, for every thread count. */
+
+/* Bytes of text per block (tests make it small: jf__xyz_block_bytes). */
+static size_t block_bytes = (size_t)1 << 20;
+
+void jf__xyz_block_bytes(size_t bytes)
+{
+    block_bytes = bytes ? bytes : (size_t)1 << 20;
+}
+
+typedef struct {
+    size_t row, line;        /* in the block, from 0 and 1               */
+    const char *ls, *le;     /* the line (comment cut)                    */
+    uint64_t cnt;            /* cand: its integer                         */
+    int cand;                /* a line of one integer (a NaN slot)        */
+} xevent;
+
+typedef struct {
+    const char *s, *e;       /* whole lines                               */
+    double *xyz, *nrm, *av;  /* rows (attributes: na a row)              */
+    size_t n, cap;
+    xevent *ev;
+    size_t nev, evcap;
+    size_t lines;
+    unsigned char *text;     /* per attribute: a word seen                */
+    int nomem;
+} xblock;
+
+static void block_free(xblock *b)
+{
+    free(b->xyz);
+    free(b->nrm);
+    free(b->av);
+    free(b->ev);
+    free(b->text);
+}
+
+static int block_room(xblock *b, int have_nrm, int na)
+{
+    size_t nc = b->cap ? 2 * b->cap : 4096;
+    double *q = realloc(b->xyz, nc * 3 * sizeof *q);
+    if (!q)
+        return 0;
+    b->xyz = q;
+    if (have_nrm) {
+        if (!(q = realloc(b->nrm, nc * 3 * sizeof *q)))
+            return 0;
+        b->nrm = q;
+    }
+    if (na) {
+        if (!(q = realloc(b->av, nc * (size_t)na * sizeof *q)))
+            return 0;
+        b->av = q;
+    }
+    b->cap = nc;
+    return 1;
+}
+
+/* Parses block b (one thread).  Error mode stops at the first bad row
+ * that is not a line of one integer: nothing after it matters. */
+static void parse_block(const tab *t0, const xstate *s, xblock *b, int skip)
+{
+    tab t = *t0;
+    t.hash = NULL;
+    t.tend = b->e;
+    const int na = t.ta ? t.ta->na : 0;
+    jf_text tx = {b->s, b->e, 0, !memchr(b->s, '\r', (size_t)(b->e - b->s))};
+    const char *ls, *le;
+    b->n = b->nev = 0;
+    b->nomem = 0;
+    if (na)
+        memset(b->text, 0, (size_t)na);
+    while (jf_text_line(&tx, &ls, &le)) {
+        if (!strip_comment(&t, ls, &le))
+            continue;
+        double v[6];
+        char why[160];
+        int nf, bad;
+        uint64_t cnt = 0;
+        /* a count is possible only after a count (the first data row is
+         * behind us) */
+        int cand = s->counted && count_candidate(&t, ls, le, &cnt);
+        bad = cand || parse_row(&t, ls, le, s->nf0, s->fast, v, why, sizeof why, &nf);
+        if (bad) {
+            if (b->nev == b->evcap) {
+                size_t nc = b->evcap ? 2 * b->evcap : 64;
+                xevent *q = realloc(b->ev, nc * sizeof *q);
+                if (!q) {
+                    b->nomem = 1;
+                    break;
+                }
+                b->ev = q;
+                b->evcap = nc;
+            }
+            b->ev[b->nev++] = (xevent){b->n, tx.line, ls, le, cnt, cand};
+            if (!cand && !skip)
+                break;
+            for (int k = 0; k < 6; k++)
+                v[k] = NAN;
+        }
+        if (b->n == b->cap && !block_room(b, s->have_nrm, na)) {
+            b->nomem = 1;
+            break;
+        }
+        memcpy(b->xyz + 3 * b->n, v, 3 * sizeof(double));
+        if (s->have_nrm)
+            memcpy(b->nrm + 3 * b->n, v + 3, 3 * sizeof(double));
+        if (na)
+            attrs_fill(&t, b->av + b->n * (size_t)na, b->text, ls, le, bad);
+        b->n++;
+    }
+    b->lines = tx.line;
+}
+
+/* Appends rows [from, to) of block b to the cloud. */
+static jf_status take_rows(const tab *t, xstate *s, const xblock *b, size_t from, size_t to,
+                           jf_cloud *c)
+{
+    size_t k = to - from;
+    if (!k)
+        return JF_OK;
+    while (s->cap < s->n + k) {
+        int room = grow_rows(c, &s->cap, s->lines, s->have_nrm);
+        if (room <= 0)
+            return room < 0 ? jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0,
+                                         "out of memory for %zu points", s->n + k)
+                            : jf_io_fail(t->err, JF_ERR_TOO_LARGE, t->name, 0,
+                                         "more than %zu rows", (size_t)JF_MAX_POINTS);
+    }
+    memcpy(c->xyz + 3 * s->n, b->xyz + 3 * from, 3 * k * sizeof(double));
+    if (s->have_nrm)
+        memcpy(c->nrm + 3 * s->n, b->nrm + 3 * from, 3 * k * sizeof(double));
+    if (t->ta) {
+        size_t na = (size_t)t->ta->na;
+        if (!attrs_room(t->ta, s->n + k))
+            return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+        memcpy(t->ta->v + s->n * na, b->av + from * na, k * na * sizeof(double));
+    }
+    s->n += k;
+    s->since_count += k;
+    return JF_OK;
+}
+
+/* Block b's rows after the cloud's, its events settled in order. */
+static jf_status merge_block(const tab *t, xstate *s, const xblock *b, int skip, jf_cloud *c)
+{
+    size_t seg = 0; /* rows of b not taken yet start here */
+    jf_status st;
+    for (size_t i = 0; i < b->nev; i++) {
+        const xevent *e = &b->ev[i];
+        if (e->cand && s->since_count + (e->row - seg) == s->last_count) {
+            if ((st = take_rows(t, s, b, seg, e->row, c)) != JF_OK)
+                return st;
+            s->last_count = (size_t)e->cnt;
+            s->count_line = s->line + e->line;
+            s->since_count = 0;
+            seg = e->row + 1; /* a count line is not a row */
+            continue;
+        }
+        if (!skip) {
+            double v[6];
+            char why[160];
+            int nf;
+            parse_row(t, e->ls, e->le, s->nf0, s->fast, v, why, sizeof why, &nf);
+            return jf_io_fail(t->err, JF_ERR_FORMAT, t->name, s->line + e->line, "row %zu: %s",
+                              s->n + (e->row - seg) + 1, why);
+        }
+        /* --bad-rows skip: its NaN row is in the block */
+        if (c->nbad < sizeof c->bad_line / sizeof c->bad_line[0])
+            c->bad_line[c->nbad] = s->line + e->line;
+        c->nbad++;
+    }
+    if (b->nomem)
+        return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory for %zu points",
+                          s->n + b->n);
+    if ((st = take_rows(t, s, b, seg, b->n, c)) != JF_OK)
+        return st;
+    if (t->ta)
+        for (int k = 0; k < t->ta->na; k++)
+            t->ta->text[k] |= b->text[k];
+    s->line += b->lines;
+    return JF_OK;
+}
+
+/* The text [p, end): blocks handed out one at a time, each parsed by a
+ * thread into its own rows, then merged in order (ordered) while the
+ * other threads parse the next ones; no round barrier. */
+static jf_status read_blocks(const tab *t, xstate *s, const char *p, const char *end, int nt,
+                             int skip, jf_cloud *c, const jf_read_opts *o, const char *buf0,
+                             size_t total)
+{
+    const int na = t->ta ? t->ta->na : 0;
+    size_t nblk = 0, cap = 0;
+    const char **cut = NULL;
+    for (const char *q = p; q < end; nblk++) { /* the blocks' ends, at line ends */
+        const char *e = (size_t)(end - q) > block_bytes ? q + block_bytes : end;
+        if (e < end) {
+            const char *nl = memchr(e - 1, '\n', (size_t)(end - e + 1));
+            e = nl ? nl + 1 : end;
+        }
+        if (nblk + 2 > cap) {
+            cap = cap ? 2 * cap : 256;
+            const char **g = realloc(cut, cap * sizeof *g);
+            if (!g) {
+                free(cut);
+                return jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+            }
+            cut = g;
+        }
+        cut[nblk] = q;
+        q = e;
+        cut[nblk + 1] = e;
+    }
+    xblock *bl = calloc((size_t)nt, sizeof *bl);
+    int ok = bl != NULL;
+    for (int i = 0; ok && i < nt; i++)
+        ok = !na || (bl[i].text = malloc((size_t)na)) != NULL;
+    jf_status st = ok ? JF_OK : jf_io_fail(t->err, JF_ERR_NOMEM, t->name, 0, "out of memory");
+    const xstate s0 = *s; /* what the parsers read; the merge changes s */
+    int stop = st != JF_OK;
+#pragma omp parallel num_threads(nt) if (ok)
+    {
+        const int tid = omp_get_thread_num();
+        xblock *b = ok ? &bl[tid] : NULL;
+#pragma omp for schedule(dynamic, 1) ordered
+        for (size_t i = 0; i < nblk; i++) {
+            int halt;
+#pragma omp atomic read
+            halt = stop;
+            if (!halt) {
+                b->s = cut[i];
+                b->e = cut[i + 1];
+                parse_block(t, &s0, b, skip);
+            }
+#pragma omp ordered
+            if (!halt && st == JF_OK) {
+                st = merge_block(t, s, b, skip, c);
+                if (st != JF_OK) {
+#pragma omp atomic write
+                    stop = 1;
+                } else if (tid == 0 && o->progress) { /* the calling thread */
+                    o->progress(o->progress_user, JF_PHASE_READ, (size_t)(cut[i + 1] - buf0),
+                                total);
+                }
+            }
+        }
+    }
+    for (int i = 0; bl && i < nt; i++)
+        block_free(&bl[i]);
+    free(bl);
+    free(cut);
+    return st;
+}
+
 static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                          const char *name, const jf_read_opts *o, jf_cloud *c,
                          jf_error *err, text_attrs *ta)
 {
-    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, 0};
+    tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, NULL, NULL};
     int setx = 0, setn = 0;
     for (int k = 0; k < 6; k++) {
         if (o->columns[k] < -1 || o->columns[k] > 4095)
@@ -422,46 +790,51 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         return jf_io_fail(err, JF_ERR_INVALID, name, 0,
                           "columns: give all of x,y,z (and of nx,ny,nz) or "
                           "none");
+    const char *const buf0 = buf;
+    const size_t total = len;
     /* upper bound on data rows: the lines, and the bytes (a row of m
      * needed fields takes at least 2m, separators and newline included) */
     /* a UTF-8 byte order mark (spreadsheet exports) is not data */
     if (len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
         buf += 3, len -= 3;
+    const int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     size_t lines = 1, crs = 0;
-    for (const char *q = buf, *e = buf + len;
-         (q = memchr(q, '\n', (size_t)(e - q))) != NULL; q++)
-        lines++;
-    for (const char *q = buf, *e = buf + len; /* lone-CR line ends too */
-         (q = memchr(q, '\r', (size_t)(e - q))) != NULL; q++)
-        crs++;
+    /* counted in nt slices on the threads (a pass over the whole text);
+     * lone-CR line ends too */
+#pragma omp parallel for num_threads(nt) reduction(+ : lines, crs) schedule(static, 1)
+    for (int k = 0; k < nt; k++) {
+        const char *q = buf + len / (size_t)nt * (size_t)k,
+                   *e = k == nt - 1 ? buf + len : buf + len / (size_t)nt * (size_t)(k + 1);
+        lines += count_byte(q, (size_t)(e - q), '\n');
+        crs += count_byte(q, (size_t)(e - q), '\r');
+    }
     lines += crs;
-    /* no '\r' or '#' anywhere: the per-line searches for them are skipped */
-    t.no_hash = !memchr(buf, '#', len);
-    size_t cap = 0;
+    /* no '\r' anywhere: the per-line search for it is skipped */
+    t.tend = buf + len;
     jf_text tx = {buf, buf + len, 0, crs == 0};
     const char *ls, *le;
-    int started = 0, have_nrm = 0;
-    size_t n = 0, since_count = 0, last_count = 0;
-    int counted = 0, nf0 = -1, fast = 0;
-    size_t count_line = 0;
+    int started = 0;
+    xstate s = {0, 0, lines, 0, 0, 0, 0, 0, -1, 0, 0};
     const int skip = o->bad_rows == 1;
-    while (jf_text_line(&tx, &ls, &le)) {
+    for (size_t r = 0;; r++) {
+        /* the columns and width are known: the rest in parallel blocks */
+        if (nt > 1 && s.nf0 >= 0 && (size_t)(tx.end - tx.p) > 2 * block_bytes)
+            break;
+        if (!jf_text_line(&tx, &ls, &le))
+            break;
+        if (o->progress && (r & 0xFFFF) == 0xFFFF)
+            o->progress(o->progress_user, JF_PHASE_READ, (size_t)(tx.p - buf0), total);
         if (!strip_comment(&t, ls, &le))
             continue;
         /* a point count line (PTS) */
-        if (!t.csv && digits_first(ls, le)) {
-            const char *p = ls, *fs, *fe, *gs, *ge;
-            uint64_t cnt;
-            if (next_field(&t, &p, le, &fs, &fe) &&
-                !next_field(&t, &p, le, &gs, &ge) &&
-                jf_parse_size(fs, fe, UINT64_MAX, &cnt) &&
-                (!counted ? n == 0 : since_count == last_count)) {
-                counted = 1;
-                count_line = tx.line;
-                last_count = (size_t)cnt;
-                since_count = 0;
-                continue;
-            }
+        uint64_t cnt;
+        if (count_candidate(&t, ls, le, &cnt) &&
+            (!s.counted ? s.n == 0 : s.since_count == s.last_count)) {
+            s.counted = 1;
+            s.count_line = tx.line;
+            s.last_count = (size_t)cnt;
+            s.since_count = 0;
+            continue;
         }
         if (!started) {
             /* the first data line decides the columns */
@@ -490,63 +863,33 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                     t.col[3] = 3, t.col[4] = 4, t.col[5] = 5;
             }
             set_maxcol(&t);
-            have_nrm = t.col[3] >= 0;
-            cap = (len + 1) / (2 * (size_t)(t.maxcol + 1));
-            cap = cap < lines ? cap : lines;
-            cap = cap < JF_MAX_POINTS ? cap : JF_MAX_POINTS;
-            c->xyz = malloc(cap * 3 * sizeof(double));
-            c->nrm = have_nrm ? malloc(cap * 3 * sizeof(double)) : NULL;
-            if (!c->xyz || (have_nrm && !c->nrm))
+            s.have_nrm = t.col[3] >= 0;
+            s.cap = (len + 1) / (2 * (size_t)(t.maxcol + 1));
+            s.cap = s.cap < lines ? s.cap : lines;
+            s.cap = s.cap < JF_MAX_POINTS ? s.cap : JF_MAX_POINTS;
+            c->xyz = malloc(s.cap * 3 * sizeof(double));
+            c->nrm = s.have_nrm ? malloc(s.cap * 3 * sizeof(double)) : NULL;
+            if (!c->xyz || (s.have_nrm && !c->nrm))
                 return jf_io_fail(err, JF_ERR_NOMEM, name, 0,
-                                  "out of memory for %zu points", cap);
+                                  "out of memory for %zu points", s.cap);
             if (header)
                 continue;
         }
         double v[6];
-        int room;
-        if (fast && fast_row(ls, le, nf0, v))
-            goto store;
-        const char *p = ls, *fs, *fe;
-        int j = 0, bad = 0;
-        char why[160]; /* rows, like lines and columns, count from 1 (docs/formats.md) */
-        why[0] = '\0';
-        for (; j <= t.maxcol && next_field(&t, &p, le, &fs, &fe); j++) {
-            for (int k = 0; k < 6 && !bad; k++) {
-                if (t.col[k] != j)
-                    continue;
-                if (fs == fe)
-                    bad = snprintf(why, sizeof why, "row %zu: empty field in column %d", n + 1,
-                                   j + 1);
-                else if (!jf_parse_double(fs, fe, &v[k]))
-                    bad = snprintf(why, sizeof why, "row %zu: column %d: '%.*s' is not a number",
-                                   n + 1, j + 1, (int)(fe - fs > 40 ? 40 : fe - fs), fs);
-            }
-        }
-        int nf = j;
-        while (next_field(&t, &p, le, &fs, &fe))
-            nf++;
-        if (!bad && j <= t.maxcol)
-            bad = snprintf(why, sizeof why, "row %zu: expected %d numbers, found %d", n + 1,
-                           t.maxcol + 1, nf);
-        /* a row of another width is a broken or shifted line, not data */
-        if (!bad && nf0 >= 0 && nf != nf0)
-            bad = !t.csv && decimal_commas(ls, le)
-                      ? snprintf(why, sizeof why, "row %zu: '%.*s' has decimal commas; jetfit "
-                                 "reads '.' as the decimal point (sed 's/,/./g')", n + 1,
-                                 (int)(le - ls > 40 ? 40 : le - ls), ls)
-                      : snprintf(why, sizeof why, "row %zu: %d columns, the first data row has %d",
-                                 n + 1, nf, nf0);
+        char why[160];
+        int nf, room;
+        int bad = parse_row(&t, ls, le, s.nf0, s.fast, v, why, sizeof why, &nf);
         if (bad && !skip)
-            return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line, "%s", why);
+            return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line, "row %zu: %s", s.n + 1, why);
         if (bad) { /* --bad-rows skip: a NaN row keeps every later index */
             if (c->nbad < sizeof c->bad_line / sizeof c->bad_line[0])
                 c->bad_line[c->nbad] = tx.line;
             c->nbad++;
             for (int k = 0; k < 6; k++)
                 v[k] = NAN;
-        } else if (nf0 < 0) {
-            nf0 = nf;
-            fast = !t.csv && !ta && nf0 == t.maxcol + 1 && in_order(&t);
+        } else if (s.nf0 < 0) {
+            s.nf0 = nf;
+            s.fast = !t.csv && !ta && s.nf0 == t.maxcol + 1 && in_order(&t);
             /* the rows are narrower than the header: its last names
              * name nothing */
             if (ta)
@@ -554,36 +897,42 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                     if (ta->acol[jj] >= 0)
                         ta->text[ta->acol[jj]] = 1;
         }
-        if (ta && !text_attrs_row(&t, n, ls, le, bad))
+        if (ta && !text_attrs_row(&t, s.n, ls, le, bad))
             return jf_io_fail(err, JF_ERR_NOMEM, name, tx.line, "out of memory");
-    store:
         /* rows that parse fit the byte bound; bad rows kept as NaN under
          * --bad-rows skip can be shorter ("4 5"): only the line count
          * bounds them, so the arrays grow up to it */
-        if (n == cap && (room = grow_rows(c, &cap, lines, have_nrm)) <= 0)
+        if (s.n == s.cap && (room = grow_rows(c, &s.cap, lines, s.have_nrm)) <= 0)
             return room < 0 ? jf_io_fail(err, JF_ERR_NOMEM, name, tx.line,
-                                         "out of memory for %zu points", n + 1)
+                                         "out of memory for %zu points", s.n + 1)
                             : jf_io_fail(err, JF_ERR_TOO_LARGE, name, tx.line,
                                          "more than %zu rows", (size_t)JF_MAX_POINTS);
-        memcpy(c->xyz + 3 * n, v, 3 * sizeof(double));
-        if (have_nrm)
-            memcpy(c->nrm + 3 * n, v + 3, 3 * sizeof(double));
-        n++;
-        since_count++;
+        memcpy(c->xyz + 3 * s.n, v, 3 * sizeof(double));
+        if (s.have_nrm)
+            memcpy(c->nrm + 3 * s.n, v + 3, 3 * sizeof(double));
+        s.n++;
+        s.since_count++;
     }
-    if (counted && since_count != last_count)
-        return jf_io_fail(err, JF_ERR_FORMAT, name, count_line,
-                          "the count line says %zu points, %zu rows follow it", last_count,
-                          since_count);
+    s.line = tx.line;
+    if (tx.p < tx.end) {
+        jf_status st = read_blocks(&t, &s, tx.p, tx.end, nt, skip, c, o, buf0, total);
+        if (st != JF_OK)
+            return st;
+    }
+    size_t n = s.n;
+    if (s.counted && s.since_count != s.last_count)
+        return jf_io_fail(err, JF_ERR_FORMAT, name, s.count_line,
+                          "the count line says %zu points, %zu rows follow it", s.last_count,
+                          s.since_count);
     if (n == 0 || n == c->nbad)
-        return jf_io_fail(err, JF_ERR_FORMAT, name, tx.line ? tx.line : 0,
+        return jf_io_fail(err, JF_ERR_FORMAT, name, s.line ? s.line : 0,
                           "no points in the file");
     c->n = n;
     /* give back the unused tail of the estimate */
     double *q = realloc(c->xyz, n * 3 * sizeof(double));
     if (q)
         c->xyz = q;
-    if (have_nrm && (q = realloc(c->nrm, n * 3 * sizeof(double))) != NULL)
+    if (s.have_nrm && (q = realloc(c->nrm, n * 3 * sizeof(double))) != NULL)
         c->nrm = q;
     return ta ? text_attrs_pack(&t, n, c) : JF_OK;
 }

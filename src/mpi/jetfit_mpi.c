@@ -28,6 +28,7 @@
 #include "io_internal.h"
 #include "mpi_internal.h"
 #include "opts.h"
+#include "progress.h"
 
 static void usage(FILE *f)
 {
@@ -399,6 +400,13 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     jf_mpi_load(m, in, &lay, &q, normals, o.threads, &c);
     int failed = m->failed;
     double t1 = MPI_Wtime();
+    /* rank 0's progress line: its own points (the ranks fit at one pace) */
+    jf_cli_progress pg;
+    jf_cli_progress_init(&pg, "jetfit-mpi", m->rank == 0 && !cmd.quiet && isatty(2));
+    if (m->rank == 0) {
+        o.phase = jf_cli_progress_phase;
+        o.phase_user = &pg;
+    }
     jf_result *res = NULL;
     if (!failed) {
         res = malloc((c.n ? c.n : 1) * sizeof *res);
@@ -408,6 +416,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         lc.nrm = c.nrm;
         jf_error err = {{0}};
         jf_status st = res ? jf__estimate_masked(&lc, &o, c.own, res, &err) : JF_ERR_NOMEM;
+        jf_cli_progress_end(&pg);
         if (st != JF_OK) jf_mpi_fail(m, "%s: %s", in, err.msg[0] ? err.msg : jf_strerror(st));
         /* fault injection for tests/mpi/test_mpi.sh: this rank fails here */
         const char *inj = getenv("JETFIT_MPI_TEST_FAIL");
@@ -429,7 +438,10 @@ static int estimate(jf_mpi *m, int argc, char **argv)
     if (!failed && m->rank == 0 && !commit_length(m, &w, out, bytes)) {
         jf_error err = {{0}};
         if (w.txt) {
+            jf_writer_progress(w.txt, jf_cli_progress_phase, &pg);
+            jf_cli_progress_phase(&pg, JF_PHASE_WRITE, 0, (size_t)lay.count);
             convert_text(m, &w, cols, ncols, lay.count, o.threads);
+            jf_cli_progress_end(&pg);
             jf_writer_abort(w.bin); /* the side file's temporary goes */
             w.bin = NULL;
             jf_writer *t = w.txt;

@@ -18,6 +18,8 @@
  * floats (as scanners write them), written by the tests' E57 writer
  * (tests/io/e57_write.h, not timed against anything) and read by jetfit,
  * against reading them as LAS format 0 (uncompressed) in the same run.
+ * Text read and written on all threads (blocks: io_xyz.c, jf_writer_rows)
+ * against one thread, in the same run.
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -125,14 +127,18 @@ static double write_fprintf(void)
     return bad ? -1 : t;
 }
 
-static double read_cloud(const char *ext)
+/* threads: the text parser's (0: all cores) */
+static double read_cloud(const char *ext, int threads)
 {
     char p[600];
     path(p, ext);
     jf_cloud c;
     jf_error e;
+    jf_read_opts o;
+    jf_read_opts_init(&o);
+    o.threads = threads;
     double t = now();
-    jf_status st = jf_cloud_read(p, NULL, &c, &e);
+    jf_status st = jf_cloud_read(p, &o, &c, &e);
     t = now() - t;
     if (st != JF_OK) {
         fprintf(stderr, "%s\n", e.msg);
@@ -176,6 +182,26 @@ static double write_e57(void)
     free(b);
     free(x);
     return bad ? -1 : t;
+}
+
+/* The points as .xyz through the table writer on `threads` threads
+ * (jf_cloud_write's bytes: test_io_write). */
+static double write_xyz_threads(int threads)
+{
+    double *x = gen(N);
+    jf_column cols[3] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64}};
+    char p[600];
+    path(p, "1t.xyz");
+    jf_writer *w;
+    jf_error e;
+    double t = now();
+    if (jf_writer_open(p, cols, 3, N, 0, &w, &e) != JF_OK)
+        return -1;
+    jf_writer_rows(w, x, N, threads);
+    jf_status st = jf_writer_commit(w, &e);
+    t = now() - t;
+    free(x);
+    return st == JF_OK ? t : -1;
 }
 
 static double read_fscanf(void)
@@ -250,7 +276,9 @@ static double run(const step *s)
     switch (s->kind) {
     case 0: return write_cloud(s->ext, s->ascii);
     case 1: return write_fprintf();
-    case 2: return read_cloud(s->ext);
+    case 2: return read_cloud(s->ext, 0);
+    case 6: return read_cloud(s->ext, 1);
+    case 7: return write_xyz_threads(1);
     case 3: return read_fscanf();
     case 5: return write_e57();
     default: return write_table(s->ext);
@@ -280,9 +308,11 @@ int main(int argc, char **argv)
         {"table N/10 x 28 cols, CSV", 4, "t.csv", 0, 1},
         {"write E57 float (tests' writer)", 5, "e57", 0, 0},
         {"read E57 float (jetfit)", 2, "e57", 0, 0},
+        {"read xyz (jetfit, 1 thread)", 6, "xyz", 0, 0},
+        {"write xyz (jetfit, 1 thread)", 7, "1t.xyz", 0, 0},
     };
     size_t nsteps = sizeof steps / sizeof *steps;
-    double secs[16], cpus[16];
+    double secs[20], cpus[20];
     printf("bench_io: N = %zu points, files in %s\n", N, dir);
     printf("%-36s %9s %9s %14s %9s %10s\n", "step", "seconds", "cpu s",
            "points/s", "MB/s", "peak MiB");
@@ -344,8 +374,13 @@ int main(int argc, char **argv)
     if (secs[9] > 0 && secs[13] > 0 && cpus[9] > 0)
         printf("read E57 float: %.2fx the time of read LAS (CPU time: %.2fx; goal <= 2x)\n",
                secs[13] / secs[9], cpus[13] / cpus[9]);
+    /* text in blocks on the threads (issue 28.3): against one thread */
+    if (secs[7] > 0 && secs[14] > 0)
+        printf("read xyz: all threads %.2fx the speed of 1 thread\n", secs[14] / secs[7]);
+    if (secs[2] > 0 && secs[15] > 0)
+        printf("write xyz: all threads %.2fx the speed of 1 thread\n", secs[15] / secs[2]);
     static const char *const exts[] = {"ply", "a.ply", "xyz", "peer.xyz",
-                                       "las", "t.ply", "t.csv", "e57"};
+                                       "las", "t.ply", "t.csv", "e57", "1t.xyz"};
     for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
         char p[600];
         path(p, exts[i]);

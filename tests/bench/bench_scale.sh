@@ -16,9 +16,67 @@
 #      (parts with halos), compared byte for byte with cmp.
 # Peak RSS: /usr/bin/time -v when present, else Python's
 # resource.getrusage(RUSAGE_CHILDREN).  Build first: cmake --build build.
+#
+#   tests/bench/bench_scale.sh --phases [FOLDER] [N]
+#
+# issue 28.3 instead: N (default 4000000) points of the same cloud as
+# binary PLY and as .xyz, `jetfit estimate --neighbors knn:16 --degree 2`
+# at 1 and $(nproc) threads (THREADS overrides N threads), inputs ply ->
+# ply, xyz -> ply and xyz -> xyz: wall time and each phase's time from the
+# summary's "phases" line (read, order or tree, fit, write: the command's
+# progress hooks), then the end-to-end speed-ups 1 -> N threads and the
+# time of .xyz over binary PLY input at N threads.  REPS (default 1): the
+# best of that many runs of each.
 set -eu
 top=$(cd "$(dirname "$0")/../.." && pwd)
 bin=${JETFIT:-$top/build/jetfit}
+if [ "${1:-}" = "--phases" ]; then
+    shift
+    dir=${1:-}
+    N=${2:-4000000}
+    nt=${THREADS:-$(nproc)}
+    reps=${REPS:-1}
+    if [ -z "$dir" ]; then dir=$(mktemp -d /tmp/jf_phases.XXXXXX); fi
+    mkdir -p "$dir"
+    trap 'rm -f "$dir"/ph_*' EXIT
+    [ -x "$bin" ] || { echo "bench_scale: $bin not built" >&2; exit 1; }
+    echo "machine: $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GB", $2/1048576}' /proc/meminfo)," \
+         "load $(cut -d' ' -f1-3 /proc/loadavg); jetfit $($bin --version 2>/dev/null | head -1)"
+    "$bin" generate exp --n "$N" --seed 12 -o "$dir/ph_in.ply" >/dev/null
+    "$bin" generate exp --n "$N" --seed 12 -o "$dir/ph_in.xyz" >/dev/null
+    echo "N = $N points (ply $(du -m "$dir/ph_in.ply" | cut -f1) MB, xyz $(du -m "$dir/ph_in.xyz" | cut -f1) MB); best of $reps"
+    printf "%-10s %7s %8s %7s %7s %7s %7s %7s\n" in-out threads wall read order tree fit write
+    for io in ply-ply xyz-ply xyz-xyz; do
+        for t in 1 "$nt"; do
+            best=""
+            r=0
+            while [ "$r" -lt "$reps" ]; do
+                s0=$(date +%s.%N)
+                "$bin" estimate "$dir/ph_in.${io%-*}" -o "$dir/ph_out.${io#*-}" --neighbors knn:16 \
+                    --degree 2 --threads "$t" 2>"$dir/ph_err" >/dev/null ||
+                    { cat "$dir/ph_err" >&2; exit 1; }
+                s1=$(date +%s.%N)
+                line=$(awk -v w="$(awk -v a="$s0" -v b="$s1" 'BEGIN { print b - a }')" '/phases:/ {
+                    sub(/.*phases: /, ""); n = split($0, f, ", ")
+                    for (i = 1; i <= n; i++) { split(f[i], kv, " "); v[kv[1]] = kv[2] }
+                    printf "%.2f %.2f %.2f %.2f %.2f %.2f", w, v["read"], v["order"], v["tree"],
+                           v["fit"], v["write"] }' "$dir/ph_err")
+                if [ -z "$best" ] || awk -v a="${line%% *}" -v b="${best%% *}" 'BEGIN { exit !(a < b) }'; then
+                    best=$line
+                fi
+                r=$((r + 1))
+            done
+            set -- $best
+            printf "%-10s %7s %8s %7s %7s %7s %7s %7s\n" "$io" "$t" "$1" "$2" "$3" "$4" "$5" "$6"
+            eval "w_${io%-*}_${io#*-}_$t=$1"
+        done
+    done
+    eval "a=\$w_ply_ply_1 b=\$w_ply_ply_$nt c=\$w_xyz_ply_1 d=\$w_xyz_ply_$nt e=\$w_xyz_xyz_1 f=\$w_xyz_xyz_$nt"
+    echo "$a $b $c $d $e $f" | awk -v nt="$nt" '{
+        printf "end to end 1 -> %d threads: ply -> ply %.2fx, xyz -> ply %.2fx, xyz -> xyz %.2fx (goal >= 1.75x on 2)\n", nt, $1 / $2, $3 / $4, $5 / $6
+        printf ".xyz input / binary PLY input at %d threads: %.2fx (goal <= 1.1x)\n", nt, $4 / $2 }'
+    exit 0
+fi
 dir=${1:-}
 N=${2:-100000000}
 threads=${THREADS:-$(nproc)}

@@ -255,15 +255,20 @@ START_TEST(neighbourhood_kinds)
 }
 END_TEST
 
-/* On a terminal: a progress line ("\r", percent, points/s, ETA) ending at
- * 100%, then the summary; --quiet draws nothing. */
+/* On a terminal: a progress line ("\r", phase, percent, points/s, ETA)
+ * ending at 100% in each phase, then the summary; --quiet draws nothing. */
 START_TEST(progress_on_terminal)
 {
     make_points();
     cli_write_xyz(cli_path("in.xyz"), pts, NULL, N);
     ck_assert_int_eq(cli_run_tty("estimate", cli_path("in.xyz"), "-o", cli_path("p.csv"), NULL),
                      0);
-    ck_assert_msg(strstr(cli_err, "\rjetfit: 100.0%  700/700 points") != NULL, "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, "\rjetfit: fitting  100.0%  700/700 points") != NULL, "%s",
+                  cli_err);
+    /* every phase: the file read (bytes), the rows written */
+    ck_assert_msg(strstr(cli_err, "\rjetfit: reading  100.0%") != NULL, "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, "\rjetfit: writing  100.0%  700/700 points") != NULL, "%s",
+                  cli_err);
     ck_assert(strstr(cli_err, "ETA") && strstr(cli_err, "cond: p50"));
     ck_assert_int_eq(cli_run_tty("estimate", cli_path("in.xyz"), "-o", cli_path("p.csv"),
                                  "--quiet", NULL), 0);

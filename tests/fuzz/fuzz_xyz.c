@@ -5,9 +5,38 @@
  * Each input is read twice, with bad_rows = error and = skip (--bad-rows):
  * a file the strict read accepts reads the same, bit for bit, under skip
  * with nothing skipped; a skip read keeps a parsable row, lists its bad
- * lines in increasing order, and every bad row is NaN.
+ * lines in increasing order, and every bad row is NaN.  Both modes are
+ * also read on one thread and on three in blocks of a few bytes: the
+ * same status, message and cloud.
  */
 #include "fuzz_common.h"
+#include "io_internal.h"
+
+/* One thread against three with blocks of a few bytes (io_xyz.c's
+ * parallel blocks): the same status, message and cloud, bit for bit. */
+static void same_threads(const uint8_t *d, size_t n, jf_format f, jf_read_opts o)
+{
+    jf_cloud a, b;
+    jf_error ea, eb;
+    o.threads = 1;
+    jf_status sa = jf_cloud_read_mem((const char *)d, n, f, "fuzz", &o, &a, &ea);
+    o.threads = 3;
+    jf__xyz_block_bytes(8 + n % 61);
+    jf_status sb = jf_cloud_read_mem((const char *)d, n, f, "fuzz", &o, &b, &eb);
+    jf__xyz_block_bytes(0);
+    if (sa != sb || (sa != JF_OK && strcmp(ea.msg, eb.msg)))
+        abort();
+    if (sa != JF_OK)
+        return;
+    if (a.n != b.n || a.nbad != b.nbad || memcmp(a.bad_line, b.bad_line, sizeof a.bad_line) ||
+        memcmp(a.xyz, b.xyz, 3 * a.n * sizeof(double)) || !!a.nrm != !!b.nrm ||
+        (a.nrm && memcmp(a.nrm, b.nrm, 3 * a.n * sizeof(double))) ||
+        a.attrs.nattrs != b.attrs.nattrs || a.attrs.stride != b.attrs.stride ||
+        (a.attrs.nattrs && memcmp(a.attrs.rec, b.attrs.rec, a.n * a.attrs.stride)))
+        abort();
+    jf_cloud_free(&a);
+    jf_cloud_free(&b);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -24,6 +53,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (int k = 0; k < 3; k++)
             o.columns[3 + k] = (int)((sel >> 6) & 3) + k;
     jf_fuzz_check(data + 1, size - 1, fmts[sel % 3], &o);
+    same_threads(data + 1, size - 1, fmts[sel % 3], o);
+    o.bad_rows = 1;
+    same_threads(data + 1, size - 1, fmts[sel % 3], o);
+    o.bad_rows = 0;
 
     jf_cloud a, b;
     jf_error e;
