@@ -7,7 +7,7 @@ if(TEST test_io_laz)
 endif()
 add_executable(laz_dump ${CMAKE_CURRENT_SOURCE_DIR}/io/laz_dump.c)
 target_link_libraries(laz_dump PRIVATE jetfit_lib OpenMP::OpenMP_C)
-target_include_directories(laz_dump PRIVATE ${JF_INTERNAL_INCLUDES})
+target_include_directories(laz_dump PRIVATE ${JF_INTERNAL_INCLUDES} ${CMAKE_CURRENT_SOURCE_DIR}/io)
 add_test(NAME test_laz_perf
          COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/io/laz_perf_check.sh $<TARGET_FILE:laz_dump>
                  ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/test_laz_perf)

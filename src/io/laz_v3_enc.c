@@ -205,7 +205,8 @@ static void gps_encode(p14ctx *c, lz_enc *e, uint64_t t)
     }
 }
 
-/* One point; its scanner channel, or -1 out of memory. */
+/* One point; the other items' context (laz_v3.c: the new channel on a
+ * switch, else 0), or -1 out of memory. */
 static int p14_encode(p14 *s, lz_arena *a, const uint8_t *r)
 {
     p14pt nv;
@@ -298,7 +299,7 @@ static int p14_encode(p14 *s, lz_arena *a, const uint8_t *r)
         o->gps = nv.gps;
     }
     c->gps_change = gpsc;
-    return (int)s->cur;
+    return sw ? (int)sc : 0;
 }
 
 /* ---- RGB14, RGBNIR14 ------------------------------------------------ */
