@@ -27,11 +27,6 @@
 #include "laz_enc.h"
 #include "laz_internal.h"
 
-int jf__laz_v2_encode(const lz_item *items, unsigned nitems, unsigned rec_len,
-                      const uint8_t *recs, uint32_t count, lz_enc *out);
-int jf__laz_v3_encode(const lz_item *items, unsigned nitems, unsigned rec_len,
-                      const uint8_t *recs, uint32_t count, lz_enc *out);
-
 #define LZW_CHUNK 50000u
 #define LZW_CHUNK_BYTES ((size_t)1 << 28) /* a chunk's records at most */
 

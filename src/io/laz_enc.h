@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "laz_arith.h"
+#include "laz_internal.h"
 
 /* An encoder writing into its own growing buffer. */
 typedef struct {
@@ -43,5 +44,13 @@ void lz_write_bits(lz_enc *e, uint32_t bits, uint32_t sym);
 void lz_write_int(lz_enc *e, uint32_t v);
 /* real as pred + a corrector in context ctx (ic set up by lz_ic_init). */
 void lz_ic_encode(lz_enc *e, lz_ic *ic, int32_t pred, int32_t real, uint32_t ctx);
+
+/* One chunk of `count` records (rec_len bytes each, the items' sizes
+ * summing to rec_len) appended to out as LASzip writes it: pointwise
+ * (laz_v2_enc.c) or layered (laz_v3_enc.c).  0, or -1 out of memory. */
+int jf__laz_v2_encode(const lz_item *items, unsigned nitems, unsigned rec_len,
+                      const uint8_t *recs, uint32_t count, lz_enc *out);
+int jf__laz_v3_encode(const lz_item *items, unsigned nitems, unsigned rec_len,
+                      const uint8_t *recs, uint32_t count, lz_enc *out);
 
 #endif /* JF_LAZ_ENC_H */
