@@ -192,9 +192,10 @@ static jf_status find_vlr(const unsigned char *b, size_t hsize, size_t data_off,
  * points. */
 static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_off, uint64_t n,
                             const lz_vlr *z, const char *name, lz_chunk **out, size_t *nout,
-                            jf_error *err)
+                            int *bad_table, jf_error *err)
 {
     *out = NULL, *nout = 0;
+    *bad_table = 1; /* the table itself unusable (not the header lying) */
     uint64_t first = data_off + 8;
     if (z->compressor == 1) { /* pointwise, not chunked: one stream */
         lz_chunk *c = malloc(sizeof *c);
@@ -265,6 +266,7 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
             break;
         }
         if (c[i].count == 0 || c[i].count > n - total) {
+            *bad_table = z->chunk_size == LZ_VARIABLE && !c[i].count;
             st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                             "chunk %u: %u points, more than the header's %llu leave "
                             "(or none)", (unsigned)i, c[i].count,
@@ -272,6 +274,7 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
             break;
         }
         if (pb < z->rec_len || (uint64_t)c[i].count * z->rec_len > (uint64_t)pb << LZ_MAX_EXPANSION) {
+            *bad_table = pb < z->rec_len;
             st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                             "chunk %u: %u points of %u bytes cannot be coded in its %u bytes "
                             "(a lying count or chunk table)", (unsigned)i, c[i].count,
@@ -289,16 +292,109 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
         total += c[i].count;
     }
     lz_arena_free(&a);
-    if (st == JF_OK && total != n)
+    if (st == JF_OK && total != n) {
+        *bad_table = 0;
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                         "chunk table: its %u chunks hold %llu points, the header says %llu",
                         nc, (unsigned long long)total, (unsigned long long)n);
+    }
     if (st != JF_OK) {
         free(c);
         return st;
     }
     *out = c, *nout = nc;
     return JF_OK;
+}
+
+/* A missing or damaged chunk table rebuilt by walking the chunks from the
+ * first (LASzip writes them back to back): a layered chunk (compressor 3)
+ * says its point count and its layers' sizes, so its length is read off;
+ * a pointwise chunk (2) of the fixed size is decoded to find where its
+ * stream ends (the decoder stops where the encoder did).  Stops at the
+ * header's point count; 0 and why filled when a chunk does not fit. */
+static int scan_table(const unsigned char *b, size_t len, uint64_t data_off, uint64_t n,
+                      const lz_vlr *z, lz_chunk **out, size_t *nout, char *why, size_t whylen)
+{
+    *out = NULL, *nout = 0;
+    if (z->compressor == 2 && z->chunk_size == LZ_VARIABLE) {
+        snprintf(why, whylen, "variable-size pointwise chunks cannot be found without it");
+        return 0;
+    }
+    unsigned nl = 0; /* layers of a layered chunk */
+    for (unsigned i = 0; i < z->nitems; i++)
+        nl += z->items[i].type == LZ_POINT14 ? 9 : z->items[i].type == LZ_RGB14 ? 1
+              : z->items[i].type == LZ_RGBNIR14 ? 2 : z->items[i].size;
+    size_t cap = 0, nc = 0;
+    lz_chunk *c = NULL;
+    uint8_t *scratch = NULL;
+    uint64_t pos = data_off + 8, total = 0;
+    int ok = 1;
+    while (ok && total < n) {
+        uint32_t want = z->chunk_size == LZ_VARIABLE ? 0
+                        : n - total < z->chunk_size ? (uint32_t)(n - total) : z->chunk_size;
+        uint64_t bytes = 0;
+        uint32_t cnt = want;
+        char msg[160];
+        if (pos > len) {
+            snprintf(why, whylen, "the file ends before chunk %zu", nc);
+            ok = 0;
+        } else if (z->compressor == 3) {
+            uint64_t head = (uint64_t)z->rec_len + 4 + 4 * (uint64_t)nl;
+            if (len - pos < head) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: the file ends in its head", nc,
+                         (unsigned long long)pos);
+                ok = 0;
+                break;
+            }
+            const unsigned char *q = b + pos + z->rec_len;
+            cnt = g32(q);
+            bytes = head;
+            for (unsigned k = 0; k < nl; k++)
+                bytes += g32(q + 4 + 4 * k);
+            if (!cnt || cnt > n - total || (want && cnt != want) || bytes > len - pos) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %u points in %llu bytes do not fit "
+                         "the file", nc, (unsigned long long)pos, cnt, (unsigned long long)bytes);
+                ok = 0;
+                break;
+            }
+        } else {
+            size_t used = 0;
+            if (!scratch && !(scratch = malloc((size_t)z->chunk_size * z->rec_len))) {
+                snprintf(why, whylen, "out of memory");
+                ok = 0;
+                break;
+            }
+            if (jf__laz_v2_chunk_len(z->items, z->nitems, z->rec_len, b + pos, b + len, want,
+                                     scratch, &used, msg, sizeof msg) != 0) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %s", nc, (unsigned long long)pos,
+                         msg);
+                ok = 0;
+                break;
+            }
+            bytes = used;
+        }
+        if (nc == cap) {
+            cap = cap ? 2 * cap : 64;
+            lz_chunk *t = realloc(c, cap * sizeof *c);
+            if (!t) {
+                snprintf(why, whylen, "out of memory");
+                ok = 0;
+                break;
+            }
+            c = t;
+        }
+        c[nc].start = pos, c[nc].bytes = bytes, c[nc].count = cnt, c[nc].first = total;
+        nc++;
+        pos += bytes;
+        total += cnt;
+    }
+    free(scratch);
+    if (!ok) {
+        free(c);
+        return 0;
+    }
+    *out = c, *nout = nc;
+    return 1;
 }
 
 jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
@@ -339,8 +435,22 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
         return st;
     lz_chunk *ch;
     size_t nc;
-    if ((st = read_table(b, len, data_off, n, &z, name, &ch, &nc, err)) != JF_OK)
-        return st;
+    int bad_table = 0;
+    if ((st = read_table(b, len, data_off, n, &z, name, &ch, &nc, &bad_table, err)) != JF_OK) {
+        /* missing or damaged: rebuilt from the chunks, else both reasons */
+        char why[200] = "";
+        if (st == JF_ERR_NOMEM || z.compressor == 1 || !bad_table ||
+            !scan_table(b, len, data_off, n, &z, &ch, &nc, why, sizeof why)) {
+            if (st != JF_ERR_NOMEM && z.compressor != 1 && bad_table && err) {
+                size_t l = strlen(err->msg);
+                snprintf(err->msg + l, sizeof err->msg - l, "; rebuilding it from the chunks "
+                         "failed: %s", why);
+            }
+            return st;
+        }
+        if (err)
+            err->msg[0] = '\0';
+    }
     /* EVLRs (1.4) after the chunk table are kept, moved with the points */
     uint64_t evlr = 0, nevlr = 0;
     if (minor >= 4 && hsize >= 375) {
