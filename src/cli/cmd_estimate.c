@@ -28,7 +28,7 @@ static void usage(FILE *f)
         "\n"
         "Fits an osculating jet (Cazals & Pouget 2003) at every point of INPUT\n"
         "and writes one row per input point, in input order.\n"
-        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx .e57   OUTPUT: .ply .csv .xyz .txt .las\n"
+        "INPUT: .ply .xyz .pts .txt .csv .off .las .ptx .e57   OUTPUT: .ply .csv .xyz .txt .las .laz\n"
         "\n"
         "  -o, --output FILE     output file (written to a temporary, renamed at the end);\n"
         "                        '-' is standard output (with --output-format)\n"
