@@ -51,6 +51,19 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name,
  * the compression bits cleared).  err "NAME: reason" naming the chunk. */
 jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
                          size_t *img_len, jf_error *err);
+/* The same, a piece at a time (jetfit-mpi: each rank its rows): the file
+ * image buf (kept by the caller while L lives) checked and indexed; the
+ * plain LAS file's header and VLRs (head_len bytes: its records would
+ * start there), its point count and record length; count records from
+ * point `first` decoded into out (the chunks they lie in; the last one
+ * kept for the next call: not thread-safe). */
+typedef struct jf_laz jf_laz;
+jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **L,
+                       jf_error *err);
+const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n,
+                                  unsigned *rec_len);
+jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err);
+void jf__laz_close(jf_laz *L);
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,
