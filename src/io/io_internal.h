@@ -64,6 +64,10 @@ const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n
                                   unsigned *rec_len);
 jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err);
 void jf__laz_close(jf_laz *L);
+/* jf__laz_open of a malloc'ed image that L then owns (freed by
+ * jf__laz_close; on failure at once). */
+jf_status jf__laz_open_owned(char *buf, size_t len, const char *name, jf_laz **L,
+                             jf_error *err);
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,
@@ -92,6 +96,7 @@ typedef struct {
     size_t off[6];         /* PLY: their offsets in the row              */
     int las;               /* LAS: x y z are int32 at 0, 4, 8, then      */
     double scale[3], offset[3]; /* value * scale + offset                */
+    struct jf_laz *laz;    /* LAZ: the rows come from its chunks (jf__laz_rows) */
 } jf_row_layout;
 
 /* The layout from the file's first len bytes (the whole header), the

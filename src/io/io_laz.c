@@ -412,6 +412,7 @@ struct jf_laz {
     size_t cached;       /* the chunk in cache (nc: none), for jf__laz_rows */
     uint8_t *cache;
     const char *name;
+    char *owned;         /* the image, when L owns it */
 };
 
 void jf__laz_close(jf_laz *L)
@@ -421,7 +422,19 @@ void jf__laz_close(jf_laz *L)
     free(L->ch);
     free(L->head);
     free(L->cache);
+    free(L->owned);
     free(L);
+}
+
+jf_status jf__laz_open_owned(char *buf, size_t len, const char *name, jf_laz **L,
+                             jf_error *err)
+{
+    jf_status st = jf__laz_open(buf, len, name, L, err);
+    if (st != JF_OK)
+        free(buf);
+    else
+        (*L)->owned = buf;
+    return st;
 }
 
 jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **out,

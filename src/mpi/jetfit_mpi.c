@@ -38,7 +38,7 @@ static void usage(FILE *f)
         "the same output file, byte for byte.  Each rank reads 1/N of INPUT, owns\n"
         "one spatial part of the cloud and fetches the exact halo it needs; no rank\n"
         "holds the whole cloud.  Options: jetfit estimate --help.\n"
-        "INPUT: binary PLY or LAS.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
+        "INPUT: binary PLY, LAS or LAZ.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
         "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
         "(they need the whole cloud at once), LAS output; the input's\n"
         "other properties are not carried (the output is that of --keep none).\n"
