@@ -11,7 +11,8 @@
  * .xyz, .txt, --ascii) go through a binary temporary that rank 0 converts
  * in one sequential pass with the same writer.  Refused with one line:
  * natural and rings neighbourhoods, --orient mst and scanner (they need
- * the whole cloud at once), inputs other than binary PLY and LAS, LAS output. */
+ * the whole cloud at once), inputs other than binary PLY and LAS (LAZ
+ * included), LAS output. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
