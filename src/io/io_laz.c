@@ -351,7 +351,8 @@ static int scan_table(const unsigned char *b, size_t len, uint64_t data_off, uin
             bytes = head;
             for (unsigned k = 0; k < nl; k++)
                 bytes += g32(q + 4 + 4 * k);
-            if (!cnt || cnt > n - total || (want && cnt != want) || bytes > len - pos) {
+            if (!cnt || cnt > n - total || (want && cnt != want) || bytes > len - pos ||
+                (uint64_t)cnt * z->rec_len > bytes << LZ_MAX_EXPANSION) {
                 snprintf(why, whylen, "chunk %zu at byte %llu: %u points in %llu bytes do not fit "
                          "the file", nc, (unsigned long long)pos, cnt, (unsigned long long)bytes);
                 ok = 0;
@@ -359,7 +360,15 @@ static int scan_table(const unsigned char *b, size_t len, uint64_t data_off, uin
             }
         } else {
             size_t used = 0;
-            if (!scratch && !(scratch = malloc((size_t)z->chunk_size * z->rec_len))) {
+            if ((uint64_t)want * z->rec_len > (uint64_t)(len - pos) << LZ_MAX_EXPANSION) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %u points cannot be coded in the "
+                         "%llu bytes left", nc, (unsigned long long)pos, want,
+                         (unsigned long long)(len - pos));
+                ok = 0;
+                break;
+            }
+            /* the first chunk is the largest (fixed size) */
+            if (!scratch && !(scratch = malloc((size_t)want * z->rec_len))) {
                 snprintf(why, whylen, "out of memory");
                 ok = 0;
                 break;
