@@ -103,7 +103,9 @@ jf_lazw *jf__lazw_open(unsigned fmt, unsigned rec_len, size_t prefix, char *why,
     z->chunk = LZW_CHUNK;
     if ((size_t)z->chunk * rec_len > LZW_CHUNK_BYTES) /* long records: smaller chunks */
         z->chunk = (uint32_t)(LZW_CHUNK_BYTES / rec_len);
-    int nt = omp_get_max_threads();
+    /* a chunk per thread at once, within 64 MB of records */
+    size_t nt = (size_t)omp_get_max_threads(), fit = ((size_t)64 << 20) / ((size_t)z->chunk * rec_len);
+    nt = nt < fit ? nt : fit;
     z->nbuf = nt > 1 ? (unsigned)(nt < 64 ? nt : 64) : 1;
     z->buf = malloc((size_t)z->nbuf * z->chunk * rec_len);
     z->out = calloc(z->nbuf, sizeof *z->out);
