@@ -13,7 +13,7 @@ if(JF_FUZZ)
   list(APPEND JF_FUZZ_READER_SOURCES ${PROJECT_SOURCE_DIR}/src/core/threads.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
-  foreach(reader ply xyz off las ptx ply_layout e57 laz)
+  foreach(reader ply xyz off las ptx ply_layout e57 laz laz_rt)
     add_executable(fuzz_${reader} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_${reader}.c
                    ${JF_FUZZ_READER_SOURCES})
     target_include_directories(fuzz_${reader} PRIVATE ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/src/io)

@@ -119,7 +119,7 @@ PyDoc_STRVAR(read_doc,
 
 PyDoc_STRVAR(write_doc,
 "write(path, result, *, points=None, faces=None, ascii=False, threads=None)\n--\n\n"
-"Writes the command's output file of a Result (.ply, .csv, .xyz, .txt, .las),\n"
+"Writes the command's output file of a Result (.ply, .csv, .xyz, .txt, .las, .laz),\n"
 "byte for byte; through a temporary renamed at the end.\n"
 "\n"
 "Parameters:\n"

@@ -17,7 +17,7 @@
 
 #include "pipes.h"
 
-static const char *const formats[] = {"ply", "xyz", "txt", "pts", "csv", "off", "las", "ptx"};
+static const char *const formats[] = {"ply", "xyz", "txt", "pts", "csv", "off", "las", "laz", "ptx", "e57"};
 
 int jf_cli_format_ok(const char *fmt)
 {
@@ -88,7 +88,7 @@ jf_status jf_cli_in_begin(jf_cli_in *r, const char *path, const char *fmt, jf_er
     }
     if (!fmt)
         return fail(err, JF_ERR_INVALID, "%s: standard input has no extension: give "
-                                         "--input-format FMT (ply, xyz, txt, pts, csv, off, las, ptx)%s",
+                                         "--input-format FMT (ply, xyz, txt, pts, csv, off, las, laz, ptx, e57)%s",
                     r->shown, "");
     if (!jf_cli_format_ok(fmt))
         return fail(err, JF_ERR_INVALID, "--input-format '%s': expected ply, xyz, txt, pts, csv, "

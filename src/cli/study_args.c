@@ -49,7 +49,7 @@ static void usage(FILE *f)
         "  --mesh                SURFACE: a perturbed triangulated grid of about N\n"
         "                        vertices, as generate --mesh (rings need it)\n"
         "  --subset IDX          only these 0-based rows count (as eval --subset)\n"
-        "  --input-format FMT    read INPUT as FMT (ply xyz txt pts csv off las ptx):\n"
+        "  --input-format FMT    read INPUT as FMT (ply xyz txt pts csv off las laz ptx e57):\n"
         "                        needed when INPUT is '-' (standard input)\n"
         "  --metrics LIST        best.csv's metrics (default all): normal_rms,\n"
         "                        normal_median, normal_p95, k1_median, k1_p95,\n"

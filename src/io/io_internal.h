@@ -54,6 +54,23 @@ jf_status jf_read_las(const char *buf, size_t len, const char *name,
  * the compression bits cleared).  err "NAME: reason" naming the chunk. */
 jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
                          size_t *img_len, jf_error *err);
+/* The same, a piece at a time (jetfit-mpi: each rank its rows): the file
+ * image buf (kept by the caller while L lives) checked and indexed; the
+ * plain LAS file's header and VLRs (head_len bytes: its records would
+ * start there), its point count and record length; count records from
+ * point `first` decoded into out (the chunks they lie in; the last one
+ * kept for the next call: not thread-safe). */
+typedef struct jf_laz jf_laz;
+jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **L,
+                       jf_error *err);
+const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n,
+                                  unsigned *rec_len);
+jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err);
+void jf__laz_close(jf_laz *L);
+/* jf__laz_open of a malloc'ed image that L then owns (freed by
+ * jf__laz_close; on failure at once). */
+jf_status jf__laz_open_owned(char *buf, size_t len, const char *name, jf_laz **L,
+                             jf_error *err);
 jf_status jf_read_ptx(const char *buf, size_t len, const char *name, const jf_read_opts *o,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_read_opts *o,
@@ -82,6 +99,7 @@ typedef struct {
     size_t off[6];         /* PLY: their offsets in the row              */
     int las;               /* LAS: x y z are int32 at 0, 4, 8, then      */
     double scale[3], offset[3]; /* value * scale + offset                */
+    struct jf_laz *laz;    /* LAZ: the rows come from its chunks (jf__laz_rows) */
 } jf_row_layout;
 
 /* The layout from the file's first len bytes (the whole header), the
@@ -165,6 +183,12 @@ int jf__las_names(jf_las_out *L, const char *file);
 void jf__las_out_free(jf_las_out *L);
 size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, char *o);
 int jf__las_write_prefix(int fd, const jf_las_out *L);
+/* The header and VLRs jf__las_write_prefix writes, in a buffer of *len
+ * bytes for the caller to free (NULL without memory). */
+unsigned char *jf__las_prefix(const jf_las_out *L, size_t *len);
+/* The output's point format (the input's under keep, else 0). */
+unsigned jf__las_out_format(const jf_las_out *L);
+
 /* The dimension names of point format 0 (as the LAS reader names them). */
 #define JF__LAS_FMT0_NDIMS 12
 extern const char *const jf__las_fmt0_dims[JF__LAS_FMT0_NDIMS];
@@ -357,5 +381,25 @@ static inline char *jf_wf_room(jf_wfile *f, size_t need)
         return NULL;
     return f->buf + f->len;
 }
+
+/* LAZ output (io_laz_write.c): the records of a LAS output, compressed in
+ * chunks as they come (LASzip compressor 2 for point formats 0-3, 3 for
+ * 6-8), the chunk table after them, and the LAS prefix with the laszip
+ * VLR and the table's offset at commit. */
+typedef struct jf_lazw jf_lazw;
+/* NULL with why filled for a format not written as LAZ (4, 5, 9, 10, or
+ * out of memory). */
+jf_lazw *jf__lazw_open(unsigned fmt, unsigned rec_len, size_t prefix, char *why, size_t whylen);
+/* Bytes the LAZ adds between the LAS prefix and the records (the laszip
+ * VLR and the chunk table's offset). */
+size_t jf__lazw_extra(const jf_lazw *z);
+/* Takes n whole records (n * rec_len bytes), writing full chunks to f. */
+jf_status jf__lazw_add(jf_lazw *z, const char *recs, size_t n, jf_wfile *f);
+/* The last chunk and the chunk table, to f. */
+jf_status jf__lazw_finish(jf_lazw *z, jf_wfile *f);
+/* The prefix (header, VLRs, laszip VLR, table offset) at offset 0 of fd;
+ * 0, or -1 on a write error or without memory. */
+int jf__lazw_write_prefix(int fd, const jf_las_out *L, const jf_lazw *z);
+void jf__lazw_free(jf_lazw *z);
 
 #endif /* JF_IO_INTERNAL_H */

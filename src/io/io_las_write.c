@@ -213,6 +213,7 @@ size_t jf__las_record_size(const jf_las_out *L)
 /* The input's point format and header size (keep mode). */
 static unsigned in_fmt(const jf_las_out *L) { return L->a->las_head[104] & 0x3f; }
 static size_t in_hsize(const jf_las_out *L) { return g16(L->a->las_head + 94); }
+unsigned jf__las_out_format(const jf_las_out *L) { return keep(L) ? in_fmt(L) : 0; }
 
 /* Walks the input's VLRs: calls f on each (offset, total size) that lies
  * inside the header block; returns the number visited. */
@@ -472,11 +473,11 @@ static void keep_header(const jf_las_out *L, unsigned char *b, size_t prefix)
     }
 }
 
-int jf__las_write_prefix(int fd, const jf_las_out *L)
+unsigned char *jf__las_prefix(const jf_las_out *L, size_t *lenp)
 {
-    size_t len = jf__las_prefix_size(L);
+    size_t len = *lenp = jf__las_prefix_size(L);
     unsigned char *b = calloc(1, len);
-    if (!b) return -1;
+    if (!b) return NULL;
     memcpy(b, "LASF", 4);
     b[24] = 1;
     b[25] = 4;
@@ -571,7 +572,14 @@ int jf__las_write_prefix(int fd, const jf_las_out *L)
         put_desc(d, L->types[j] == JF_COL_F64 ? 10 : L->types[j] == JF_COL_F32 ? 9 : 6,
                  L->ebn[(L->a ? L->a->nattrs : 0) + j - 3], what);
     }
-    size_t done = 0;
+    return b;
+}
+
+int jf__las_write_prefix(int fd, const jf_las_out *L)
+{
+    size_t len, done = 0;
+    unsigned char *b = jf__las_prefix(L, &len);
+    if (!b) return -1;
     while (done < len) {
         ssize_t w = pwrite(fd, b + done, len - done, (off_t)done);
         if (w <= 0) {

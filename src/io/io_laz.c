@@ -192,9 +192,10 @@ static jf_status find_vlr(const unsigned char *b, size_t hsize, size_t data_off,
  * points. */
 static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_off, uint64_t n,
                             const lz_vlr *z, const char *name, lz_chunk **out, size_t *nout,
-                            jf_error *err)
+                            int *bad_table, jf_error *err)
 {
     *out = NULL, *nout = 0;
+    *bad_table = 1; /* the table itself unusable (not the header lying) */
     uint64_t first = data_off + 8;
     if (z->compressor == 1) { /* pointwise, not chunked: one stream */
         lz_chunk *c = malloc(sizeof *c);
@@ -265,6 +266,7 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
             break;
         }
         if (c[i].count == 0 || c[i].count > n - total) {
+            *bad_table = z->chunk_size == LZ_VARIABLE && !c[i].count;
             st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                             "chunk %u: %u points, more than the header's %llu leave "
                             "(or none)", (unsigned)i, c[i].count,
@@ -272,6 +274,7 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
             break;
         }
         if (pb < z->rec_len || (uint64_t)c[i].count * z->rec_len > (uint64_t)pb << LZ_MAX_EXPANSION) {
+            *bad_table = pb < z->rec_len;
             st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                             "chunk %u: %u points of %u bytes cannot be coded in its %u bytes "
                             "(a lying count or chunk table)", (unsigned)i, c[i].count,
@@ -289,10 +292,12 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
         total += c[i].count;
     }
     lz_arena_free(&a);
-    if (st == JF_OK && total != n)
+    if (st == JF_OK && total != n) {
+        *bad_table = 0;
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                         "chunk table: its %u chunks hold %llu points, the header says %llu",
                         nc, (unsigned long long)total, (unsigned long long)n);
+    }
     if (st != JF_OK) {
         free(c);
         return st;
@@ -301,11 +306,151 @@ static jf_status read_table(const unsigned char *b, size_t len, uint64_t data_of
     return JF_OK;
 }
 
-jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
-                         size_t *img_len, jf_error *err)
+/* A missing or damaged chunk table rebuilt by walking the chunks from the
+ * first (LASzip writes them back to back): a layered chunk (compressor 3)
+ * says its point count and its layers' sizes, so its length is read off;
+ * a pointwise chunk (2) of the fixed size is decoded to find where its
+ * stream ends (the decoder stops where the encoder did).  Stops at the
+ * header's point count; 0 and why filled when a chunk does not fit. */
+static int scan_table(const unsigned char *b, size_t len, uint64_t data_off, uint64_t n,
+                      const lz_vlr *z, lz_chunk **out, size_t *nout, char *why, size_t whylen)
+{
+    *out = NULL, *nout = 0;
+    if (z->compressor == 2 && z->chunk_size == LZ_VARIABLE) {
+        snprintf(why, whylen, "variable-size pointwise chunks cannot be found without it");
+        return 0;
+    }
+    unsigned nl = 0; /* layers of a layered chunk */
+    for (unsigned i = 0; i < z->nitems; i++)
+        nl += z->items[i].type == LZ_POINT14 ? 9 : z->items[i].type == LZ_RGB14 ? 1
+              : z->items[i].type == LZ_RGBNIR14 ? 2 : z->items[i].size;
+    size_t cap = 0, nc = 0;
+    lz_chunk *c = NULL;
+    uint8_t *scratch = NULL;
+    uint64_t pos = data_off + 8, total = 0;
+    int ok = 1;
+    while (ok && total < n) {
+        uint32_t want = z->chunk_size == LZ_VARIABLE ? 0
+                        : n - total < z->chunk_size ? (uint32_t)(n - total) : z->chunk_size;
+        uint64_t bytes = 0;
+        uint32_t cnt = want;
+        char msg[160];
+        if (pos > len) {
+            snprintf(why, whylen, "the file ends before chunk %zu", nc);
+            ok = 0;
+        } else if (z->compressor == 3) {
+            uint64_t head = (uint64_t)z->rec_len + 4 + 4 * (uint64_t)nl;
+            if (len - pos < head) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: the file ends in its head", nc,
+                         (unsigned long long)pos);
+                ok = 0;
+                break;
+            }
+            const unsigned char *q = b + pos + z->rec_len;
+            cnt = g32(q);
+            bytes = head;
+            for (unsigned k = 0; k < nl; k++)
+                bytes += g32(q + 4 + 4 * k);
+            if (!cnt || cnt > n - total || (want && cnt != want) || bytes > len - pos ||
+                (uint64_t)cnt * z->rec_len > bytes << LZ_MAX_EXPANSION) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %u points in %llu bytes do not fit "
+                         "the file", nc, (unsigned long long)pos, cnt, (unsigned long long)bytes);
+                ok = 0;
+                break;
+            }
+        } else {
+            size_t used = 0;
+            if ((uint64_t)want * z->rec_len > (uint64_t)(len - pos) << LZ_MAX_EXPANSION) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %u points cannot be coded in the "
+                         "%llu bytes left", nc, (unsigned long long)pos, want,
+                         (unsigned long long)(len - pos));
+                ok = 0;
+                break;
+            }
+            /* the first chunk is the largest (fixed size) */
+            if (!scratch && !(scratch = malloc((size_t)want * z->rec_len))) {
+                snprintf(why, whylen, "out of memory");
+                ok = 0;
+                break;
+            }
+            if (jf__laz_v2_chunk_len(z->items, z->nitems, z->rec_len, b + pos, b + len, want,
+                                     scratch, &used, msg, sizeof msg) != 0) {
+                snprintf(why, whylen, "chunk %zu at byte %llu: %s", nc, (unsigned long long)pos,
+                         msg);
+                ok = 0;
+                break;
+            }
+            bytes = used;
+        }
+        if (nc == cap) {
+            cap = cap ? 2 * cap : 64;
+            lz_chunk *t = realloc(c, cap * sizeof *c);
+            if (!t) {
+                snprintf(why, whylen, "out of memory");
+                ok = 0;
+                break;
+            }
+            c = t;
+        }
+        c[nc].start = pos, c[nc].bytes = bytes, c[nc].count = cnt, c[nc].first = total;
+        nc++;
+        pos += bytes;
+        total += cnt;
+    }
+    free(scratch);
+    if (!ok) {
+        free(c);
+        return 0;
+    }
+    *out = c, *nout = nc;
+    return 1;
+}
+
+/* A LAZ file checked and indexed (jf__laz_open): the prefix of the plain
+ * LAS file it stands for, its VLR and chunks, where its EVLRs are. */
+struct jf_laz {
+    const unsigned char *b; /* the caller's file image */
+    size_t len;
+    lz_vlr z;
+    lz_chunk *ch;
+    size_t nc;
+    uint64_t n;
+    unsigned char *head; /* header and VLRs without LASzip's, format cleared */
+    size_t head_len;
+    uint64_t evlr;       /* offset of the EVLRs in the file, 0 if none */
+    size_t cached;       /* the chunk in cache (nc: none), for jf__laz_rows */
+    uint8_t *cache;
+    const char *name;
+    char *owned;         /* the image, when L owns it */
+};
+
+void jf__laz_close(jf_laz *L)
+{
+    if (!L)
+        return;
+    free(L->ch);
+    free(L->head);
+    free(L->cache);
+    free(L->owned);
+    free(L);
+}
+
+jf_status jf__laz_open_owned(char *buf, size_t len, const char *name, jf_laz **L,
+                             jf_error *err)
+{
+    jf_status st = jf__laz_open(buf, len, name, L, err);
+    if (st != JF_OK)
+        free(buf);
+    else
+        (*L)->owned = buf;
+    return st;
+}
+
+jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **out,
+                       jf_error *err)
 {
     const unsigned char *b = (const unsigned char *)buf;
-    *img = NULL, *img_len = 0;
+    *out = NULL;
     if (len < 227)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                           "header: %zu bytes, a LAS header has at least 227", len);
@@ -333,14 +478,34 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
     if (n > JF_MAX_POINTS)
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: more than supported",
                           (unsigned long long)n);
-    lz_vlr z;
-    jf_status st = find_vlr(b, hsize, data_off, nvlr, fmt, rec_len, name, &z, err);
-    if (st != JF_OK)
+    jf_laz *L = calloc(1, sizeof *L);
+    if (!L)
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+    L->b = b, L->len = len, L->n = n, L->name = name;
+    lz_vlr *z = &L->z;
+    jf_status st = find_vlr(b, hsize, data_off, nvlr, fmt, rec_len, name, z, err);
+    if (st != JF_OK) {
+        jf__laz_close(L);
         return st;
-    lz_chunk *ch;
-    size_t nc;
-    if ((st = read_table(b, len, data_off, n, &z, name, &ch, &nc, err)) != JF_OK)
-        return st;
+    }
+    int bad_table = 0;
+    if ((st = read_table(b, len, data_off, n, z, name, &L->ch, &L->nc, &bad_table, err)) !=
+        JF_OK) {
+        /* missing or damaged: rebuilt from the chunks, else both reasons */
+        char why[200] = "";
+        if (st == JF_ERR_NOMEM || z->compressor == 1 || !bad_table ||
+            !scan_table(b, len, data_off, n, z, &L->ch, &L->nc, why, sizeof why)) {
+            if (st != JF_ERR_NOMEM && z->compressor != 1 && bad_table && err) {
+                size_t l = strlen(err->msg);
+                snprintf(err->msg + l, sizeof err->msg - l, "; rebuilding it from the chunks "
+                         "failed: %s", why);
+            }
+            jf__laz_close(L);
+            return st;
+        }
+        if (err)
+            err->msg[0] = '\0';
+    }
     /* EVLRs (1.4) after the chunk table are kept, moved with the points */
     uint64_t evlr = 0, nevlr = 0;
     if (minor >= 4 && hsize >= 375) {
@@ -351,7 +516,7 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
     for (uint64_t k = 0, q = evlr; evlr && k < nevlr; k++) { /* a cut EVLR is lost data */
         uint64_t el = q + 60 <= len ? g64(b + q + 20) : 0;
         if (q + 60 > len || el > len - q - 60) {
-            free(ch);
+            jf__laz_close(L);
             return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
                               "EVLR %llu at byte %llu runs past the end of the file (%zu "
                               "bytes): truncated file", (unsigned long long)k,
@@ -359,46 +524,117 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
         }
         q += 60 + el;
     }
-    size_t head = data_off - z.vlr_len, recs = (size_t)n * rec_len;
-    size_t tail = evlr ? len - (size_t)evlr : 0;
-    if (recs / rec_len != n || head + recs + tail < recs) {
-        free(ch);
+    L->evlr = evlr;
+    size_t head = data_off - z->vlr_len, recs = (size_t)n * rec_len;
+    if (recs / rec_len != n || head + recs < recs) {
+        jf__laz_close(L);
         return jf_io_fail(err, JF_ERR_TOO_LARGE, name, 0, "%llu points: too large",
                           (unsigned long long)n);
     }
-    unsigned char *o = malloc(head + recs + tail);
+    L->head_len = head;
+    L->cached = L->nc;
+    unsigned char *o = L->head = malloc(head);
     if (!o) {
-        free(ch);
-        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
-                          (unsigned long long)n);
+        jf__laz_close(L);
+        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
     }
     /* header and VLRs without LASzip's; bits 6-7 of the format cleared */
-    memcpy(o, b, z.vlr_at);
-    memcpy(o + z.vlr_at, b + z.vlr_at + z.vlr_len, data_off - z.vlr_at - z.vlr_len);
+    memcpy(o, b, z->vlr_at);
+    memcpy(o + z->vlr_at, b + z->vlr_at + z->vlr_len, data_off - z->vlr_at - z->vlr_len);
     o[104] = (unsigned char)fmt;
     p32(o + 96, (uint32_t)head);
     p32(o + 100, nvlr - 1);
-    if (evlr) {
+    if (evlr)
         p64(o + 235, head + recs);
-        memcpy(o + head + recs, b + evlr, tail);
+    *out = L;
+    return JF_OK;
+}
+
+const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n,
+                                  unsigned *rec_len)
+{
+    *head_len = L->head_len, *n = L->n, *rec_len = L->z.rec_len;
+    return L->head;
+}
+
+/* Chunk i decoded into out; 0, or -1 and msg. */
+static int decode_chunk(const jf_laz *L, size_t i, uint8_t *out, char *msg, size_t msglen)
+{
+    const uint8_t *p = L->b + L->ch[i].start, *e = p + L->ch[i].bytes;
+    return L->z.compressor == 3
+               ? jf__laz_v3_chunk(L->z.items, L->z.nitems, L->z.rec_len, p, e, L->ch[i].count,
+                                  out, msg, msglen)
+               : jf__laz_v2_chunk(L->z.items, L->z.nitems, L->z.rec_len, p, e, L->ch[i].count,
+                                  out, msg, msglen);
+}
+
+jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err)
+{
+    unsigned rl = L->z.rec_len;
+    if (first > L->n || count > L->n - first)
+        return jf_io_fail(err, JF_ERR_INVALID, L->name, 0, "rows past the end");
+    /* the chunk holding `first` (chunks are in point order) */
+    size_t lo = 0, hi = L->nc;
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (L->ch[mid].first <= first)
+            lo = mid;
+        else
+            hi = mid;
     }
+    for (size_t i = lo; count && i < L->nc; i++) {
+        if (L->cached != i) { /* decoded once, kept for the next call */
+            uint32_t most = 0;
+            for (size_t k = 0; k < L->nc; k++)
+                most = L->ch[k].count > most ? L->ch[k].count : most;
+            if (!L->cache && !(L->cache = malloc((size_t)most * rl)))
+                return jf_io_fail(err, JF_ERR_NOMEM, L->name, 0, "out of memory");
+            char msg[160];
+            L->cached = L->nc;
+            if (decode_chunk(L, i, L->cache, msg, sizeof msg))
+                return jf_io_fail(err, JF_ERR_FORMAT, L->name, 0, "chunk %zu (at byte %llu): %s",
+                                  i, (unsigned long long)L->ch[i].start, msg);
+            L->cached = i;
+        }
+        uint64_t from = first - L->ch[i].first, k = L->ch[i].count - from;
+        if (k > count)
+            k = count;
+        memcpy(out, L->cache + from * rl, (size_t)k * rl);
+        out += k * rl, first += k, count -= (size_t)k;
+    }
+    return JF_OK;
+}
+
+jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
+                         size_t *img_len, jf_error *err)
+{
+    *img = NULL, *img_len = 0;
+    jf_laz *L;
+    jf_status st = jf__laz_open(buf, len, name, &L, err);
+    if (st != JF_OK)
+        return st;
+    size_t head = L->head_len, rec_len = L->z.rec_len, recs = (size_t)L->n * rec_len;
+    size_t tail = L->evlr ? len - (size_t)L->evlr : 0;
+    unsigned char *o = head + recs + tail >= recs ? malloc(head + recs + tail) : NULL;
+    if (!o) {
+        st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
+                        (unsigned long long)L->n);
+        jf__laz_close(L);
+        return st;
+    }
+    memcpy(o, L->head, head);
+    if (tail)
+        memcpy(o + head + recs, L->b + L->evlr, tail);
     /* the chunks, in parallel: each writes only its own records; every
      * chunk is decoded even after a failure, so the error names the first
      * bad chunk whatever the thread count */
     int failed = 0;
-    size_t bad_chunk = nc;
+    size_t bad_chunk = L->nc, nc = L->nc;
     char bad_msg[160] = "";
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t i = 0; i < nc; i++) {
         char msg[160];
-        const uint8_t *p = b + ch[i].start, *e = p + ch[i].bytes;
-        uint8_t *out = o + head + ch[i].first * rec_len;
-        int rc = z.compressor == 3
-                     ? jf__laz_v3_chunk(z.items, z.nitems, rec_len, p, e, ch[i].count, out, msg,
-                                        sizeof msg)
-                     : jf__laz_v2_chunk(z.items, z.nitems, rec_len, p, e, ch[i].count, out, msg,
-                                        sizeof msg);
-        if (rc) {
+        if (decode_chunk(L, i, o + head + L->ch[i].first * rec_len, msg, sizeof msg)) {
 #pragma omp critical(jf_laz_fail)
             if (i < bad_chunk) {
                 bad_chunk = i;
@@ -409,12 +645,12 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
     }
     if (failed) {
         st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "chunk %zu (at byte %llu): %s", bad_chunk,
-                        (unsigned long long)ch[bad_chunk].start, bad_msg);
-        free(ch);
+                        (unsigned long long)L->ch[bad_chunk].start, bad_msg);
+        jf__laz_close(L);
         free(o);
         return st;
     }
-    free(ch);
+    jf__laz_close(L);
     *img = (char *)o;
     *img_len = head + recs + tail;
     return JF_OK;

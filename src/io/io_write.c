@@ -35,6 +35,8 @@ struct jf_writer {
     const uint32_t *fidx;
     int las_framed;                  /* LAS: jf_writer_las_frame called  */
     jf_las_out las;                  /* LAS: what the output holds       */
+    int is_laz;                      /* LAS compressed: .laz             */
+    jf_lazw *laz;                    /* its chunk writer (io_laz_write.c) */
     const jf_attrs *attrs;           /* carried attributes, or NULL      */
     char (*anames)[64];              /* their output names               */
     size_t row_max;                  /* bytes a formatted row may take   */
@@ -77,6 +79,14 @@ static jf_status write_header(jf_writer *w)
             return jf_wf_fail(f, JF_ERR_INVALID, "LAS output needs the cloud's frame "
                                                  "(jf_writer_las_frame) before the rows");
         size_t n = jf__las_prefix_size(&w->las);
+        if (w->is_laz) {
+            char why[160];
+            w->laz = jf__lazw_open(jf__las_out_format(&w->las),
+                                   (unsigned)jf__las_record_size(&w->las), n, why, sizeof why);
+            if (!w->laz)
+                return jf_wf_fail(f, JF_ERR_UNSUPPORTED, "%s", why);
+            n += jf__lazw_extra(w->laz);
+        }
         while (n && f->st == JF_OK) {
             size_t k = n < 4096 ? n : 4096;
             char *o = jf_wf_room(f, k);
@@ -148,10 +158,10 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     jf_format fmt = jf_format_from_path(path);
     size_t pl = strlen(path);
     int laz = pl >= 4 && (!strcmp(path + pl - 4, ".laz") || !strcmp(path + pl - 4, ".LAZ"));
-    if ((fmt != JF_FMT_PLY && fmt != JF_FMT_CSV && fmt != JF_FMT_XYZ && fmt != JF_FMT_LAS) || laz)
+    if (fmt != JF_FMT_PLY && fmt != JF_FMT_CSV && fmt != JF_FMT_XYZ && fmt != JF_FMT_LAS)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, nm, 0,
                           "cannot write a table in this format (use .ply, "
-                          ".csv, .xyz, .txt or .las)");
+                          ".csv, .xyz, .txt, .las or .laz)");
     if (fmt == JF_FMT_LAS &&
         (ncols < 3 || strcmp(cols[0].name, "x") || strcmp(cols[1].name, "y") ||
          strcmp(cols[2].name, "z") || ncols - 3 > 65535 / 192))
@@ -172,6 +182,7 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
     w->fmt = fmt == JF_FMT_PLY ? FMT_PLY : fmt == JF_FMT_CSV ? FMT_CSV
                                          : fmt == JF_FMT_LAS ? FMT_LAS : FMT_XYZ;
     w->ascii = ascii != 0;
+    w->is_laz = laz;
     w->ncols = ncols;
     w->nrows = nrows;
     w->types = malloc(ncols * sizeof *w->types);
@@ -438,7 +449,11 @@ jf_status jf_writer_row(jf_writer *w, const double *vals)
     char *o = jf_wf_room(f, w->row_max);
     if (!o)
         return f->st;
-    f->len += format_row(w, vals, w->rows, o);
+    size_t len = format_row(w, vals, w->rows, o);
+    if (w->laz) /* the record goes to the chunk writer, not the file */
+        jf__lazw_add(w->laz, o, 1, f);
+    else
+        f->len += len;
     w->rows++;
     return JF_OK;
 }
@@ -461,9 +476,24 @@ jf_status jf_writer_rows(jf_writer *w, const double *vals, size_t nrows,
                  blk = row_max * ROWS_BLOCK <= ((size_t)8 << 20) ? ROWS_BLOCK
                        : row_max >= ((size_t)8 << 20) ? 1 : ((size_t)8 << 20) / row_max,
                  slot = blk * row_max;
-    char *scratch = malloc((size_t)nt * slot);
+    char *scratch = malloc((w->laz ? 1 : (size_t)nt) * slot);
     if (!scratch)
         return jf_wf_fail(f, JF_ERR_NOMEM, "out of memory");
+    if (w->laz) { /* LAS records, cheap to format: the chunk writer
+                     compresses them on the threads (io_laz_write.c) */
+        for (size_t a = 0; a < nrows && f->st == JF_OK; a += blk) {
+            size_t e = a + blk < nrows ? a + blk : nrows, l = 0;
+            for (size_t r = a; r < e; r++)
+                l += format_row(w, vals + r * w->ncols, w->rows + r, scratch + l);
+            jf__lazw_add(w->laz, scratch, e - a, f);
+            if (w->prog && f->st == JF_OK)
+                w->prog(w->prog_user, JF_PHASE_WRITE, w->rows + e, w->nrows);
+        }
+        free(scratch);
+        if (f->st == JF_OK)
+            w->rows += nrows;
+        return f->st;
+    }
     /* blocks of blk rows handed out one at a time: each thread formats
      * its block into its slot, then waits for its turn (ordered) to
      * write it, while the others format the next ones -- no round
@@ -655,6 +685,7 @@ static void free_writer(jf_writer *w)
     free(w->types);
     free(w->anames);
     jf__las_out_free(&w->las);
+    jf__lazw_free(w->laz);
     free(w->warn);
     free(w);
 }
@@ -673,12 +704,16 @@ jf_status jf_writer_commit(jf_writer *w, jf_error *err)
                 w->rows, w->nrows);
     if (f->st == JF_OK && w->fmt == FMT_PLY && w->foff)
         write_faces(w);
+    /* LAZ: the last chunk and the chunk table */
+    if (f->st == JF_OK && w->laz)
+        jf__lazw_finish(w->laz, f);
     /* LAS: the input's EVLRs after the records, then the header */
     if (f->st == JF_OK && w->fmt == FMT_LAS && w->attrs && w->attrs->las_head &&
         w->attrs->rec && w->attrs->las_evlr)
         jf_wf_write(f, (const char *)w->attrs->las_evlr, w->attrs->las_evlr_len);
     if (f->st == JF_OK && w->fmt == FMT_LAS && jf_wf_flush(f) == JF_OK &&
-        jf__las_write_prefix(f->fd, &w->las) != 0)
+        (w->laz ? jf__lazw_write_prefix(f->fd, &w->las, w->laz)
+                : jf__las_write_prefix(f->fd, &w->las)) != 0)
         jf_wf_fail(f, JF_ERR_IO, "cannot write the LAS header");
     jf_status st = jf_wf_close(f, err);
     free_writer(w);

@@ -36,6 +36,12 @@ typedef struct {
 int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
                      const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
                      char *msg, size_t msglen);
+/* jf__laz_v2_chunk on a chunk whose end is not known (a chunk table to
+ * rebuild): decodes from p on, end bounding the reads, and sets *used to
+ * the bytes the chunk took (the decoder ends where the encoder did). */
+int jf__laz_v2_chunk_len(const lz_item *items, unsigned nitems, unsigned rec_len,
+                         const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
+                         size_t *used, char *msg, size_t msglen);
 int jf__laz_v3_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
                      const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
                      char *msg, size_t msglen);

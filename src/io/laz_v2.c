@@ -305,10 +305,11 @@ static void byte_decode(byte2 *s, lz_dec *d, uint8_t *r)
 
 /* ---- the chunk ------------------------------------------------------ */
 
-int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
-                     const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
-                     char *msg, size_t msglen)
+static int v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
+                    const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
+                    char *msg, size_t msglen, size_t *used)
 {
+    const uint8_t *p0 = p;
     if (!count)
         return 0;
     if ((size_t)(end - p) < rec_len) {
@@ -382,7 +383,9 @@ int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
     /* the decoder reads exactly the bytes the encoder wrote (its last
      * symbol flushed, then 2 or 3 zero bytes): bytes left over mean the
      * stream did not decode as written */
-    if (!rc && d.p != end) {
+    if (used)
+        *used = (size_t)(d.p - p0);
+    else if (!rc && d.p != end) {
         snprintf(msg, msglen, "point %u: the compressed stream has %zu bytes more than its "
                  "%u points use (corrupt chunk)", (unsigned)count - 1, (size_t)(end - d.p),
                  (unsigned)count);
@@ -392,4 +395,18 @@ int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
         free(st[i]);
     lz_arena_free(&a);
     return rc;
+}
+
+int jf__laz_v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
+                     const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
+                     char *msg, size_t msglen)
+{
+    return v2_chunk(items, nitems, rec_len, p, end, count, out, msg, msglen, NULL);
+}
+
+int jf__laz_v2_chunk_len(const lz_item *items, unsigned nitems, unsigned rec_len,
+                         const uint8_t *p, const uint8_t *end, uint32_t count, uint8_t *out,
+                         size_t *used, char *msg, size_t msglen)
+{
+    return v2_chunk(items, nitems, rec_len, p, end, count, out, msg, msglen, used);
 }

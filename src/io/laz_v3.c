@@ -207,19 +207,25 @@ static int p14_gps(p14ctx *c, lz_dec *d)
     return 1;
 }
 
-/* -1 out of memory, -2 corrupt GPS stream, else the scanner channel. */
+/* -1 out of memory, -2 corrupt GPS stream, else the context of the other
+ * items: the new scanner channel on a point that switches channel, 0 on
+ * every other point (LASzip's LASreadPoint starts each point's context at
+ * 0 and only POINT14's switch sets it; laz-perf does the same), so RGB14
+ * and BYTE14 go back to their channel-0 set after a switch. */
 static int p14_decode(p14 *s, lz_arena *a, uint8_t *r)
 {
     p14ctx *prev = &s->c[s->cur];
     lz_dec *xy = &s->L[0].d;
     unsigned lpr = (prev->rn == 1) | (prev->rn >= prev->nr) << 1 | (unsigned)prev->gps_change << 2;
     uint32_t cv = lz_decode_lazy(xy, &prev->changed[lpr], 128);
+    int item_ctx = 0;
     if (cv & 64) { /* another scanner channel */
         unsigned sc = (s->cur + lz_decode_lazy(xy, &prev->sc_m, 3) + 1) % 4;
         if (!s->c[sc].used && !p14_ctx_init(&s->c[sc], a, prev, NULL))
             return -1;
         s->cur = sc;
         s->c[sc].sc = (uint8_t)sc;
+        item_ctx = (int)sc;
     }
     p14ctx *c = &s->c[s->cur];
     int gpsc = (cv >> 4) & 1;
@@ -293,7 +299,7 @@ static int p14_decode(p14 *s, lz_arena *a, uint8_t *r)
         return -2;
     c->gps_change = gpsc;
     p14_pack(c, r);
-    return (int)s->cur;
+    return item_ctx;
 }
 
 /* ---- RGB14, RGBNIR14 ------------------------------------------------ */

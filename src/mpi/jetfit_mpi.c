@@ -11,7 +11,8 @@
  * .xyz, .txt, --ascii) go through a binary temporary that rank 0 converts
  * in one sequential pass with the same writer.  Refused with one line:
  * natural and rings neighbourhoods, --orient mst and scanner (they need
- * the whole cloud at once), inputs other than binary PLY and LAS, LAS output. */
+ * the whole cloud at once), inputs other than binary PLY and LAS (LAZ
+ * included), LAS output. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
@@ -39,7 +40,7 @@ static void usage(FILE *f)
         "the same output file, byte for byte.  Each rank reads 1/N of INPUT, owns\n"
         "one spatial part of the cloud and fetches the exact halo it needs; no rank\n"
         "holds the whole cloud.  Options: jetfit estimate --help.\n"
-        "INPUT: binary PLY or LAS.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
+        "INPUT: binary PLY, LAS or LAZ.   OUTPUT: .ply (binary or --ascii), .csv, .xyz, .txt.\n"
         "Not in distributed runs: --neighbors natural|rings, --orient mst|scanner\n"
         "(they need the whole cloud at once), LAS output; the input's\n"
         "other properties are not carried (the output is that of --keep none).\n"

@@ -107,7 +107,27 @@ void jf_mpi_probe(jf_mpi *m, const char *path, jf_row_layout *l)
     jf_error err = {{0}};
     if (!buf) jf_mpi_fail(m, "out of memory");
     else if (read_at(fd, buf, len, 0)) jf_mpi_fail(m, "%s: %s", path, strerror(errno));
-    else if ((jf_format_from_path(path) == JF_FMT_LAS ? jf__las_layout : jf__ply_layout)(
+    else if (len > 104 && !memcmp(buf, "LASF", 4) && (buf[104] & 0xC0)) {
+        /* LAZ: every rank holds the compressed file and decodes the chunks
+         * of its rows (io_laz.c); the layout is the plain LAS file's */
+        char *all = (uint64_t)sb.st_size > SIZE_MAX ? NULL : malloc((size_t)sb.st_size);
+        size_t hl;
+        uint64_t n;
+        unsigned rl;
+        if (!all) jf_mpi_fail(m, "%s: out of memory for the compressed file", path);
+        else if (read_at(fd, all, (size_t)sb.st_size, 0)) {
+            jf_mpi_fail(m, "%s: %s", path, strerror(errno));
+            free(all);
+        } else if (jf__laz_open_owned(all, (size_t)sb.st_size, path, &l->laz, &err) != JF_OK)
+            jf_mpi_fail(m, "%s", err.msg);
+        else {
+            const unsigned char *h = jf__laz_head(l->laz, &hl, &n, &rl);
+            jf_laz *z = l->laz;
+            if (jf__las_layout((const char *)h, hl, hl + n * rl, path, l, &err) != JF_OK)
+                jf_mpi_fail(m, "%s", err.msg);
+            l->laz = z;
+        }
+    } else if ((jf_format_from_path(path) == JF_FMT_LAS ? jf__las_layout : jf__ply_layout)(
                  buf, len, (uint64_t)sb.st_size, path, l, &err) != JF_OK)
         jf_mpi_fail(m, "%s", err.msg);
     free(buf);
@@ -263,7 +283,12 @@ static void read_rows(jf_mpi *m, const char *path, const jf_row_layout *l, int n
     else if (fd < 0) jf_mpi_fail(m, "%s: %s", path, strerror(errno));
     for (uint64_t r0 = 0; !m->failed && r0 < cnt; r0 += CHUNK) {
         size_t k = cnt - r0 < CHUNK ? (size_t)(cnt - r0) : CHUNK;
-        if (read_at(fd, raw, k * l->row, l->vertex_off + (first + r0) * l->row)) {
+        jf_error e = {{0}};
+        if (l->laz && jf__laz_rows(l->laz, first + r0, k, (char *)raw, &e) != JF_OK) {
+            jf_mpi_fail(m, "%s", e.msg);
+            break;
+        }
+        if (!l->laz && read_at(fd, raw, k * l->row, l->vertex_off + (first + r0) * l->row)) {
             jf_mpi_fail(m, "%s: cannot read element vertex %llu..%llu (%s)", path,
                         (unsigned long long)(first + r0), (unsigned long long)(first + r0 + k),
                         errno ? strerror(errno) : "file shorter than its header says");
@@ -621,6 +646,7 @@ void jf_mpi_load(jf_mpi *m, const char *path, const jf_row_layout *l, const jf_p
     hpt *halo = NULL;
     size_t npts = 0, nbad = 0, nhalo = 0;
     read_rows(m, path, l, normals, &pts, &npts, &bad, &nbad);
+    jf__laz_close(l->laz); /* LAZ: the rows are read */
     if (jf_mpi_check(m)) goto out;
     double t0 = MPI_Wtime();
     /* one rank: its rows are the whole cloud, read in input order */

@@ -6,6 +6,13 @@
  * run when node and laz-perf are there.
  *
  *   bench_laz FILE.laz [REPEATS [NODE_MODULES]]
+ *   bench_laz --tile IN N OUT.laz
+ *
+ * --tile makes a benchmark file of a real one: IN's records (a LAS or LAZ
+ * tile) repeated, each copy moved east by the tile's width and later by
+ * its GPS time span, until N points, written by jetfit's LAZ writer (no
+ * LAZ file of 10^6 points is in the repositories; this keeps a real
+ * file's field statistics).
  *
  * Each figure is the best of REPEATS (default 5) wall times of a whole
  * read (jf_cloud_read: file read, chunks decoded, records and x y z made);
@@ -64,8 +71,94 @@ static double best_read(const char *path, int reps, size_t *n, double *cpu_s)
     return best;
 }
 
+static uint32_t g32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static void p32(unsigned char *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+static void p64(unsigned char *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
+}
+
+static int tile(const char *in, size_t n, const char *out)
+{
+    jf_cloud c;
+    jf_error e;
+    if (jf_cloud_read(in, NULL, &c, &e) != JF_OK || !c.attrs.las_head || !c.n) {
+        fprintf(stderr, "bench_laz: %s\n", c.attrs.las_head ? e.msg : "not a LAS/LAZ input");
+        return 1;
+    }
+    const unsigned char *h = c.attrs.las_head;
+    unsigned fmt = h[104] & 0x3f;
+    size_t rl = c.attrs.stride, gps = fmt >= 6 ? 22 : fmt == 1 || fmt == 3 || fmt == 4 || fmt == 5 ? 20 : 0;
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN;
+    double tmin = 1e300, tmax = -1e300;
+    for (size_t i = 0; i < c.n; i++) {
+        const unsigned char *r = c.attrs.rec + i * rl;
+        int32_t x = (int32_t)g32(r);
+        xmin = x < xmin ? x : xmin, xmax = x > xmax ? x : xmax;
+        if (gps) {
+            double t;
+            memcpy(&t, r + gps, 8);
+            tmin = t < tmin ? t : tmin, tmax = t > tmax ? t : tmax;
+        }
+    }
+    /* a LAS file: the input's header and VLRs (count patched), the copies */
+    size_t hl = c.attrs.las_head_len;
+    unsigned char *b = malloc(hl + n * rl);
+    if (!b) return 1;
+    memcpy(b, h, hl);
+    p32(b + 96, (uint32_t)hl);
+    p32(b + 107, fmt < 6 ? (uint32_t)n : 0);
+    if (b[25] >= 4) p64(b + 247, n), memset(b + 235, 0, 12);
+    for (size_t i = 0; i < n; i++) {
+        size_t copy = i / c.n;
+        unsigned char *r = b + hl + i * rl;
+        memcpy(r, c.attrs.rec + (i % c.n) * rl, rl);
+        p32(r, (uint32_t)((int64_t)(int32_t)g32(r) + (int64_t)copy * ((int64_t)xmax - xmin + 1)));
+        if (gps) {
+            double t;
+            memcpy(&t, r + gps, 8);
+            t += (double)copy * (tmax - tmin + 1.0);
+            memcpy(r + gps, &t, 8);
+        }
+    }
+    char las[] = "/tmp/jf_bench_tile_XXXXXX.las";
+    int fd = mkstemps(las, 4);
+    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    int ok = f && fwrite(b, 1, hl + n * rl, f) == hl + n * rl;
+    if (f && fclose(f)) ok = 0;
+    free(b);
+    jf_cloud_free(&c);
+    jf_cloud t;
+    if (!ok || jf_cloud_read(las, NULL, &t, &e) != JF_OK) {
+        fprintf(stderr, "bench_laz: tiled file: %s\n", ok ? e.msg : "cannot write");
+        unlink(las);
+        return 1;
+    }
+    unlink(las);
+    jf_column cols[3] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64}};
+    jf_writer *w;
+    jf_status st = jf_writer_open(out, cols, 3, t.n, 0, &w, &e);
+    if (st == JF_OK) {
+        jf_writer_attrs(w, &t.attrs);
+        jf_writer_rows(w, t.xyz, t.n, 0);
+        st = jf_writer_commit(w, &e);
+    }
+    if (st != JF_OK) fprintf(stderr, "bench_laz: %s\n", e.msg);
+    else printf("bench_laz: %s: %zu points of format %u\n", out, t.n, fmt);
+    jf_cloud_free(&t);
+    return st != JF_OK;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 5 && !strcmp(argv[1], "--tile"))
+        return tile(argv[2], (size_t)atol(argv[3]), argv[4]);
     if (argc < 2) {
         fprintf(stderr, "usage: bench_laz FILE.laz [REPEATS [NODE_MODULES]]\n");
         return 2;

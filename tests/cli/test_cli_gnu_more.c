@@ -43,17 +43,6 @@ static int run_stdin(const char *in_path, const char *tmpdir, const char *first,
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    char *t = malloc(1 << 20);
-    size_t n = t ? fread(t, 1, (1 << 20) - 1, f) : 0;
-    fclose(f);
-    if (t) t[n] = '\0';
-    return t;
-}
-
 /* Splits a CSV line (quotes "..." may hold commas) into at most 32 fields,
  * in place. */
 static int split_csv(char *line, char *f[32])
@@ -75,7 +64,7 @@ static int same_study(const char *dir_a, const char *dir_b, int skip_flags)
     char pa[600], pb[600];
     snprintf(pa, sizeof pa, "%s/study.csv", dir_a);
     snprintf(pb, sizeof pb, "%s/study.csv", dir_b);
-    char *a = slurp(pa), *b = slurp(pb);
+    char *a = jf_test_slurp(pa, NULL), *b = jf_test_slurp(pb, NULL);
     ck_assert_ptr_nonnull(a);
     ck_assert_ptr_nonnull(b);
     int rows = 0;
@@ -96,16 +85,30 @@ static int same_study(const char *dir_a, const char *dir_b, int skip_flags)
     return rows - 1;
 }
 
-static void rm_rf(const char *path)
+/* A LAZ (or E57) on standard input, named by --input-format: the same
+ * result as from the file; -o - with --output-format laz likewise. */
+START_TEST(compressed_formats_through_pipes)
 {
-    const char *argv[] = {"/bin/rm", "-rf", path, NULL};
-    pid_t pid = fork();
-    if (pid == 0) {
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    waitpid(pid, NULL, 0);
+    cli_setup();
+    const char *laz = JF_TESTS_DIR "/data/laz/1815.laz";
+    char tmp[300];
+    snprintf(tmp, sizeof tmp, "%s", cli_path("tmp"));
+    ck_assert_int_eq(mkdir(tmp, 0700), 0);
+    ck_assert_int_eq(cli_run("estimate", laz, "-o", cli_path("file.laz"), "--neighbors", "knn:8",
+                             "-q", NULL), 0);
+    ck_assert_int_eq(run_stdin(laz, tmp, "estimate", "-", "--input-format", "laz", "-o",
+                               cli_path("pipe.laz"), "--neighbors", "knn:8", "-q", NULL), 0);
+    size_t na, nb;
+    char *a = jf_test_slurp(cli_path("file.laz"), &na), *b = jf_test_slurp(cli_path("pipe.laz"), &nb);
+    ck_assert(a && b && na == nb && !memcmp(a, b, na));
+    free(a), free(b);
+    ck_assert_int_eq(run_stdin(laz, tmp, "estimate", "-", "-o", cli_path("x.laz"), NULL), 1);
+    ck_assert(!cli_exists(cli_path("x.laz")));
+    ck_assert_ptr_nonnull(strstr(cli_err, "--input-format"));
+    cli_rm_rf(tmp);
+    cli_teardown();
 }
+END_TEST
 
 START_TEST(standard_input_is_the_file)
 {
@@ -132,7 +135,7 @@ START_TEST(standard_input_is_the_file)
     char p1[600], p2[600];
     snprintf(p1, sizeof p1, "%s/study.def", d1);
     snprintf(p2, sizeof p2, "%s/study.def", d2);
-    char *t1 = slurp(p1), *t2 = slurp(p2);
+    char *t1 = jf_test_slurp(p1, NULL), *t2 = jf_test_slurp(p2, NULL);
     ck_assert_ptr_nonnull(t1);
     ck_assert_ptr_nonnull(t2);
     ck_assert_str_eq(t1, t2);
@@ -170,7 +173,7 @@ START_TEST(standard_input_is_the_file)
     ck_assert_int_eq(cli_run("study", "exp", "--input-format", "ply", "-o", d4, NULL), 2);
     ck_assert_ptr_nonnull(strstr(cli_err, "applies to INPUT"));
     ck_assert(!cli_exists(d4));
-    rm_rf(d1), rm_rf(d2), rm_rf(d3), rm_rf(tmp);
+    cli_rm_rf(d1), cli_rm_rf(d2), cli_rm_rf(d3), cli_rm_rf(tmp);
     cli_teardown();
 }
 END_TEST
@@ -197,7 +200,7 @@ START_TEST(flag_sets_take_gnu_spellings)
     /* the sets differ: not every row measured the same (the check can fail) */
     char p[600];
     snprintf(p, sizeof p, "%s/study.csv", full);
-    char *t = slurp(p);
+    char *t = jf_test_slurp(p, NULL);
     ck_assert_ptr_nonnull(t);
     char *l1 = strchr(t, '\n') + 1, *l2 = strchr(l1, '\n') + 1, *f1[32], *f2[32];
     l1[-1] = '\0', *strchr(l1, '\n') = '\0', *strchr(l2, '\n') = '\0';
@@ -226,7 +229,7 @@ START_TEST(flag_sets_take_gnu_spellings)
         ck_assert_int_eq((int)(strchr(cli_err, '\n') - cli_err + 1), (int)strlen(cli_err));
         ck_assert(!cli_exists(bad));
     }
-    rm_rf(full), rm_rf(gnu);
+    cli_rm_rf(full), cli_rm_rf(gnu);
     cli_teardown();
 }
 END_TEST
@@ -234,7 +237,7 @@ END_TEST
 /* 1 if the two files hold the same bytes (and at least one byte). */
 static int same_bytes(const char *a, const char *b)
 {
-    char *x = slurp(a), *y = slurp(b);
+    char *x = jf_test_slurp(a, NULL), *y = jf_test_slurp(b, NULL);
     int same = x && y && *x && !strcmp(x, y);
     free(x), free(y);
     return same;
@@ -293,6 +296,7 @@ int main(void)
     tcase_set_timeout(t, 300);
     tcase_add_test(t, standard_input_is_the_file);
     tcase_add_test(t, flag_sets_take_gnu_spellings);
+    tcase_add_test(t, compressed_formats_through_pipes);
     tcase_add_test(t, view_takes_gnu_spellings);
     suite_add_tcase(s, t);
     return jf_test_run(s);

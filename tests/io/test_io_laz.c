@@ -152,6 +152,23 @@ static void refused(const char *name, const unsigned char *b, size_t len, const 
     ck_assert_ptr_null(c.xyz);
 }
 
+/* A file whose chunk table is damaged: read all the same, the records of
+ * the intact file `ref`. */
+static void rebuilt(const char *name, const unsigned char *b, size_t len,
+                    const unsigned char *ref, size_t rlen)
+{
+    jf_cloud c, r;
+    jf_error e;
+    const char *p = fixture("ref.laz", ref, rlen);
+    ck_assert_msg(jf_cloud_read(p, NULL, &r, &e) == JF_OK, "%s", e.msg);
+    p = fixture(name, b, len);
+    ck_assert_msg(jf_cloud_read(p, NULL, &c, &e) == JF_OK, "%s: %s", name, e.msg);
+    ck_assert_uint_eq(c.n, r.n);
+    ck_assert(!memcmp(c.attrs.rec, r.attrs.rec, c.n * c.attrs.stride));
+    jf_cloud_free(&c);
+    jf_cloud_free(&r);
+}
+
 /* Where the laszip VLR's payload starts in b. */
 static size_t vlr_payload(const unsigned char *b)
 {
@@ -173,15 +190,27 @@ START_TEST(damaged)
     uint32_t off = g32(b + 96);
     uint32_t table = g32(b + off); /* the chunk table's offset */
     size_t q = vlr_payload(b);
-    /* truncated: the chunk table gone, or the chunk cut */
-    refused("t1.laz", b, table, "chunk table");
-    refused("t2.laz", b, off + 4, "chunk table");
+    /* the chunk table gone, pointing past the end or at itself, or
+     * garbage: rebuilt from the chunks (the same records) */
+    rebuilt("t1.laz", b, table, b, len);
     memcpy(m, b, len);
     p32(m + off, (uint32_t)len + 100);
-    refused("past.laz", m, len, "past the end");
+    rebuilt("past.laz", m, len, b, len);
     memcpy(m, b, len);
     p32(m + off, off);
-    refused("self.laz", m, len, "missing");
+    rebuilt("self.laz", m, len, b, len);
+    memcpy(m, b, len);
+    memset(m + table, 0x5a, len - table);
+    rebuilt("garbage.laz", m, len, b, len);
+    /* the table gone and the chunk cut, or the file cut before the
+     * table's offset: both reasons */
+    refused("t2.laz", b, off + 4, "chunk table");
+    refused("cut.laz", b, off + 8 + 500, "rebuilding it from the chunks failed: chunk 0");
+    memcpy(m, b, len);
+    p32(m + off, (uint32_t)len + 100);
+    for (size_t k = off + 8 + 40; k < off + 8 + 140; k++)
+        m[k] ^= 0x5a;
+    refused("past_corrupt.laz", m, len, "past the end");
     /* more points than the chunk holds: the stream runs out */
     memcpy(m, b, len);
     p32(m + 107, 1066);
@@ -236,6 +265,16 @@ START_TEST(damaged_v3)
     for (size_t k = off + 8 + 40 + 44 + 10; k < off + 8 + 40 + 44 + 60; k++)
         m[k] ^= 0xa5;
     refused("corrupt.laz", m, len, "chunk 0");
+    /* variable-size layered chunks without their table (offset -1, the
+     * file's last 8 bytes no table either): rebuilt from the chunks'
+     * own counts and layer sizes */
+    memcpy(m, b, len);
+    for (int k = 0; k < 8; k++)
+        m[off + k] = 0xff;
+    rebuilt("minus1.laz", m, len, b, len);
+    /* ... but not when a chunk's layer sizes then run past the file */
+    p32(m + off + 8 + 40, 1u << 30);
+    refused("minus1_layer.laz", m, len, "rebuilding it from the chunks failed: chunk 0");
     /* the point format of a waveform file */
     memcpy(m, b, len);
     m[104] = 0x80 | 10;

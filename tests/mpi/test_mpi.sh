@@ -80,6 +80,13 @@ equal-knn)
     bad "jetfit estimate clusters.ply -o clusters.las"
   same "1 2 3" clusters.las ply --neighbors knn:16
   same "2" clusters.las csv --neighbors knn:24,radius:0.01 --degree 3
+  # LAZ input (issue 25.3): each rank decodes the chunks of its rows; our
+  # writer's format 0, and a real 65-chunk COPC file (format 7)
+  "$jetfit" estimate "$d/clusters.ply" -o "$d/clusters.laz" --quiet --keep none ||
+    bad "jetfit estimate clusters.ply -o clusters.laz"
+  same "1 2 3" clusters.laz ply --neighbors knn:16
+  cp "$here/../data/laz/simple.copc.laz" "$d/copc.laz"
+  same "1 2 3" copc.laz ply --neighbors knn:12
   ;;
 equal-more)
   same "2 3" lattice.ply ply --neighbors radius:1.2
@@ -103,6 +110,9 @@ errors)
   "$jetfit" estimate "$d/lattice.ply" -o "$d/lattice.las" --quiet --keep none
   head -c 5000 "$d/lattice.las" >"$d/cut.las" # past the VLRs, into the records
   refused "point record" 2 "$d/cut.las" -o "$d/err.ply"
+  "$jetfit" estimate "$d/lattice.ply" -o "$d/lattice.laz" --quiet --keep none
+  head -c 5000 "$d/lattice.laz" >"$d/cut.laz" # into the first chunk, the table gone
+  refused "rebuilding it from the chunks failed" 2 "$d/cut.laz" -o "$d/err.ply"
   refused "err.ply" 2 "$d/lattice.ply" -o "$d/nodir/err.ply"
   # one fault, one message: jetfit estimate's words (issue 32.5, 33.8)
   printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n' >"$d/xonly.ply"
