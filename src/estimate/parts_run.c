@@ -366,7 +366,8 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
     if (st == JF_OK && nrq) {
         size_t w = 0;
         for (int t = 0; t < nt; t++) {
-            memcpy(rq + w, trq[t].r, trq[t].n * sizeof *rq);
+            if (trq[t].n) /* a thread with none may hold no array */
+                memcpy(rq + w, trq[t].r, trq[t].n * sizeof *rq);
             w += trq[t].n;
         }
     }
@@ -414,7 +415,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
         double ext = 0;
         for (int d = 0; d < 3; d++) ext = ghi[d] - glo[d] > ext ? ghi[d] - glo[d] : ext;
         if (!isfinite(ext)) { /* coordinates near the overflow: all scanned */
-            memcpy(far + nfar, rq, nrq * sizeof *rq);
+            if (nrq) memcpy(far + nfar, rq, nrq * sizeof *rq);
             nfar += nrq;
             nrq = 0;
         }

@@ -190,7 +190,8 @@ jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err)
     /* the name must still be our file: another process with write access
      * to the folder may have put a link there (issue 33.2), and the
      * rename would make that link the output */
-    struct stat a, b;
+    struct stat a = {0}, b;
+    const int known = t->fd >= 0;
     if (t->fd >= 0 && (fstat(t->fd, &a) != 0 || lstat(t->tmp, &b) != 0 ||
                        a.st_dev != b.st_dev || a.st_ino != b.st_ino)) {
         st = jf_io_fail(err, JF_ERR_IO, name, 0,
@@ -204,6 +205,14 @@ jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err)
     if (st == JF_OK && rename(t->tmp, t->target) != 0)
         st = jf_io_fail(err, JF_ERR_IO, name, 0, "cannot rename the finished file onto it: %s",
                         strerror(errno));
+    /* the name may have been swapped between the check and the rename:
+     * then what the rename put in place is not our file, and it goes */
+    struct stat c;
+    if (st == JF_OK && known && (lstat(t->target, &c) != 0 || c.st_dev != a.st_dev || c.st_ino != a.st_ino)) {
+        unlink(t->target);
+        st = jf_io_fail(err, JF_ERR_IO, name, 0,
+                        "its temporary %s was replaced by another process", t->tmp);
+    }
     if (st != JF_OK)
         unlink(t->tmp);
     slot_drop(t->slot);
