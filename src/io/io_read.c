@@ -31,6 +31,7 @@ void jf_read_opts_init(jf_read_opts *o)
 {
     if (!o)
         return;
+    memset(o, 0, sizeof *o); /* padding too: the options compare whole */
     for (int i = 0; i < 6; i++)
         o->columns[i] = -1;
     o->bad_rows = 0;
