@@ -32,27 +32,6 @@ int jf_cli_parse_double(const char *s, double *out)
     return 0;
 }
 
-int jf_cli_parse_list(const char *s, double *v, int max)
-{
-    int n = 0;
-    const char *p = s;
-    while (*p) {
-        char buf[64];
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
-        if (len == 0 || len >= sizeof buf || n == max) return -1;
-        memcpy(buf, p, len);
-        buf[len] = '\0';
-        if (jf_cli_parse_double(buf, &v[n++])) return -1;
-        p += len;
-        if (*p == ',') {
-            p++;
-            if (!*p) return -1;
-        }
-    }
-    return n;
-}
-
 void jf_cli_est_init(jf_cli_est *e)
 {
     memset(e, 0, sizeof *e);

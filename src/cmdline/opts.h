@@ -14,8 +14,6 @@
 /* Strict parsing: the whole string must be consumed; 0 or -1. */
 int jf_cli_parse_int(const char *s, int lo, int hi, int *out);
 int jf_cli_parse_double(const char *s, double *out);
-/* "a,b,c" -> up to max doubles; returns the count or -1. */
-int jf_cli_parse_list(const char *s, double *v, int max);
 
 /* One set of estimation options as the command line gives them. */
 typedef struct {
