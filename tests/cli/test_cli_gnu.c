@@ -10,38 +10,6 @@
 #include "jf_test.h"
 #include "test_cli_util.h"
 
-/* Runs `jetfit ARGS...` with stdin from in_path (NULL: /dev/null) and
- * stdout to out_path; stderr in cli_err.  Exit status. */
-static int run_io(const char *in_path, const char *out_path, const char *first, ...)
-{
-    const char *argv[64];
-    va_list ap;
-    va_start(ap, first);
-    cli_argv(argv, first, ap);
-    va_end(ap);
-    char errpath[512];
-    snprintf(errpath, sizeof errpath, "%s.stderr", cli_dir);
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fi = open(in_path ? in_path : "/dev/null", O_RDONLY);
-        int fo = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int fe = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fi < 0 || fo < 0 || fe < 0) _exit(126);
-        dup2(fi, 0), dup2(fo, 1), dup2(fe, 2);
-        execv(JETFIT_BIN, (char *const *)argv);
-        _exit(127);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    FILE *f = fopen(errpath, "r");
-    size_t m = f ? fread(cli_err, 1, sizeof cli_err - 1, f) : 0;
-    cli_err[m] = '\0';
-    if (f) fclose(f);
-    unlink(errpath);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
-
 /* 1 if the two files hold the same bytes (and at least one byte). */
 static int same_bytes(const char *a, const char *b)
 {
@@ -154,34 +122,41 @@ START_TEST(standard_input_and_output)
     ck_assert_int_eq(cli_run("estimate", cli_path("s.xyz"), "-q", "-o", cli_path("ref.csv"), NULL), 0);
     ck_assert_int_eq(cli_run("estimate", cli_path("s.xyz"), "-q", "-o", cli_path("ref.ply"), NULL), 0);
     /* a pipe in: '-' with --input-format */
-    ck_assert_int_eq(run_io(cli_path("s.xyz"), cli_path("stdout"), "estimate", "-",
-                            "--input-format", "xyz", "-q", "-o", cli_path("in.csv"), NULL), 0);
+    ck_assert_int_eq(cli_run_io(cli_path("s.xyz"), cli_path("stdout"), NULL, "estimate", "-",
+                                "--input-format", "xyz", "-q", "-o", cli_path("in.csv"), NULL),
+                     0);
     ck_assert(same_bytes(cli_path("ref.csv"), cli_path("in.csv")));
     /* a pipe out: '-o -' with --output-format, binary too */
-    ck_assert_int_eq(run_io(NULL, cli_path("out.csv"), "estimate", cli_path("s.xyz"), "-q", "-o",
-                            "-", "--output-format", "csv", NULL), 0);
+    ck_assert_int_eq(cli_run_io(NULL, cli_path("out.csv"), NULL, "estimate", cli_path("s.xyz"),
+                                "-q", "-o", "-", "--output-format", "csv", NULL),
+                     0);
     ck_assert(same_bytes(cli_path("ref.csv"), cli_path("out.csv")));
-    ck_assert_int_eq(run_io(cli_path("s.xyz"), cli_path("out.ply"), "estimate", "-", "-q",
-                            "--input-format=xyz", "-o", "-", "--output-format=ply", NULL), 0);
+    ck_assert_int_eq(cli_run_io(cli_path("s.xyz"), cli_path("out.ply"), NULL, "estimate", "-", "-q",
+                                "--input-format=xyz", "-o", "-", "--output-format=ply", NULL),
+                     0);
     ck_assert(same_bytes(cli_path("ref.ply"), cli_path("out.ply")));
     /* a summary goes to stderr, never into the data on stdout */
-    ck_assert_int_eq(run_io(NULL, cli_path("out2.csv"), "estimate", cli_path("s.xyz"), "-o", "-",
-                            "--output-format", "csv", NULL), 0);
+    ck_assert_int_eq(cli_run_io(NULL, cli_path("out2.csv"), NULL, "estimate", cli_path("s.xyz"),
+                                "-o", "-", "--output-format", "csv", NULL),
+                     0);
     ck_assert(same_bytes(cli_path("ref.csv"), cli_path("out2.csv")));
     ck_assert_ptr_nonnull(strstr(cli_err, "points in"));
     /* standard input needs its format; a bad row is named on it */
-    ck_assert_int_eq(run_io(cli_path("s.xyz"), cli_path("o"), "estimate", "-", "-o", cli_path("x.csv"),
-                            NULL), 1);
+    ck_assert_int_eq(cli_run_io(cli_path("s.xyz"), cli_path("o"), NULL, "estimate", "-", "-o",
+                                cli_path("x.csv"), NULL),
+                     1);
     ck_assert_ptr_nonnull(strstr(cli_err, "--input-format"));
     cli_write_text(cli_path("bad.xyz"), "0 0 0\n1 0 0\n0 1\n");
-    ck_assert_int_eq(run_io(cli_path("bad.xyz"), cli_path("o"), "estimate", "-", "--input-format",
-                            "xyz", "-o", cli_path("x.csv"), NULL), 1);
+    ck_assert_int_eq(cli_run_io(cli_path("bad.xyz"), cli_path("o"), NULL, "estimate", "-",
+                                "--input-format", "xyz", "-o", cli_path("x.csv"), NULL),
+                     1);
     ck_assert_ptr_nonnull(strstr(cli_err, "jetfit: (standard input):3:"));
     ck_assert(!cli_exists(cli_path("x.csv")));
     /* generate to a pipe: the bytes of its file */
     ck_assert_int_eq(cli_run("generate", "torus", "--n", "300", "-o", cli_path("g.xyz"), NULL), 0);
-    ck_assert_int_eq(run_io(NULL, cli_path("g.out"), "generate", "torus", "--n=300", "-o-",
-                            "--output-format", "xyz", NULL), 0);
+    ck_assert_int_eq(cli_run_io(NULL, cli_path("g.out"), NULL, "generate", "torus", "--n=300",
+                                "-o-", "--output-format", "xyz", NULL),
+                     0);
     ck_assert(same_bytes(cli_path("g.xyz"), cli_path("g.out")));
     cli_teardown();
 }
@@ -245,9 +220,12 @@ START_TEST(closed_pipe_leaves_nothing)
     rmdir(tmpd);
     /* eval reads its RESULT from a pipe: the same table as from the file */
     ck_assert_int_eq(cli_run("estimate", cli_path("s.xyz"), "-q", "-o", cli_path("r.csv"), NULL), 0);
-    ck_assert_int_eq(run_io(NULL, cli_path("e1.txt"), "eval", cli_path("r.csv"), cli_path("r.csv"), NULL), 0);
-    ck_assert_int_eq(run_io(cli_path("r.csv"), cli_path("e2.txt"), "eval", "-", cli_path("r.csv"),
-                            "--input-format", "csv", NULL), 0);
+    ck_assert_int_eq(cli_run_io(NULL, cli_path("e1.txt"), NULL, "eval", cli_path("r.csv"),
+                                cli_path("r.csv"), NULL),
+                     0);
+    ck_assert_int_eq(cli_run_io(cli_path("r.csv"), cli_path("e2.txt"), NULL, "eval", "-",
+                                cli_path("r.csv"), "--input-format", "csv", NULL),
+                     0);
     /* the first line names the inputs; the table after it must agree */
     FILE *a = fopen(cli_path("e1.txt"), "r"), *b = fopen(cli_path("e2.txt"), "r");
     char la[512], lb[512];
@@ -268,7 +246,7 @@ END_TEST
 START_TEST(help_lists_short_options)
 {
     cli_setup();
-    ck_assert_int_eq(run_io(NULL, cli_path("h.txt"), "estimate", "--help", NULL), 0);
+    ck_assert_int_eq(cli_run_io(NULL, cli_path("h.txt"), NULL, "estimate", "--help", NULL), 0);
     FILE *f = fopen(cli_path("h.txt"), "r");
     char buf[16384];
     size_t m = fread(buf, 1, sizeof buf - 1, f);

@@ -11,38 +11,6 @@
 #include "jf_test.h"
 #include "test_cli_util.h"
 
-/* Runs `jetfit ARGS...` with stdin from in_path, TMPDIR=tmpdir, stdout to
- * /dev/null; stderr in cli_err.  Exit status. */
-static int run_stdin(const char *in_path, const char *tmpdir, const char *first, ...)
-{
-    const char *argv[64];
-    va_list ap;
-    va_start(ap, first);
-    cli_argv(argv, first, ap);
-    va_end(ap);
-    char errpath[512];
-    snprintf(errpath, sizeof errpath, "%s.stderr", cli_dir);
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fi = open(in_path, O_RDONLY), fo = open("/dev/null", O_WRONLY);
-        int fe = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fi < 0 || fo < 0 || fe < 0) _exit(126);
-        dup2(fi, 0), dup2(fo, 1), dup2(fe, 2);
-        setenv("TMPDIR", tmpdir, 1);
-        execv(JETFIT_BIN, (char *const *)argv);
-        _exit(127);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    FILE *f = fopen(errpath, "r");
-    size_t m = f ? fread(cli_err, 1, sizeof cli_err - 1, f) : 0;
-    cli_err[m] = '\0';
-    if (f) fclose(f);
-    unlink(errpath);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
-
 /* Splits a CSV line (quotes "..." may hold commas) into at most 32 fields,
  * in place. */
 static int split_csv(char *line, char *f[32])
@@ -96,13 +64,14 @@ START_TEST(compressed_formats_through_pipes)
     ck_assert_int_eq(mkdir(tmp, 0700), 0);
     ck_assert_int_eq(cli_run("estimate", laz, "-o", cli_path("file.laz"), "--neighbors", "knn:8",
                              "-q", NULL), 0);
-    ck_assert_int_eq(run_stdin(laz, tmp, "estimate", "-", "--input-format", "laz", "-o",
-                               cli_path("pipe.laz"), "--neighbors", "knn:8", "-q", NULL), 0);
+    ck_assert_int_eq(cli_run_io(laz, NULL, tmp, "estimate", "-", "--input-format", "laz", "-o",
+                                cli_path("pipe.laz"), "--neighbors", "knn:8", "-q", NULL),
+                     0);
     size_t na, nb;
     char *a = jf_test_slurp(cli_path("file.laz"), &na), *b = jf_test_slurp(cli_path("pipe.laz"), &nb);
     ck_assert(a && b && na == nb && !memcmp(a, b, na));
     free(a), free(b);
-    ck_assert_int_eq(run_stdin(laz, tmp, "estimate", "-", "-o", cli_path("x.laz"), NULL), 1);
+    ck_assert_int_eq(cli_run_io(laz, NULL, tmp, "estimate", "-", "-o", cli_path("x.laz"), NULL), 1);
     ck_assert(!cli_exists(cli_path("x.laz")));
     ck_assert_ptr_nonnull(strstr(cli_err, "--input-format"));
     cli_rm_rf(tmp);
@@ -126,9 +95,10 @@ START_TEST(standard_input_is_the_file)
     const char *nb = "knn:16;knn:24";
     ck_assert_int_eq(cli_run("study", cloud, "--truth", truth, "-o", d1, "-q", "--neighbors",
                              nb, "--noise", "0;0.002", NULL), 0);
-    ck_assert_int_eq(run_stdin(cloud, tmp, "study", "-", "--input-format", "ply", "--truth",
-                               truth, "-o", d2, "-q", "--neighbors", nb, "--noise", "0;0.002",
-                               NULL), 0);
+    ck_assert_int_eq(cli_run_io(cloud, NULL, tmp, "study", "-", "--input-format", "ply", "--truth",
+                                truth, "-o", d2, "-q", "--neighbors", nb, "--noise", "0;0.002",
+                                NULL),
+                     0);
     ck_assert_str_eq(cli_err, "");
     ck_assert_int_eq(same_study(d1, d2, 0), 4);
     /* study.def: the input by its content, the same for the pipe */
@@ -150,25 +120,29 @@ START_TEST(standard_input_is_the_file)
     /* the same bytes piped into a --resume of the file's study keep its cells */
     ck_assert_int_eq(cli_run("study", cloud, "--truth", truth, "-o", d3, "-q", "--neighbors",
                              "knn:16", NULL), 0);
-    ck_assert_int_eq(run_stdin(cloud, tmp, "study", "-", "--input-format=ply", "--truth", truth,
-                               "-o", d3, "--neighbors", nb, "--resume", NULL), 0);
+    ck_assert_int_eq(cli_run_io(cloud, NULL, tmp, "study", "-", "--input-format=ply", "--truth",
+                                truth, "-o", d3, "--neighbors", nb, "--resume", NULL),
+                     0);
     ck_assert_msg(strstr(cli_err, "resuming: 1 of 2 cells kept"), "%s", cli_err);
     /* a bad standard input: one line naming it, no folder */
     char junk[512], d4[512];
     snprintf(junk, sizeof junk, "%s/junk.txt", cli_dir);
     snprintf(d4, sizeof d4, "%s/never", cli_dir);
     cli_write_text(junk, "0 0 0\n1 x 2\n");
-    ck_assert_int_eq(run_stdin(junk, tmp, "study", "-", "--input-format", "xyz", "--truth",
-                               truth, "-o", d4, "-q", NULL), 1);
+    ck_assert_int_eq(cli_run_io(junk, NULL, tmp, "study", "-", "--input-format", "xyz", "--truth",
+                                truth, "-o", d4, "-q", NULL),
+                     1);
     ck_assert_msg(!strncmp(cli_err, "jetfit: (standard input):2", 26), "%s", cli_err);
     ck_assert_int_eq((int)(strchr(cli_err, '\n') - cli_err + 1), (int)strlen(cli_err));
     ck_assert(!cli_exists(d4));
     /* without --input-format standard input has no extension to go by */
-    ck_assert_int_eq(run_stdin(cloud, tmp, "study", "-", "--truth", truth, "-o", d4, NULL), 1);
+    ck_assert_int_eq(cli_run_io(cloud, NULL, tmp, "study", "-", "--truth", truth, "-o", d4, NULL),
+                     1);
     ck_assert_ptr_nonnull(strstr(cli_err, "--input-format"));
     ck_assert(!cli_exists(d4));
     /* only INPUT may come from standard input */
-    ck_assert_int_eq(run_stdin(truth, tmp, "study", cloud, "--truth", "-", "-o", d4, NULL), 2);
+    ck_assert_int_eq(cli_run_io(truth, NULL, tmp, "study", cloud, "--truth", "-", "-o", d4, NULL),
+                     2);
     ck_assert_ptr_nonnull(strstr(cli_err, "--truth '-'"));
     ck_assert_int_eq(cli_run("study", "exp", "--input-format", "ply", "-o", d4, NULL), 2);
     ck_assert_ptr_nonnull(strstr(cli_err, "applies to INPUT"));

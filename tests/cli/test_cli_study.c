@@ -58,21 +58,6 @@ static int run_to(const char *outpath, const char *const *argv)
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) n = 0;
-    if (b) b[n] = '\0';
-    fclose(f);
-    if (len) *len = (size_t)n;
-    return b;
-}
-
 static int count_str(const char *hay, const char *needle)
 {
     int n = 0;
@@ -193,7 +178,7 @@ static void check_cell(const csv_row *h, const csv_row *c, const char *input, co
     ck_assert_msg(run_to(NULL, e) == 0, "estimate: %s", cli_err);
     const char *v[] = {JETFIT_BIN, "eval", est, truth, subset ? "--subset" : NULL, subset, NULL};
     ck_assert_msg(run_to(evo, v) == 0, "eval: %s", cli_err);
-    char *out = slurp(evo, NULL);
+    char *out = jf_test_slurp(evo, NULL);
     char tn[7][32], t1[7][32], t2[7][32];
     eval_row(out, "normal_deg", tn);
     eval_row(out, "k1_rel", t1);
@@ -352,7 +337,7 @@ END_TEST
 
 static int lines_in(const char *path)
 {
-    char *b = slurp(path, NULL);
+    char *b = jf_test_slurp(path, NULL);
     int n = b ? count_str(b, "\n") : 0;
     free(b);
     return n;
@@ -370,7 +355,7 @@ static char *strrstr_cut(char *s, const char *sep)
 /* Same text but for the last two fields of each line (the timing). */
 static void same_but_timing(const char *a_path, const char *b_path, const char *sep)
 {
-    char *a = slurp(a_path, NULL), *b = slurp(b_path, NULL);
+    char *a = jf_test_slurp(a_path, NULL), *b = jf_test_slurp(b_path, NULL);
     ck_assert(a && b);
     char *sa, *sb, *la = strtok_r(a, "\n", &sa), *lb = strtok_r(b, "\n", &sb);
     int line = 0;
@@ -396,7 +381,7 @@ static void same_but_timing(const char *a_path, const char *b_path, const char *
 static int same_file(const char *a, const char *b)
 {
     size_t la, lb;
-    char *x = slurp(a, &la), *y = slurp(b, &lb);
+    char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
     int same = x && y && la == lb && !memcmp(x, y, la);
     free(x);
     free(y);
@@ -499,7 +484,7 @@ START_TEST(resume_after_kill_gives_the_same_files)
     ck_assert_msg(sent, "the study ended before it was interrupted");
     waitpid(pid, &status, 0);
     ck_assert_msg(WIFEXITED(status) && WEXITSTATUS(status) == 130, "status %d", status);
-    char *said = slurp(errpath, NULL);
+    char *said = jf_test_slurp(errpath, NULL);
     unlink(errpath);
     ck_assert_msg(said && strstr(said, "interrupted") && strstr(said, "--resume") &&
                   count_str(said, "\n") == 1, "%s", said ? said : "");
@@ -574,7 +559,7 @@ START_TEST(report_opens_in_chromium)
     snprintf(page, sizeof page, "%s/report.html", dir);
     snprintf(dom, sizeof dom, "%s", cli_path("dom.html"));
     ck_assert_msg(chromium(page, "--dump-dom", dom) == 0, "chromium: %s", cli_err);
-    char *d = slurp(dom, NULL);
+    char *d = jf_test_slurp(dom, NULL);
     ck_assert(d != NULL);
     /* rows: best 3 levels x 7 metrics; summary 3 strategies x 2 degrees
      * x 3 levels; cells x 2 repeats; one heading row each */
@@ -610,7 +595,7 @@ START_TEST(report_opens_in_chromium)
         "}\n</script></body></html>\n");
     ck_assert_msg(chromium_flag(wrap, "--dump-dom", dom, "--allow-file-access-from-files") == 0,
                   "chromium: %s", cli_err);
-    d = slurp(dom, NULL);
+    d = jf_test_slurp(dom, NULL);
     char *asc = strstr(d, "\nASC "), *desc = strstr(d, "\nDESC ");
     ck_assert_msg(asc && desc, "the sorting page did not run");
     for (int pass = 0; pass < 2; pass++) {
@@ -639,7 +624,7 @@ START_TEST(report_opens_in_chromium)
         "}\n</script></body></html>\n");
     ck_assert_msg(chromium_flag(wrap, "--dump-dom", dom, "--allow-file-access-from-files") == 0,
                   "chromium: %s", cli_err);
-    d = slurp(dom, NULL);
+    d = jf_test_slurp(dom, NULL);
     char *wd = d ? strstr(d, "\nWIDTH ") : NULL;
     ck_assert_msg(wd != NULL, "the width page did not run");
     long sw = 0, cw = 0;
@@ -655,7 +640,7 @@ START_TEST(report_opens_in_chromium)
     ck_assert_msg(chromium(page, shot, NULL) == 0, "chromium: %s", cli_err);
     ck_assert_msg(chromium(empty, blank, NULL) == 0, "chromium: %s", cli_err);
     size_t ls = 0, lb = 0;
-    char *s = slurp(cli_path("shot.png"), &ls), *b = slurp(cli_path("blank.png"), &lb);
+    char *s = jf_test_slurp(cli_path("shot.png"), &ls), *b = jf_test_slurp(cli_path("blank.png"), &lb);
     ck_assert_msg(s && ls > 8 && !memcmp(s, "\x89PNG", 4), "no PNG screenshot");
     ck_assert_msg(b && lb > 8, "no blank screenshot");
     ck_assert_msg(ls > 10 * lb, "screenshot %zu bytes, a blank page %zu", ls, lb);
@@ -752,7 +737,7 @@ END_TEST
 static void plant(const char *path, int line, int col, const char *val)
 {
     size_t len;
-    char *t = slurp(path, &len), out[65536];
+    char *t = jf_test_slurp(path, &len), out[65536];
     ck_assert(t && len < sizeof out - 64);
     size_t u = 0;
     int ln = 1, c = 0;
@@ -783,7 +768,7 @@ START_TEST(resume_refuses_another_study)
                                  "--quiet", __VA_ARGS__, NULL)
     ck_assert_msg(STUDY("ellipsoid", "--n", "400") == 0, "%s", cli_err);
     size_t clen;
-    char *ctext = slurp(csv, &clen);
+    char *ctext = jf_test_slurp(csv, &clen);
     FILE *cf = fopen(copy, "wb");
     ck_assert(ctext && cf && fwrite(ctext, 1, clen, cf) == clen);
     fclose(cf);
@@ -884,7 +869,7 @@ START_TEST(failing_cell_recorded_study_goes_on)
     ck_assert(strtod(r[2].f[cm], NULL) < 1.0);
     free_csv(r, nr);
     snprintf(path, sizeof path, "%s/best.csv", dir);
-    char *b = slurp(path, NULL);
+    char *b = jf_test_slurp(path, NULL);
     ck_assert(b && strstr(b, ",knn:16,") && !strstr(b, ",rings,"));
     free(b);
     const char *rm[] = {"/bin/rm", "-rf", dir, NULL};
@@ -931,7 +916,7 @@ START_TEST(user_text_stays_text)
     snprintf(path, sizeof path, "%s/k.png", dir);
     ck_assert_int_eq(cli_exists(path), have_gnuplot);
     snprintf(path, sizeof path, "%s/report.html", dir);
-    char *html = slurp(path, NULL);
+    char *html = jf_test_slurp(path, NULL);
     ck_assert(html != NULL);
     ck_assert_msg(!strstr(html, "<b>") && strstr(html, "&quot;`touch jf_study_pwned`&quot; &lt;b&gt;") &&
                       strstr(html, "it&#39;"),

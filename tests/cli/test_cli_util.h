@@ -115,25 +115,27 @@ static inline void cli_argv(const char *argv[64], const char *first, va_list ap)
     argv[argc] = NULL;
 }
 
-/* Runs `jetfit ARGS...` (NULL-terminated), stdout to /dev/null, stderr
+/* Runs `jetfit ARGS...` with stdin from in (NULL: inherited), stdout to
+ * out (NULL: /dev/null) and, when tmpdir is not NULL, TMPDIR=tmpdir; stderr
  * captured in cli_err.  Returns the exit status (or 128 + signal). */
-static inline int cli_run(const char *first, ...)
+static inline int cli_vrun(const char *in, const char *out, const char *tmpdir, const char *first,
+                           va_list ap)
 {
     const char *argv[64];
-    va_list ap;
-    va_start(ap, first);
     cli_argv(argv, first, ap);
-    va_end(ap);
     char errpath[512];
     snprintf(errpath, sizeof errpath, "%s.stderr", cli_dir);
     fflush(NULL);
     pid_t pid = fork();
     if (pid == 0) {
         int fe = open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int fo = open("/dev/null", O_WRONLY);
-        if (fe < 0 || fo < 0) _exit(126);
+        int fo = out ? open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644) : open("/dev/null", O_WRONLY);
+        int fi = in ? open(in, O_RDONLY) : 0;
+        if (fe < 0 || fo < 0 || fi < 0) _exit(126);
+        if (in) dup2(fi, 0);
         dup2(fe, 2);
         dup2(fo, 1);
+        if (tmpdir) setenv("TMPDIR", tmpdir, 1);
         execv(JETFIT_BIN, (char *const *)argv);
         _exit(127);
     }
@@ -149,6 +151,29 @@ static inline int cli_run(const char *first, ...)
     unlink(errpath);
     if (WIFEXITED(status)) return WEXITSTATUS(status);
     return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+/* Runs `jetfit ARGS...` (NULL-terminated), stdout to /dev/null, stderr
+ * captured in cli_err.  Returns the exit status (or 128 + signal). */
+static inline int cli_run(const char *first, ...)
+{
+    va_list ap;
+    va_start(ap, first);
+    int st = cli_vrun(NULL, NULL, NULL, first, ap);
+    va_end(ap);
+    return st;
+}
+
+/* cli_run with stdin from in (NULL: /dev/null), stdout to out (NULL:
+ * /dev/null) and TMPDIR=tmpdir unless NULL. */
+static inline int cli_run_io(const char *in, const char *out, const char *tmpdir,
+                             const char *first, ...)
+{
+    va_list ap;
+    va_start(ap, first);
+    int st = cli_vrun(in ? in : "/dev/null", out, tmpdir, first, ap);
+    va_end(ap);
+    return st;
 }
 
 /* glibc declares these only under _XOPEN_SOURCE, which check.h's

@@ -60,6 +60,14 @@ static inline void *jf_test_slurp(const char *path, size_t *len)
     return b;
 }
 
+/* jf_test_slurp that fails the test, naming the file, when it cannot read it. */
+static inline char *jf_test_must_slurp(const char *path, size_t *len)
+{
+    char *b = (char *)jf_test_slurp(path, len);
+    ck_assert_msg(b != NULL, "cannot read %s", path);
+    return b;
+}
+
 /* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */
 static inline uint64_t jf_splitmix64(uint64_t *state)
 {

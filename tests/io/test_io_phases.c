@@ -149,20 +149,6 @@ END_TEST
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_phases_XXXXXX"); }
 
-static char *slurp(const char *p, size_t *len)
-{
-    FILE *f = fopen(p, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    ck_assert_uint_eq(fread(b, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return b;
-}
-
 /* Positioned rows, in a scrambled order, through commit: WRITE reports
  * up to nrows; the bytes of 1 and 4 threads agree, and agree with rows
  * written one by one. */
@@ -219,7 +205,7 @@ START_TEST(writer_phases_and_bytes)
             ck_assert_int_eq(lg.other_thread, 0);
         }
         size_t la, lb, lc;
-        char *a = slurp(ref, &la), *b = slurp(p1, &lb), *c = slurp(p4, &lc);
+        char *a = jf_test_must_slurp(ref, &la), *b = jf_test_must_slurp(p1, &lb), *c = jf_test_must_slurp(p4, &lc);
         ck_assert_uint_eq(la, lb);
         ck_assert_uint_eq(la, lc);
         ck_assert(!memcmp(a, b, la));

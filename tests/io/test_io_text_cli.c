@@ -40,20 +40,6 @@ static void write_file(const char *path, size_t only, size_t *line_of_bad, size_
     ck_assert_int_eq(fclose(f), 0);
 }
 
-static char *slurp(const char *p, size_t *len)
-{
-    FILE *f = fopen(p, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    ck_assert_uint_eq(fread(b, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return b;
-}
-
 START_TEST(skip_same_bytes)
 {
     size_t bl = 0, br = 0;
@@ -77,7 +63,7 @@ START_TEST(skip_same_bytes)
         ck_assert_msg(strstr(cli_err, "61 unparsable rows kept as NaN rows") &&
                           strstr(cli_err, "lines 7, "), "%s", cli_err);
         size_t l;
-        char *o = slurp(cli_path(out), &l);
+        char *o = jf_test_must_slurp(cli_path(out), &l);
         if (!k) {
             snprintf(err1, sizeof err1, "%s", cli_err);
             o1 = o, l1 = l;

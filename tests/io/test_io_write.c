@@ -34,22 +34,6 @@ static int exists(const char *p)
     return stat(p, &sb) == 0;
 }
 
-static char *slurp(const char *p, size_t *len)
-{
-    FILE *f = fopen(p, "rb");
-    ck_assert_ptr_nonnull(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    ck_assert_uint_eq(fread(b, 1, (size_t)n, f), (size_t)n);
-    b[n] = '\0';
-    fclose(f);
-    if (len)
-        *len = (size_t)n;
-    return b;
-}
-
 static void setup(void)
 {
     tmpdir_setup("/tmp/jf_io_write_XXXXXX");
@@ -223,14 +207,14 @@ static void write_table(const char *p, int ascii)
 START_TEST(table_text)
 {
     write_table(tpath("t.csv"), 0);
-    char *s = slurp(tpath("t.csv"), NULL);
+    char *s = jf_test_must_slurp(tpath("t.csv"), NULL);
     ck_assert_str_eq(s, "x,y,z,status\n"
                         "1.5,-2,0.100000001,3\n"
                         "nan,1e-300,0.100000001,-3\n"
                         "7,8,9,-2147483648\n");
     free(s);
     write_table(tpath("t.xyz"), 0);
-    s = slurp(tpath("t.xyz"), NULL);
+    s = jf_test_must_slurp(tpath("t.xyz"), NULL);
     ck_assert_str_eq(s, "# x y z status\n"
                         "1.5 -2 0.100000001 3\n"
                         "nan 1e-300 0.100000001 -3\n"
@@ -249,7 +233,7 @@ END_TEST
 START_TEST(table_ply)
 {
     write_table(tpath("t.ply"), 1);
-    char *s = slurp(tpath("t.ply"), NULL);
+    char *s = jf_test_must_slurp(tpath("t.ply"), NULL);
     ck_assert_ptr_nonnull(strstr(s, "format ascii 1.0\n"));
     ck_assert_ptr_nonnull(strstr(s, "element vertex 3\nproperty double x\n"
                                     "property double y\nproperty float z\n"
@@ -258,7 +242,7 @@ START_TEST(table_ply)
     free(s);
     write_table(tpath("b.ply"), 0);
     size_t len;
-    s = slurp(tpath("b.ply"), &len);
+    s = jf_test_must_slurp(tpath("b.ply"), &len);
     ck_assert_ptr_nonnull(strstr(s, "format binary_little_endian 1.0\n"));
     const char *body = strstr(s, "end_header\n") + 11;
     ck_assert_uint_eq(len - (size_t)(body - s), 3 * (8 + 8 + 4 + 4));
@@ -300,7 +284,7 @@ START_TEST(rows_in_blocks)
         for (size_t i = 0; i < n; i++) ck_assert_int_eq(jf_writer_row(w, v + 4 * i), JF_OK);
         ck_assert_int_eq(jf_writer_commit(w, &e), JF_OK);
         size_t lr, lg;
-        char *a = slurp(tpath(ref), &lr);
+        char *a = jf_test_must_slurp(tpath(ref), &lr);
         const int threads = 3;
         snprintf(got, sizeof got, "t_%s", names[f]);
         if (f == 0) { /* one row too many fails, and leaves no file */
@@ -315,7 +299,7 @@ START_TEST(rows_in_blocks)
         ck_assert_int_eq(jf_writer_rows(w, v + 4, split - 1, threads), JF_OK);
         ck_assert_int_eq(jf_writer_rows(w, v + 4 * split, n - split, threads), JF_OK);
         ck_assert_int_eq(jf_writer_commit(w, &e), JF_OK);
-        char *b = slurp(tpath(got), &lg);
+        char *b = jf_test_must_slurp(tpath(got), &lg);
         ck_assert_uint_eq(lg, lr);
         ck_assert(memcmp(a, b, lr) == 0);
         free(b);
@@ -368,11 +352,11 @@ START_TEST(temp_then_rename)
     fclose(f);
     ck_assert_int_eq(jf_writer_open(p, cols, 4, 3, 0, &w, &e), JF_OK);
     jf_writer_abort(w);
-    char *s = slurp(p, NULL);
+    char *s = jf_test_must_slurp(p, NULL);
     ck_assert_str_eq(s, "old\n");
     free(s);
     write_table(p, 0);
-    s = slurp(p, NULL);
+    s = jf_test_must_slurp(p, NULL);
     ck_assert(strncmp(s, "x,y,z,status\n", 13) == 0);
     free(s);
     ck_assert(tmp_count() == 0);

@@ -45,18 +45,7 @@ static char *slurp(const char *name, size_t *len)
 {
     char p[256];
     snprintf(p, sizeof p, "%s/%s", dir, name);
-    FILE *f = fopen(p, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    size_t got = fread(b, 1, (size_t)n, f);
-    b[got] = 0;
-    fclose(f);
-    *len = got;
-    return b;
+    return jf_test_slurp(p, len);
 }
 
 static int same_file(const char *a, const char *b)
