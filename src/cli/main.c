@@ -50,8 +50,9 @@ static void usage(FILE *out)
     fprintf(out, "\n  --help       this list\n  --version    print the version\n");
 }
 
-/* SIGINT, SIGTERM, SIGHUP: no temporary output file is left behind, and
- * the exit status says which signal (128 + its number: 130, 143, 129). */
+/* SIGINT, SIGTERM, SIGHUP, SIGPIPE (a reader of stdout or stderr gone): no
+ * temporary output file is left behind, and the exit status says which
+ * signal (128 + its number: 130, 143, 129, 141). */
 static void on_fatal_signal(int sig)
 {
     jf_tmpfiles_remove_all();
@@ -64,7 +65,7 @@ int main(int argc, char **argv)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_fatal_signal;
     sigemptyset(&sa.sa_mask);
-    int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
     for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
         struct sigaction old;
         /* an ignored signal (nohup, a shell's background job) stays ignored */

@@ -43,16 +43,6 @@ static void write_colour_ply(const char *path)
     fclose(f);
 }
 
-static void same_bytes(const char *a, const char *b)
-{
-    size_t la, lb;
-    unsigned char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
-    ck_assert_msg(la == lb && !memcmp(x, y, la), "%s and %s differ (%zu, %zu bytes)", a, b, la,
-                  lb);
-    free(x);
-    free(y);
-}
-
 START_TEST(colour_carried)
 {
     make_points();
@@ -118,7 +108,7 @@ START_TEST(keep_none_is_todays_bytes)
                                  "--keep", "none", NULL), 0);
         ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path(b), "--quiet",
                                  NULL), 0);
-        same_bytes(cli_path(a), cli_path(b));
+        jf_test_assert_same_files("colour and attributes", cli_path(a), cli_path(b));
     }
     /* a LAS input: --keep none is the format 0 output of its x y z */
     const char *las = JF_TESTS_DIR "/data/las/simple.las";
@@ -130,7 +120,7 @@ START_TEST(keep_none_is_todays_bytes)
                              "none", NULL), 0);
     ck_assert_int_eq(cli_run("estimate", cli_path("s.xyz"), "-o", cli_path("s2.las"), "--quiet",
                              NULL), 0);
-    same_bytes(cli_path("s1.las"), cli_path("s2.las"));
+    jf_test_assert_same_files("colour and attributes", cli_path("s1.las"), cli_path("s2.las"));
     /* --keep all (the default) keeps the input's format 3 records */
     ck_assert_int_eq(cli_run("estimate", las, "-o", cli_path("s3.las"), "--quiet", NULL), 0);
     size_t len;

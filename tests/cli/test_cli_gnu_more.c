@@ -208,15 +208,6 @@ START_TEST(flag_sets_take_gnu_spellings)
 }
 END_TEST
 
-/* 1 if the two files hold the same bytes (and at least one byte). */
-static int same_bytes(const char *a, const char *b)
-{
-    char *x = jf_test_slurp(a, NULL), *y = jf_test_slurp(b, NULL);
-    int same = x && y && *x && !strcmp(x, y);
-    free(x), free(y);
-    return same;
-}
-
 START_TEST(view_takes_gnu_spellings)
 {
     cli_setup();
@@ -235,11 +226,11 @@ START_TEST(view_takes_gnu_spellings)
     ck_assert_int_eq(cli_run("view", "--colo=k2", ob, "--max-p=700", "--tit", "T", "--", res,
                              NULL), 0);
     ck_assert_str_eq(cli_err, "");
-    ck_assert(same_bytes(a, b));
+    ck_assert(jf_test_same_files(a, b));
     /* another colour: another page (the comparison can fail) */
     ck_assert_int_eq(cli_run("view", res, "-o", c, "-q", "--color", "k1", "--max-points", "700",
                              "--title", "T", NULL), 0);
-    ck_assert(!same_bytes(a, c));
+    ck_assert(!jf_test_same_files(a, c));
     /* with --estimate, estimate's options in the same spellings */
     unlink(c);
     ck_assert_int_eq(cli_run("view", "--est", cloud, "-q", "--neighb=knn:16", "--degree=3",

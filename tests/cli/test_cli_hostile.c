@@ -218,8 +218,8 @@ START_TEST(signals_leave_nothing)
 {
     const char *in = cli_path("big.ply");
     ck_assert_int_eq(cli_run("generate", "exp", "--n", "400000", "-o", in, NULL), 0);
-    int sigs[3] = {SIGINT, SIGTERM, SIGHUP};
-    for (int k = 0; k < 3; k++) {
+    int sigs[4] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE}; /* SIGPIPE: `2>&1 | head` */
+    for (int k = 0; k < 4; k++) {
         const char *out = cli_path("sig.ply");
         fflush(NULL);
         pid_t pid = fork();

@@ -166,16 +166,6 @@ static jf_status write_blocks(const char *path, const jf_cloud *c, const jf_esti
     return jf_writer_commit(w, &err);
 }
 
-static void assert_same_file(const char *a, const char *b, const char *what)
-{
-    size_t la, lb;
-    char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
-    ck_assert_msg(la == lb && !memcmp(x, y, la), "%s: %s and %s differ (%zu, %zu bytes)", what,
-                  a, b, la, lb);
-    free(x);
-    free(y);
-}
-
 /* ---- the configurations ---------------------------------------------- */
 
 typedef struct {
@@ -266,7 +256,7 @@ START_TEST(blocks_equal_whole_array)
         char what[128];
         snprintf(what, sizeof what, "%s, %s%s", cf->name, formats[k].ext,
                  formats[k].ascii ? " ascii" : "");
-        assert_same_file(pa, pb, what);
+        jf_test_assert_same_files(what, pa, pb);
     }
     /* no spool or temporary left behind: 2 files per format */
     ck_assert_int_eq(cli_count_files(), 2 * (int)(sizeof formats / sizeof *formats));
@@ -327,7 +317,7 @@ START_TEST(parts_equal_whole_cloud)
         ck_assert_int_eq(st, JF_OK);
         char what[128];
         snprintf(what, sizeof what, "%s, %d parts", cf->name, P[k]);
-        assert_same_file(pa, cli_path(nb), what);
+        jf_test_assert_same_files(what, pa, cli_path(nb));
     }
     cli_teardown();
     jf_cloud_free(&c);
@@ -385,7 +375,7 @@ START_TEST(put_checks_rows)
     const double sw[6] = {4, 5, 6, 1, 2, 3};
     ck_assert_int_eq(jf_writer_put(w, r, sw, 2), JF_OK);
     ck_assert_int_eq(jf_writer_commit(w, &err), JF_OK);
-    assert_same_file(cli_path("a.csv"), cli_path("b.csv"), "csv rows put out of order");
+    jf_test_assert_same_files("csv rows put out of order", cli_path("a.csv"), cli_path("b.csv"));
     cli_teardown();
 }
 END_TEST
@@ -487,7 +477,7 @@ START_TEST(command_equals_whole_array)
                                  "--neighbors", runs[k].nb, "--degree", "2", "--orient",
                                  runs[k].orient, "--threads", "2", "--quiet", NULL),
                          0);
-        assert_same_file(ref, cli_path(runs[k].out), runs[k].out);
+        jf_test_assert_same_files(runs[k].out, ref, cli_path(runs[k].out));
         /* --memory 4K: rings and mst fit the whole cloud with a note;
          * for knn it is refused with the least that works, which runs in
          * parts: the same bytes */
@@ -505,7 +495,7 @@ START_TEST(command_equals_whole_array)
                                      runs[k].orient, "--threads", "2", "--memory", mem, NULL),
                              0);
         }
-        assert_same_file(ref, cli_path(runs[k].out), runs[k].out);
+        jf_test_assert_same_files(runs[k].out, ref, cli_path(runs[k].out));
         ck_assert_msg((strstr(cli_err, "note:") != NULL) == (runs[k].kind == 1 || runs[k].kind == 2),
                       "%s", cli_err);
     }
@@ -531,7 +521,7 @@ START_TEST(generate_streamed)
     ck_assert_int_eq(cli_run("generate", "exp", "--n", "1100000", "--seed", "5", "-o",
                              cli_path("b.ply"), "--truth", cli_path("t.ply"), NULL),
                      0);
-    assert_same_file(cli_path("a.ply"), cli_path("b.ply"), "generate, streamed and whole");
+    jf_test_assert_same_files("generate, streamed and whole", cli_path("a.ply"), cli_path("b.ply"));
     cli_teardown();
 }
 END_TEST

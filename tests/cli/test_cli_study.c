@@ -378,16 +378,6 @@ static void same_but_timing(const char *a_path, const char *b_path, const char *
     free(b);
 }
 
-static int same_file(const char *a, const char *b)
-{
-    size_t la, lb;
-    char *x = jf_test_slurp(a, &la), *y = jf_test_slurp(b, &lb);
-    int same = x && y && la == lb && !memcmp(x, y, la);
-    free(x);
-    free(y);
-    return same;
-}
-
 START_TEST(resume_after_kill_gives_the_same_files)
 {
     cli_setup();
@@ -441,13 +431,13 @@ START_TEST(resume_after_kill_gives_the_same_files)
     same_but_timing(pa, pb, ",");
     snprintf(pa, sizeof pa, "%s/best.csv", a);
     snprintf(pb, sizeof pb, "%s/best.csv", b);
-    ck_assert_msg(same_file(pa, pb), "best.csv differs");
+    ck_assert_msg(jf_test_same_files(pa, pb), "best.csv differs");
     static const char *const png[] = {"normal.png", "curvature.png", "k.png"};
     for (int i = 0; i < 3; i++) {
         snprintf(pa, sizeof pa, "%s/%s", a, png[i]);
         snprintf(pb, sizeof pb, "%s/%s", b, png[i]);
         ck_assert_int_eq(cli_exists(pa), cli_exists(pb));
-        if (cli_exists(pa)) ck_assert_msg(same_file(pa, pb), "%s differs", png[i]);
+        if (cli_exists(pa)) ck_assert_msg(jf_test_same_files(pa, pb), "%s differs", png[i]);
     }
     snprintf(pa, sizeof pa, "%s/report.html", a);
     snprintf(pb, sizeof pb, "%s/report.html", b);
@@ -497,7 +487,7 @@ START_TEST(resume_after_kill_gives_the_same_files)
     same_but_timing(pa, pb, ",");
     snprintf(pa, sizeof pa, "%s/best.csv", a);
     snprintf(pb, sizeof pb, "%s/best.csv", c);
-    ck_assert_msg(same_file(pa, pb), "best.csv differs after Ctrl-C and --resume");
+    ck_assert_msg(jf_test_same_files(pa, pb), "best.csv differs after Ctrl-C and --resume");
     const char *rm[] = {"/bin/rm", "-rf", c, NULL};
     run_to(NULL, rm);
 
@@ -787,7 +777,7 @@ START_TEST(resume_refuses_another_study)
         ck_assert_msg(rc == 1, "case %zu: exit %d: %s", k, rc, cli_err);
         ck_assert_msg(strstr(cli_err, cases[k].says), "case %zu: %s", k, cli_err);
         ck_assert_int_eq(count_str(cli_err, "\n"), 1);
-        ck_assert_msg(same_file(csv, copy), "case %zu: study.csv changed", k);
+        ck_assert_msg(jf_test_same_files(csv, copy), "case %zu: study.csv changed", k);
     }
     /* the same study resumes; --threads does not define it */
     ck_assert_msg(STUDY("ellipsoid", "--n", "400", "--threads", "2", "--resume") == 0, "%s",

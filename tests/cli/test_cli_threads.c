@@ -9,20 +9,6 @@
 #include "test_cli_util.h"
 #include "jf_test.h"
 
-static int same_bytes(const char *a, const char *b)
-{
-    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
-    int same = f && g;
-    while (same) {
-        int x = fgetc(f), y = fgetc(g);
-        if (x != y) same = 0;
-        if (x == EOF || y == EOF) break;
-    }
-    if (f) fclose(f);
-    if (g) fclose(g);
-    return same;
-}
-
 static int count_lines(const char *s)
 {
     int n = 0;
@@ -47,7 +33,7 @@ START_TEST(huge_omp_num_threads_clamped)
     ck_assert_msg(strstr(cli_err, "OMP_NUM_THREADS asks for 100000 threads") != NULL, "%s",
                   cli_err);
     ck_assert_int_eq(count_lines(cli_err), 1);
-    ck_assert(same_bytes(ref, got));
+    ck_assert(jf_test_same_files(ref, got));
     cli_teardown();
 }
 END_TEST
@@ -65,12 +51,12 @@ START_TEST(explicit_threads_and_empty_environment)
     ck_assert_msg(cli_run("estimate", in, "-o", got, "--threads", "6", "--quiet", NULL) == 0,
                   "%s", cli_err);
     ck_assert_msg(cli_err[0] == '\0', "%s", cli_err);
-    ck_assert(same_bytes(ref, got));
+    ck_assert(jf_test_same_files(ref, got));
     setenv("OMP_NUM_THREADS", "", 1);
     int rc = cli_run("estimate", in, "-o", got, "--quiet", NULL);
     unsetenv("OMP_NUM_THREADS");
     ck_assert_msg(rc == 0, "exit %d: %s", rc, cli_err);
-    ck_assert(same_bytes(ref, got));
+    ck_assert(jf_test_same_files(ref, got));
     cli_teardown();
 }
 END_TEST

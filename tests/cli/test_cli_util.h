@@ -33,23 +33,6 @@ static inline void cli_setup(void)
     }
 }
 
-/* Removes the folder and everything in it (flat). */
-static inline void cli_teardown(void)
-{
-    DIR *d = opendir(cli_dir);
-    if (d) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(d))) {
-            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-            snprintf(p, sizeof p, "%s/%s", cli_dir, e->d_name);
-            unlink(p);
-        }
-        closedir(d);
-    }
-    rmdir(cli_dir);
-}
-
 /* rm -rf path (a test folder holding folders). */
 static inline void cli_rm_rf(const char *path)
 {
@@ -61,6 +44,9 @@ static inline void cli_rm_rf(const char *path)
     }
     waitpid(p, NULL, 0);
 }
+
+/* Removes the test's folder and everything in it (study folders too). */
+static inline void cli_teardown(void) { cli_rm_rf(cli_dir); }
 
 /* 1 if path holds a whole PNG: the signature first and the IEND chunk last
  * (ISO/IEC 15948 §5.2, §11.2.5), read independently of jetfit. */

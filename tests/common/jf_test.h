@@ -68,6 +68,29 @@ static inline char *jf_test_must_slurp(const char *path, size_t *len)
     return b;
 }
 
+/* 1 if the files at a and b can be read and hold the same bytes, at least
+ * one (two empty outputs prove nothing). */
+static inline int jf_test_same_files(const char *a, const char *b)
+{
+    size_t la, lb;
+    char *x = (char *)jf_test_slurp(a, &la), *y = (char *)jf_test_slurp(b, &lb);
+    int same = x && y && la == lb && la > 0 && !memcmp(x, y, la);
+    free(x);
+    free(y);
+    return same;
+}
+
+/* Fails the test unless a and b hold the same bytes; what names the case. */
+static inline void jf_test_assert_same_files(const char *what, const char *a, const char *b)
+{
+    size_t la, lb;
+    char *x = (char *)jf_test_slurp(a, &la), *y = (char *)jf_test_slurp(b, &lb);
+    ck_assert_msg(x && y && la == lb && !memcmp(x, y, la), "%s: %s and %s differ (%zu, %zu bytes)",
+                  what, a, b, la, lb);
+    free(x);
+    free(y);
+}
+
 /* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */
 static inline uint64_t jf_splitmix64(uint64_t *state)
 {

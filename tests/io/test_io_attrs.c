@@ -17,6 +17,7 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "test_las_bytes.h"
 #include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_attrs_XXXXXX"); }
@@ -258,30 +259,6 @@ START_TEST(rename_clash)
 END_TEST
 
 /* ---- LAS: the input's records, VLRs and EVLRs kept ----------------------- */
-
-static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-
-static void put16(unsigned char *p, unsigned v) { p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8); }
-static void put32(unsigned char *p, uint32_t v)
-{
-    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void put64(unsigned char *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void putd(unsigned char *p, double d)
-{
-    uint64_t b;
-    memcpy(&b, &d, 8);
-    put64(p, b);
-}
-static uint16_t g16(const unsigned char *p) { return (uint16_t)(p[0] | p[1] << 8); }
-static uint32_t g32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-static uint64_t g64(const unsigned char *p) { return g32(p) | (uint64_t)g32(p + 4) << 32; }
 
 /* A VLR: user, record id, payload. */
 static unsigned char *vlr(unsigned char *p, const char *user, unsigned id, const void *data,

@@ -16,27 +16,10 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "test_las_bytes.h"
 #include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_las_XXXXXX"); }
-
-static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-
-static void put16(unsigned char *p, unsigned v) { p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8); }
-static void put32(unsigned char *p, uint32_t v)
-{
-    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void put64(unsigned char *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void putd(unsigned char *p, double d)
-{
-    uint64_t b;
-    memcpy(&b, &d, 8);
-    put64(p, b);
-}
 
 /* A LAS file of n points in record format fmt, record length base + pad:
  * X = 1000 i - 7, Y = -3 i, Z = i * i, scale (0.001, 0.002, 0.01), offset

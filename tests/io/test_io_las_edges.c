@@ -18,38 +18,10 @@
 #include "jetfit.h"
 
 #include "test_io_util.h"
+#include "test_las_bytes.h"
 #include "jf_test.h"
 
 static void setup(void) { tmpdir_setup("/tmp/jf_io_lase_XXXXXX"); }
-
-static const unsigned base_len[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-
-static void put16(unsigned char *p, unsigned v) { p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8); }
-static void put32(unsigned char *p, uint32_t v)
-{
-    for (int k = 0; k < 4; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void put64(unsigned char *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (unsigned char)(v >> (8 * k));
-}
-static void putd(unsigned char *p, double d)
-{
-    uint64_t b;
-    memcpy(&b, &d, 8);
-    put64(p, b);
-}
-static uint32_t get32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-static double getd(const unsigned char *p)
-{
-    uint64_t b = get32(p) | (uint64_t)get32(p + 4) << 32;
-    double d;
-    memcpy(&d, &b, 8);
-    return d;
-}
 
 /* n records of format fmt after a 1.2 (fmt < 6) or 1.4 header, `extra`
  * zero bytes after them; count fields as given (legacy, 64-bit for 1.4). */
@@ -175,7 +147,7 @@ static size_t eb_names(const char *path, char names[][33], size_t max)
     size_t len = fread(b, 1, sizeof b, f);
     fclose(f);
     size_t p = b[94] | b[95] << 8, n = 0;
-    uint32_t nv = get32(b + 100);
+    uint32_t nv = g32(b + 100);
     for (uint32_t v = 0; v < nv && p + 54 <= len; v++) {
         size_t rl = b[p + 20] | b[p + 21] << 8;
         if (!memcmp(b + p + 2, "LASF_Spec", 10) && (b[p + 18] | b[p + 19] << 8) == 4)
