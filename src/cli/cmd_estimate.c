@@ -97,10 +97,11 @@ static void usage(FILE *f)
         "                        the scale is the smallest power of ten >= 1e-7\n"
         "                        keeping counts in int32, with a warning when an\n"
         "                        outlier makes it coarse (docs/formats.md)\n"
-        "  --las-columns TYPE    double | float: the Extra Bytes type of jetfit's\n"
-        "                        real-valued columns in a .las or .laz output (default\n"
-        "                        double for .las, float for .laz: 7 digits, about\n"
-        "                        half the compressed size)\n"
+        "  --las-columns TYPE    double | float | compact: the Extra Bytes type of\n"
+        "                        jetfit's real-valued columns in a .las or .laz output\n"
+        "                        (default double for .las, compact for .laz: floats,\n"
+        "                        nx ny nz d1x..d2z rounded to multiples of 2^-16;\n"
+        "                        float: 7 digits; docs/formats.md)\n"
         "  -q, --quiet           no progress line, no summary\n"
         "  -h, --help            this text\n"
         "Options follow GNU conventions: --degree=3 or --degree 3, -oFILE, unique\n"
@@ -307,11 +308,12 @@ static int memory_precheck(const char *in, const char *fmt, unsigned long long m
     return 1;
 }
 
-/* --las-columns: the Extra Bytes type of jetfit's floating-point columns in
- * a .las or .laz output (LAS 1.4 R15 table 24: 10 double, 9 float).  A .laz
- * takes float unless told: LASzip codes each extra byte as a difference
- * from the previous point's, and a double's low mantissa bytes are noise
- * (docs/formats.md#laz). */
+/* --las-columns: the Extra Bytes type of jetfit's real-valued columns in a
+ * .las or .laz output (LAS 1.4 R15 table 24: 10 double, 9 float).  A .laz
+ * takes compact unless told -- floats, the unit vectors' components
+ * (nx ... d2z) rounded to multiples of 2^-16 -- because LASzip codes each
+ * extra byte as a difference from the previous point's, and low mantissa
+ * bytes are noise (docs/formats.md#laz). */
 static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, jf_column *cols,
                              size_t ncols, jf_error *err)
 {
@@ -322,9 +324,14 @@ static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, j
                  cmd->out);
         return JF_ERR_INVALID;
     }
-    if (cmd->las_columns == 2 || (!cmd->las_columns && laz))
-        for (size_t j = 3; j < ncols; j++)
-            if (cols[j].type == JF_COL_F64) cols[j].type = JF_COL_F32;
+    int mode = cmd->las_columns ? cmd->las_columns : laz ? 3 : 1;
+    for (size_t j = 3; mode > 1 && j < ncols; j++) {
+        const char *n = cols[j].name;
+        int unit = (n[0] == 'n' && n[1] && strchr("xyz", n[1]) && !n[2]) ||
+                   (n[0] == 'd' && (n[1] == '1' || n[1] == '2') && n[2] && strchr("xyz", n[2]) &&
+                    !n[3]);
+        if (cols[j].type == JF_COL_F64) cols[j].type = mode == 3 && unit ? JF_COL_F32_Q16 : JF_COL_F32;
+    }
     return JF_OK;
 }
 

@@ -237,7 +237,8 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
         } else if (!strcmp(name, "--las-columns")) {
             if (!strcmp(val, "double")) cmd->las_columns = 1;
             else if (!strcmp(val, "float")) cmd->las_columns = 2;
-            else return bad_set(bad, "--las-columns", val, "expected double or float");
+            else if (!strcmp(val, "compact")) cmd->las_columns = 3;
+            else return bad_set(bad, "--las-columns", val, "expected double, float or compact");
         } else if (!strcmp(name, "--keep")) {
             if (!strcmp(val, "all")) cmd->keep = 1;
             else if (!strcmp(val, "none")) cmd->keep = 0;
