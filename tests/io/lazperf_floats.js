@@ -2,15 +2,18 @@
 // wrote with float columns and checks its records against the .las of the
 // same run with double columns: every Extra Byte a float in the .laz and a
 // double in the .las (LAS 1.4 R15 table 24: types 9 and 10) holds
-// Math.fround of the double (NaN for NaN); every other byte -- the input's
-// records, the integer columns -- is the same.  Both files' Extra Bytes
+// Math.fround of the double (NaN for NaN) -- or, for a unit vector's
+// component (nx ny nz d1x ... d2z) under `compact`, a whole number of 2^-16
+// within 2^-17 of the double; every other byte -- the input's records, the
+// integer columns -- is the same.  Both files' Extra Bytes
 // VLRs are read here, from the headers, independently of jetfit.
-// usage: node lazperf_floats.js NODE_MODULES OUT.laz OUT.las
+// usage: node lazperf_floats.js NODE_MODULES OUT.laz OUT.las [compact]
 // Exit 0 with a line of counts, 1 on a difference (message on stderr).
 'use strict';
 const fs = require('fs');
 const path = require('path');
-const [, , modules, lazPath, lasPath] = process.argv;
+const [, , modules, lazPath, lasPath, mode] = process.argv;
+const UNIT = /^(n[xyz]|d[12][xyz])$/;
 const { createLazPerf } = require(path.join(modules, 'laz-perf'));
 const BASE = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67];
 const EBSIZE = [0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8];
@@ -27,7 +30,8 @@ function extraBytes(b) {
         // 0: `options` undocumented bytes; 11-30: the deprecated 2- and 3-vectors
         const type = b[d + 2], size = type === 0 ? b[d + 3] : type <= 10 ? EBSIZE[type]
           : EBSIZE[(type - 11) % 10 + 1] * (type <= 20 ? 2 : 3);
-        out.push({ at, size, type });
+        const name = b.toString('latin1', d + 4, d + 36).replace(/\0.*$/s, '');
+        out.push({ at, size, type, name });
         at += size;
       }
     }
@@ -48,7 +52,7 @@ function extraBytes(b) {
   const n = laz.getCount(), zlen = laz.getPointLength();
   const slen = s.readUInt16LE(105), sdata = s.readUInt32LE(96);
   const one = lp._malloc(zlen);
-  let floats = 0;
+  let floats = 0, units = 0;
   for (let i = 0; i < n; i++) {
     laz.getPoint(one);
     const r = Buffer.from(lp.HEAPU8.subarray(one, one + zlen));
@@ -59,10 +63,19 @@ function extraBytes(b) {
     for (let k = 0; k < ez.length; k++) {
       const a = ez[k], c = es[k];
       if (a.type === 9 && c.type === 10) {
-        const want = Math.fround(t.readDoubleLE(c.at)), got = r.readFloatLE(a.at);
-        if (!(got === want || (got !== got && want !== want)))
-          throw new Error(`point ${i}: Extra Byte ${k}: float ${got}, fround of the double ${want}`);
-        floats++;
+        const dbl = t.readDoubleLE(c.at), got = r.readFloatLE(a.at);
+        if (mode === 'compact' && UNIT.test(a.name)) {
+          const q = got * 65536;
+          if (!(q === Math.floor(q) && Math.abs(got - dbl) <= 2 ** -17) &&
+              !(got !== got && dbl !== dbl))
+            throw new Error(`point ${i}: ${a.name}: float ${got} for ${dbl}: not the nearest multiple of 2^-16`);
+          units++;
+        } else {
+          const want = Math.fround(dbl);
+          if (!(got === want || (got !== got && want !== want)))
+            throw new Error(`point ${i}: ${a.name}: float ${got}, fround of the double ${want}`);
+          floats++;
+        }
       } else if (a.type !== c.type || Buffer.compare(r.subarray(a.at, a.at + a.size),
                                                      t.subarray(c.at, c.at + c.size)) !== 0) {
         throw new Error(`point ${i}: Extra Byte ${k} (type ${a.type}) differs`);
@@ -72,8 +85,9 @@ function extraBytes(b) {
   laz.delete();
   lp._free(one);
   lp._free(src);
-  if (!floats) throw new Error('no float column');
-  console.log(`lazperf_floats: ${lazPath}: ${n} points, ${floats} float values = fround(double)`);
+  if (!floats || (mode === 'compact' && !units)) throw new Error('no float or unit column');
+  console.log(`lazperf_floats: ${lazPath}: ${n} points, ${floats} floats = fround(double), ` +
+              `${units} unit components to 2^-16`);
 })().catch((e) => {
   process.stderr.write(`lazperf_floats: ${lazPath}: ${e.message || e}\n`);
   process.exit(1);

@@ -14,6 +14,7 @@
 #define _GNU_SOURCE
 #include <check.h>
 #include <omp.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,9 @@ static const char *tmp(const char *name)
     return p[k];
 }
 
+/* The value written as nx for point i, in [-1, 1]. */
+static double nx_of(size_t i) { return sin(0.7 * (double)i); }
+
 /* The value written as k1 for point i: a double that no float holds. */
 static double k1_of(const jf_cloud *c, size_t i) { return 1.0 / (1.0 + (double)i) + c->xyz[3 * i]; }
 
@@ -66,9 +70,9 @@ static double k1_of(const jf_cloud *c, size_t i) { return 1.0 / (1.0 + (double)i
 static jf_status write_table_t(const jf_cloud *c, const char *path, int extra, jf_col_type kt,
                                jf_error *e)
 {
-    jf_column cols[5] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
-                         {"k1", kt}, {"status", JF_COL_I32}};
-    size_t nc = extra ? 5 : 3;
+    jf_column cols[6] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
+                         {"k1", kt}, {"status", JF_COL_I32}, {"nx", JF_COL_F32_Q16}};
+    size_t nc = extra ? (extra == 2 ? 6 : 5) : 3; /* 2: nx too */
     jf_writer *w;
     jf_status st = jf_writer_open(path, cols, nc, c->n, 0, &w, e);
     if (st != JF_OK)
@@ -80,6 +84,7 @@ static jf_status write_table_t(const jf_cloud *c, const char *path, int extra, j
         if (extra) {
             v[nc * i + 3] = k1_of(c, i);
             v[nc * i + 4] = (double)(i % 7);
+            if (nc == 6) v[nc * i + 5] = nx_of(i);
         }
     }
     if (c->attrs.nattrs || c->attrs.las_head)
@@ -142,10 +147,12 @@ static size_t attr_index(const jf_attrs *a, const char *nm)
     return k;
 }
 
-/* Float columns (`--las-columns float`, the .laz default of estimate):
- * the .laz unpacks to the .las of the same columns, and our reader gives
- * back k1 as the float nearest the double written, (float)k1 exactly, the
- * input's attributes and coordinates as they were; 4 bytes a value, not 8. */
+/* Float columns (`--las-columns float` and `compact`, the .laz default of
+ * estimate): the .laz unpacks to the .las of the same columns, and our
+ * reader gives back k1 as the float nearest the double written, (float)k1
+ * exactly, nx (JF_COL_F32_Q16) as a float that is a whole number of
+ * 2^-16 within 2^-17 of the double, the input's attributes and
+ * coordinates as they were; 4 bytes a value, not 8. */
 START_TEST(float_columns)
 {
     static const char *const f[] = {"append-bug.laz", "1_4_w_evlr.laz",
@@ -154,7 +161,7 @@ START_TEST(float_columns)
         char in[256], tag[32];
         snprintf(in, sizeof in, DATA "%s", f[k]);
         snprintf(tag, sizeof tag, "float%zu", k);
-        roundtrip_t(in, 1, JF_COL_F32, tag);
+        roundtrip_t(in, 2, JF_COL_F32, tag);
         jf_cloud c, r, d;
         jf_error e;
         ck_assert_msg(jf_cloud_read(in, NULL, &c, &e) == JF_OK, "%s", e.msg);
@@ -166,12 +173,17 @@ START_TEST(float_columns)
         ck_assert_uint_eq(r.n, c.n);
         size_t j = attr_index(&r.attrs, "k1");
         ck_assert_msg(j < r.attrs.nattrs && r.attrs.attr[j].type == JF_ATTR_F32, "%s: k1", f[k]);
+        size_t jn = attr_index(&r.attrs, "nx");
+        ck_assert_msg(jn < r.attrs.nattrs && r.attrs.attr[jn].type == JF_ATTR_F32, "%s: nx", f[k]);
         size_t rounded = 0;
         for (size_t i = 0; i < c.n; i++) {
             double want = (double)(float)k1_of(&c, i), got = jf_attr_get(&r.attrs, j, i);
             ck_assert_msg(got == want, "%s: point %zu: k1 %.17g, (float) %.17g", f[k], i, got,
                           want);
             rounded += got != k1_of(&c, i);
+            double q = jf_attr_get(&r.attrs, jn, i), q16 = q * 65536.0;
+            ck_assert_msg(q16 == floor(q16) && fabs(q - nx_of(i)) <= 0x1p-17,
+                          "%s: point %zu: nx %.17g for %.17g", f[k], i, q, nx_of(i));
             for (int a = 0; a < 3; a++)
                 ck_assert(r.xyz[3 * i + a] == c.xyz[3 * i + a]);
         }
@@ -185,11 +197,11 @@ START_TEST(float_columns)
                               c.attrs.attr[q].name, i);
             }
         }
-        /* the same table with double k1: 4 more bytes a record */
+        /* the same table with double k1 (and no nx): the same record length */
         ck_assert_msg(write_table(&d, tmp(dlaz), 1, &e) == JF_OK, "%s", e.msg);
         jf_cloud_free(&d);
         ck_assert_msg(jf_cloud_read(tmp(dlaz), NULL, &d, &e) == JF_OK, "%s", e.msg);
-        ck_assert_uint_eq(d.attrs.stride, r.attrs.stride + 4);
+        ck_assert_uint_eq(d.attrs.stride, r.attrs.stride);
         jf_cloud_free(&d);
         jf_cloud_free(&r);
         jf_cloud_free(&c);
