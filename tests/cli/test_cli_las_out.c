@@ -3,10 +3,12 @@
  * --las-scale / --las-offset written into the header (decoded here) and
  * every bad use refused; coordinates LAS cannot hold refused with no file;
  * long column names shortened with a line each; --keep none keeps a LAS
- * input's CRS VLR byte for byte; --las-columns (issue 25.2): floats by
- * default in a .laz, doubles in a .las, each way on request, read back as
- * the float of the double; bad uses refused. */
+ * input's CRS VLR byte for byte; --las-columns (issue 25.2): compact by
+ * default in a .laz (floats, unit vectors to 2^-16), doubles in a .las,
+ * each way on request, read back as the float of the double; bad uses
+ * refused. */
 #include <check.h>
+#include <math.h>
 
 #include "test_cli_util.h"
 #include "jf_test.h"
@@ -116,16 +118,20 @@ START_TEST(las_columns)
     for (size_t q = 0; q < sizeof names / sizeof *names; q++) {
         size_t j[4];
         for (int k = 0; k < 4; k++) j[k] = read_attr(cli_path(out[k]), names[q], &c[k]);
-        int integer = !strcmp(names[q], "status");
+        int integer = !strcmp(names[q], "status"), unit = q == 0 || q == 2;
         for (int k = 0; k < 4; k++)
             ck_assert_msg(c[k].attrs.attr[j[k]].type ==
                               (integer ? JF_ATTR_I32 : k == 0 || k == 3 ? JF_ATTR_F64 : JF_ATTR_F32),
                           "%s: %s", out[k], names[q]);
         for (size_t i = 0; i < c[0].n; i++) {
             double d = jf_attr_get(&c[0].attrs, j[0], i);
-            double f = integer ? d : (double)(float)d;
+            double f = integer ? d : (double)(float)d, g = jf_attr_get(&c[2].attrs, j[2], i);
             ck_assert(jf_attr_get(&c[1].attrs, j[1], i) == f || (d != d));
-            ck_assert(jf_attr_get(&c[2].attrs, j[2], i) == f || (d != d));
+            if (unit) /* compact: the nearest multiple of 2^-16 */
+                ck_assert_msg((g * 65536 == floor(g * 65536) && fabs(g - d) <= 0x1p-17) || (d != d),
+                              "%s: %.17g for %.17g", names[q], g, d);
+            else
+                ck_assert(g == f || (d != d));
             ck_assert(jf_attr_get(&c[3].attrs, j[3], i) == d || (d != d));
         }
         for (int k = 0; k < 4; k++) jf_cloud_free(&c[k]);
@@ -139,7 +145,7 @@ START_TEST(las_columns)
     /* refused: a bad type (a bad option), an output that is not LAS */
     ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("b.las"),
                              "--las-columns", "half", NULL), 2);
-    ck_assert_msg(strstr(cli_err, "--las-columns") && strstr(cli_err, "expected double or float"),
+    ck_assert_msg(strstr(cli_err, "--las-columns") && strstr(cli_err, "expected double, float or compact"),
                   "'%s'", cli_err);
     ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("b.ply"),
                              "--las-columns", "float", NULL), 1);
