@@ -727,8 +727,12 @@ void jf_cloud_free(jf_cloud *c);
  * The file is written to a temporary ".NAME.tmp.PID" in the same folder
  * and renamed onto NAME only by a successful jf_writer_commit: after a
  * failure or jf_writer_abort no file with the final name is created (an
- * existing one is left untouched).  A writer is used by one thread. */
-typedef enum { JF_COL_F64 = 0, JF_COL_F32 = 1, JF_COL_I32 = 2 } jf_col_type;
+ * existing one is left untouched).  A writer is used by one thread.
+ * F32_Q16 is F32 of the value rounded to the nearest multiple of 2^-16
+ * (a unit vector's components: error <= 2^-17, 7.6e-6; the float's low
+ * mantissa bits are zero, which LASzip's extra-byte coder stores almost
+ * for free: jetfit estimate's .laz, docs/formats.md). */
+typedef enum { JF_COL_F64 = 0, JF_COL_F32 = 1, JF_COL_I32 = 2, JF_COL_F32_Q16 = 3 } jf_col_type;
 
 typedef struct {
     const char *name;    /* column / property name (copied at open)    */

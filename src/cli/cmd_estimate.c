@@ -97,6 +97,11 @@ static void usage(FILE *f)
         "                        the scale is the smallest power of ten >= 1e-7\n"
         "                        keeping counts in int32, with a warning when an\n"
         "                        outlier makes it coarse (docs/formats.md)\n"
+        "  --las-columns TYPE    double | float | compact: the Extra Bytes type of\n"
+        "                        jetfit's real-valued columns in a .las or .laz output\n"
+        "                        (default double for .las, compact for .laz: floats,\n"
+        "                        nx ny nz d1x..d2z rounded to multiples of 2^-16;\n"
+        "                        float: 7 digits; docs/formats.md)\n"
         "  -q, --quiet           no progress line, no summary\n"
         "  -h, --help            this text\n"
         "Options follow GNU conventions: --degree=3 or --degree 3, -oFILE, unique\n"
@@ -303,6 +308,33 @@ static int memory_precheck(const char *in, const char *fmt, unsigned long long m
     return 1;
 }
 
+/* --las-columns: the Extra Bytes type of jetfit's real-valued columns in a
+ * .las or .laz output (LAS 1.4 R15 table 24: 10 double, 9 float).  A .laz
+ * takes compact unless told -- floats, the unit vectors' components
+ * (nx ... d2z) rounded to multiples of 2^-16 -- because LASzip codes each
+ * extra byte as a difference from the previous point's, and low mantissa
+ * bytes are noise (docs/formats.md#laz). */
+static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, jf_column *cols,
+                             size_t ncols, jf_error *err)
+{
+    size_t l = strlen(path);
+    int laz = l >= 4 && !strcasecmp(path + l - 4, ".laz");
+    if (cmd->las_columns && !laz && !(l >= 4 && !strcasecmp(path + l - 4, ".las"))) {
+        snprintf(err->msg, sizeof err->msg, "%s: --las-columns applies to a .las or .laz output",
+                 cmd->out);
+        return JF_ERR_INVALID;
+    }
+    int mode = cmd->las_columns ? cmd->las_columns : laz ? 3 : 1;
+    for (size_t j = 3; mode > 1 && j < ncols; j++) {
+        const char *n = cols[j].name;
+        int unit = (n[0] == 'n' && n[1] && strchr("xyz", n[1]) && !n[2]) ||
+                   (n[0] == 'd' && (n[1] == '1' || n[1] == '2') && n[2] && strchr("xyz", n[2]) &&
+                    !n[3]);
+        if (cols[j].type == JF_COL_F64) cols[j].type = mode == 3 && unit ? JF_COL_F32_Q16 : JF_COL_F32;
+    }
+    return JF_OK;
+}
+
 int jf_cmd_estimate(int argc, char **argv)
 {
     jf_cli_estimate_cmd cmd;
@@ -408,6 +440,7 @@ int jf_cmd_estimate(int argc, char **argv)
     jf_writer *w = NULL;
     jf_cli_out po; /* "-o -" and --output-format: through a private file */
     st = jf_cli_out_begin(&po, out, cmd.out_fmt, &err);
+    if (st == JF_OK) st = las_columns(&cmd, po.path, cols, ncols, &err);
     if (st == JF_OK) st = jf_writer_open(po.path, cols, ncols, c.n, ascii, &w, &err);
     if (st != JF_OK) {
         jf_cli_out_msg(&po, &err);

@@ -192,6 +192,7 @@ static const jf_cli_optdef estimate_optdefs[] = {
     {"--output-format", 1, 0, NULL},
     {"--las-scale", 1, 0, NULL},
     {"--las-offset", 1, 0, NULL},
+    {"--las-columns", 1, 0, NULL},
     {NULL, 0, 0, NULL}};
 
 int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cli_bad *bad)
@@ -233,6 +234,11 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
                                sc ? "expected X,Y,Z (or one value): positive numbers"
                                   : "expected X,Y,Z (or one value): finite numbers");
             *(sc ? &cmd->las_scale_set : &cmd->las_offset_set) = 1;
+        } else if (!strcmp(name, "--las-columns")) {
+            if (!strcmp(val, "double")) cmd->las_columns = 1;
+            else if (!strcmp(val, "float")) cmd->las_columns = 2;
+            else if (!strcmp(val, "compact")) cmd->las_columns = 3;
+            else return bad_set(bad, "--las-columns", val, "expected double, float or compact");
         } else if (!strcmp(name, "--keep")) {
             if (!strcmp(val, "all")) cmd->keep = 1;
             else if (!strcmp(val, "none")) cmd->keep = 0;

@@ -58,6 +58,7 @@ typedef struct {
     jf_cli_args args;              /* the scanner (its message outlives the parse) */
     int las_scale_set, las_offset_set; /* --las-scale, --las-offset given */
     double las_scale[3], las_offset[3];
+    int las_columns;               /* --las-columns: 0 not given, 1 double, 2 float, 3 compact */
 } jf_cli_estimate_cmd;
 
 /* Parses argv[1..] (argv[0] is the command's name).  0, or -1 with *bad

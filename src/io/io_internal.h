@@ -9,10 +9,18 @@
 
 #include "jetfit.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
+
+/* A float column's value: the nearest float, after rounding to a multiple
+ * of 2^-16 for JF_COL_F32_Q16 (exact scalings by 2^16; NaN stays NaN). */
+static inline float jf__f32(jf_col_type t, double v)
+{
+    return (float)(t == JF_COL_F32_Q16 ? nearbyint(v * 65536.0) / 65536.0 : v);
+}
 
 typedef enum {
     JF_FMT_UNKNOWN = 0,

@@ -333,8 +333,8 @@ size_t jf__las_format_row(const jf_las_out *L, size_t row, const double *vals, c
         if (L->types[j] == JF_COL_F64) {
             putd(e, vals[j]);
             e += 8;
-        } else if (L->types[j] == JF_COL_F32) {
-            float f = (float)vals[j];
+        } else if (L->types[j] != JF_COL_I32) {
+            float f = jf__f32(L->types[j], vals[j]);
             uint32_t u;
             memcpy(&u, &f, 4);
             put32(e, u);
@@ -569,7 +569,7 @@ unsigned char *jf__las_prefix(const jf_las_out *L, size_t *lenp)
     for (size_t j = 3; j < L->ncols; j++, d += EB_DESC) {
         char what[32];
         snprintf(what, sizeof what, "jetfit %s", L->names[j]);
-        put_desc(d, L->types[j] == JF_COL_F64 ? 10 : L->types[j] == JF_COL_F32 ? 9 : 6,
+        put_desc(d, L->types[j] == JF_COL_F64 ? 10 : L->types[j] != JF_COL_I32 ? 9 : 6,
                  L->ebn[(L->a ? L->a->nattrs : 0) + j - 3], what);
     }
     return b;

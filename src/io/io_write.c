@@ -69,7 +69,7 @@ static int32_t to_i32(double v)
 static jf_status write_header(jf_writer *w)
 {
     jf_wfile *f = &w->f;
-    static const char *const ply_t[] = {"double", "float", "int"};
+    static const char *const ply_t[] = {"double", "float", "int", "float"};
     char line[128];
     w->header_done = 1;
     if (w->fmt == FMT_LAS) {
@@ -169,7 +169,7 @@ jf_status jf_writer_open(const char *path, const jf_column *cols,
                           "LAS output needs x y z as the first columns (and at most 341 more)");
     for (size_t j = 0; j < ncols; j++) {
         const char *c = cols[j].name;
-        int bad = !c || !*c || (unsigned)cols[j].type > JF_COL_I32;
+        int bad = !c || !*c || (unsigned)cols[j].type > JF_COL_F32_Q16;
         for (; c && *c && !bad; c++)
             bad = (unsigned char)*c <= ' ' || *c == ',' || *c == '#';
         if (bad)
@@ -359,8 +359,8 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
             if (w->types[j] == JF_COL_F64) {
                 memcpy(o, &v, 8);
                 o += 8;
-            } else if (w->types[j] == JF_COL_F32) {
-                float x = (float)v;
+            } else if (w->types[j] != JF_COL_I32) {
+                float x = jf__f32(w->types[j], v);
                 memcpy(o, &x, 4);
                 o += 4;
             } else {
@@ -378,8 +378,8 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
             size_t n;
             if (w->types[j] == JF_COL_F64) {
                 memcpy(b, &vals[j], 8), n = 8;
-            } else if (w->types[j] == JF_COL_F32) {
-                float x = (float)vals[j];
+            } else if (w->types[j] != JF_COL_I32) {
+                float x = jf__f32(w->types[j], vals[j]);
                 memcpy(b, &x, 4), n = 4;
             } else {
                 int32_t x = to_i32(vals[j]);
@@ -403,8 +403,8 @@ static size_t format_row(const jf_writer *w, const double *vals, size_t row, cha
             double v = vals[j];
             if (w->types[j] == JF_COL_F64) {
                 o = jf_fmt_g17(o, v);
-            } else if (w->types[j] == JF_COL_F32) {
-                float x = (float)v;
+            } else if (w->types[j] != JF_COL_I32) {
+                float x = jf__f32(w->types[j], v);
                 if (isnan(x))
                     memcpy(o, "nan", 3), o += 3;
                 else
@@ -663,8 +663,8 @@ void jf__ply_row_le(const jf_col_type *types, size_t ncols, const double *vals, 
         size_t n;
         if (types[j] == JF_COL_F64) {
             memcpy(b, &vals[j], 8), n = 8;
-        } else if (types[j] == JF_COL_F32) {
-            float x = (float)vals[j];
+        } else if (types[j] != JF_COL_I32) {
+            float x = jf__f32(types[j], vals[j]);
             memcpy(b, &x, 4), n = 4;
         } else {
             int32_t x = to_i32(vals[j]);

@@ -341,6 +341,9 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         return refuse(m, "%s: distributed runs read and write named files (each rank reads its "
                          "share): no standard input or output, no --input-format or "
                          "--output-format; use jetfit estimate for pipes", "-");
+    if (cmd.las_columns)
+        return refuse(m, "%s: --las-columns: jetfit-mpi writes doubles; use jetfit estimate for "
+                         "float columns", out);
     char nbs[64];
     jf_nb_format(&o.nb, nbs, sizeof nbs);
     if (o.nb.kind == JF_NB_NATURAL || o.nb.kind == JF_NB_RINGS)

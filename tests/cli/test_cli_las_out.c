@@ -3,8 +3,12 @@
  * --las-scale / --las-offset written into the header (decoded here) and
  * every bad use refused; coordinates LAS cannot hold refused with no file;
  * long column names shortened with a line each; --keep none keeps a LAS
- * input's CRS VLR byte for byte. */
+ * input's CRS VLR byte for byte; --las-columns (issue 25.2): compact by
+ * default in a .laz (floats, unit vectors to 2^-16), doubles in a .las,
+ * each way on request, read back as the float of the double; bad uses
+ * refused. */
 #include <check.h>
+#include <math.h>
 
 #include "test_cli_util.h"
 #include "jf_test.h"
@@ -82,6 +86,73 @@ START_TEST(scale_warning_and_options)
     ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("b.ply"),
                              "--las-scale", "1e-3", NULL), 1);
     ck_assert_msg(strstr(cli_err, "apply to a .las output"), "'%s'", cli_err);
+    ck_assert(!cli_exists(cli_path("b.las")) && !cli_exists(cli_path("b.ply")));
+}
+END_TEST
+
+/* The attribute named nm of a cloud read from path (its index), the
+ * cloud in *c. */
+static size_t read_attr(const char *path, const char *nm, jf_cloud *c)
+{
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(path, NULL, c, &e) == JF_OK, "%s", e.msg);
+    size_t k = 0;
+    while (k < c->attrs.nattrs && strcmp(c->attrs.attr[k].name, nm)) k++;
+    ck_assert_msg(k < c->attrs.nattrs, "%s: no %s", path, nm);
+    return k;
+}
+
+/* 25.2: the Extra Bytes type of jetfit's real columns; one thread, so the
+ * doubles are the same in every run */
+START_TEST(las_columns)
+{
+    patch(cli_path("p.xyz"), 400, NULL);
+    static const char *const out[] = {"d.las", "f.las", "f.laz", "d.laz"};
+    static const char *const opt[] = {NULL, "float", NULL, "double"};
+    for (int k = 0; k < 4; k++)
+        ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path(out[k]),
+                                 "--quiet", "--threads", "1",
+                                 opt[k] ? "--las-columns" : NULL, opt[k], NULL), 0);
+    static const char *const names[] = {"nx", "k1", "d2z", "cond", "residual", "status"};
+    jf_cloud c[4];
+    for (size_t q = 0; q < sizeof names / sizeof *names; q++) {
+        size_t j[4];
+        for (int k = 0; k < 4; k++) j[k] = read_attr(cli_path(out[k]), names[q], &c[k]);
+        int integer = !strcmp(names[q], "status"), unit = q == 0 || q == 2;
+        for (int k = 0; k < 4; k++)
+            ck_assert_msg(c[k].attrs.attr[j[k]].type ==
+                              (integer ? JF_ATTR_I32 : k == 0 || k == 3 ? JF_ATTR_F64 : JF_ATTR_F32),
+                          "%s: %s", out[k], names[q]);
+        for (size_t i = 0; i < c[0].n; i++) {
+            double d = jf_attr_get(&c[0].attrs, j[0], i);
+            double f = integer ? d : (double)(float)d, g = jf_attr_get(&c[2].attrs, j[2], i);
+            ck_assert(jf_attr_get(&c[1].attrs, j[1], i) == f || (d != d));
+            if (unit) /* compact: the nearest multiple of 2^-16 */
+                ck_assert_msg((g * 65536 == floor(g * 65536) && fabs(g - d) <= 0x1p-17) || (d != d),
+                              "%s: %.17g for %.17g", names[q], g, d);
+            else
+                ck_assert(g == f || (d != d));
+            ck_assert(jf_attr_get(&c[3].attrs, j[3], i) == d || (d != d));
+        }
+        for (int k = 0; k < 4; k++) jf_cloud_free(&c[k]);
+    }
+    /* 13 real columns of 4 bytes, not 8 */
+    read_attr(cli_path("d.las"), "nx", &c[0]);
+    read_attr(cli_path("f.laz"), "nx", &c[1]);
+    ck_assert_uint_eq(c[0].attrs.stride, c[1].attrs.stride + 13 * 4);
+    jf_cloud_free(&c[0]);
+    jf_cloud_free(&c[1]);
+    /* refused: a bad type (a bad option), an output that is not LAS */
+    ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("b.las"),
+                             "--las-columns", "half", NULL), 2);
+    ck_assert_msg(strstr(cli_err, "--las-columns") && strstr(cli_err, "expected double, float or compact"),
+                  "'%s'", cli_err);
+    ck_assert_int_eq(cli_run("estimate", cli_path("p.xyz"), "-o", cli_path("b.ply"),
+                             "--las-columns", "float", NULL), 1);
+    char want[600];
+    snprintf(want, sizeof want, "jetfit: %s: --las-columns applies to a .las or .laz output\n",
+             cli_path("b.ply"));
+    ck_assert_str_eq(cli_err, want);
     ck_assert(!cli_exists(cli_path("b.las")) && !cli_exists(cli_path("b.ply")));
 }
 END_TEST
@@ -186,6 +257,7 @@ int main(void)
     tcase_add_test(tc, huge_refused);
     tcase_add_test(tc, long_names);
     tcase_add_test(tc, keep_none_keeps_crs);
+    tcase_add_test(tc, las_columns);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }

@@ -5,9 +5,13 @@
 #  1. every LAZ file of tests/data/laz: jetfit's records (DUMP at 1 and 2
 #     threads) = laz-perf's;
 #  2. the same file through `jetfit estimate -o out.laz` (and -o out.las):
-#     laz-perf decodes out.laz to the records of out.las, whose first bytes
-#     are the input's records as laz-perf decodes them (every original
-#     attribute intact);
+#     laz-perf decodes out.laz (`--las-columns compact`, the .laz default)
+#     to the records of `-o out.las --las-columns compact`, whose first
+#     bytes are the input's records as laz-perf decodes them (every original
+#     attribute intact); its floats are Math.fround of out.las's doubles,
+#     nx ... d2z the nearest multiples of 2^-16, its other bytes out.las's
+#     (lazperf_floats.js); so for `--las-columns float` (every float the
+#     fround); `--las-columns double` gives out.las's records;
 #  3. generated LAS files (laz_gen.h: formats 0-3 and 6-8 with extra bytes,
 #     100,001 points: two full chunks and one of a single point, scanner
 #     channels switching, GPS sequences) through jetfit's writer to .laz
@@ -38,9 +42,18 @@ for f in "$tests"/data/laz/*.laz; do
   cmp "$work/$b.jetfit1" "$work/$b.jetfit2"
   "$jetfit" estimate "$f" -o "$work/$b.out.laz" >/dev/null 2>&1
   "$jetfit" estimate "$f" -o "$work/$b.out.las" >/dev/null 2>&1
+  "$jetfit" estimate "$f" -o "$work/$b.outc.las" --las-columns compact >/dev/null 2>&1
+  "$jetfit" estimate "$f" -o "$work/$b.outf.laz" --las-columns float >/dev/null 2>&1
+  "$jetfit" estimate "$f" -o "$work/$b.outd.laz" --las-columns double >/dev/null 2>&1
   lp "$work/$b.out.laz" "$work/$b.out.lazperf"
-  "$dump" "$work/$b.out.las" "$work/$b.out.jetfit"
+  "$dump" "$work/$b.outc.las" "$work/$b.out.jetfit"
   cmp "$work/$b.out.lazperf" "$work/$b.out.jetfit"
+  "$node" "$tests/io/lazperf_floats.js" "$modules" "$work/$b.out.laz" "$work/$b.out.las" \
+    compact >/dev/null
+  "$node" "$tests/io/lazperf_floats.js" "$modules" "$work/$b.outf.laz" "$work/$b.out.las" >/dev/null
+  lp "$work/$b.outd.laz" "$work/$b.outd.lazperf"
+  "$dump" "$work/$b.out.las" "$work/$b.outd.jetfit"
+  cmp "$work/$b.outd.lazperf" "$work/$b.outd.jetfit"
   lp "$work/$b.out.laz" "$work/$b.out.kept" "$(reclen "$f")"
   cmp "$work/$b.lazperf" "$work/$b.out.kept"
   n=$((n + 1))

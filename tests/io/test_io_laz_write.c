@@ -14,6 +14,7 @@
 #define _GNU_SOURCE
 #include <check.h>
 #include <omp.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,13 +59,20 @@ static const char *tmp(const char *name)
     return p[k];
 }
 
+/* The value written as nx for point i, in [-1, 1]. */
+static double nx_of(size_t i) { return sin(0.7 * (double)i); }
+
+/* The value written as k1 for point i: a double that no float holds. */
+static double k1_of(const jf_cloud *c, size_t i) { return 1.0 / (1.0 + (double)i) + c->xyz[3 * i]; }
+
 /* The cloud c written to path with x y z and, if extra, two jetfit-like
- * columns (a double, an int) of values from the points. */
-static jf_status write_table(const jf_cloud *c, const char *path, int extra, jf_error *e)
+ * columns (k1 of type kt, an int) of values from the points. */
+static jf_status write_table_t(const jf_cloud *c, const char *path, int extra, jf_col_type kt,
+                               jf_error *e)
 {
-    jf_column cols[5] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
-                         {"k1", JF_COL_F64}, {"status", JF_COL_I32}};
-    size_t nc = extra ? 5 : 3;
+    jf_column cols[6] = {{"x", JF_COL_F64}, {"y", JF_COL_F64}, {"z", JF_COL_F64},
+                         {"k1", kt}, {"status", JF_COL_I32}, {"nx", JF_COL_F32_Q16}};
+    size_t nc = extra ? (extra == 2 ? 6 : 5) : 3; /* 2: nx too */
     jf_writer *w;
     jf_status st = jf_writer_open(path, cols, nc, c->n, 0, &w, e);
     if (st != JF_OK)
@@ -74,8 +82,9 @@ static jf_status write_table(const jf_cloud *c, const char *path, int extra, jf_
     for (size_t i = 0; i < c->n; i++) {
         memcpy(v + nc * i, c->xyz + 3 * i, 3 * sizeof *v);
         if (extra) {
-            v[nc * i + 3] = 1.0 / (1.0 + (double)i) + c->xyz[3 * i];
+            v[nc * i + 3] = k1_of(c, i);
             v[nc * i + 4] = (double)(i % 7);
+            if (nc == 6) v[nc * i + 5] = nx_of(i);
         }
     }
     if (c->attrs.nattrs || c->attrs.las_head)
@@ -87,9 +96,14 @@ static jf_status write_table(const jf_cloud *c, const char *path, int extra, jf_
     return jf_writer_commit(w, e);
 }
 
-/* in read, written as .las and .laz: the .laz decodes to the .las file
- * byte for byte; returns the .laz size / .las size. */
-static double roundtrip(const char *in, int extra, const char *tag)
+static jf_status write_table(const jf_cloud *c, const char *path, int extra, jf_error *e)
+{
+    return write_table_t(c, path, extra, JF_COL_F64, e);
+}
+
+/* in read, written as .las and .laz (k1 of type kt): the .laz decodes to
+ * the .las file byte for byte; returns the .laz size / .las size. */
+static double roundtrip_t(const char *in, int extra, jf_col_type kt, const char *tag)
 {
     jf_cloud c;
     jf_error e;
@@ -98,8 +112,8 @@ static double roundtrip(const char *in, int extra, const char *tag)
     snprintf(las, sizeof las, "%s.las", tag);
     snprintf(laz, sizeof laz, "%s.laz", tag);
     const char *plas = tmp(las), *plaz = tmp(laz);
-    ck_assert_msg(write_table(&c, plas, extra, &e) == JF_OK, "%s", e.msg);
-    ck_assert_msg(write_table(&c, plaz, extra, &e) == JF_OK, "%s", e.msg);
+    ck_assert_msg(write_table_t(&c, plas, extra, kt, &e) == JF_OK, "%s", e.msg);
+    ck_assert_msg(write_table_t(&c, plaz, extra, kt, &e) == JF_OK, "%s", e.msg);
     size_t la, lz, li;
     unsigned char *a = slurp(plas, &la), *z = slurp(plaz, &lz);
     ck_assert_msg((z[104] & 0x80) && (z[104] & 0x3f) == (a[104] & 0x3f), "%s: format byte", tag);
@@ -119,6 +133,81 @@ static double roundtrip(const char *in, int extra, const char *tag)
     jf_cloud_free(&c);
     return (double)lz / (double)la;
 }
+
+static double roundtrip(const char *in, int extra, const char *tag)
+{
+    return roundtrip_t(in, extra, JF_COL_F64, tag);
+}
+
+/* The index of the attribute named nm, or nattrs. */
+static size_t attr_index(const jf_attrs *a, const char *nm)
+{
+    size_t k = 0;
+    while (k < a->nattrs && strcmp(a->attr[k].name, nm)) k++;
+    return k;
+}
+
+/* Float columns (`--las-columns float` and `compact`, the .laz default of
+ * estimate): the .laz unpacks to the .las of the same columns, and our
+ * reader gives back k1 as the float nearest the double written, (float)k1
+ * exactly, nx (JF_COL_F32_Q16) as a float that is a whole number of
+ * 2^-16 within 2^-17 of the double, the input's attributes and
+ * coordinates as they were; 4 bytes a value, not 8. */
+START_TEST(float_columns)
+{
+    static const char *const f[] = {"append-bug.laz", "1_4_w_evlr.laz",
+                                    "point-color-time.las.laz", "point10.las.laz"};
+    for (size_t k = 0; k < sizeof f / sizeof *f; k++) {
+        char in[256], tag[32];
+        snprintf(in, sizeof in, DATA "%s", f[k]);
+        snprintf(tag, sizeof tag, "float%zu", k);
+        roundtrip_t(in, 2, JF_COL_F32, tag);
+        jf_cloud c, r, d;
+        jf_error e;
+        ck_assert_msg(jf_cloud_read(in, NULL, &c, &e) == JF_OK, "%s", e.msg);
+        ck_assert_msg(jf_cloud_read(in, NULL, &d, &e) == JF_OK, "%s", e.msg);
+        char laz[80], dlaz[80];
+        snprintf(laz, sizeof laz, "%s.laz", tag);
+        snprintf(dlaz, sizeof dlaz, "%sd.laz", tag);
+        ck_assert_msg(jf_cloud_read(tmp(laz), NULL, &r, &e) == JF_OK, "%s", e.msg);
+        ck_assert_uint_eq(r.n, c.n);
+        size_t j = attr_index(&r.attrs, "k1");
+        ck_assert_msg(j < r.attrs.nattrs && r.attrs.attr[j].type == JF_ATTR_F32, "%s: k1", f[k]);
+        size_t jn = attr_index(&r.attrs, "nx");
+        ck_assert_msg(jn < r.attrs.nattrs && r.attrs.attr[jn].type == JF_ATTR_F32, "%s: nx", f[k]);
+        size_t rounded = 0;
+        for (size_t i = 0; i < c.n; i++) {
+            double want = (double)(float)k1_of(&c, i), got = jf_attr_get(&r.attrs, j, i);
+            ck_assert_msg(got == want, "%s: point %zu: k1 %.17g, (float) %.17g", f[k], i, got,
+                          want);
+            rounded += got != k1_of(&c, i);
+            double q = jf_attr_get(&r.attrs, jn, i), q16 = q * 65536.0;
+            ck_assert_msg(q16 == floor(q16) && fabs(q - nx_of(i)) <= 0x1p-17,
+                          "%s: point %zu: nx %.17g for %.17g", f[k], i, q, nx_of(i));
+            for (int a = 0; a < 3; a++)
+                ck_assert(r.xyz[3 * i + a] == c.xyz[3 * i + a]);
+        }
+        ck_assert_msg(rounded > c.n / 2, "%s: k1 not rounded to float", f[k]);
+        for (size_t q = 0; q < c.attrs.nattrs; q++) {
+            size_t m = attr_index(&r.attrs, c.attrs.attr[q].name);
+            ck_assert_msg(m < r.attrs.nattrs, "%s: %s lost", f[k], c.attrs.attr[q].name);
+            for (size_t i = 0; i < c.n; i++) {
+                double x = jf_attr_get(&c.attrs, q, i), y = jf_attr_get(&r.attrs, m, i);
+                ck_assert_msg(!memcmp(&x, &y, sizeof x), "%s: %s, point %zu", f[k],
+                              c.attrs.attr[q].name, i);
+            }
+        }
+        /* the same table with double k1 (and no nx): the same record length */
+        ck_assert_msg(write_table(&d, tmp(dlaz), 1, &e) == JF_OK, "%s", e.msg);
+        jf_cloud_free(&d);
+        ck_assert_msg(jf_cloud_read(tmp(dlaz), NULL, &d, &e) == JF_OK, "%s", e.msg);
+        ck_assert_uint_eq(d.attrs.stride, r.attrs.stride);
+        jf_cloud_free(&d);
+        jf_cloud_free(&r);
+        jf_cloud_free(&c);
+    }
+}
+END_TEST
 
 START_TEST(real_files)
 {
@@ -311,6 +400,7 @@ int main(void)
     tcase_add_test(t, generated);
     tcase_add_test(t, threads);
     tcase_add_test(t, non_las);
+    tcase_add_test(t, float_columns);
     tcase_add_test(t, codec_fuzz);
     tcase_add_test(t, bad_output);
     suite_add_tcase(s, t);

@@ -103,6 +103,7 @@ errors)
   refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --orient mst
   refused "binary PLY and LAS only" 2 "$d/lattice.csv" -o "$d/err.ply"
   refused "No such file" 3 "$d/missing.ply" -o "$d/err.ply"
+  refused "jetfit-mpi writes doubles" 2 "$d/lattice.ply" -o "$d/err.laz" --las-columns float
   printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n' >"$d/ascii.ply"
   refused "ascii PLY" 2 "$d/ascii.ply" -o "$d/err.ply"
   head -c 3000 "$d/lattice.ply" >"$d/cut.ply"
