@@ -123,7 +123,9 @@ START_TEST(study_convergence_temporaries_swapped)
     stop(sw);
     size_t n;
     char *v = jf_test_slurp(victim, &n);
-    ck_assert_msg(v && !strcmp(v, victim_text), "a picture went into the link's target");
+    ck_assert_msg(v && !strcmp(v, victim_text),
+                  "something went into the link's target (study %d, convergence %d): %zu bytes "
+                  "starting %.40s", rs, rcv, n, v ? v : "(unreadable)");
     free(v);
     ck_assert_int_eq(links_in(sdir), 0);
     ck_assert_int_eq(links_in(cdir), 0);
