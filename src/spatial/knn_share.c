@@ -1,0 +1,183 @@
+/* knn_share.c -- the k nearest of consecutive, nearby query points from
+ * one k-d tree search (neighbors auto's 256 nearest: docs/robustness.md).
+ *
+ * design:
+ *  1. At a query point c, one search for its KSHARE x k nearest (the
+ *     candidates), with rk = |c - k-th| and R = |c - last candidate|:
+ *     every point nearer c than R is a candidate.
+ *  2. A later query q, delta = |q - c|: c's k nearest lie within
+ *     rk + delta of q, so q's k nearest are among the candidates within
+ *     that of q (a prefix of them: within rk + 2 delta of c).  Sorted by
+ *     (squared distance, input index), the tree's order with its own d2
+ *     arithmetic, the first k give t = |q - k-th|; every point within t
+ *     of q is within t + delta of c, so if t + delta < R they are q's k
+ *     nearest -- the same list, bit for bit, as jf__index_query,
+ *     whichever point built the candidates (threads, parts and ranks
+ *     still agree).  A bucket sort by d2 (as the tree's buf_finish).
+ *  3. Otherwise q becomes the new c.
+ * Rounding: the test keeps a relative margin of 1e-9 (distances carry
+ * errors near 1e-16), and a selection that finds fewer than k inside
+ * the bound falls back to the search.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "index_internal.h"
+
+#define KSHARE 2 /* candidates: KSHARE x k (2k: the tree's fast buffer mode) */
+
+struct jf__knn_share {
+    size_t k, kc;  /* asked, candidates searched                       */
+    size_t nc;     /* candidates held (0: none yet)                     */
+    double c[3];   /* the point they were searched from                 */
+    double rk, R;  /* |c - k-th|, |c - last| (INFINITY: the whole cloud) */
+    uint32_t *cid; /* input indices, coordinates of the candidates      */
+    double *cxyz;
+    double *cd2;   /* their squared distances to c, ascending           */
+    double *d2;    /* per query: candidates' d2                          */
+    uint32_t *sel, *start;
+    double *td;
+    uint32_t *tp;
+};
+
+void jf__knn_share_free(jf__knn_share *s)
+{
+    if (!s) return;
+    free(s->cid);
+    free(s->cxyz);
+    free(s->d2);
+    free(s->cd2);
+    free(s->sel);
+    free(s->start);
+    free(s->td);
+    free(s->tp);
+    free(s);
+}
+
+jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
+{
+    *out = NULL;
+    if (!k) return JF_ERR_INVALID;
+    jf__knn_share *s = calloc(1, sizeof *s);
+    if (!s) return JF_ERR_NOMEM;
+    s->k = k;
+    s->kc = KSHARE * k;
+    s->cid = malloc(s->kc * sizeof *s->cid);
+    s->cxyz = malloc(3 * s->kc * sizeof *s->cxyz);
+    s->d2 = malloc(s->kc * sizeof *s->d2);
+    s->cd2 = malloc(s->kc * sizeof *s->cd2);
+    s->sel = malloc(s->kc * sizeof *s->sel);
+    s->start = malloc((s->kc + 1) * sizeof *s->start);
+    s->td = malloc(s->kc * sizeof *s->td);
+    s->tp = malloc(s->kc * sizeof *s->tp);
+    if (!s->cid || !s->cxyz || !s->d2 || !s->cd2 || !s->sel || !s->start || !s->td || !s->tp) {
+        jf__knn_share_free(s);
+        return JF_ERR_NOMEM;
+    }
+    *out = s;
+    return JF_OK;
+}
+
+/* (d, id) < (da, ida): the tree's order */
+#define SH_LESS(d, i, da, ia) ((d) < (da) || ((d) == (da) && (i) < (ia)))
+
+/* Step 1 at q: the candidates, and q's own k nearest as their prefix. */
+static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3], uint32_t *idx,
+                         double *d2, double *xyz, size_t *found)
+{
+    size_t f = 0;
+    s->nc = 0;
+    jf_status st = jf__index_query(ix, q, s->kc, INFINITY, s->cid, s->cd2, s->cxyz, &f);
+    if (st != JF_OK) return st;
+    size_t m = f < s->k ? f : s->k;
+    memcpy(idx, s->cid, m * sizeof *idx);
+    if (d2) memcpy(d2, s->cd2, m * sizeof *d2);
+    if (xyz) memcpy(xyz, s->cxyz, 3 * m * sizeof *xyz);
+    *found = m;
+    if (f <= s->k) return JF_OK; /* the whole cloud: nothing to share */
+    memcpy(s->c, q, sizeof s->c);
+    s->rk = sqrt(s->cd2[s->k - 1]);
+    s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
+    s->nc = f;
+    return JF_OK;
+}
+
+jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
+                              uint32_t *idx, double *d2, double *xyz, size_t *found)
+{
+    *found = 0;
+    if (!s->nc) return rebuild(s, ix, q, idx, d2, xyz, found);
+    double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
+    const double delta = sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+    /* q's k-th nearest is within rk + delta (c's k nearest are), so its k
+     * nearest are the candidates within that of q, and among those no
+     * farther than rk + 2 delta from c: a prefix of the candidates */
+    if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return rebuild(s, ix, q, idx, d2, xyz, found);
+    const double b = (s->rk + delta) * (1.0 + 1e-9), b2 = b * b;
+    const double lc = (s->rk + 2.0 * delta) * (1.0 + 1e-9), lc2 = lc * lc;
+    size_t lim = 0, hi = s->nc;
+    while (lim < hi) {
+        size_t mid = lim + (hi - lim) / 2;
+        if (s->cd2[mid] <= lc2) lim = mid + 1;
+        else hi = mid;
+    }
+    const double q0 = q[0], q1 = q[1], q2 = q[2];
+    size_t n = 0;
+    for (size_t j = 0; j < lim; j++) {
+        const double *p = s->cxyz + 3 * j;
+        double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+        double d = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
+        s->d2[n] = d;
+        s->sel[n] = (uint32_t)j;
+        n += d <= b2;
+    }
+    if (n < s->k || !(b2 > 0.0)) return rebuild(s, ix, q, idx, d2, xyz, found);
+    /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
+     * the first k into td, tp */
+    uint32_t *start = s->start;
+    const double scale = (double)n / b2;
+    memset(start, 0, (n + 1) * sizeof *start);
+    for (size_t j = 0; j < n; j++) {
+        size_t bk = (size_t)(s->d2[j] * scale);
+        start[(bk < n ? bk : n - 1) + 1]++;
+    }
+    for (size_t bk = 0; bk < n; bk++) start[bk + 1] += start[bk];
+    for (size_t j = 0; j < n; j++) {
+        size_t bk = (size_t)(s->d2[j] * scale);
+        uint32_t at = start[bk < n ? bk : n - 1]++;
+        s->td[at] = s->d2[j];
+        s->tp[at] = s->sel[j];
+    }
+    size_t lo = 0;
+    for (size_t bk = 0; bk < n && lo < s->k; bk++) {
+        size_t end = start[bk];
+        for (size_t i = lo + 1; i < end; i++) { /* insertion sort of the bucket */
+            double d = s->td[i];
+            uint32_t p = s->tp[i], pid = s->cid[p];
+            size_t j = i;
+            while (j > lo && SH_LESS(d, pid, s->td[j - 1], s->cid[s->tp[j - 1]])) {
+                s->td[j] = s->td[j - 1];
+                s->tp[j] = s->tp[j - 1];
+                j--;
+            }
+            s->td[j] = d;
+            s->tp[j] = p;
+        }
+        lo = end;
+    }
+    /* every point within t = |q - k-th| of q is within t + delta of c:
+     * a candidate if that is below R (else a point beyond the candidates
+     * may be nearer q) */
+    const size_t k = s->k;
+    if (!((sqrt(s->td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
+        return rebuild(s, ix, q, idx, d2, xyz, found);
+    for (size_t i = 0; i < k; i++) {
+        uint32_t p = s->tp[i];
+        idx[i] = s->cid[p];
+        if (d2) d2[i] = s->td[i];
+        if (xyz) memcpy(xyz + 3 * i, s->cxyz + 3 * (size_t)p, 3 * sizeof *xyz);
+    }
+    *found = k;
+    return JF_OK;
+}
