@@ -630,6 +630,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                                   blocks ? &w.blk[m++] : &R->out[i1]);
                     k += 2;
                 } else {
+                    if (w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, end - k);
                     wst = fit_one(&w, x, i, pt, d0);
                     k++;
                 }

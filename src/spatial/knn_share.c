@@ -25,6 +25,7 @@
 
 #include "index_internal.h"
 
+#define SH_AHEAD 16 /* walk points looked at for a search's centre */
 #define KSHARE 2 /* candidates: KSHARE x k (2k: the tree's fast buffer mode) */
 
 struct jf__knn_share {
@@ -39,7 +40,16 @@ struct jf__knn_share {
     uint32_t *sel, *start;
     double *td;
     uint32_t *tp;
+    const double *ahead; /* the walk's next points (ahead[0..2]: this one) */
+    size_t nahead;
+    double rk_last;      /* rk of the last search (0: none yet)          */
 };
+
+void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n)
+{
+    s->ahead = xyz;
+    s->nahead = n;
+}
 
 void jf__knn_share_free(jf__knn_share *s)
 {
@@ -97,23 +107,23 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     *found = m;
     if (f <= s->k) return JF_OK; /* the whole cloud: nothing to share */
     memcpy(s->c, q, sizeof s->c);
-    s->rk = sqrt(s->cd2[s->k - 1]);
+    s->rk = s->rk_last = sqrt(s->cd2[s->k - 1]);
     s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
     s->nc = f;
     return JF_OK;
 }
 
-jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
-                              uint32_t *idx, double *d2, double *xyz, size_t *found)
+/* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
+static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *d2, double *xyz,
+                    size_t *found)
 {
-    *found = 0;
-    if (!s->nc) return rebuild(s, ix, q, idx, d2, xyz, found);
+    if (!s->nc) return 0;
     double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
     const double delta = sqrt(e0 * e0 + e1 * e1 + e2 * e2);
     /* q's k-th nearest is within rk + delta (c's k nearest are), so its k
      * nearest are the candidates within that of q, and among those no
      * farther than rk + 2 delta from c: a prefix of the candidates */
-    if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return rebuild(s, ix, q, idx, d2, xyz, found);
+    if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return 0;
     const double b = (s->rk + delta) * (1.0 + 1e-9), b2 = b * b;
     const double lc = (s->rk + 2.0 * delta) * (1.0 + 1e-9), lc2 = lc * lc;
     size_t lim = 0, hi = s->nc;
@@ -132,7 +142,7 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
         s->sel[n] = (uint32_t)j;
         n += d <= b2;
     }
-    if (n < s->k || !(b2 > 0.0)) return rebuild(s, ix, q, idx, d2, xyz, found);
+    if (n < s->k || !(b2 > 0.0)) return 0;
     /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
      * the first k into td, tp */
     uint32_t *start = s->start;
@@ -171,7 +181,7 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
      * may be nearer q) */
     const size_t k = s->k;
     if (!((sqrt(s->td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
-        return rebuild(s, ix, q, idx, d2, xyz, found);
+        return 0;
     for (size_t i = 0; i < k; i++) {
         uint32_t p = s->tp[i];
         idx[i] = s->cid[p];
@@ -179,5 +189,36 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
         if (xyz) memcpy(xyz + 3 * i, s->cxyz + 3 * (size_t)p, 3 * sizeof *xyz);
     }
     *found = k;
-    return JF_OK;
+    return 1;
+}
+
+jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
+                              uint32_t *idx, double *d2, double *xyz, size_t *found)
+{
+    *found = 0;
+    if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+    /* step 3, from the centroid of the walk's next points near q (within
+     * half the last rk: the walk goes leaf by leaf, so a search there
+     * serves the whole leaf); q itself when there are none */
+    double c[3] = {q[0], q[1], q[2]};
+    size_t nc = 1;
+    if (s->ahead && s->rk_last > 0.0 && s->ahead[0] == q[0] && s->ahead[1] == q[1] &&
+        s->ahead[2] == q[2]) {
+        const double lim = s->rk_last / 2.0, lim2 = lim * lim;
+        for (size_t j = 1; j < s->nahead && j < SH_AHEAD; j++) {
+            const double *a = s->ahead + 3 * j;
+            double e0 = a[0] - q[0], e1 = a[1] - q[1], e2 = a[2] - q[2];
+            if (!(e0 * e0 + e1 * e1 + e2 * e2 <= lim2)) continue;
+            c[0] += a[0], c[1] += a[1], c[2] += a[2];
+            nc++;
+        }
+        for (int d = 0; d < 3; d++) c[d] /= (double)nc;
+    }
+    if (nc > 1) {
+        size_t f = 0;
+        jf_status st = rebuild(s, ix, c, idx, d2, xyz, &f);
+        if (st != JF_OK) return st;
+        if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+    }
+    return rebuild(s, ix, q, idx, d2, xyz, found);
 }
