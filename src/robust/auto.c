@@ -35,6 +35,7 @@
  *     --degree d up to rounding (test_auto), without a second fit;
  *     flagged JF_PT_AUTO.
  */
+#include <emmintrin.h>
 #include <math.h>
 #include <string.h>
 
@@ -259,7 +260,7 @@ static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const d
     A->m += w;
     v2d r2 = x * x + y * y;
     A->rmax2 = (v2d)(((v2l)r2 & (v2l)(r2 > A->rmax2)) | ((v2l)A->rmax2 & ~(v2l)(r2 > A->rmax2)));
-    if (rs) A->rsum += (v2d){sqrt(r2[0]), sqrt(r2[1])};
+    if (rs) A->rsum += (v2d)_mm_sqrt_pd((__m128d)r2); /* IEEE sqrt: sqrt()'s bits */
 }
 
 /* The power sums of the first k neighbours in the frame fr (as step 1's,
@@ -351,19 +352,15 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
             flags |= JF_PT_LOWERED_FEW;
             continue;
         }
-        double E[NMON * NMON], ev[NMON], wk[NMON];
+        double E[NMON * NMON], lo = 0.0, hi = 0.0;
         for (int i = 0; i < nd; i++)
             for (int j = 0; j < nd; j++)
                 E[i * nd + j] = L[i * NMON + j] =
                     mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
-        if (jf__sym_eigvals(E, (size_t)nd, ev, wk) != 0) {
+        /* the extremes only, as the jet's own (gram_eig.c) */
+        if (!jf__gram_extremes(E, (size_t)nd, &hi, &lo)) {
             flags |= JF_PT_LOWERED_RANK;
             continue;
-        }
-        double lo = ev[0], hi = ev[0];
-        for (int i = 1; i < nd; i++) {
-            if (ev[i] < lo) lo = ev[i];
-            if (ev[i] > hi) hi = ev[i];
         }
         cond = lo > 0.0 ? sqrt(hi / lo) : INFINITY;
         int okc = 1;

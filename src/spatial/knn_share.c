@@ -35,6 +35,7 @@ struct jf__knn_share {
     double rk, R;  /* |c - k-th|, |c - last| (INFINITY: the whole cloud) */
     uint32_t *cid; /* input indices, coordinates of the candidates      */
     double *cxyz;
+    double *cx, *cy, *cz; /* the same coordinates by axis (the d2 loop)    */
     double *cd2;   /* their squared distances to c, ascending           */
     double *d2;    /* per query: candidates' d2                          */
     uint32_t *sel, *start;
@@ -56,6 +57,7 @@ void jf__knn_share_free(jf__knn_share *s)
     if (!s) return;
     free(s->cid);
     free(s->cxyz);
+    free(s->cx);
     free(s->d2);
     free(s->cd2);
     free(s->sel);
@@ -75,13 +77,14 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     s->kc = KSHARE * k;
     s->cid = malloc(s->kc * sizeof *s->cid);
     s->cxyz = malloc(3 * s->kc * sizeof *s->cxyz);
+    s->cx = malloc(3 * s->kc * sizeof *s->cx);
     s->d2 = malloc(s->kc * sizeof *s->d2);
     s->cd2 = malloc(s->kc * sizeof *s->cd2);
     s->sel = malloc(s->kc * sizeof *s->sel);
     s->start = malloc((s->kc + 1) * sizeof *s->start);
     s->td = malloc(s->kc * sizeof *s->td);
     s->tp = malloc(s->kc * sizeof *s->tp);
-    if (!s->cid || !s->cxyz || !s->d2 || !s->cd2 || !s->sel || !s->start || !s->td || !s->tp) {
+    if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->start || !s->td || !s->tp) {
         jf__knn_share_free(s);
         return JF_ERR_NOMEM;
     }
@@ -109,6 +112,13 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     memcpy(s->c, q, sizeof s->c);
     s->rk = s->rk_last = sqrt(s->cd2[s->k - 1]);
     s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
+    s->cy = s->cx + s->kc;
+    s->cz = s->cy + s->kc;
+    for (size_t j = 0; j < f; j++) {
+        s->cx[j] = s->cxyz[3 * j];
+        s->cy[j] = s->cxyz[3 * j + 1];
+        s->cz[j] = s->cxyz[3 * j + 2];
+    }
     s->nc = f;
     return JF_OK;
 }
@@ -133,14 +143,17 @@ static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *
         else hi = mid;
     }
     const double q0 = q[0], q1 = q[1], q2 = q[2];
+    double *dd = s->td; /* scratch until the sort */
+    const double *cx = s->cx, *cy = s->cy, *cz = s->cz;
+    for (size_t j = 0; j < lim; j++) {
+        double dx = q0 - cx[j], dy = q1 - cy[j], dz = q2 - cz[j];
+        dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
+    }
     size_t n = 0;
     for (size_t j = 0; j < lim; j++) {
-        const double *p = s->cxyz + 3 * j;
-        double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
-        double d = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
-        s->d2[n] = d;
+        s->d2[n] = dd[j];
         s->sel[n] = (uint32_t)j;
-        n += d <= b2;
+        n += dd[j] <= b2;
     }
     if (n < s->k || !(b2 > 0.0)) return 0;
     /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
