@@ -38,12 +38,13 @@ struct jf__knn_share {
     double *cx, *cy, *cz; /* the same coordinates by axis (the d2 loop)    */
     double *cd2;   /* their squared distances to c, ascending           */
     double *d2;    /* per query: candidates' d2                          */
-    uint32_t *sel, *start;
+    uint32_t *sel, *start, *bkt;
     double *td;
     uint32_t *tp;
     const double *ahead; /* the walk's next points (ahead[0..2]: this one) */
     size_t nahead;
     double rk_last;      /* rk of the last search (0: none yet)          */
+    double t_last;       /* the last query's k-th distance               */
 };
 
 void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n)
@@ -61,6 +62,7 @@ void jf__knn_share_free(jf__knn_share *s)
     free(s->d2);
     free(s->cd2);
     free(s->sel);
+    free(s->bkt);
     free(s->start);
     free(s->td);
     free(s->tp);
@@ -81,10 +83,11 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     s->d2 = malloc(s->kc * sizeof *s->d2);
     s->cd2 = malloc(s->kc * sizeof *s->cd2);
     s->sel = malloc(s->kc * sizeof *s->sel);
+    s->bkt = malloc(s->kc * sizeof *s->bkt);
     s->start = malloc((s->kc + 1) * sizeof *s->start);
     s->td = malloc(s->kc * sizeof *s->td);
     s->tp = malloc(s->kc * sizeof *s->tp);
-    if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->start || !s->td || !s->tp) {
+    if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
         jf__knn_share_free(s);
         return JF_ERR_NOMEM;
     }
@@ -110,7 +113,7 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     *found = m;
     if (f <= s->k) return JF_OK; /* the whole cloud: nothing to share */
     memcpy(s->c, q, sizeof s->c);
-    s->rk = s->rk_last = sqrt(s->cd2[s->k - 1]);
+    s->rk = s->rk_last = s->t_last = sqrt(s->cd2[s->k - 1]);
     s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
     s->cy = s->cx + s->kc;
     s->cz = s->cy + s->kc;
@@ -134,8 +137,12 @@ static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *
      * nearest are the candidates within that of q, and among those no
      * farther than rk + 2 delta from c: a prefix of the candidates */
     if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return 0;
-    const double b = (s->rk + delta) * (1.0 + 1e-9), b2 = b * b;
-    const double lc = (s->rk + 2.0 * delta) * (1.0 + 1e-9), lc2 = lc * lc;
+    const double bmax = (s->rk + delta) * (1.0 + 1e-9);
+    /* first a tighter b from the last query's k-th distance (+5%): if k
+     * candidates lie within it, q's k nearest do too (fewer to sort) */
+    double b = s->t_last * 1.05 < bmax ? s->t_last * 1.05 : bmax;
+again:;
+    const double b2 = b * b, lc = (b + delta) * (1.0 + 1e-9), lc2 = lc * lc;
     size_t lim = 0, hi = s->nc;
     while (lim < hi) {
         size_t mid = lim + (hi - lim) / 2;
@@ -155,52 +162,63 @@ static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *
         s->sel[n] = (uint32_t)j;
         n += dd[j] <= b2;
     }
+    if (n < s->k && b < bmax) {
+        b = bmax;
+        goto again;
+    }
     if (n < s->k || !(b2 > 0.0)) return 0;
     /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
-     * the first k into td, tp */
-    uint32_t *start = s->start;
+     * the first k into td, tp (locals: the stores below alias nothing) */
+    uint32_t *start = s->start, *tp = s->tp, *bkt = s->bkt;
+    double *td = s->td;
+    const double *sd = s->d2;
+    const uint32_t *sel = s->sel, *cid = s->cid;
     const double scale = (double)n / b2;
     memset(start, 0, (n + 1) * sizeof *start);
     for (size_t j = 0; j < n; j++) {
-        size_t bk = (size_t)(s->d2[j] * scale);
-        start[(bk < n ? bk : n - 1) + 1]++;
+        size_t bk = (size_t)(sd[j] * scale);
+        bkt[j] = (uint32_t)(bk < n ? bk : n - 1);
+        start[bkt[j] + 1]++;
     }
     for (size_t bk = 0; bk < n; bk++) start[bk + 1] += start[bk];
     for (size_t j = 0; j < n; j++) {
-        size_t bk = (size_t)(s->d2[j] * scale);
-        uint32_t at = start[bk < n ? bk : n - 1]++;
-        s->td[at] = s->d2[j];
-        s->tp[at] = s->sel[j];
+        uint32_t at = start[bkt[j]]++;
+        td[at] = sd[j];
+        tp[at] = sel[j];
     }
+    const size_t k = s->k;
     size_t lo = 0;
-    for (size_t bk = 0; bk < n && lo < s->k; bk++) {
+    for (size_t bk = 0; bk < n && lo < k; bk++) {
         size_t end = start[bk];
         for (size_t i = lo + 1; i < end; i++) { /* insertion sort of the bucket */
-            double d = s->td[i];
-            uint32_t p = s->tp[i], pid = s->cid[p];
+            double d = td[i];
+            uint32_t p = tp[i], pid = cid[p];
             size_t j = i;
-            while (j > lo && SH_LESS(d, pid, s->td[j - 1], s->cid[s->tp[j - 1]])) {
-                s->td[j] = s->td[j - 1];
-                s->tp[j] = s->tp[j - 1];
+            while (j > lo && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]])) {
+                td[j] = td[j - 1];
+                tp[j] = tp[j - 1];
                 j--;
             }
-            s->td[j] = d;
-            s->tp[j] = p;
+            td[j] = d;
+            tp[j] = p;
         }
         lo = end;
     }
     /* every point within t = |q - k-th| of q is within t + delta of c:
      * a candidate if that is below R (else a point beyond the candidates
      * may be nearer q) */
-    const size_t k = s->k;
-    if (!((sqrt(s->td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
+    if (!((sqrt(td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
         return 0;
-    for (size_t i = 0; i < k; i++) {
-        uint32_t p = s->tp[i];
-        idx[i] = s->cid[p];
-        if (d2) d2[i] = s->td[i];
-        if (xyz) memcpy(xyz + 3 * i, s->cxyz + 3 * (size_t)p, 3 * sizeof *xyz);
-    }
+    const double *cxyz = s->cxyz;
+    for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
+    if (d2) memcpy(d2, td, k * sizeof *d2);
+    if (xyz)
+        for (size_t i = 0; i < k; i++) {
+            const double *a = cxyz + 3 * (size_t)tp[i];
+            double *o = xyz + 3 * i;
+            o[0] = a[0], o[1] = a[1], o[2] = a[2];
+        }
+    s->t_last = sqrt(s->td[k - 1]);
     *found = k;
     return 1;
 }
