@@ -48,10 +48,6 @@ typedef double v2d __attribute__((vector_size(16)));
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND 10
 #define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
-#ifndef CUBIC_MAXK
-#define CUBIC_MAXK 128 /* largest K of a cubic candidate: beyond it the
-                          power sums stop at the quadric's (degree 4) */
-#endif
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
@@ -119,7 +115,7 @@ static int put_fit(double a1, double a2, double var, double rss, size_t m, int n
  * of the quadric).  A degree whose block is (near) singular, or with
  * fewer than its size + 4 points, is left out (ok = 0). */
 static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
-                    const double fr[9], int cubic, cand_fit out[2])
+                    const double fr[9], cand_fit out[2])
 {
     /* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
     static const unsigned char gpos[NMON][NMON] = {
@@ -135,7 +131,7 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
         {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
     double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
     double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
-    int nd = m >= NMON + 4 && cubic ? NMON : m >= 6 + 4 ? 6 : 0;
+    int nd = m >= NMON + 4 ? NMON : m >= 6 + 4 ? 6 : 0;
     for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
     for (int i = 0; i < nd; i++)
         for (int j = 0; j <= i; j++)
@@ -484,10 +480,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     mom mo[NCAND];
     int c = 0;
     for (size_t i = 0; i < nmax && c < nc; i += 2) {
-        if (i + 2 <= CUBIC_MAXK)
-            acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 6, 3, 0);
-        else
-            acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 4, 2, 0);
+        acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 6, 3, 0);
         if (i + 2 < ks[c]) continue;
         mom *mc = &mo[c];
         double *S = mc->S, *T = mc->T;
@@ -499,7 +492,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         double hK = sqrt(A.rmax2[0] > A.rmax2[1] ? A.rmax2[0] : A.rmax2[1]) * H;
         if (hK > 0.0) {
             cand_fit two[2] = {{0}, {0}};
-            solve_k(S, T, mc->zz, mc->m, H, hK, fr, ks[c] <= CUBIC_MAXK, two);
+            solve_k(S, T, mc->zz, mc->m, H, hK, fr, two);
             cf[0][c] = two[0];
             cf[1][c] = two[1];
         }
@@ -568,11 +561,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
          * cubic at the same K, if its sd is below the cubic's choice */
         double sd3 = sqrt(s2 * cf[1][c3].tr);
         for (int i = c2; i >= 0; i--) {
-            /* beyond CUBIC_MAXK: against the cubic at the largest K it has */
-            int j = i;
-            while (j >= 0 && !cf[1][j].ok && ks[j] > CUBIC_MAXK) j--;
-            if (j < 0 || !cf[0][i].ok || !cf[1][j].ok) continue;
-            if (jf__angle(cf[0][i].nrm, cf[1][j].nrm) > tau * sqrt(s2 * cf[1][j].tr)) continue;
+            if (!cf[0][i].ok || !cf[1][i].ok) continue;
+            if (jf__angle(cf[0][i].nrm, cf[1][i].nrm) > tau * sqrt(s2 * cf[1][i].tr)) continue;
             if (sqrt(s2 * cf[0][i].tr) < sd3) {
                 d = 2;
                 ci = i;
