@@ -180,8 +180,11 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
 }
 
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
- * agrees with every smaller accepted K's.  Returns its index or -1. */
-static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax)
+ * agrees with every smaller accepted K's (within tau (sd_j + sd_K), or with
+ * nest > 0 within nest sqrt(|sd_j^2 - sd_K^2|): the difference of nested
+ * least-squares estimates has the variance difference).  Returns its
+ * index or -1. */
+static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax, double nest)
 {
     int acc[NCAND], na = 0, best = -1;
     for (int i = 0; i < nc; i++) {
@@ -191,7 +194,8 @@ static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax
         for (int j = 0; j < na && okk; j++) {
             double sdj = sqrt(s2 * c[acc[j]].tr);
             if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
-            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <= tau * (sdi + sdj);
+            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <=
+                  (nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
         }
         if (!okk) break;
         acc[na++] = i;
@@ -550,7 +554,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     }
     /* step 3: Lepski per degree */
     double tau = kn->auto_tau;
-    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax), c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax);
+    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax, kn->auto_nest),
+        c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax, kn->auto_nest);
     /* step 4: the degree */
     int d = 3, ci = c3;
     if (c3 < 0) {
