@@ -35,7 +35,6 @@
  *     --degree d up to rounding (test_auto), without a second fit;
  *     flagged JF_PT_AUTO.
  */
-#include <emmintrin.h>
 #include <math.h>
 #include <string.h>
 
@@ -221,33 +220,50 @@ static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const doubl
     return JF_OK;
 }
 
-/* Power sums in SIMD lanes (two neighbours a step). */
-typedef long long v2l __attribute__((vector_size(16)));
+/* Power sums in four SIMD lanes (four neighbours a step, lane l the
+ * neighbours l, l + 4, ...; summed (l0 + l1) + (l2 + l3) at the end).  The
+ * loops are built twice (target_clones): AVX (four lanes a register, no
+ * FMA, so no contraction) and the default (two SSE2 registers) -- the same
+ * operations on every lane, so the same bits on every machine. */
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
 typedef struct {
-    v2d S[NPOW], T[NMON], zz, m, rmax2, rsum;
-} acc2;
+    v4d S[NPOW], T[NMON], zz, m, rmax2, rsum;
+} acc4;
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
+#define JF_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define JF_CLONES
+#endif
 
-/* Adds neighbours q0, q1 (q1 NULL: none) to A: their frame coordinates x,
+static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+/* Adds neighbours q[0..3] (NULL: none) to A: their frame coordinates x,
  * y (units of H: scaled by iH), z; x^i y^j for i + j <= top, x^i y^j z for
  * i + j <= deg, z^2, the count, the largest x^2 + y^2 and (rs) the sum of
  * sqrt(x^2 + y^2).  A non-finite neighbour weighs 0. */
-static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const double p[3],
-                            const double fr[9], double iH, int top, int deg, int rs)
+static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
+                                                           const double p[3], const double fr[9],
+                                                           double iH, int top, int deg, int rs)
 {
-    const v2d zero = {0.0, 0.0}, one = {1.0, 1.0};
-    v2d v0 = {q0[0] - p[0], q1 ? q1[0] - p[0] : 0.0};
-    v2d v1 = {q0[1] - p[1], q1 ? q1[1] - p[1] : 0.0};
-    v2d v2 = {q0[2] - p[2], q1 ? q1[2] - p[2] : 0.0};
-    v2d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
-    v2d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
-    v2d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
+    const v4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+    v4d v0, v1, v2;
+    v4l live;
+    for (int l = 0; l < 4; l++) {
+        v0[l] = q[l] ? q[l][0] - p[0] : 0.0;
+        v1[l] = q[l] ? q[l][1] - p[1] : 0.0;
+        v2[l] = q[l] ? q[l][2] - p[2] : 0.0;
+        live[l] = q[l] ? -1 : 0;
+    }
+    v4d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
+    v4d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
+    v4d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
     /* finite: t - t == 0 (NaN for an infinity or a NaN) */
-    v2l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero);
-    if (!q1) ok[1] = 0;
-    x = (v2d)((v2l)x & ok);
-    y = (v2d)((v2l)y & ok);
-    z = (v2d)((v2l)z & ok);
-    v2d w = (v2d)((v2l)one & ok), xp[7], yp[7];
+    v4l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero) & live;
+    x = (v4d)((v4l)x & ok);
+    y = (v4d)((v4l)y & ok);
+    z = (v4d)((v4l)z & ok);
+    v4d w = (v4d)((v4l)one & ok), xp[7], yp[7];
     xp[0] = w;
     yp[0] = one;
     for (int e = 1; e <= top; e++) {
@@ -262,33 +278,68 @@ static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const d
         for (int j = 0; j <= t; j++) A->T[at++] += xp[t - j] * yp[j] * z;
     A->zz += w * z * z;
     A->m += w;
-    v2d r2 = x * x + y * y;
-    A->rmax2 = (v2d)(((v2l)r2 & (v2l)(r2 > A->rmax2)) | ((v2l)A->rmax2 & ~(v2l)(r2 > A->rmax2)));
-    if (rs) A->rsum += (v2d)_mm_sqrt_pd((__m128d)r2); /* IEEE sqrt: sqrt()'s bits */
+    v4d r2 = x * x + y * y;
+    v4l gt = (v4l)(r2 > A->rmax2);
+    A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
+    if (rs)
+        for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+}
+
+/* The four neighbours from i (NULL past k). */
+static inline void quad_of(const double *nbr, size_t i, size_t k, const double *q[4])
+{
+    for (int l = 0; l < 4; l++) q[l] = i + (size_t)l < k ? nbr + 3 * (i + (size_t)l) : NULL;
 }
 
 /* The power sums of the first k neighbours in the frame fr (as step 1's,
  * x, y in units of H; up to degree 2 deg), their count and mean planar
  * distance (length units). */
-static void moments(const double p[3], const double *nbr, size_t k, const double fr[9], double H,
-                    int deg, mom *mo)
+JF_CLONES static void moments(const double p[3], const double *nbr, size_t k, const double fr[9],
+                              double H, int deg, mom *mo)
 {
     const double iH = 1.0 / H;
     const int top = 2 * deg, ntop = (top + 1) * (top + 2) / 2, nt = (deg + 1) * (deg + 2) / 2;
-    acc2 A;
+    acc4 A;
     memset(&A, 0, sizeof A);
-    size_t i = 0;
+    const double *q[4];
     if (deg == 2)
-        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, 4, 2, 1);
+        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
     else
-        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, top, deg, 1);
-    if (i < k) acc_pair(&A, nbr + 3 * i, NULL, p, fr, iH, top, deg, 1);
-    v2d *SA = A.S, *TA = A.T, ZA = A.zz, MA = A.m, RA = A.rsum;
-    for (int j = 0; j < ntop; j++) mo->S[j] = SA[j][0] + SA[j][1];
-    for (int j = 0; j < nt; j++) mo->T[j] = TA[j][0] + TA[j][1];
-    mo->zz = ZA[0] + ZA[1];
-    mo->m = (size_t)(MA[0] + MA[1]);
-    mo->hmean = mo->m ? (RA[0] + RA[1]) / (double)mo->m * H : 0.0;
+        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    for (int j = 0; j < ntop; j++) mo->S[j] = sum4(A.S[j]);
+    for (int j = 0; j < nt; j++) mo->T[j] = sum4(A.T[j]);
+    mo->zz = sum4(A.zz);
+    mo->m = (size_t)sum4(A.m);
+    mo->hmean = mo->m ? sum4(A.rsum) / (double)mo->m * H : 0.0;
+}
+
+/* Step 1's power sums (degree 6 and 3, in the frame fr) of the first ks[c]
+ * neighbours for every candidate c < nc into mo[c], and their radius
+ * (largest planar distance, length units) into hk[c].  Every candidate K
+ * but a short list's last (nmax) is a multiple of 4. */
+JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nmax, const double fr[9],
+                                 double H, const size_t *ks, int nc, mom *mo, double *hk)
+{
+    const double iH = 1.0 / H;
+    acc4 A;
+    memset(&A, 0, sizeof A);
+    const double *q[4];
+    int c = 0;
+    for (size_t i = 0; i < nmax && c < nc; i += 4) {
+        quad_of(nbr, i, nmax, q);
+        acc_quad(&A, q, p, fr, iH, 6, 3, 0);
+        if ((i + 4 < nmax ? i + 4 : nmax) < ks[c]) continue;
+        mom *mc = &mo[c];
+        mc->zz = sum4(A.zz);
+        for (int j = 0; j < NPOW; j++) mc->S[j] = sum4(A.S[j]);
+        for (int j = 0; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
+        mc->m = (size_t)sum4(A.m);
+        mc->hmean = 0.0; /* unused: the reported jet has its own sums */
+        v4d r = A.rmax2;
+        double a = r[0] > r[1] ? r[0] : r[1], b = r[2] > r[3] ? r[2] : r[3];
+        hk[c] = sqrt(a > b ? a : b) * H;
+        c++;
+    }
 }
 
 /* The chosen jet straight from its power sums (mo) in the frame fr: the
@@ -475,32 +526,20 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
 
     /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
-     * and x^i y^j z (i + j <= 3, with z'z), two neighbours at a time (SIMD
-     * lanes; every candidate K but a short list's last is even) */
-    acc2 A;
-    memset(&A, 0, sizeof A);
+     * and x^i y^j z (i + j <= 3, with z'z), four neighbours at a time */
     cand_fit cf[2][NCAND];
     memset(cf, 0, sizeof cf);
     mom mo[NCAND];
-    int c = 0;
-    for (size_t i = 0; i < nmax && c < nc; i += 2) {
-        acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 6, 3, 0);
-        if (i + 2 < ks[c]) continue;
+    double hks[NCAND];
+    first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
+    for (int c = 0; c < nc; c++) {
         mom *mc = &mo[c];
-        double *S = mc->S, *T = mc->T;
-        mc->zz = A.zz[0] + A.zz[1];
-        for (int j = 0; j < NPOW; j++) S[j] = A.S[j][0] + A.S[j][1];
-        for (int j = 0; j < NMON; j++) T[j] = A.T[j][0] + A.T[j][1];
-        mc->m = (size_t)(A.m[0] + A.m[1]);
-        mc->hmean = 0.0; /* unused: the reported jet has its own sums */
-        double hK = sqrt(A.rmax2[0] > A.rmax2[1] ? A.rmax2[0] : A.rmax2[1]) * H;
-        if (hK > 0.0) {
+        if (hks[c] > 0.0) {
             cand_fit two[2] = {{0}, {0}};
-            solve_k(S, T, mc->zz, mc->m, H, hK, fr, two);
+            solve_k(mc->S, mc->T, mc->zz, mc->m, H, hks[c], fr, two);
             cf[0][c] = two[0];
             cf[1][c] = two[1];
         }
-        c++;
     }
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
