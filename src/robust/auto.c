@@ -35,6 +35,7 @@
  *     --degree d up to rounding (test_auto), without a second fit;
  *     flagged JF_PT_AUTO.
  */
+#include <emmintrin.h>
 #include <math.h>
 #include <string.h>
 
@@ -43,6 +44,7 @@
 
 #define NMON 10        /* monomials of a cubic                         */
 typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND 10
@@ -113,21 +115,22 @@ static int put_fit(double a1, double a2, double var, double rss, size_t m, int n
  * for the cubic (L^-1 is lower triangular: its leading block inverts G'
  * of the quadric).  A degree whose block is (near) singular, or with
  * fewer than its size + 4 points, is left out (ok = 0). */
+/* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
+static const unsigned char gpos[NMON][NMON] = {
+    {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
+    {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
+    {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
+    {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
+    {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
+    {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
+    {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
+    {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
+    {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
+    {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
+
 static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
                     const double fr[9], cand_fit out[2])
 {
-    /* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
-    static const unsigned char gpos[NMON][NMON] = {
-        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
-        {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
-        {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
-        {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
-        {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
-        {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
-        {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
-        {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
-        {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
-        {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
     double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
     double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
     int nd = m >= NMON + 4 ? NMON : m >= 6 + 4 ? 6 : 0;
@@ -176,6 +179,76 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
         if (i == 5) put_fit(a1, a2, var, rss, m, 6, hK, fr, &out[0]);
     }
     if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
+}
+
+/* solve_k for two candidates a and b at once, one in each SIMD lane
+ * (the Cholesky's square roots and divisions are a chain of dependent
+ * latencies: two chains side by side), the same operations per lane, so
+ * the same bits; when the lanes would part (a different size, a singular
+ * block) each runs solve_k on its own. */
+static void solve_k2(const mom *ma, const mom *mb, double H, double ha, double hb, const double fr[9],
+                     cand_fit oa[2], cand_fit ob[2])
+{
+    const int nd = ma->m >= NMON + 4 ? NMON : 0;
+    if (!nd || !(mb->m >= NMON + 4)) {
+        solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
+        solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
+        return;
+    }
+    v2d D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
+    const v2d sv = {H / ha, H / hb}, one = {1.0, 1.0};
+    const v2d sp[4] = {one, sv, sv * sv, sv * sv * sv};
+    for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
+    for (int i = 0; i < nd; i++)
+        for (int j = 0; j <= i; j++)
+            L[i * NMON + j] = (v2d){ma->S[gpos[i][j]], mb->S[gpos[i][j]]} * D[i] * D[j];
+    const v2d floor = (v2d){ma->S[0], mb->S[0]} * 1e-12;
+    for (int j = 0; j < nd; j++) {
+        v2d sum = L[j * NMON + j];
+        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
+        v2l pos = (v2l)(sum > floor);
+        if (!pos[0] || !pos[1]) { /* a lane leaves the common path */
+            solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
+            solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
+            return;
+        }
+        L[j * NMON + j] = (v2d)_mm_sqrt_pd((__m128d)sum);
+        v2d inv = idg[j] = one / L[j * NMON + j];
+        for (int i = j + 1; i < nd; i++) {
+            v2d t = L[i * NMON + j];
+            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
+            L[i * NMON + j] = t * inv;
+        }
+    }
+    for (int i = 0; i < nd; i++) { /* L y = D M^T z */
+        v2d t = (v2d){ma->T[PIDX(mex[i], mey[i])], mb->T[PIDX(mex[i], mey[i])]} * D[i];
+        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
+        y[i] = t * idg[i];
+    }
+    const v2d zero = {0.0, 0.0};
+    for (int c = 1; c <= 2; c++) { /* L u = e_c */
+        v2d *z = u[c - 1];
+        z[0] = zero;
+        if (c == 2) z[1] = zero;
+        for (int i = c; i < nd; i++) {
+            v2d t = i == c ? one : zero;
+            for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
+            z[i] = t * idg[i];
+        }
+    }
+    v2d a1 = zero, a2 = zero, var = zero, rss = {ma->zz, mb->zz};
+    for (int i = 0; i < nd; i++) {
+        a1 += u[0][i] * y[i];
+        a2 += u[1][i] * y[i];
+        var += u[0][i] * u[0][i] + u[1][i] * u[1][i];
+        rss -= y[i] * y[i];
+        if (i == 5) {
+            put_fit(a1[0], a2[0], var[0], rss[0], ma->m, 6, ha, fr, &oa[0]);
+            put_fit(a1[1], a2[1], var[1], rss[1], mb->m, 6, hb, fr, &ob[0]);
+        }
+    }
+    put_fit(a1[0], a2[0], var[0], rss[0], ma->m, NMON, ha, fr, &oa[1]);
+    put_fit(a1[1], a2[1], var[1], rss[1], mb->m, NMON, hb, fr, &ob[1]);
 }
 
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
@@ -533,13 +606,16 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     double hks[NCAND];
     first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
     for (int c = 0; c < nc; c++) {
-        mom *mc = &mo[c];
-        if (hks[c] > 0.0) {
-            cand_fit two[2] = {{0}, {0}};
-            solve_k(mc->S, mc->T, mc->zz, mc->m, H, hks[c], fr, two);
-            cf[0][c] = two[0];
-            cf[1][c] = two[1];
-        }
+        cand_fit two[2] = {{0}, {0}}, nxt[2] = {{0}, {0}};
+        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) { /* two at once */
+            solve_k2(&mo[c], &mo[c + 1], H, hks[c], hks[c + 1], fr, two, nxt);
+            cf[0][c + 1] = nxt[0];
+            cf[1][c + 1] = nxt[1];
+        } else if (hks[c] > 0.0)
+            solve_k(mo[c].S, mo[c].T, mo[c].zz, mo[c].m, H, hks[c], fr, two);
+        cf[0][c] = two[0];
+        cf[1][c] = two[1];
+        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) c++;
     }
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
