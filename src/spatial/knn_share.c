@@ -174,6 +174,7 @@ again:;
     const double *sd = s->d2;
     const uint32_t *sel = s->sel, *cid = s->cid;
     const double scale = (double)n / b2;
+    if (!isfinite(scale)) return 0; /* b2 subnormal: the buckets would overflow */
     memset(start, 0, (n + 1) * sizeof *start);
     for (size_t j = 0; j < n; j++) {
         size_t bk = (size_t)(sd[j] * scale);

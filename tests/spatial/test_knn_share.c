@@ -3,7 +3,8 @@
  * as one jf__index_query per point, whatever the walk and the hint:
  * a noisy sphere walked in the tree's order (the pipeline's walk) and in
  * a shuffled order, a grid (many equal distances: the index breaks the
- * ties), duplicates, and clouds of fewer than 2k points. */
+ * ties), duplicates, clouds of fewer than 2k points, and coordinates
+ * whose squared distances are subnormal or near 1e10. */
 #include <check.h>
 #include <math.h>
 #include <stdint.h>
@@ -115,6 +116,19 @@ START_TEST(test_share_duplicates)
 }
 END_TEST
 
+/* a sphere of radius 1e-155: squared distances near 1e-312, subnormal
+ * (the bucket sort's scale would overflow: the plain search answers) */
+START_TEST(test_share_subnormal)
+{
+    double *xyz = sphere(2000, 11);
+    for (size_t i = 0; i < 3 * 2000; i++) xyz[i] *= 1e-155;
+    ck_assert_uint_eq(mismatches(xyz, 2000, 256, 0), 0);
+    for (size_t i = 0; i < 3 * 2000; i++) xyz[i] *= 1e160; /* and large ones */
+    ck_assert_uint_eq(mismatches(xyz, 2000, 256, 0), 0);
+    free(xyz);
+}
+END_TEST
+
 /* fewer than k, between k and 2k points: the whole cloud */
 START_TEST(test_share_small)
 {
@@ -135,6 +149,7 @@ int main(void)
     tcase_add_test(tc, test_share_grid_ties);
     tcase_add_test(tc, test_share_duplicates);
     tcase_add_test(tc, test_share_small);
+    tcase_add_test(tc, test_share_subnormal);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
