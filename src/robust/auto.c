@@ -322,12 +322,24 @@ static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double
     const v4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
     v4d v0, v1, v2;
     v4l live;
-    for (int l = 0; l < 4; l++) {
-        v0[l] = q[l] ? q[l][0] - p[0] : 0.0;
-        v1[l] = q[l] ? q[l][1] - p[1] : 0.0;
-        v2[l] = q[l] ? q[l][2] - p[2] : 0.0;
-        live[l] = q[l] ? -1 : 0;
-    }
+    if (q[3]) { /* four in a row (quad_of): one transpose of 12 doubles */
+        const double *a = q[0];
+        v4d r0, r1, r2;
+        memcpy(&r0, a, sizeof r0); /* x0 y0 z0 x1 */
+        memcpy(&r1, a + 4, sizeof r1); /* y1 z1 x2 y2 */
+        memcpy(&r2, a + 8, sizeof r2); /* z2 x3 y3 z3 */
+        const v4d pp = {p[0], p[1], p[2], p[0]};
+        v0 = (v4d){r0[0], r0[3], r1[2], r2[1]} - pp[0];
+        v1 = (v4d){r0[1], r1[0], r1[3], r2[2]} - pp[1];
+        v2 = (v4d){r0[2], r1[1], r2[0], r2[3]} - pp[2];
+        live = (v4l){-1, -1, -1, -1};
+    } else
+        for (int l = 0; l < 4; l++) {
+            v0[l] = q[l] ? q[l][0] - p[0] : 0.0;
+            v1[l] = q[l] ? q[l][1] - p[1] : 0.0;
+            v2[l] = q[l] ? q[l][2] - p[2] : 0.0;
+            live[l] = q[l] ? -1 : 0;
+        }
     v4d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
     v4d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
     v4d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
