@@ -140,6 +140,9 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
 int jf__eigvals(jf_fitter *f, size_t cols);
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
 int jf__sym_eigvals(double *a, size_t n, double *d, double *e);
+/* jf__gram_extremes (gram_eig.c): the largest and least eigenvalues of
+ * the symmetric cols x cols g (2 <= cols <= 10), as jf__eigvals; 1 ok. */
+int jf__gram_extremes(const double *g, size_t cols, double *hi, double *lo);
 int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond);
 
 /* jet.c */

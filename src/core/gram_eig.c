@@ -211,3 +211,14 @@ int jf__eigvals(jf_fitter *f, size_t cols)
     put(f, cols, hi[0], lo[0]);
     return rc[0] == 0;
 }
+
+int jf__gram_extremes(const double *g, size_t cols, double *hi, double *lo)
+{
+    if (cols > GE_MAX || cols < 2) return 0;
+    v2d h, l;
+    int rc[2];
+    gram_extremes(g, g, cols, &h, &l, rc);
+    *hi = h[0];
+    *lo = l[0];
+    return rc[0] == 0;
+}

@@ -284,8 +284,9 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
  * tree's kinds (knn, radius), their coordinates from its own storage into
  * xyz (other kinds leave that to the caller); *flags gets per-point flags
  * (few neighbours, the natural normal's source, failure). */
-static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const double *p,
-                          uint32_t *idx, double *d2, double *xyz, size_t *found, unsigned *flags)
+static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, size_t i,
+                          const double *p, uint32_t *idx, double *d2, double *xyz, size_t *found,
+                          unsigned *flags)
 {
     jf_status st;
     *found = 0;
@@ -313,8 +314,9 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, size_t i, const dou
         st = jf__natural_neighbors_own(x->nt, ws, i, m, x->want,
                                        x->graph || x->fit_moved ? idx : NULL, x->cap, found);
         break;
-    default:
-        st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
+    default: /* sh: auto's 256 nearest, shared along the walk (knn_share.c) */
+        st = sh ? jf__knn_share_query(sh, x->ix, p, idx, d2, xyz, found)
+                : jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
     }
     if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
     return st;
@@ -329,6 +331,7 @@ typedef struct {
     double *d2, *coords, *coords2;
     double *raw, *raw2;   /* natural fit_moved: the raw ring of each    */
     jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
+    jf__knn_share *share; /* auto: the shared k-NN search               */
     uint32_t *bidx;       /* and their input indices                    */
 } worker;
 
@@ -345,6 +348,7 @@ static void worker_free(worker *w)
     free(w->raw2);
     free(w->blk);
     free(w->bidx);
+    jf__knn_share_free(w->share);
     memset(w, 0, sizeof *w);
 }
 
@@ -371,6 +375,8 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->bidx = malloc(CHUNK * sizeof *w->bidx);
         if (!w->blk || !w->bidx) st = JF_ERR_NOMEM;
     }
+    if (st == JF_OK && p->auto_select && x->nb->kind == JF_NB_KNN && x->nb->k >= 128)
+        st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
     if (st != JF_OK) worker_free(w);
     return st;
 }
@@ -435,7 +441,7 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
         nonfinite_row(x, i, row);
         return JF_OK;
     }
-    jf_status st = nb_query(x, w->nws, i, p, w->idx, w->d2, coords, found, flags);
+    jf_status st = nb_query(x, w->nws, w->share, i, p, w->idx, w->d2, coords, found, flags);
     if (st != JF_OK) return st;
     if (x->graph) keep_edges(x, i, w->idx, *found);
     if (*flags & JF_PT_FAILED) {
@@ -624,6 +630,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                                   blocks ? &w.blk[m++] : &R->out[i1]);
                     k += 2;
                 } else {
+                    if (w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, end - k);
                     wst = fit_one(&w, x, i, pt, d0);
                     k++;
                 }

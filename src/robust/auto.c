@@ -35,6 +35,7 @@
  *     --degree d up to rounding (test_auto), without a second fit;
  *     flagged JF_PT_AUTO.
  */
+#include <emmintrin.h>
 #include <math.h>
 #include <string.h>
 
@@ -43,6 +44,7 @@
 
 #define NMON 10        /* monomials of a cubic                         */
 typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2l __attribute__((vector_size(16)));
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND 10
@@ -113,21 +115,22 @@ static int put_fit(double a1, double a2, double var, double rss, size_t m, int n
  * for the cubic (L^-1 is lower triangular: its leading block inverts G'
  * of the quadric).  A degree whose block is (near) singular, or with
  * fewer than its size + 4 points, is left out (ok = 0). */
+/* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
+static const unsigned char gpos[NMON][NMON] = {
+    {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
+    {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
+    {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
+    {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
+    {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
+    {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
+    {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
+    {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
+    {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
+    {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
+
 static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
                     const double fr[9], cand_fit out[2])
 {
-    /* gpos[a][b]: PIDX of x^(mex a + mex b) y^(mey a + mey b) */
-    static const unsigned char gpos[NMON][NMON] = {
-        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
-        {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
-        {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
-        {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
-        {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
-        {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
-        {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
-        {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
-        {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
-        {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
     double D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
     double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
     int nd = m >= NMON + 4 ? NMON : m >= 6 + 4 ? 6 : 0;
@@ -178,9 +181,82 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
     if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
 }
 
+/* solve_k for two candidates a and b at once, one in each SIMD lane
+ * (the Cholesky's square roots and divisions are a chain of dependent
+ * latencies: two chains side by side), the same operations per lane, so
+ * the same bits; when the lanes would part (a different size, a singular
+ * block) each runs solve_k on its own. */
+static void solve_k2(const mom *ma, const mom *mb, double H, double ha, double hb, const double fr[9],
+                     cand_fit oa[2], cand_fit ob[2])
+{
+    const int nd = ma->m >= NMON + 4 ? NMON : 0;
+    if (!nd || !(mb->m >= NMON + 4)) {
+        solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
+        solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
+        return;
+    }
+    v2d D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
+    const v2d sv = {H / ha, H / hb}, one = {1.0, 1.0};
+    const v2d sp[4] = {one, sv, sv * sv, sv * sv * sv};
+    for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
+    for (int i = 0; i < nd; i++)
+        for (int j = 0; j <= i; j++)
+            L[i * NMON + j] = (v2d){ma->S[gpos[i][j]], mb->S[gpos[i][j]]} * D[i] * D[j];
+    const v2d floor = (v2d){ma->S[0], mb->S[0]} * 1e-12;
+    for (int j = 0; j < nd; j++) {
+        v2d sum = L[j * NMON + j];
+        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
+        v2l pos = (v2l)(sum > floor);
+        if (!pos[0] || !pos[1]) { /* a lane leaves the common path */
+            solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
+            solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
+            return;
+        }
+        L[j * NMON + j] = (v2d)_mm_sqrt_pd((__m128d)sum);
+        v2d inv = idg[j] = one / L[j * NMON + j];
+        for (int i = j + 1; i < nd; i++) {
+            v2d t = L[i * NMON + j];
+            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
+            L[i * NMON + j] = t * inv;
+        }
+    }
+    for (int i = 0; i < nd; i++) { /* L y = D M^T z */
+        v2d t = (v2d){ma->T[PIDX(mex[i], mey[i])], mb->T[PIDX(mex[i], mey[i])]} * D[i];
+        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
+        y[i] = t * idg[i];
+    }
+    const v2d zero = {0.0, 0.0};
+    for (int c = 1; c <= 2; c++) { /* L u = e_c */
+        v2d *z = u[c - 1];
+        z[0] = zero;
+        if (c == 2) z[1] = zero;
+        for (int i = c; i < nd; i++) {
+            v2d t = i == c ? one : zero;
+            for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
+            z[i] = t * idg[i];
+        }
+    }
+    v2d a1 = zero, a2 = zero, var = zero, rss = {ma->zz, mb->zz};
+    for (int i = 0; i < nd; i++) {
+        a1 += u[0][i] * y[i];
+        a2 += u[1][i] * y[i];
+        var += u[0][i] * u[0][i] + u[1][i] * u[1][i];
+        rss -= y[i] * y[i];
+        if (i == 5) {
+            put_fit(a1[0], a2[0], var[0], rss[0], ma->m, 6, ha, fr, &oa[0]);
+            put_fit(a1[1], a2[1], var[1], rss[1], mb->m, 6, hb, fr, &ob[0]);
+        }
+    }
+    put_fit(a1[0], a2[0], var[0], rss[0], ma->m, NMON, ha, fr, &oa[1]);
+    put_fit(a1[1], a2[1], var[1], rss[1], mb->m, NMON, hb, fr, &ob[1]);
+}
+
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
- * agrees with every smaller accepted K's.  Returns its index or -1. */
-static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax)
+ * agrees with every smaller accepted K's (within tau (sd_j + sd_K), or with
+ * nest > 0 within nest sqrt(|sd_j^2 - sd_K^2|): the difference of nested
+ * least-squares estimates has the variance difference).  Returns its
+ * index or -1. */
+static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax, double nest)
 {
     int acc[NCAND], na = 0, best = -1;
     for (int i = 0; i < nc; i++) {
@@ -190,7 +266,8 @@ static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax
         for (int j = 0; j < na && okk; j++) {
             double sdj = sqrt(s2 * c[acc[j]].tr);
             if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
-            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <= tau * (sdi + sdj);
+            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <=
+                  (nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
         }
         if (!okk) break;
         acc[na++] = i;
@@ -216,33 +293,62 @@ static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const doubl
     return JF_OK;
 }
 
-/* Power sums in SIMD lanes (two neighbours a step). */
-typedef long long v2l __attribute__((vector_size(16)));
+/* Power sums in four SIMD lanes (four neighbours a step, lane l the
+ * neighbours l, l + 4, ...; summed (l0 + l1) + (l2 + l3) at the end).  The
+ * loops are built twice (target_clones): AVX (four lanes a register, no
+ * FMA, so no contraction) and the default (two SSE2 registers) -- the same
+ * operations on every lane, so the same bits on every machine. */
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
 typedef struct {
-    v2d S[NPOW], T[NMON], zz, m, rmax2, rsum;
-} acc2;
+    v4d S[NPOW], T[NMON], zz, m, rmax2, rsum;
+} acc4;
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
+#define JF_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define JF_CLONES
+#endif
 
-/* Adds neighbours q0, q1 (q1 NULL: none) to A: their frame coordinates x,
+static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+/* Adds neighbours q[0..3] (NULL: none) to A: their frame coordinates x,
  * y (units of H: scaled by iH), z; x^i y^j for i + j <= top, x^i y^j z for
  * i + j <= deg, z^2, the count, the largest x^2 + y^2 and (rs) the sum of
  * sqrt(x^2 + y^2).  A non-finite neighbour weighs 0. */
-static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const double p[3],
-                            const double fr[9], double iH, int top, int deg, int rs)
+static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
+                                                           const double p[3], const double fr[9],
+                                                           double iH, int top, int deg, int rs)
 {
-    const v2d zero = {0.0, 0.0}, one = {1.0, 1.0};
-    v2d v0 = {q0[0] - p[0], q1 ? q1[0] - p[0] : 0.0};
-    v2d v1 = {q0[1] - p[1], q1 ? q1[1] - p[1] : 0.0};
-    v2d v2 = {q0[2] - p[2], q1 ? q1[2] - p[2] : 0.0};
-    v2d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
-    v2d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
-    v2d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
+    const v4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+    v4d v0, v1, v2;
+    v4l live;
+    if (q[3]) { /* four in a row (quad_of): one transpose of 12 doubles */
+        const double *a = q[0];
+        v4d r0, r1, r2;
+        memcpy(&r0, a, sizeof r0); /* x0 y0 z0 x1 */
+        memcpy(&r1, a + 4, sizeof r1); /* y1 z1 x2 y2 */
+        memcpy(&r2, a + 8, sizeof r2); /* z2 x3 y3 z3 */
+        const v4d pp = {p[0], p[1], p[2], p[0]};
+        v0 = (v4d){r0[0], r0[3], r1[2], r2[1]} - pp[0];
+        v1 = (v4d){r0[1], r1[0], r1[3], r2[2]} - pp[1];
+        v2 = (v4d){r0[2], r1[1], r2[0], r2[3]} - pp[2];
+        live = (v4l){-1, -1, -1, -1};
+    } else
+        for (int l = 0; l < 4; l++) {
+            v0[l] = q[l] ? q[l][0] - p[0] : 0.0;
+            v1[l] = q[l] ? q[l][1] - p[1] : 0.0;
+            v2[l] = q[l] ? q[l][2] - p[2] : 0.0;
+            live[l] = q[l] ? -1 : 0;
+        }
+    v4d x = (v0 * fr[0] + v1 * fr[1] + v2 * fr[2]) * iH;
+    v4d y = (v0 * fr[3] + v1 * fr[4] + v2 * fr[5]) * iH;
+    v4d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
     /* finite: t - t == 0 (NaN for an infinity or a NaN) */
-    v2l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero);
-    if (!q1) ok[1] = 0;
-    x = (v2d)((v2l)x & ok);
-    y = (v2d)((v2l)y & ok);
-    z = (v2d)((v2l)z & ok);
-    v2d w = (v2d)((v2l)one & ok), xp[7], yp[7];
+    v4l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero) & live;
+    x = (v4d)((v4l)x & ok);
+    y = (v4d)((v4l)y & ok);
+    z = (v4d)((v4l)z & ok);
+    v4d w = (v4d)((v4l)one & ok), xp[7], yp[7];
     xp[0] = w;
     yp[0] = one;
     for (int e = 1; e <= top; e++) {
@@ -257,33 +363,68 @@ static inline void acc_pair(acc2 *A, const double *q0, const double *q1, const d
         for (int j = 0; j <= t; j++) A->T[at++] += xp[t - j] * yp[j] * z;
     A->zz += w * z * z;
     A->m += w;
-    v2d r2 = x * x + y * y;
-    A->rmax2 = (v2d)(((v2l)r2 & (v2l)(r2 > A->rmax2)) | ((v2l)A->rmax2 & ~(v2l)(r2 > A->rmax2)));
-    if (rs) A->rsum += (v2d){sqrt(r2[0]), sqrt(r2[1])};
+    v4d r2 = x * x + y * y;
+    v4l gt = (v4l)(r2 > A->rmax2);
+    A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
+    if (rs)
+        for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+}
+
+/* The four neighbours from i (NULL past k). */
+static inline void quad_of(const double *nbr, size_t i, size_t k, const double *q[4])
+{
+    for (int l = 0; l < 4; l++) q[l] = i + (size_t)l < k ? nbr + 3 * (i + (size_t)l) : NULL;
 }
 
 /* The power sums of the first k neighbours in the frame fr (as step 1's,
  * x, y in units of H; up to degree 2 deg), their count and mean planar
  * distance (length units). */
-static void moments(const double p[3], const double *nbr, size_t k, const double fr[9], double H,
-                    int deg, mom *mo)
+JF_CLONES static void moments(const double p[3], const double *nbr, size_t k, const double fr[9],
+                              double H, int deg, mom *mo)
 {
     const double iH = 1.0 / H;
     const int top = 2 * deg, ntop = (top + 1) * (top + 2) / 2, nt = (deg + 1) * (deg + 2) / 2;
-    acc2 A;
+    acc4 A;
     memset(&A, 0, sizeof A);
-    size_t i = 0;
+    const double *q[4];
     if (deg == 2)
-        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, 4, 2, 1);
+        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
     else
-        for (; i + 1 < k; i += 2) acc_pair(&A, nbr + 3 * i, nbr + 3 * i + 3, p, fr, iH, top, deg, 1);
-    if (i < k) acc_pair(&A, nbr + 3 * i, NULL, p, fr, iH, top, deg, 1);
-    v2d *SA = A.S, *TA = A.T, ZA = A.zz, MA = A.m, RA = A.rsum;
-    for (int j = 0; j < ntop; j++) mo->S[j] = SA[j][0] + SA[j][1];
-    for (int j = 0; j < nt; j++) mo->T[j] = TA[j][0] + TA[j][1];
-    mo->zz = ZA[0] + ZA[1];
-    mo->m = (size_t)(MA[0] + MA[1]);
-    mo->hmean = mo->m ? (RA[0] + RA[1]) / (double)mo->m * H : 0.0;
+        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    for (int j = 0; j < ntop; j++) mo->S[j] = sum4(A.S[j]);
+    for (int j = 0; j < nt; j++) mo->T[j] = sum4(A.T[j]);
+    mo->zz = sum4(A.zz);
+    mo->m = (size_t)sum4(A.m);
+    mo->hmean = mo->m ? sum4(A.rsum) / (double)mo->m * H : 0.0;
+}
+
+/* Step 1's power sums (degree 6 and 3, in the frame fr) of the first ks[c]
+ * neighbours for every candidate c < nc into mo[c], and their radius
+ * (largest planar distance, length units) into hk[c].  Every candidate K
+ * but a short list's last (nmax) is a multiple of 4. */
+JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nmax, const double fr[9],
+                                 double H, const size_t *ks, int nc, mom *mo, double *hk)
+{
+    const double iH = 1.0 / H;
+    acc4 A;
+    memset(&A, 0, sizeof A);
+    const double *q[4];
+    int c = 0;
+    for (size_t i = 0; i < nmax && c < nc; i += 4) {
+        quad_of(nbr, i, nmax, q);
+        acc_quad(&A, q, p, fr, iH, 6, 3, 0);
+        if ((i + 4 < nmax ? i + 4 : nmax) < ks[c]) continue;
+        mom *mc = &mo[c];
+        mc->zz = sum4(A.zz);
+        for (int j = 0; j < NPOW; j++) mc->S[j] = sum4(A.S[j]);
+        for (int j = 0; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
+        mc->m = (size_t)sum4(A.m);
+        mc->hmean = 0.0; /* unused: the reported jet has its own sums */
+        v4d r = A.rmax2;
+        double a = r[0] > r[1] ? r[0] : r[1], b = r[2] > r[3] ? r[2] : r[3];
+        hk[c] = sqrt(a > b ? a : b) * H;
+        c++;
+    }
 }
 
 /* The chosen jet straight from its power sums (mo) in the frame fr: the
@@ -351,19 +492,15 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
             flags |= JF_PT_LOWERED_FEW;
             continue;
         }
-        double E[NMON * NMON], ev[NMON], wk[NMON];
+        double E[NMON * NMON], lo = 0.0, hi = 0.0;
         for (int i = 0; i < nd; i++)
             for (int j = 0; j < nd; j++)
                 E[i * nd + j] = L[i * NMON + j] =
                     mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
-        if (jf__sym_eigvals(E, (size_t)nd, ev, wk) != 0) {
+        /* the extremes only, as the jet's own (gram_eig.c) */
+        if (!jf__gram_extremes(E, (size_t)nd, &hi, &lo)) {
             flags |= JF_PT_LOWERED_RANK;
             continue;
-        }
-        double lo = ev[0], hi = ev[0];
-        for (int i = 1; i < nd; i++) {
-            if (ev[i] < lo) lo = ev[i];
-            if (ev[i] > hi) hi = ev[i];
         }
         cond = lo > 0.0 ? sqrt(hi / lo) : INFINITY;
         int okc = 1;
@@ -474,32 +611,23 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
 
     /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
-     * and x^i y^j z (i + j <= 3, with z'z), two neighbours at a time (SIMD
-     * lanes; every candidate K but a short list's last is even) */
-    acc2 A;
-    memset(&A, 0, sizeof A);
+     * and x^i y^j z (i + j <= 3, with z'z), four neighbours at a time */
     cand_fit cf[2][NCAND];
     memset(cf, 0, sizeof cf);
     mom mo[NCAND];
-    int c = 0;
-    for (size_t i = 0; i < nmax && c < nc; i += 2) {
-        acc_pair(&A, nbr + 3 * i, i + 1 < nmax ? nbr + 3 * i + 3 : NULL, p, fr, iH, 6, 3, 0);
-        if (i + 2 < ks[c]) continue;
-        mom *mc = &mo[c];
-        double *S = mc->S, *T = mc->T;
-        mc->zz = A.zz[0] + A.zz[1];
-        for (int j = 0; j < NPOW; j++) S[j] = A.S[j][0] + A.S[j][1];
-        for (int j = 0; j < NMON; j++) T[j] = A.T[j][0] + A.T[j][1];
-        mc->m = (size_t)(A.m[0] + A.m[1]);
-        mc->hmean = 0.0; /* unused: the reported jet has its own sums */
-        double hK = sqrt(A.rmax2[0] > A.rmax2[1] ? A.rmax2[0] : A.rmax2[1]) * H;
-        if (hK > 0.0) {
-            cand_fit two[2] = {{0}, {0}};
-            solve_k(S, T, mc->zz, mc->m, H, hK, fr, two);
-            cf[0][c] = two[0];
-            cf[1][c] = two[1];
-        }
-        c++;
+    double hks[NCAND];
+    first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
+    for (int c = 0; c < nc; c++) {
+        cand_fit two[2] = {{0}, {0}}, nxt[2] = {{0}, {0}};
+        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) { /* two at once */
+            solve_k2(&mo[c], &mo[c + 1], H, hks[c], hks[c + 1], fr, two, nxt);
+            cf[0][c + 1] = nxt[0];
+            cf[1][c + 1] = nxt[1];
+        } else if (hks[c] > 0.0)
+            solve_k(mo[c].S, mo[c].T, mo[c].zz, mo[c].m, H, hks[c], fr, two);
+        cf[0][c] = two[0];
+        cf[1][c] = two[1];
+        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) c++;
     }
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
@@ -553,7 +681,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     }
     /* step 3: Lepski per degree */
     double tau = kn->auto_tau;
-    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax), c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax);
+    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax, kn->auto_nest),
+        c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax, kn->auto_nest);
     /* step 4: the degree */
     int d = 3, ci = c3;
     if (c3 < 0) {

@@ -61,11 +61,13 @@
  * radius is a blob of noise whose cubic follows the noise (the noise is
  * then read at a larger K); a normal whose sd exceeds auto_sdmax (rad) is
  * noise and stops no K; noise below auto_clean x the radius allows cubics
- * on 16-24 points; auto_gl 1 = Goldenshluger-Lepski over every (K, degree)
- * (worse: docs/robustness.md "Neighbourhood auto"). */
+ * on 16-24 points; auto_gl 1 = Goldenshluger-Lepski over every (K, degree);
+ * auto_nest T > 0: Lepski against T sqrt(sd_j^2 - sd_K^2), the sd of the
+ * difference of nested least-squares normals (both worse on PCPNet:
+ * docs/robustness.md "Neighbourhood auto"). */
 const jf__knobs jf__knob_defaults = {
     JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
-    2.0, 0.2, 0.3, 0.05, 1.0, 0};
+    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -126,6 +128,7 @@ int jf__robust_tune(jf_fitter *f, const char *name, double v)
     else if (!strcmp(name, "auto_varw")) k->auto_varw = v;
     else if (!strcmp(name, "auto_clean")) k->auto_clean = v;
     else if (!strcmp(name, "auto_gl")) k->auto_gl = (int)v;
+    else if (!strcmp(name, "auto_nest")) k->auto_nest = v;
     else return -1;
     return 0;
 }

@@ -26,6 +26,7 @@ typedef struct {
                               sqrt(degree_floor_n / n) above this n */
     double auto_tau, auto_blob, auto_sdmax, auto_clean, auto_varw; /* auto.c */
     int auto_gl;
+    double auto_nest; /* auto.c: > 0: Lepski on nested variances (dropped) */
 } jf__knobs;
 extern const jf__knobs jf__knob_defaults;
 

@@ -28,6 +28,18 @@ size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t *
 jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, double bound,
                           uint32_t *idx, double *d2, double *xyz, size_t *found);
 
+/* knn_share.c: jf__index_query's k nearest (bound INFINITY) of a run of
+ * nearby query points from one search per few points (neighbors auto).
+ * The same lists, bit for bit; a jf__knn_share is one thread's. */
+typedef struct jf__knn_share jf__knn_share;
+jf_status jf__knn_share_create(size_t k, jf__knn_share **out);
+void jf__knn_share_free(jf__knn_share *s);
+/* The walk's next n points, xyz[0..2] the next query's (a hint for where
+ * to search: any hint gives the same lists). */
+void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n);
+jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
+                              uint32_t *idx, double *d2, double *xyz, size_t *found);
+
 /* n given to the build (jf_index_size counts the finite ones only). */
 size_t jf__index_input_size(const jf_index *ix);
 

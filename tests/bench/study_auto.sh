@@ -72,8 +72,8 @@ fi
 
 echo
 echo "## jetfit generate, $N points: auto vs the plain jet on k+1 points"
-echo "| surface | noise | auto normal | best k | best normal | auto dk1 | best k | best dk1 | auto dk2 | best k | best dk2 |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| surface | noise | auto normal | best k | best normal | auto dk1 | best k | best dk1 | auto dk2 | best k | best dk2 | auto / best: normal, dk1, dk2 |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for S in ellipsoid torus exp; do
     DEN=""
     [ "$S" = torus ] && DEN="--density gradient"
@@ -97,7 +97,7 @@ for S in ellipsoid torus exp; do
                 if ($(i+2) < bk1) { bk1 = $(i+2); kk1 = $i }
                 if ($(i+3) < bk2) { bk2 = $(i+3); kk2 = $i }
             }
-            printf "| %s | %s | %.3f | %d | %.3f | %.4g | %d | %.4g | %.4g | %d | %.4g |\n",
-                $1, $2, $3, kn, bn, $4, kk1, bk1, $5, kk2, bk2 }'
+            printf "| %s | %s | %.3f | %d | %.3f | %.4g | %d | %.4g | %.4g | %d | %.4g | %.3f, %.3f, %.3f |\n",
+                $1, $2, $3, kn, bn, $4, kk1, bk1, $5, kk2, bk2, $3 / bn, $4 / bk1, $5 / bk2 }'
     done
 done

@@ -1,0 +1,256 @@
+/* knn_share.c -- the k nearest of consecutive, nearby query points from
+ * one k-d tree search (neighbors auto's 256 nearest: docs/robustness.md).
+ *
+ * design:
+ *  1. At a query point c, one search for its KSHARE x k nearest (the
+ *     candidates), with rk = |c - k-th| and R = |c - last candidate|:
+ *     every point nearer c than R is a candidate.
+ *  2. A later query q, delta = |q - c|: c's k nearest lie within
+ *     rk + delta of q, so q's k nearest are among the candidates within
+ *     that of q (a prefix of them: within rk + 2 delta of c).  Sorted by
+ *     (squared distance, input index), the tree's order with its own d2
+ *     arithmetic, the first k give t = |q - k-th|; every point within t
+ *     of q is within t + delta of c, so if t + delta < R they are q's k
+ *     nearest -- the same list, bit for bit, as jf__index_query,
+ *     whichever point built the candidates (threads, parts and ranks
+ *     still agree).  A bucket sort by d2 (as the tree's buf_finish).
+ *  3. Otherwise q becomes the new c.
+ * Rounding: the test keeps a relative margin of 1e-9 (distances carry
+ * errors near 1e-16), and a selection that finds fewer than k inside
+ * the bound falls back to the search.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "index_internal.h"
+
+#define SH_AHEAD 16 /* walk points looked at for a search's centre */
+#define KSHARE 2 /* candidates: KSHARE x k (2k: the tree's fast buffer mode) */
+
+struct jf__knn_share {
+    size_t k, kc;  /* asked, candidates searched                       */
+    size_t nc;     /* candidates held (0: none yet)                     */
+    double c[3];   /* the point they were searched from                 */
+    double rk, R;  /* |c - k-th|, |c - last| (INFINITY: the whole cloud) */
+    uint32_t *cid; /* input indices, coordinates of the candidates      */
+    double *cxyz;
+    double *cx, *cy, *cz; /* the same coordinates by axis (the d2 loop)    */
+    double *cd2;   /* their squared distances to c, ascending           */
+    double *d2;    /* per query: candidates' d2                          */
+    uint32_t *sel, *start, *bkt;
+    double *td;
+    uint32_t *tp;
+    const double *ahead; /* the walk's next points (ahead[0..2]: this one) */
+    size_t nahead;
+    double rk_last;      /* rk of the last search (0: none yet)          */
+    double t_last;       /* the last query's k-th distance               */
+};
+
+void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n)
+{
+    s->ahead = xyz;
+    s->nahead = n;
+}
+
+void jf__knn_share_free(jf__knn_share *s)
+{
+    if (!s) return;
+    free(s->cid);
+    free(s->cxyz);
+    free(s->cx);
+    free(s->d2);
+    free(s->cd2);
+    free(s->sel);
+    free(s->bkt);
+    free(s->start);
+    free(s->td);
+    free(s->tp);
+    free(s);
+}
+
+jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
+{
+    *out = NULL;
+    if (!k) return JF_ERR_INVALID;
+    jf__knn_share *s = calloc(1, sizeof *s);
+    if (!s) return JF_ERR_NOMEM;
+    s->k = k;
+    s->kc = KSHARE * k;
+    s->cid = malloc(s->kc * sizeof *s->cid);
+    s->cxyz = malloc(3 * s->kc * sizeof *s->cxyz);
+    s->cx = malloc(3 * s->kc * sizeof *s->cx);
+    s->d2 = malloc(s->kc * sizeof *s->d2);
+    s->cd2 = malloc(s->kc * sizeof *s->cd2);
+    s->sel = malloc(s->kc * sizeof *s->sel);
+    s->bkt = malloc(s->kc * sizeof *s->bkt);
+    s->start = malloc((s->kc + 1) * sizeof *s->start);
+    s->td = malloc(s->kc * sizeof *s->td);
+    s->tp = malloc(s->kc * sizeof *s->tp);
+    if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
+        jf__knn_share_free(s);
+        return JF_ERR_NOMEM;
+    }
+    *out = s;
+    return JF_OK;
+}
+
+/* (d, id) < (da, ida): the tree's order */
+#define SH_LESS(d, i, da, ia) ((d) < (da) || ((d) == (da) && (i) < (ia)))
+
+/* Step 1 at q: the candidates, and q's own k nearest as their prefix. */
+static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3], uint32_t *idx,
+                         double *d2, double *xyz, size_t *found)
+{
+    size_t f = 0;
+    s->nc = 0;
+    jf_status st = jf__index_query(ix, q, s->kc, INFINITY, s->cid, s->cd2, s->cxyz, &f);
+    if (st != JF_OK) return st;
+    size_t m = f < s->k ? f : s->k;
+    memcpy(idx, s->cid, m * sizeof *idx);
+    if (d2) memcpy(d2, s->cd2, m * sizeof *d2);
+    if (xyz) memcpy(xyz, s->cxyz, 3 * m * sizeof *xyz);
+    *found = m;
+    if (f <= s->k) return JF_OK; /* the whole cloud: nothing to share */
+    memcpy(s->c, q, sizeof s->c);
+    s->rk = s->rk_last = s->t_last = sqrt(s->cd2[s->k - 1]);
+    s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
+    s->cy = s->cx + s->kc;
+    s->cz = s->cy + s->kc;
+    for (size_t j = 0; j < f; j++) {
+        s->cx[j] = s->cxyz[3 * j];
+        s->cy[j] = s->cxyz[3 * j + 1];
+        s->cz[j] = s->cxyz[3 * j + 2];
+    }
+    s->nc = f;
+    return JF_OK;
+}
+
+/* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
+static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *d2, double *xyz,
+                    size_t *found)
+{
+    if (!s->nc) return 0;
+    double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
+    const double delta = sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+    /* q's k-th nearest is within rk + delta (c's k nearest are), so its k
+     * nearest are the candidates within that of q, and among those no
+     * farther than rk + 2 delta from c: a prefix of the candidates */
+    if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return 0;
+    const double bmax = (s->rk + delta) * (1.0 + 1e-9);
+    /* first a tighter b from the last query's k-th distance (+5%): if k
+     * candidates lie within it, q's k nearest do too (fewer to sort) */
+    double b = s->t_last * 1.05 < bmax ? s->t_last * 1.05 : bmax;
+again:;
+    const double b2 = b * b, lc = (b + delta) * (1.0 + 1e-9), lc2 = lc * lc;
+    size_t lim = 0, hi = s->nc;
+    while (lim < hi) {
+        size_t mid = lim + (hi - lim) / 2;
+        if (s->cd2[mid] <= lc2) lim = mid + 1;
+        else hi = mid;
+    }
+    const double q0 = q[0], q1 = q[1], q2 = q[2];
+    double *dd = s->td; /* scratch until the sort */
+    const double *cx = s->cx, *cy = s->cy, *cz = s->cz;
+    for (size_t j = 0; j < lim; j++) {
+        double dx = q0 - cx[j], dy = q1 - cy[j], dz = q2 - cz[j];
+        dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
+    }
+    size_t n = 0;
+    for (size_t j = 0; j < lim; j++) {
+        s->d2[n] = dd[j];
+        s->sel[n] = (uint32_t)j;
+        n += dd[j] <= b2;
+    }
+    if (n < s->k && b < bmax) {
+        b = bmax;
+        goto again;
+    }
+    if (n < s->k || !(b2 > 0.0)) return 0;
+    /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
+     * the first k into td, tp (locals: the stores below alias nothing) */
+    uint32_t *start = s->start, *tp = s->tp, *bkt = s->bkt;
+    double *td = s->td;
+    const double *sd = s->d2;
+    const uint32_t *sel = s->sel, *cid = s->cid;
+    const double scale = (double)n / b2;
+    if (!isfinite(scale)) return 0; /* b2 subnormal: the buckets would overflow */
+    memset(start, 0, (n + 1) * sizeof *start);
+    for (size_t j = 0; j < n; j++) {
+        size_t bk = (size_t)(sd[j] * scale);
+        bkt[j] = (uint32_t)(bk < n ? bk : n - 1);
+        start[bkt[j] + 1]++;
+    }
+    for (size_t bk = 0; bk < n; bk++) start[bk + 1] += start[bk];
+    for (size_t j = 0; j < n; j++) {
+        uint32_t at = start[bkt[j]]++;
+        td[at] = sd[j];
+        tp[at] = sel[j];
+    }
+    const size_t k = s->k;
+    size_t lo = 0;
+    for (size_t bk = 0; bk < n && lo < k; bk++) {
+        size_t end = start[bk];
+        for (size_t i = lo + 1; i < end; i++) { /* insertion sort of the bucket */
+            double d = td[i];
+            uint32_t p = tp[i], pid = cid[p];
+            size_t j = i;
+            while (j > lo && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]])) {
+                td[j] = td[j - 1];
+                tp[j] = tp[j - 1];
+                j--;
+            }
+            td[j] = d;
+            tp[j] = p;
+        }
+        lo = end;
+    }
+    /* every point within t = |q - k-th| of q is within t + delta of c:
+     * a candidate if that is below R (else a point beyond the candidates
+     * may be nearer q) */
+    if (!((sqrt(td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
+        return 0;
+    const double *cxyz = s->cxyz;
+    for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
+    if (d2) memcpy(d2, td, k * sizeof *d2);
+    if (xyz)
+        for (size_t i = 0; i < k; i++) {
+            const double *a = cxyz + 3 * (size_t)tp[i];
+            double *o = xyz + 3 * i;
+            o[0] = a[0], o[1] = a[1], o[2] = a[2];
+        }
+    s->t_last = sqrt(s->td[k - 1]);
+    *found = k;
+    return 1;
+}
+
+jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
+                              uint32_t *idx, double *d2, double *xyz, size_t *found)
+{
+    *found = 0;
+    if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+    /* step 3, from the centroid of the walk's next points near q (within
+     * half the last rk: the walk goes leaf by leaf, so a search there
+     * serves the whole leaf); q itself when there are none */
+    double c[3] = {q[0], q[1], q[2]};
+    size_t nc = 1;
+    if (s->ahead && s->rk_last > 0.0 && s->ahead[0] == q[0] && s->ahead[1] == q[1] &&
+        s->ahead[2] == q[2]) {
+        const double lim = s->rk_last / 2.0, lim2 = lim * lim;
+        for (size_t j = 1; j < s->nahead && j < SH_AHEAD; j++) {
+            const double *a = s->ahead + 3 * j;
+            double e0 = a[0] - q[0], e1 = a[1] - q[1], e2 = a[2] - q[2];
+            if (!(e0 * e0 + e1 * e1 + e2 * e2 <= lim2)) continue;
+            c[0] += a[0], c[1] += a[1], c[2] += a[2];
+            nc++;
+        }
+        for (int d = 0; d < 3; d++) c[d] /= (double)nc;
+    }
+    if (nc > 1) {
+        size_t f = 0;
+        jf_status st = rebuild(s, ix, c, idx, d2, xyz, &f);
+        if (st != JF_OK) return st;
+        if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+    }
+    return rebuild(s, ix, q, idx, d2, xyz, found);
+}
