@@ -66,6 +66,11 @@ jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **L
 const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n,
                                   unsigned *rec_len);
 jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err);
+/* Every record of L decoded into rec (n * rec_len bytes), the chunks in
+ * parallel (the bytes do not depend on the thread count); the plain LAS
+ * file's EVLRs (*len bytes, in the caller's image; 0 if none). */
+jf_status jf__laz_decode(jf_laz *L, unsigned char *rec, jf_error *err);
+const unsigned char *jf__laz_evlr(const jf_laz *L, size_t *len);
 void jf__laz_close(jf_laz *L);
 /* jf__laz_open of a malloc'ed image that L then owns (freed by
  * jf__laz_close; on failure at once). */
