@@ -49,6 +49,9 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
+/* io_bigalloc.c: malloc of a large buffer about to be written whole,
+ * asked (on Linux) to be backed by huge pages; free() frees it. */
+void *jf__big_alloc(size_t bytes);
 /* io_laz.c: a LAZ file image decoded into the plain LAS file it stands
  * for (*img, *img_len: malloc'd, the caller frees; the laszip VLR dropped,
  * the compression bits cleared).  err "NAME: reason" naming the chunk. */

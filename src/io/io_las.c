@@ -23,9 +23,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 #include "io_internal.h"
 
@@ -346,19 +343,6 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
     return JF_OK;
 }
 
-/* A large buffer about to be written whole: on Linux, asked to be backed
- * by huge pages (one fault a 2 MiB page instead of 512; a hint only). */
-static void *big_alloc(size_t bytes)
-{
-    void *p = malloc(bytes);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    uintptr_t a = ((uintptr_t)p + 4095) & ~(uintptr_t)4095, e = ((uintptr_t)p + bytes) & ~(uintptr_t)4095;
-    if (p && bytes >= (4u << 20) && e > a)
-        madvise((void *)a, e - a, MADV_HUGEPAGE);
-#endif
-    return p;
-}
-
 /* The cloud from a LAS file's parts: b its header and VLRs (h->data_off
  * bytes), rec its h->n records, ev its EVLRs (ev_len bytes).  own: rec
  * is malloc'ed and becomes the attribute table (LAZ: decoded there, no
@@ -375,7 +359,7 @@ static jf_status las_fill(const unsigned char *b, const las_hdr *h, const unsign
     jf_attrs *at = &c->attrs;
     if (own && !o->no_attrs) /* freed with the cloud from here on */
         at->rec = own, at->stride = rec_len;
-    c->xyz = big_alloc((size_t)n * 3 * sizeof(double));
+    c->xyz = jf__big_alloc((size_t)n * 3 * sizeof(double));
     if (!c->xyz) {
         if (own && o->no_attrs)
             free(own);
@@ -438,7 +422,7 @@ static jf_status laz_read(const char *buf, size_t len, const char *name, const j
     unsigned rec_len;
     const unsigned char *head = jf__laz_head(L, &head_len, &n, &rec_len);
     const unsigned char *ev = jf__laz_evlr(L, &ev_len);
-    unsigned char *rec = big_alloc((size_t)n * rec_len);
+    unsigned char *rec = jf__big_alloc((size_t)n * rec_len);
     las_hdr h;
     if (!rec)
         st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
