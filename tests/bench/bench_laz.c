@@ -181,9 +181,10 @@ static int write_las(const char *laz, const char *las)
 }
 
 /* argv run as a child process (each figure in its own process, so that
- * its peak resident set is its own); its first line of output in out,
- * its peak RSS in MB; 0 when it failed. */
-static int run(char *const argv[], char *out, size_t outlen, double *rss_mb)
+ * its peak resident set is its own); its output in out, its peak RSS in
+ * MB; 0 when it failed.  quiet: its stderr dropped (node without
+ * laz-perf is a note, not an error). */
+static int run(char *const argv[], char *out, size_t outlen, double *rss_mb, int quiet)
 {
     int fd[2];
     if (pipe(fd))
@@ -192,6 +193,8 @@ static int run(char *const argv[], char *out, size_t outlen, double *rss_mb)
     if (pid == 0) {
         dup2(fd[1], 1);
         close(fd[0]), close(fd[1]);
+        if (quiet && !freopen("/dev/null", "w", stderr))
+            _exit(127);
         execvp(argv[0], argv);
         _exit(127);
     }
@@ -218,7 +221,7 @@ static int measure(const char *self, const char *file, int threads, int reps, do
     char th[16], rp[16], out[256];
     snprintf(th, sizeof th, "%d", threads), snprintf(rp, sizeof rp, "%d", reps);
     char *const argv[] = {(char *)self, "--read", (char *)file, th, rp, NULL};
-    return run(argv, out, sizeof out, rss) && sscanf(out, "%lf %lf %zu", t, c, n) == 3;
+    return run(argv, out, sizeof out, rss, 0) && sscanf(out, "%lf %lf %zu", t, c, n) == 3;
 }
 
 int main(int argc, char **argv)
@@ -261,7 +264,7 @@ int main(int argc, char **argv)
     close(fd);
     char *const wr[] = {self, "--las", (char *)laz, las, NULL};
     if (!measure(self, laz, 1, reps, &t1, &c1, &n, &r1) ||
-        !measure(self, laz, all, reps, &tn, &cn, &n, &rn) || !run(wr, out, sizeof out, &rs) ||
+        !measure(self, laz, all, reps, &tn, &cn, &n, &rn) || !run(wr, out, sizeof out, &rs, 0) ||
         !measure(self, las, all, reps, &tl, &cl, &n2, &rl)) {
         fprintf(stderr, "bench_laz: a read failed\n");
         unlink(las);
@@ -281,7 +284,7 @@ int main(int argc, char **argv)
     char *const node[] = {"node", script, (char *)modules, (char *)laz, rp, NULL};
     double tp = 0, cp = 0, rp_mb = 0;
     size_t np = 0;
-    if (run(node, out, sizeof out, &rp_mb) &&
+    if (run(node, out, sizeof out, &rp_mb, 1) &&
         sscanf(out, "lazperf %lf %lf %zu", &tp, &cp, &np) == 3 && np == n)
         printf("| LAZ (laz-perf %s, WASM under node, decode loop only) | 1 | %.4f | %.4f | "
                "%.3g | %.0f |\n", "0.0.7", tp, cp, n / tp, rp_mb);
