@@ -57,6 +57,9 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
+/* io_bigalloc.c: malloc of a large buffer about to be written whole,
+ * asked (on Linux) to be backed by huge pages; free() frees it. */
+void *jf__big_alloc(size_t bytes);
 /* io_laz.c: a LAZ file image decoded into the plain LAS file it stands
  * for (*img, *img_len: malloc'd, the caller frees; the laszip VLR dropped,
  * the compression bits cleared).  err "NAME: reason" naming the chunk. */
@@ -74,6 +77,11 @@ jf_status jf__laz_open(const char *buf, size_t len, const char *name, jf_laz **L
 const unsigned char *jf__laz_head(const jf_laz *L, size_t *head_len, uint64_t *n,
                                   unsigned *rec_len);
 jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_error *err);
+/* Every record of L decoded into rec (n * rec_len bytes), the chunks in
+ * parallel (the bytes do not depend on the thread count); the plain LAS
+ * file's EVLRs (*len bytes, in the caller's image; 0 if none). */
+jf_status jf__laz_decode(jf_laz *L, unsigned char *rec, jf_error *err);
+const unsigned char *jf__laz_evlr(const jf_laz *L, size_t *len);
 void jf__laz_close(jf_laz *L);
 /* jf__laz_open of a malloc'ed image that L then owns (freed by
  * jf__laz_close; on failure at once). */

@@ -225,7 +225,7 @@ static void las_normal_rows(const unsigned char *r, size_t k, size_t rec_len, co
 /* Into c->nrm when the records carry normals, so that orient input works
  * on them.  0 on a failed allocation. */
 static int las_normals(jf_cloud *c, const unsigned char *b, size_t hsize, size_t data_off,
-                       uint32_t nvlr, unsigned base, unsigned rec_len)
+                       uint32_t nvlr, unsigned base, unsigned rec_len, const unsigned char *rec)
 {
     size_t at[3];
     int dts[3];
@@ -233,7 +233,7 @@ static int las_normals(jf_cloud *c, const unsigned char *b, size_t hsize, size_t
         return 1;
     if (!(c->nrm = malloc(c->n * 3 * sizeof(double))))
         return 0;
-    las_normal_rows(b + data_off, c->n, rec_len, at, dts, c->nrm);
+    las_normal_rows(rec, c->n, rec_len, at, dts, c->nrm);
     return 1;
 }
 
@@ -343,72 +343,122 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
     return JF_OK;
 }
 
-jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_read_opts *o,
-                      jf_cloud *c, jf_error *err)
+/* The cloud from a LAS file's parts: b its header and VLRs (h->data_off
+ * bytes), rec its h->n records, ev its EVLRs (ev_len bytes).  own: rec
+ * is malloc'ed and becomes the attribute table (LAZ: decoded there, no
+ * copy), else it is copied.  x y z are made in parallel (a whole file's
+ * records are read once, as fast as memory allows). */
+static jf_status las_fill(const unsigned char *b, const las_hdr *h, const unsigned char *rec,
+                          unsigned char *own, const unsigned char *ev, size_t ev_len,
+                          const char *name, const jf_read_opts *o, jf_cloud *c, jf_error *err)
 {
-    const unsigned char *b = (const unsigned char *)buf;
-    if (len >= 227 && !memcmp(b, "LASF", 4) && (b[104] & 0xc0)) {
-        /* LAZ: decoded to the plain LAS file it stands for (io_laz.c) */
-        char *img;
-        size_t img_len;
-        jf_status zs = jf__laz_unpack(buf, len, name, &img, &img_len, err);
-        if (zs == JF_OK) {
-            zs = jf_read_las(img, img_len, name, o, c, err);
-            free(img);
-        }
-        return zs;
-    }
-    las_hdr h;
-    jf_status st = las_header(b, len, len, name, &h, err);
-    if (st != JF_OK)
-        return st;
-    const unsigned minor = h.minor, hsize = h.hsize, fmt = h.fmt, rec_len = h.rec_len;
-    const uint32_t data_off = h.data_off;
-    const uint64_t n = h.n;
-    const double *scale = h.scale, *off = h.offset;
-    c->xyz = malloc((size_t)n * 3 * sizeof(double));
-    if (!c->xyz)
+    const unsigned fmt = h->fmt, rec_len = h->rec_len;
+    const uint32_t data_off = h->data_off;
+    const uint64_t n = h->n;
+    const double *scale = h->scale, *off = h->offset;
+    jf_attrs *at = &c->attrs;
+    if (own && !o->no_attrs) /* freed with the cloud from here on */
+        at->rec = own, at->stride = rec_len;
+    c->xyz = jf__big_alloc((size_t)n * 3 * sizeof(double));
+    if (!c->xyz) {
+        if (own && o->no_attrs)
+            free(own);
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
                           (unsigned long long)n);
+    }
     c->n = (size_t)n;
-    const unsigned char *r = b + data_off;
-    for (size_t i = 0; i < c->n; i++, r += rec_len)
+    double *xyz = c->xyz;
+    const long long np = (long long)n;
+#pragma omp parallel for schedule(static) if (np > 100000)
+    for (long long i = 0; i < np; i++) {
+        const unsigned char *r = rec + (size_t)i * rec_len;
         for (int a = 0; a < 3; a++)
-            c->xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
-    if (!las_normals(c, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+            xyz[3 * i + a] = (double)i32(r + 4 * a) * scale[a] + off[a];
+    }
+    int nrm_ok = las_normals(c, b, h->hsize, data_off, u32(b + 100), base_len[fmt], rec_len, rec);
+    if (own && o->no_attrs)
+        free(own);
+    if (!nrm_ok)
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu normals", c->n);
     /* the header and VLRs, even without attributes: a LAS output keeps
      * the CRS (a CRS is not an attribute; docs/formats.md) */
-    jf_attrs *at = &c->attrs;
     if (!(at->las_head = malloc(data_off)))
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the header");
     memcpy(at->las_head, b, data_off);
     at->las_head_len = data_off;
     if (o->no_attrs)
         return JF_OK;
-    /* the records whole, the EVLRs (1.4: the count and start in the
-     * header; 1.3: the waveform data record) */
-    at->stride = rec_len;
-    at->rec = malloc(c->n * rec_len);
-    if (!at->rec)
-        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
-    memcpy(at->rec, b + data_off, c->n * rec_len);
-    size_t end = data_off + c->n * rec_len;
-    uint64_t evlr = 0;
-    if (minor >= 4 && u32(b + 243))
-        evlr = u64(b + 235);
-    else if (minor == 3 && (u16(b + 6) & 2) && hsize >= 235)
-        evlr = u64(b + 227); /* internal waveform data */
-    if (evlr >= end && evlr < len) {
-        at->las_evlr_len = len - (size_t)evlr;
+    /* the records whole, the EVLRs */
+    if (!own) {
+        at->stride = rec_len;
+        at->rec = malloc(c->n * rec_len);
+        if (!at->rec)
+            return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu records", c->n);
+        memcpy(at->rec, rec, c->n * rec_len);
+    }
+    if (ev_len) {
+        at->las_evlr_len = ev_len;
         if (!(at->las_evlr = malloc(at->las_evlr_len)))
             return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the EVLRs");
-        memcpy(at->las_evlr, b + evlr, at->las_evlr_len);
+        memcpy(at->las_evlr, ev, at->las_evlr_len);
     }
     if (!add_dims(at, fmt) ||
-        !add_extra_bytes(at, b, hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+        !add_extra_bytes(at, b, h->hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
     return JF_OK;
+}
+
+/* LAZ: decoded (io_laz.c) straight into the attribute table; the header
+ * the plain LAS file it stands for would have, checked as a LAS one. */
+static jf_status laz_read(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                          jf_cloud *c, jf_error *err)
+{
+    jf_laz *L;
+    jf_status st = jf__laz_open(buf, len, name, &L, err);
+    if (st != JF_OK)
+        return st;
+    size_t head_len, ev_len;
+    uint64_t n;
+    unsigned rec_len;
+    const unsigned char *head = jf__laz_head(L, &head_len, &n, &rec_len);
+    const unsigned char *ev = jf__laz_evlr(L, &ev_len);
+    unsigned char *rec = jf__big_alloc((size_t)n * rec_len);
+    las_hdr h;
+    if (!rec)
+        st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
+                        (unsigned long long)n);
+    else if ((st = jf__laz_decode(L, rec, err)) == JF_OK &&
+             (st = las_header(head, head_len, head_len + (uint64_t)n * rec_len + ev_len, name,
+                              &h, err)) == JF_OK) {
+        st = las_fill(head, &h, rec, rec, ev, ev_len, name, o, c, err);
+        rec = NULL; /* las_fill's */
+    }
+    free(rec);
+    jf__laz_close(L);
+    return st;
+}
+
+jf_status jf_read_las(const char *buf, size_t len, const char *name, const jf_read_opts *o,
+                      jf_cloud *c, jf_error *err)
+{
+    const unsigned char *b = (const unsigned char *)buf;
+    if (len >= 227 && !memcmp(b, "LASF", 4) && (b[104] & 0xc0))
+        return laz_read(buf, len, name, o, c, err);
+    las_hdr h;
+    jf_status st = las_header(b, len, len, name, &h, err);
+    if (st != JF_OK)
+        return st;
+    /* the EVLRs (1.4: the count and start in the header; 1.3: the
+     * waveform data record) */
+    size_t end = h.data_off + (size_t)h.n * h.rec_len;
+    uint64_t evlr = 0;
+    if (h.minor >= 4 && u32(b + 243))
+        evlr = u64(b + 235);
+    else if (h.minor == 3 && (u16(b + 6) & 2) && h.hsize >= 235)
+        evlr = u64(b + 227); /* internal waveform data */
+    size_t ev_len = evlr >= end && evlr < len ? len - (size_t)evlr : 0;
+    return las_fill(b, &h, b + h.data_off, NULL, b + (ev_len ? evlr : 0), ev_len, name, o, c,
+                    err);
 }
 
 /* ---- point rows for readers of a byte range (io_internal.h) ----------- */

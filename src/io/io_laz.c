@@ -605,6 +605,38 @@ jf_status jf__laz_rows(jf_laz *L, uint64_t first, size_t count, char *out, jf_er
     return JF_OK;
 }
 
+const unsigned char *jf__laz_evlr(const jf_laz *L, size_t *len)
+{
+    *len = L->evlr ? L->len - (size_t)L->evlr : 0;
+    return L->b + (*len ? L->evlr : 0);
+}
+
+jf_status jf__laz_decode(jf_laz *L, unsigned char *rec, jf_error *err)
+{
+    /* the chunks, in parallel: each writes only its own records; every
+     * chunk is decoded even after a failure, so the error names the first
+     * bad chunk whatever the thread count */
+    int failed = 0;
+    size_t bad_chunk = L->nc, nc = L->nc, rec_len = L->z.rec_len;
+    char bad_msg[160] = "";
+#pragma omp parallel for schedule(dynamic, 1)
+    for (size_t i = 0; i < nc; i++) {
+        char msg[160];
+        if (decode_chunk(L, i, rec + L->ch[i].first * rec_len, msg, sizeof msg)) {
+#pragma omp critical(jf_laz_fail)
+            if (i < bad_chunk) {
+                bad_chunk = i;
+                memcpy(bad_msg, msg, sizeof msg);
+                failed = 1;
+            }
+        }
+    }
+    if (failed)
+        return jf_io_fail(err, JF_ERR_FORMAT, L->name, 0, "chunk %zu (at byte %llu): %s",
+                          bad_chunk, (unsigned long long)L->ch[bad_chunk].start, bad_msg);
+    return JF_OK;
+}
+
 jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **img,
                          size_t *img_len, jf_error *err)
 {
@@ -613,8 +645,8 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
     jf_status st = jf__laz_open(buf, len, name, &L, err);
     if (st != JF_OK)
         return st;
-    size_t head = L->head_len, rec_len = L->z.rec_len, recs = (size_t)L->n * rec_len;
-    size_t tail = L->evlr ? len - (size_t)L->evlr : 0;
+    size_t head = L->head_len, rec_len = L->z.rec_len, recs = (size_t)L->n * rec_len, tail;
+    const unsigned char *ev = jf__laz_evlr(L, &tail);
     unsigned char *o = head + recs + tail >= recs ? malloc(head + recs + tail) : NULL;
     if (!o) {
         st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %llu points",
@@ -624,33 +656,13 @@ jf_status jf__laz_unpack(const char *buf, size_t len, const char *name, char **i
     }
     memcpy(o, L->head, head);
     if (tail)
-        memcpy(o + head + recs, L->b + L->evlr, tail);
-    /* the chunks, in parallel: each writes only its own records; every
-     * chunk is decoded even after a failure, so the error names the first
-     * bad chunk whatever the thread count */
-    int failed = 0;
-    size_t bad_chunk = L->nc, nc = L->nc;
-    char bad_msg[160] = "";
-#pragma omp parallel for schedule(dynamic, 1)
-    for (size_t i = 0; i < nc; i++) {
-        char msg[160];
-        if (decode_chunk(L, i, o + head + L->ch[i].first * rec_len, msg, sizeof msg)) {
-#pragma omp critical(jf_laz_fail)
-            if (i < bad_chunk) {
-                bad_chunk = i;
-                memcpy(bad_msg, msg, sizeof msg);
-                failed = 1;
-            }
-        }
-    }
-    if (failed) {
-        st = jf_io_fail(err, JF_ERR_FORMAT, name, 0, "chunk %zu (at byte %llu): %s", bad_chunk,
-                        (unsigned long long)L->ch[bad_chunk].start, bad_msg);
-        jf__laz_close(L);
+        memcpy(o + head + recs, ev, tail);
+    st = jf__laz_decode(L, o + head, err);
+    jf__laz_close(L);
+    if (st != JF_OK) {
         free(o);
         return st;
     }
-    jf__laz_close(L);
     *img = (char *)o;
     *img_len = head + recs + tail;
     return JF_OK;

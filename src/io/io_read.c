@@ -442,7 +442,7 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
             return cs;
         }
     }
-    char *buf = malloc(len);
+    char *buf = jf__big_alloc(len);
     if (!buf) {
         close(fd);
         return jf_io_fail(err, JF_ERR_NOMEM, path, 0,

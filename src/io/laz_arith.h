@@ -101,6 +101,10 @@ static inline void lz_dec_init(lz_dec *d, const uint8_t *p, const uint8_t *end)
     d->value |= lz_byte(d);
 }
 
+/* Below 2^24 the interval takes whole bytes until it is 2^24 or more
+ * again (Said, section 2.3): a length of b bits (1..24) takes
+ * floor((32 - b) / 8) = clz / 8 bytes, 1 to 3, read in one go when four
+ * bytes are left (byte by byte, zeros past the end, at the stream's end). */
 static inline void lz_renorm(lz_dec *d)
 {
     if (!d->length) { /* only a corrupt stream gets here: never loop forever */
@@ -108,6 +112,17 @@ static inline void lz_renorm(lz_dec *d)
         d->length = LZ_MAX_LENGTH;
         return;
     }
+#if defined(__GNUC__)
+    if (d->end - d->p >= 4) {
+        unsigned sh = (unsigned)__builtin_clz(d->length) & ~7u; /* 8, 16 or 24 bits */
+        uint32_t w = (uint32_t)d->p[0] << 24 | (uint32_t)d->p[1] << 16 |
+                     (uint32_t)d->p[2] << 8 | d->p[3];
+        d->value = d->value << sh | w >> (32 - sh);
+        d->length <<= sh;
+        d->p += sh >> 3;
+        return;
+    }
+#endif
     do
         d->value = d->value << 8 | lz_byte(d);
     while ((d->length <<= 8) < LZ_MIN_LENGTH);
@@ -141,12 +156,11 @@ LZ_INLINE uint32_t lz_decode_sym(lz_dec *d, lz_sym *m)
             t = m->tsize; /* value >= length: a corrupt stream */
         sym = m->table[t];
         n = m->table[t + 1] + 1;
-        while (n > sym + 1) {
+        while (n > sym + 1) { /* without branches: the halves are a coin toss */
             uint32_t k = (sym + n) >> 1;
-            if (m->dist[k] > dv)
-                n = k;
-            else
-                sym = k;
+            int above = m->dist[k] > dv;
+            n = above ? k : n;
+            sym = above ? sym : k;
         }
         x = m->dist[sym] * d->length;
         if (sym != m->last)
@@ -157,13 +171,11 @@ LZ_INLINE uint32_t lz_decode_sym(lz_dec *d, lz_sym *m)
         uint32_t k = (n = m->nsym) >> 1;
         do {
             uint32_t z = d->length * m->dist[k];
-            if (z > d->value) {
-                n = k;
-                y = z;
-            } else {
-                sym = k;
-                x = z;
-            }
+            int above = z > d->value;
+            n = above ? k : n;
+            y = above ? z : y;
+            sym = above ? sym : k;
+            x = above ? x : z;
         } while ((k = (sym + n) >> 1) != sym);
     }
     d->value -= x;

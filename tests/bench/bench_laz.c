@@ -15,7 +15,8 @@
  * file's field statistics).
  *
  * Each figure is the best of REPEATS (default 5) wall times of a whole
- * read (jf_cloud_read: file read, chunks decoded, records and x y z made);
+ * read, in a child process of its own (its peak RSS is the figure's:
+ * the cloud made, x y z and records, and the decoder's buffers) (jf_cloud_read: file read, chunks decoded, records and x y z made);
  * points/s = points / seconds; "CPU s" is the process's CPU time for that
  * read (all threads; on a shared machine the steadier figure).  laz-perf's figure is its decoding loop
  * alone (the file already in memory), so the ratio flatters laz-perf.
@@ -28,6 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "jetfit.h"
@@ -155,34 +158,16 @@ static int tile(const char *in, size_t n, const char *out)
     return st != JF_OK;
 }
 
-int main(int argc, char **argv)
+/* The LAS file the LAZ stands for: header and VLRs, records, EVLRs. */
+static int write_las(const char *laz, const char *las)
 {
-    if (argc == 5 && !strcmp(argv[1], "--tile"))
-        return tile(argv[2], (size_t)atol(argv[3]), argv[4]);
-    if (argc < 2) {
-        fprintf(stderr, "usage: bench_laz FILE.laz [REPEATS [NODE_MODULES]]\n");
-        return 2;
-    }
-    const char *laz = argv[1];
-    int reps = argc > 2 ? atoi(argv[2]) : 5;
-    const char *modules = argc > 3 ? argv[3] : TESTS_DIR "/node_modules";
-    int all = omp_get_max_threads();
-    size_t n = 0;
-    omp_set_num_threads(1);
-    double c1, cn, cl;
-    double t1 = best_read(laz, reps, &n, &c1);
-    omp_set_num_threads(all);
-    double tn = best_read(laz, reps, &n, &cn);
-    /* the LAS file the LAZ stands for: header and VLRs, records, EVLRs */
     jf_cloud c;
     jf_error e;
     if (jf_cloud_read(laz, NULL, &c, &e) != JF_OK) {
         fprintf(stderr, "bench_laz: %s\n", e.msg);
         return 1;
     }
-    char las[] = "/tmp/jf_bench_laz_XXXXXX.las";
-    int fd = mkstemps(las, 4);
-    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    FILE *f = fopen(las, "wb");
     if (!f || fwrite(c.attrs.las_head, 1, c.attrs.las_head_len, f) != c.attrs.las_head_len ||
         fwrite(c.attrs.rec, c.attrs.stride, c.n, f) != c.n ||
         (c.attrs.las_evlr_len &&
@@ -192,32 +177,123 @@ int main(int argc, char **argv)
         return 1;
     }
     jf_cloud_free(&c);
-    size_t n2 = 0;
-    double tl = best_read(las, reps, &n2, &cl);
+    return 0;
+}
+
+/* argv run as a child process (each figure in its own process, so that
+ * its peak resident set is its own); its output in out, its peak RSS in
+ * MB; 0 when it failed.  quiet: its stderr dropped (node without
+ * laz-perf is a note, not an error). */
+static int run(char *const argv[], char *out, size_t outlen, double *rss_mb, int quiet)
+{
+    int fd[2];
+    if (pipe(fd))
+        return 0;
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fd[1], 1);
+        close(fd[0]), close(fd[1]);
+        if (quiet && !freopen("/dev/null", "w", stderr))
+            _exit(127);
+        execvp(argv[0], argv);
+        _exit(127);
+    }
+    close(fd[1]);
+    size_t got = 0;
+    ssize_t k;
+    while (got + 1 < outlen && (k = read(fd[0], out + got, outlen - 1 - got)) > 0)
+        got += (size_t)k;
+    out[got] = '\0';
+    close(fd[0]);
+    int status = 0;
+    struct rusage ru;
+    if (pid < 0 || wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) ||
+        WEXITSTATUS(status))
+        return 0;
+    *rss_mb = (double)ru.ru_maxrss / 1024.0;
+    return 1;
+}
+
+/* One figure: `self --read FILE THREADS REPS` in a child. */
+static int measure(const char *self, const char *file, int threads, int reps, double *t,
+                   double *c, size_t *n, double *rss)
+{
+    char th[16], rp[16], out[256];
+    snprintf(th, sizeof th, "%d", threads), snprintf(rp, sizeof rp, "%d", reps);
+    char *const argv[] = {(char *)self, "--read", (char *)file, th, rp, NULL};
+    return run(argv, out, sizeof out, rss, 0) && sscanf(out, "%lf %lf %zu", t, c, n) == 3;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 5 && !strcmp(argv[1], "--tile"))
+        return tile(argv[2], (size_t)atol(argv[3]), argv[4]);
+    if (argc == 5 && !strcmp(argv[1], "--read")) { /* a child of measure() */
+        size_t n = 0;
+        double cs = 0;
+        omp_set_num_threads(atoi(argv[3]));
+        double t = best_read(argv[2], atoi(argv[4]), &n, &cs);
+        printf("%.6f %.6f %zu\n", t, cs, n);
+        return 0;
+    }
+    if (argc == 4 && !strcmp(argv[1], "--las"))
+        return write_las(argv[2], argv[3]);
+    if (argc < 2) {
+        fprintf(stderr, "usage: bench_laz FILE.laz [REPEATS [NODE_MODULES]]\n"
+                        "       bench_laz --tile IN N OUT.laz\n");
+        return 2;
+    }
+    const char *laz = argv[1];
+    int reps = argc > 2 ? atoi(argv[2]) : 5;
+    const char *modules = argc > 3 ? argv[3] : TESTS_DIR "/node_modules";
+    /* the parent runs no OpenMP region: every read is in a fresh child */
+    char self[4096];
+    ssize_t sl = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (sl <= 0) {
+        fprintf(stderr, "bench_laz: cannot find its own executable\n");
+        return 1;
+    }
+    self[sl] = '\0';
+    int all = omp_get_max_threads();
+    size_t n = 0, n2 = 0;
+    double t1, c1, r1, tn, cn, rn, tl, cl, rl, rs;
+    char las[] = "/tmp/jf_bench_laz_XXXXXX.las", out[256];
+    int fd = mkstemps(las, 4);
+    if (fd < 0)
+        return 1;
+    close(fd);
+    char *const wr[] = {self, "--las", (char *)laz, las, NULL};
+    if (!measure(self, laz, 1, reps, &t1, &c1, &n, &r1) ||
+        !measure(self, laz, all, reps, &tn, &cn, &n, &rn) || !run(wr, out, sizeof out, &rs, 0) ||
+        !measure(self, las, all, reps, &tl, &cl, &n2, &rl)) {
+        fprintf(stderr, "bench_laz: a read failed\n");
+        unlink(las);
+        return 1;
+    }
     unlink(las);
     printf("file: %s, %zu points, best of %d\n", laz, n, reps);
-    printf("| read | threads | seconds | CPU s | points/s |\n|---|---|---|---|---|\n");
-    printf("| LAZ (jetfit) | 1 | %.4f | %.4f | %.3g |\n", t1, c1, n / t1);
-    printf("| LAZ (jetfit) | %d | %.4f | %.4f | %.3g |\n", all, tn, cn, n / tn);
-    printf("| LAS, the same records (jetfit) | %d | %.4f | %.4f | %.3g |\n", all, tl, cl,
-           n2 / tl);
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "node '%s/bench/lazperf_bench.js' '%s' '%s' %d 2>/dev/null",
-             TESTS_DIR, modules, laz, reps);
-    double tp = 0, cp = 0;
+    printf("| read | threads | seconds | CPU s | points/s | peak RSS (MB) |\n"
+           "|---|---|---|---|---|---|\n");
+    printf("| LAS, the same records (jetfit) | %d | %.4f | %.4f | %.3g | %.0f |\n", all, tl, cl,
+           n2 / tl, rl);
+    printf("| LAZ (jetfit) | 1 | %.4f | %.4f | %.3g | %.0f |\n", t1, c1, n / t1, r1);
+    printf("| LAZ (jetfit) | %d | %.4f | %.4f | %.3g | %.0f |\n", all, tn, cn, n / tn, rn);
+    char script[4096], rp[16];
+    snprintf(script, sizeof script, "%s/bench/lazperf_bench.js", TESTS_DIR);
+    snprintf(rp, sizeof rp, "%d", reps);
+    char *const node[] = {"node", script, (char *)modules, (char *)laz, rp, NULL};
+    double tp = 0, cp = 0, rp_mb = 0;
     size_t np = 0;
-    FILE *p = popen(cmd, "r");
-    if (p && fscanf(p, "lazperf %lf %lf %zu", &tp, &cp, &np) == 3 && np == n)
+    if (run(node, out, sizeof out, &rp_mb, 1) &&
+        sscanf(out, "lazperf %lf %lf %zu", &tp, &cp, &np) == 3 && np == n)
         printf("| LAZ (laz-perf %s, WASM under node, decode loop only) | 1 | %.4f | %.4f | "
-               "%.3g |\n", "0.0.7", tp, cp, n / tp);
+               "%.3g | %.0f |\n", "0.0.7", tp, cp, n / tp, rp_mb);
     else
         tp = 0, printf("(laz-perf: not run -- no node or no laz-perf in %s)\n", modules);
-    if (p)
-        pclose(p);
-    printf("LAZ all threads / one thread: %.2fx\n", t1 / tn);
+    printf("LAZ %d threads / one thread: %.2fx the points/s\n", all, t1 / tn);
     printf("LAZ one thread / LAS: %.2fx the time\n", t1 / tl);
     if (tp > 0)
-        printf("LAZ one thread (jetfit) / laz-perf: %.2fx the points/s (CPU time: %.2fx)\n",
+        printf("LAZ one thread (jetfit) / laz-perf: %.2fx the points/s, %.2fx per CPU second\n",
                tp / t1, cp / c1);
     return 0;
 }

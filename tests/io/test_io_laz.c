@@ -2,8 +2,9 @@
  * laz-perf's and laspy's test sets (tests/data/laz/SOURCE.md), point
  * formats 0-3 and 6 and extra bytes, decoded to their uncompressed LAS
  * twins byte for byte (the twins were written by other software from the
- * same points), EVLRs kept; the same records for 1 and N threads on a
- * 65-chunk file; every damaged file a one-line error that names the chunk.
+ * same points), EVLRs kept, the same x y z without attributes; the same
+ * records for 1 and N threads on a 65-chunk file; every damaged file a
+ * one-line error that names the chunk.
  * Formats 7 and 8 have no twin: test_laz_perf compares them with laz-perf. */
 #define _GNU_SOURCE
 #include <check.h>
@@ -76,6 +77,19 @@ static void twin(const char *laz, const char *las, unsigned fmt, size_t n)
     ck_assert_msg(memcmp(h + 131, b + 131, 48) == 0, "%s: scale/offset differ", laz);
     ck_assert_ptr_null(memmem(h, z.attrs.las_head_len, "laszip encoded", 14));
     ck_assert_uint_eq(g32(h + 96), z.attrs.las_head_len);
+    /* without attributes (the decoded records dropped): the same x y z,
+     * the header still kept, no records */
+    jf_read_opts o;
+    jf_cloud q;
+    jf_read_opts_init(&o);
+    o.no_attrs = 1;
+    ck_assert_msg(jf_cloud_read(laz, &o, &q, &e) == JF_OK, "%s", e.msg);
+    ck_assert_uint_eq(q.n, n);
+    ck_assert_msg(memcmp(q.xyz, s.xyz, 3 * n * sizeof(double)) == 0, "%s: xyz differ", laz);
+    ck_assert_ptr_null(q.attrs.rec);
+    ck_assert_uint_eq(q.attrs.las_head_len, z.attrs.las_head_len);
+    ck_assert(memcmp(q.attrs.las_head, h, q.attrs.las_head_len) == 0);
+    jf_cloud_free(&q);
     jf_cloud_free(&z);
     jf_cloud_free(&s);
     free(b);
