@@ -191,8 +191,8 @@ extremes_of(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo, i
 static void gram_extremes(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo,
                           int rc[2])
 {
-    if (cols == 6) extremes_of(g0, g1, 6, hi, lo, rc);
-    else if (cols == 10) extremes_of(g0, g1, 10, hi, lo, rc);
+    if (cols == 6 && jf__fixed_sizes) extremes_of(g0, g1, 6, hi, lo, rc);
+    else if (cols == 10 && jf__fixed_sizes) extremes_of(g0, g1, 10, hi, lo, rc);
     else extremes_of(g0, g1, cols, hi, lo, rc);
 }
 

@@ -271,6 +271,7 @@ static inline __attribute__((always_inline)) double scaled_system(jf_fitter *f, 
  * degree 2 and 3), which the compiler unrolls: the same bits. */
 static double scaled_system_any(jf_fitter *f, size_t rows, int d)
 {
+    if (!jf__fixed_sizes) return scaled_system(f, rows, d);
     if (rows == 16 && d == 2) return scaled_system(f, 16, 2);
     if (rows == 32 && d == 2) return scaled_system(f, 32, 2);
     if (rows == 32 && d == 3) return scaled_system(f, 32, 3);

@@ -379,12 +379,16 @@ static int fast_finish(jf_fitter *f, size_t rows, size_t cols, double *cond)
 /* The SVD of R (after the QR, when the fast path declined). */
 static int svd_rest(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
+int jf__fixed_sizes = 1;
+
 int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
 {
     /* knn:16 and knn:32 at degree 2 (6 columns) and knn:32 at degree 3 (10):
      * the same code with constant sizes, which the compiler unrolls; the
      * same operations in the same order, so the same bits */
-    if (rows == 16 && cols == 6)
+    if (!jf__fixed_sizes)
+        householder_qr(f->m, f->rhs, rows, cols, f->perm, f->tmp, f->work);
+    else if (rows == 16 && cols == 6)
         householder_qr_16_6(f->m, f->rhs, f->perm, f->tmp, f->work);
     else if (rows == 32 && cols == 6)
         householder_qr_32_6(f->m, f->rhs, f->perm, f->tmp, f->work);
@@ -394,8 +398,8 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
         householder_qr(f->m, f->rhs, rows, cols, f->perm, f->tmp, f->work);
 #if !defined(JF_GSL_SVD) && !defined(JF_SVD_GSLJ)
     if (cols > 55) return 0;
-    if (cols == 6) gram(f, rows, 6);
-    else if (cols == 10) gram(f, rows, 10);
+    if (cols == 6 && jf__fixed_sizes) gram(f, rows, 6);
+    else if (cols == 10 && jf__fixed_sizes) gram(f, rows, 10);
     else gram(f, rows, cols);
     return 1;
 #else
