@@ -303,7 +303,6 @@ static void estimate_vs_loop(size_t k, int degree)
 START_TEST(test_estimate_vs_loop)
 {
     estimate_vs_loop(16, 2);
-    estimate_vs_loop(32, 2);
     estimate_vs_loop(32, 3);
 }
 END_TEST
