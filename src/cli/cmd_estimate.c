@@ -265,6 +265,10 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
     double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
     for (size_t j = 0; j < m; j++) {
+        if (j + 8 < m) { /* input order: a cache miss each, asked for early */
+            __builtin_prefetch(s->xyz + 3 * (size_t)idx[j + 8]);
+            if (s->cond) __builtin_prefetch(s->cond + idx[j + 8], 1);
+        }
         jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, s->sigma, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;

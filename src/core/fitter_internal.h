@@ -137,6 +137,12 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
  * jf__solve_after_eig: the rest (have_eig: the eigenvalues are in f->s);
  * returns as jf__svd_solve. */
 int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
+/* The QR, G's extremes and M' run the code of the common sizes (16 or 32
+ * rows, 6 or 10 columns) with those sizes as constants, which the
+ * compiler unrolls: the same operations, the same bits.  0 runs the
+ * general code for every size (tests compare the two; not thread-safe to
+ * change while fitting). */
+extern int jf__fixed_sizes;
 int jf__eigvals(jf_fitter *f, size_t cols);
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
 int jf__sym_eigvals(double *a, size_t n, double *d, double *e);

@@ -44,7 +44,7 @@ static inline v2d sqrt2(v2d x)
  * (destroyed): diagonal d, squared sub-diagonal e (e[n-1] = 0).  Each
  * lane does exactly jf__sym_eigvals' operations; a lane with a zero column
  * keeps its values (mask). */
-static void tridiag_x2(v2d *a, size_t n, v2d *d, v2d *e)
+static inline __attribute__((always_inline)) void tridiag_x2(v2d *a, size_t n, v2d *d, v2d *e)
 {
     const v2d zero = {0.0, 0.0};
     for (size_t k = 0; k + 2 < n; k++) {
@@ -87,7 +87,7 @@ static void tridiag_x2(v2d *a, size_t n, v2d *d, v2d *e)
 }
 
 /* det(T - xI) and its first two derivatives at x (per lane). */
-static inline void charpoly(const v2d *d, const v2d *e, size_t n, v2d x, v2d *p, v2d *p1,
+static inline __attribute__((always_inline)) void charpoly(const v2d *d, const v2d *e, size_t n, v2d x, v2d *p, v2d *p1,
                             v2d *p2)
 {
     v2d a = d[0] - x, a1 = {-1.0, -1.0}, a2 = {0.0, 0.0};
@@ -107,7 +107,7 @@ static inline void charpoly(const v2d *d, const v2d *e, size_t n, v2d x, v2d *p,
  * roots' other side (rounding carried x across the root), or when the
  * step makes no progress in its direction; the lane is done after a
  * step of at most GE_TOL. */
-static inline v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, v2l *done)
+static inline __attribute__((always_inline)) v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, v2l *done)
 {
     v2d p, p1, p2;
     charpoly(d, e, n, x, &p, &p1, &p2);
@@ -130,7 +130,8 @@ static inline v2d laguerre(const v2d *d, const v2d *e, size_t n, v2d x, int hi, 
 
 /* Largest and smallest eigenvalue of each lane's T; rc[lane] -1 when the
  * iteration did not settle (not finite, or GE_ITERS steps). */
-static void extremes_x2(v2d *d, v2d *e, size_t n, v2d *lmax, v2d *lmin, int rc[2])
+static inline __attribute__((always_inline)) void extremes_x2(v2d *d, v2d *e, size_t n, v2d *lmax, v2d *lmin,
+                                                              int rc[2])
 {
     /* Gershgorin's interval, and a power of two bringing it to ~1 so the
      * recurrence neither over- nor underflows (exact scaling) */
@@ -176,13 +177,23 @@ static void put(jf_fitter *f, size_t cols, double hi, double lo)
 
 /* The extremes of the Gram matrices g0 and g1 (cols x cols, cols <=
  * GE_MAX), each in its lane. */
-static void gram_extremes(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo,
-                          int rc[2])
+static inline __attribute__((always_inline)) void
+extremes_of(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo, int rc[2])
 {
     v2d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX];
     for (size_t i = 0; i < cols * cols; i++) a[i] = (v2d){g0[i], g1[i]};
     tridiag_x2(a, cols, d, e);
     extremes_x2(d, e, cols, hi, lo, rc);
+}
+
+/* Degree 2 (6 columns) and 3 (10) with the size a constant, which the
+ * compiler unrolls: the same operations in the same order, the same bits. */
+static void gram_extremes(const double *g0, const double *g1, size_t cols, v2d *hi, v2d *lo,
+                          int rc[2])
+{
+    if (cols == 6 && jf__fixed_sizes) extremes_of(g0, g1, 6, hi, lo, rc);
+    else if (cols == 10 && jf__fixed_sizes) extremes_of(g0, g1, 10, hi, lo, rc);
+    else extremes_of(g0, g1, cols, hi, lo, rc);
 }
 
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])

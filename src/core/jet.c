@@ -199,7 +199,7 @@ typedef double jet_v2d __attribute__((vector_size(16)));
  * coordinates, the products of monomials() in the same order, so the bits
  * are its; powers are built in the pure columns before they are weighted.
  * Column of x^a y^b: (a + b)(a + b + 1)/2 + b. */
-static void design(jf_fitter *f, size_t rows, int d, double ih)
+static inline __attribute__((always_inline)) void design(jf_fitter *f, size_t rows, int d, double ih)
 {
     double *m = f->m, *w = m, *x = m + rows, *y = m + 2 * rows;
     /* two rows at a time, stored as pairs: the vector loops below (and
@@ -251,6 +251,32 @@ static void design(jf_fitter *f, size_t rows, int d, double ih)
 }
 
 static int job_system(fit_job *j);
+
+/* h, the mean distance of the rows to the z axis (§2.3's scale), then M'
+ * and B of degree d scaled by it (design); returns h, and leaves M' unmade
+ * when h is not a positive finite number. */
+static inline __attribute__((always_inline)) double scaled_system(jf_fitter *f, size_t rows, int d)
+{
+    double h = 0;
+    for (size_t t = 0; t < rows; t++) {
+        const double *q = f->loc + 3 * f->order[t];
+        h += sqrt(q[0] * q[0] + q[1] * q[1]);
+    }
+    h /= (double)rows;
+    if (h > 0 && isfinite(h)) design(f, rows, d, 1.0 / h);
+    return h;
+}
+
+/* scaled_system with the common sizes as constants (k-NN of 16 and 32 at
+ * degree 2 and 3), which the compiler unrolls: the same bits. */
+static double scaled_system_any(jf_fitter *f, size_t rows, int d)
+{
+    if (!jf__fixed_sizes) return scaled_system(f, rows, d);
+    if (rows == 16 && d == 2) return scaled_system(f, 16, 2);
+    if (rows == 32 && d == 2) return scaled_system(f, 32, 2);
+    if (rows == 32 && d == 3) return scaled_system(f, 32, 3);
+    return scaled_system(f, rows, d);
+}
 
 /* The rest of step 2 (the frame from the eigenvectors evec of j->cov;
  * out->pca_eval holds the eigenvalues), then the first system of step 3.
@@ -317,18 +343,12 @@ static int job_system(fit_job *j)
             continue;
         }
         size_t rows = j->interp ? cols : j->usable;
-        double h = 0;
-        for (size_t t = 0; t < rows; t++) {
-            const double *q = f->loc + 3 * f->order[t];
-            h += sqrt(q[0] * q[0] + q[1] * q[1]);
-        }
-        h /= (double)rows;
+        const double h = scaled_system_any(f, rows, d);
         if (!(h > 0) || !isfinite(h)) { /* every point on the z axis */
             out->status |= JF_PT_LOWERED_RANK;
             out->cond = INFINITY;
             continue;
         }
-        design(f, rows, d, 1.0 / h);
         j->rows = rows;
         j->h = h;
         return jf__qr_gram(f, rows, cols) ? 1 : 2;

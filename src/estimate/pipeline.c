@@ -284,9 +284,29 @@ static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src
  * tree's kinds (knn, radius), their coordinates from its own storage into
  * xyz (other kinds leave that to the caller); *flags gets per-point flags
  * (few neighbours, the natural normal's source, failure). */
+/* knn: the previous point of the walk's neighbours (hint, hint_n of them)
+ * bound this one's k-th distance (their farthest from p): the search
+ * starts with that radius instead of none, so it inserts fewer
+ * candidates.  Exact: with k points inside, the k nearest are inside; too
+ * few found (the bound rounded low), the search runs unbounded. */
+static jf_status knn_hinted(const nbctx *x, const double *p, const double *hint, size_t hint_n,
+                            uint32_t *idx, double *d2, double *xyz, size_t *found)
+{
+    const size_t k = x->nb->k < x->cap ? x->nb->k : x->cap;
+    double b = 0;
+    for (size_t j = 0; j < hint_n; j++) {
+        const double dx = p[0] - hint[3 * j], dy = p[1] - hint[3 * j + 1], dz = p[2] - hint[3 * j + 2];
+        const double d = dx * dx + dy * dy + dz * dz;
+        b = d > b ? d : b;
+    }
+    jf_status st = jf__index_query(x->ix, p, k, b, idx, d2, xyz, found);
+    if (st == JF_OK && *found < k) st = jf__index_query(x->ix, p, k, INFINITY, idx, d2, xyz, found);
+    return st;
+}
+
 static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, size_t i,
                           const double *p, uint32_t *idx, double *d2, double *xyz, size_t *found,
-                          unsigned *flags)
+                          unsigned *flags, const double *hint, size_t hint_n)
 {
     jf_status st;
     *found = 0;
@@ -315,8 +335,13 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, 
                                        x->graph || x->fit_moved ? idx : NULL, x->cap, found);
         break;
     default: /* sh: auto's 256 nearest, shared along the walk (knn_share.c) */
-        st = sh ? jf__knn_share_query(sh, x->ix, p, idx, d2, xyz, found)
-                : jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
+        if (sh)
+            st = jf__knn_share_query(sh, x->ix, p, idx, d2, xyz, found);
+        else if (x->nb->kind == JF_NB_KNN && hint && x->nb->k && hint_n == x->nb->k &&
+                 hint_n <= x->cap)
+            st = knn_hinted(x, p, hint, hint_n, idx, d2, xyz, found);
+        else
+            st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
     }
     if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
     return st;
@@ -333,6 +358,8 @@ typedef struct {
     jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
     jf__knn_share *share; /* auto: the shared k-NN search               */
     uint32_t *bidx;       /* and their input indices                    */
+    const double *hint;   /* knn: the last query's neighbours (coords or */
+    size_t hint_n;        /* coords2) and their count, for knn_hinted    */
 } worker;
 
 static void worker_free(worker *w)
@@ -441,8 +468,12 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
         nonfinite_row(x, i, row);
         return JF_OK;
     }
-    jf_status st = nb_query(x, w->nws, w->share, i, p, w->idx, w->d2, coords, found, flags);
+    const double *hint = w->hint != coords ? w->hint : NULL; /* coords: overwritten */
+    jf_status st =
+        nb_query(x, w->nws, w->share, i, p, w->idx, w->d2, coords, found, flags, hint, w->hint_n);
     if (st != JF_OK) return st;
+    w->hint = coords;
+    w->hint_n = *found;
     if (x->graph) keep_edges(x, i, w->idx, *found);
     if (*flags & JF_PT_FAILED) {
         nan_result(row, *flags);

@@ -18,8 +18,11 @@ Contenders, R times (default 3) in turn, T threads (default 2):
     the same file with open3d.io.read_point_cloud (not timed), then
     PointCloud.estimate_normals(KDTreeSearchParamKNN(16)) is timed: its
     k-d tree and PCA normals, nothing else (compute only).
-Printed: each rep's times and ratio (Open3D's time / jetfit's), and the
-medians.  A ratio above 1: jetfit's whole run took less time than
+Printed: each rep's wall and CPU times (CPU: every thread's, from
+wait4 for the command and process_time around the call for Open3D) and
+ratios (Open3D's time / jetfit's), the medians, the peak RSS of each
+process, and the load average before and after (on a loaded machine,
+read the CPU ratio).  A ratio above 1: jetfit's whole run took less time than
 Open3D's normals alone.
 """
 import argparse
@@ -37,31 +40,46 @@ def child_open3d(path, threads):
     import open3d as o3d
     pcd = o3d.io.read_point_cloud(path, format="xyz")
     n = len(pcd.points)
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     pcd.estimate_normals(search_param=o3d.geometry.KDTreeSearchParamKNN(knn=16))
-    dt = time.perf_counter() - t
+    dt, dc = time.perf_counter() - t, time.process_time() - c
     assert len(pcd.normals) == n
-    print(dt, n)
+    print(dt, n, dc)
+
+
+def wait_child(argv, **kw):
+    """Runs argv; returns (its wall seconds, CPU seconds of all its
+    threads, peak RSS in MB, stdout): wait4 gives the child's own rusage
+    (a load on the machine stretches wall time, CPU time much less)."""
+    t = time.perf_counter()
+    p = subprocess.Popen(argv, **kw)
+    out = p.stdout.read() if p.stdout else ""
+    _, status, ru = os.wait4(p.pid, 0)
+    dt = time.perf_counter() - t
+    p.returncode = os.waitstatus_to_exitcode(status)
+    if p.returncode != 0:
+        raise RuntimeError("%s failed (%d)" % (argv[0], p.returncode))
+    return dt, ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, out
 
 
 def run_open3d(path, threads, n):
-    p = subprocess.run([sys.executable, __file__, "--child", "--threads", str(threads), path],
-                       capture_output=True, text=True)
-    if p.returncode != 0:
-        raise RuntimeError("open3d: %s" % p.stderr[-500:])
-    t, m = p.stdout.split()
+    """(wall, CPU) of estimate_normals alone, and the process's peak RSS
+    (Python, Open3D and the cloud it read included)."""
+    _, _, peak, out = wait_child([sys.executable, __file__, "--child", "--threads",
+                                  str(threads), path], stdout=subprocess.PIPE, text=True)
+    t, m, c = out.split()
     if int(m) != n:
         raise RuntimeError("open3d read %s points, not %d" % (m, n))
-    return float(t)
+    return float(t), float(c), peak
 
 
 def run_jetfit(jetfit, path, out, threads):
+    """(wall, CPU, peak RSS) of the whole command."""
     if os.path.exists(out):
         os.remove(out)  # no deletion of an old output charged to this run
-    t = time.perf_counter()
-    subprocess.run([jetfit, "estimate", path, "-o", out, "--neighbors", "knn:16", "--degree",
-                    "2", "--threads", str(threads), "--quiet"], check=True)
-    return time.perf_counter() - t
+    t, c, peak, _ = wait_child([jetfit, "estimate", path, "-o", out, "--neighbors", "knn:16",
+                                "--degree", "2", "--threads", str(threads), "--quiet"])
+    return t, c, peak
 
 
 def main():
@@ -92,18 +110,26 @@ def main():
         load = f.read().split()[:3]
     print("bench_open3d: %d points (§6.1 surface, random order, .xyz text %%.17g), "
           "%d threads, load average %s" % (a.n, a.threads, " ".join(load)))
-    print("| rep | jetfit estimate, whole command | Open3D estimate_normals alone | "
-          "Open3D / jetfit |")
+    print("| rep | jetfit estimate, whole command: wall / CPU | Open3D estimate_normals "
+          "alone: wall / CPU | Open3D / jetfit: wall / CPU |")
     print("|---|---|---|---|")
-    tj, to = [], []
+    tj, to, cj, co, pj, po = [], [], [], [], [], []
     for r in range(a.reps):
-        tj.append(run_jetfit(a.jetfit, path, out, a.threads))
-        to.append(run_open3d(path, a.threads, a.n))
-        print("| %d | %.3f s | %.3f s | %.2fx |" % (r + 1, tj[-1], to[-1], to[-1] / tj[-1]))
+        t, c, p = run_jetfit(a.jetfit, path, out, a.threads)
+        tj.append(t), cj.append(c), pj.append(p)
+        t, c, p = run_open3d(path, a.threads, a.n)
+        to.append(t), co.append(c), po.append(p)
+        print("| %d | %.3f / %.3f s | %.3f / %.3f s | %.2fx / %.2fx |"
+              % (r + 1, tj[-1], cj[-1], to[-1], co[-1], to[-1] / tj[-1], co[-1] / cj[-1]))
         sys.stdout.flush()
     mj, mo = statistics.median(tj), statistics.median(to)
-    print("| median | %.3f s (%.0f points/s) | %.3f s (%.0f points/s) | %.2fx |"
-          % (mj, a.n / mj, mo, a.n / mo, mo / mj))
+    mcj, mco = statistics.median(cj), statistics.median(co)
+    print("| median | %.3f / %.3f s (%.0f points/s) | %.3f / %.3f s (%.0f points/s) | "
+          "%.2fx / %.2fx |" % (mj, mcj, a.n / mj, mo, mco, a.n / mo, mo / mj, mco / mcj))
+    print("peak RSS: jetfit (whole process) %.0f MB, %.0f B/point; Open3D's process (Python, "
+          "the cloud read, the normals) %.0f MB" % (max(pj), max(pj) * 1048576 / a.n, max(po)))
+    with open("/proc/loadavg") as f:
+        print("load average after: %s" % " ".join(f.read().split()[:3]))
     for p in (path, out):
         if os.path.exists(p):
             os.remove(p)

@@ -189,6 +189,63 @@ START_TEST(test_fit_x2_bits)
 }
 END_TEST
 
+/* The code for the common sizes (16 or 32 rows at degree 2, 32 at degree
+ * 3: constant sizes, unrolled) gives the general code's bits
+ * (jf__fixed_sizes = 0), one fit at a time and in pairs, on every kind
+ * of neighbourhood that keeps K usable points. */
+START_TEST(test_fixed_sizes_bits)
+{
+    static const size_t ks[3] = {16, 32, 32};
+    static const int degs[3] = {2, 2, 3};
+    size_t fast = 0, total = 0;
+    rng_state = 1615;
+    for (int c = 0; c < 3; c++) {
+        jf_params p;
+        jf_params_init(&p);
+        p.degree = degs[c];
+        p.monge_degree = degs[c];
+        p.max_neighbors = MAXN;
+        jf_fitter *f0, *f1, *g0, *g1;
+        ck_assert_int_eq(jf_fitter_create(&p, &f0), JF_OK);
+        ck_assert_int_eq(jf_fitter_create(&p, &f1), JF_OK);
+        ck_assert_int_eq(jf_fitter_create(&p, &g0), JF_OK);
+        ck_assert_int_eq(jf_fitter_create(&p, &g1), JF_OK);
+        for (int t = 0; t < 400; t++) {
+            const int kind = t % 9 == 7 ? 0 : t % 9; /* 7: too few points */
+            double nb[2][3 * MAXN], res[2][MAXN];
+            for (int k = 0; k < 2; k++)
+                while (make_nbhd(kind, nb[k]) < ks[c]) {
+                }
+            jf_result r[2][2], one[2];
+            for (int fixed = 1; fixed >= 0; fixed--) {
+                jf__fixed_sizes = fixed;
+                ck_assert_int_eq(jf__fit_point_x2(f0, nb[0], nb[0], ks[c], &r[fixed][0], f1, nb[1],
+                                                  nb[1], ks[c], &r[fixed][1]),
+                                 JF_OK);
+                ck_assert_int_eq(jf_fit_point(g0, nb[0], nb[0], ks[c], &one[fixed]), JF_OK);
+                ck_assert_int_eq(jf_fitter_residuals(f0, res[fixed], ks[c]), JF_OK);
+            }
+            jf__fixed_sizes = 1;
+            ck_assert_msg(same_result(&r[1][0], &r[0][0]) && same_result(&r[1][1], &r[0][1]) &&
+                              same_result(&one[1], &one[0]) && same_result(&one[1], &r[1][0]),
+                          "K %zu d%d case %d (kind %d): k1 %.17g vs %.17g, cond %.17g vs %.17g",
+                          ks[c], degs[c], t, kind, r[1][0].k1, r[0][0].k1, r[1][0].cond,
+                          r[0][0].cond);
+            ck_assert(same_bits(res[1], res[0], ks[c]));
+            total++;
+            fast += r[1][0].degree == degs[c] && r[1][0].cond <= 1e3;
+        }
+        jf_fitter_free(f0);
+        jf_fitter_free(f1);
+        jf_fitter_free(g0);
+        jf_fitter_free(g1);
+    }
+    /* the unrolled fast path ran, and the other paths too */
+    ck_assert_uint_gt(fast, total / 2);
+    ck_assert_uint_lt(fast, total);
+}
+END_TEST
+
 /* jf_estimate (k-NN: pairs, streamed rows, 1 and 2 threads) against the
  * per-point loop of before: the same bits in every row. */
 static void estimate_vs_loop(size_t k, int degree)
@@ -258,6 +315,7 @@ int main(void)
     tcase_add_test(tc, test_ldexp_bits);
     tcase_add_test(tc, test_eig3_x2_bits);
     tcase_add_test(tc, test_fit_x2_bits);
+    tcase_add_test(tc, test_fixed_sizes_bits);
     tcase_add_test(tc, test_estimate_vs_loop);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
