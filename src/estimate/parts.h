@@ -109,7 +109,7 @@ typedef struct {
     const jf_row_layout *l; /* ... its rows                              */
     const char *name;       /* ... for messages                          */
 } jf_xyz_src;
-#define JF_SRC_CHUNK 8192   /* points a thread reads at once from disk   */
+#define JF_SRC_CHUNK 4096   /* points a thread reads at once from disk   */
 
 /* A sink that also gets the points' coordinates (3m, as read). */
 typedef jf_status (*jf__block_xyz_fn)(void *user, const uint32_t *idx, const double *xyz,
