@@ -107,7 +107,6 @@ typedef struct {
     const double *xyz;      /* in memory: 3n coordinates; NULL: on disk  */
     int fd;                 /* on disk: the input file, read by pread(2) */
     const jf_row_layout *l; /* ... its rows                              */
-    const char *name;       /* ... for messages                          */
 } jf_xyz_src;
 #define JF_SRC_CHUNK 4096   /* points a thread reads at once from disk   */
 
@@ -118,7 +117,7 @@ typedef jf_status (*jf__block_xyz_fn)(void *user, const uint32_t *idx, const dou
 /* jf_estimate_parts over n points whose coordinates come from src (c
  * gives n and what stays in memory: normals, scan ids; c->xyz unused).
  * The same rows as jf_estimate_parts, bit for bit.  Besides its errors:
- * JF_ERR_IO with err "NAME: read failed at vertex R: reason" when the
+ * JF_ERR_IO with err "read failed at vertex R: reason" when the
  * file cannot be read.  Memory beyond jf_estimate_parts's per part:
  * threads x JF_SRC_CHUNK x (24 + row) bytes of read buffers. */
 jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,

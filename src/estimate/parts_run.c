@@ -153,8 +153,8 @@ static jf_status reader_status(const reader *rd, jf_error *err)
 {
     if (!rd->fail) return JF_OK;
     if (err)
-        snprintf(err->msg, sizeof err->msg, "%s: read failed at vertex %zu: %s", rd->s->name,
-                 rd->io_row, rd->io_errno ? strerror(rd->io_errno) : "the file shrank while it was read");
+        snprintf(err->msg, sizeof err->msg, "read failed at vertex %zu: %s", rd->io_row,
+                 rd->io_errno ? strerror(rd->io_errno) : "the file shrank while it was read");
     return JF_ERR_IO;
 }
 
@@ -751,7 +751,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     }
     if (st != JF_OK || nparts == 1 || c->n == 0)
         return jf_estimate_blocks(c, o, sink, user, err); /* its own checks */
-    const jf_xyz_src src = {c->xyz, -1, NULL, NULL};
+    const jf_xyz_src src = {c->xyz, -1, NULL};
     plain pl = {sink, user};
     return jf__estimate_parts_src(c, &src, o, nparts, plain_block, &pl, err);
 }
