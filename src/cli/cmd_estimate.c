@@ -345,17 +345,22 @@ static int memory_precheck(const char *in, const char *fmt, unsigned long long m
         return 0;
     size_t n = (size_t)l->count, need_min = 0, need_ooc = 0;
     size_t held = n * (24 + (l->has_normals ? 24 : 0) + (quiet ? 0 : 8));
-    if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
     if (ply && !las_out && !l->laz) {
-        /* without the coordinates; the attributes are known once read
-         * (--keep none: none, so refused now, naming the smaller least) */
-        if (keep || jf__parts_plan_ooc(n, held - n * 24, ncols, threads, l->row, memory, &need_ooc))
+        /* the kept attributes are at most a row a point: if the cloud
+         * fits in memory with that, it is read whole; else their size is
+         * known once read (then: in memory if it fits, else from the
+         * file); --keep none: exact now */
+        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, memory, NULL, NULL))
+            return 0;
+        if (keep) return 2;
+        if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
+        if (jf__parts_plan_ooc(n, held - n * 24, ncols, threads, l->row, memory, &need_ooc))
             return 2;
-        if (need_ooc < need_min) {
-            memory_refused(in, memory, n, need_ooc, held - n * 24, 1);
-            return 1;
-        }
+        memory_refused(in, memory, n, need_ooc < need_min ? need_ooc : need_min,
+                       need_ooc < need_min ? held - n * 24 : held, need_ooc < need_min);
+        return 1;
     }
+    if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
     memory_refused(in, memory, n, need_min, held, 0);
     return 1;
 }
@@ -434,17 +439,14 @@ static int estimate(int argc, char **argv, int *fd)
         ooc = st == JF_OK;
     }
     if (ooc) {
-        /* the attributes known: parts with the coordinates on disk, or,
-         * when those do not fit but the cloud in memory would (a small
-         * cloud: the parts' fixed costs), the cloud read whole */
+        /* the attributes known: the cloud read whole when it fits (no
+         * reads per part), else parts with the coordinates on disk */
         const int pt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
         jf_column pc[JF_RESULT_MAX_COLS];
         const size_t nc = jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc);
         size_t held = c.n * ((c.nrm ? 24 : 0) + (quiet ? 0 : 8)) +
                       (c.attrs.rec ? c.n * c.attrs.stride : 0);
-        size_t need_ooc = 0, need_mem = 0;
-        if (!jf__parts_plan_ooc(c.n, held, nc, pt, lay.row, memory, &need_ooc) &&
-            jf__parts_plan(c.n, held + 24 * c.n, nc, pt, memory, NULL, &need_mem)) {
+        if (jf__parts_plan(c.n, held + 24 * c.n, nc, pt, memory, NULL, NULL)) {
             jf_cloud_free(&c);
             close(*fd);
             *fd = -1;
