@@ -7,6 +7,8 @@
 #include <string.h>
 #include <strings.h>
 #include <time.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <omp.h>
@@ -84,8 +86,9 @@ static void usage(FILE *f)
         "                        G, T: powers of 1024; default: the available memory,\n"
         "                        MemAvailable); when the whole cloud's k-d tree would\n"
         "                        not fit, the cloud is fitted in parts with exact\n"
-        "                        halos, one at a time (same output); a SIZE too small\n"
-        "                        for the points themselves is refused, naming the least\n"
+        "                        halos, one at a time (same output), a binary PLY\n"
+        "                        input's coordinates read from the file when they do\n"
+        "                        not fit; a SIZE too small is refused, naming the least\n"
         "                        that works\n"
         "  --keep MODE           all (default): the input's other per-point values\n"
         "                        (PLY properties, named CSV columns, LAS dimensions;\n"
@@ -165,6 +168,7 @@ static const int kbin[NKBIN] = {16, 24, 32, 48, 64, 96, 128, 160, 200, JF_NB_AUT
 typedef struct {
     size_t flags[32], ok, deg[JF_MAX_DEGREE + 1], k[NKBIN];
     size_t unfit; /* failed or nonfinite: no fit at all */
+    double big;   /* coordinates on disk: the largest finite |x|, |y|, |z| */
     char pad[64];
 } tally;
 
@@ -186,7 +190,7 @@ static void tally_add(tally *t, const jf_result *r)
 static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
                     const char *out)
 {
-    tally t = {{0}, 0, {0}, {0}, 0, {0}};
+    tally t = {{0}, 0, {0}, {0}, 0, 0, {0}};
     size_t nauto = 0;
     for (int k = 0; k < nt; k++) {
         for (int b = 0; b < NKBIN; b++) t.k[b] += tl[k].k[b];
@@ -279,17 +283,64 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
     return st;
 }
 
+/* The same with the coordinates handed over (--memory with the
+ * coordinates on disk: jf__estimate_parts_src reads them as it goes). */
+static jf_status sink_block_xyz(void *user, const uint32_t *idx, const double *xyz, jf_result *res,
+                                size_t m)
+{
+    sinkctx *s = user;
+    int t = omp_get_thread_num();
+    if (t >= s->nt) return JF_ERR_INVALID;
+    double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
+    for (size_t j = 0; j < m; j++) {
+        jf_result_row(xyz + 3 * j, &res[j], s->monge, s->sigma, v + j * s->ncols);
+        tally_add(&s->tl[t], &res[j]);
+        if (s->cond) s->cond[idx[j]] = res[j].cond;
+        for (int k = 0; k < 3; k++)
+            if (isfinite(xyz[3 * j + k]) && fabs(xyz[3 * j + k]) > s->tl[t].big)
+                s->tl[t].big = fabs(xyz[3 * j + k]);
+    }
+    jf_status st = jf_writer_put(s->w, idx, v, m);
+    if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
+    if (s->pg) jf_cli_progress_fitted(s->pg, m);
+    return st;
+}
+
 /* ---- the command ---------------------------------------------------------- */
+
+/* The refusal of a --memory too small, in one line; ooc: the least with
+ * the coordinates read from the file as needed. */
+static void memory_refused(const char *in, unsigned long long memory, size_t n, size_t need_min,
+                           size_t held, int ooc)
+{
+    char given[32], least[32], cloud[32];
+    if (ooc)
+        fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
+                        "works is --memory %s (with the coordinates read from the file as "
+                        "needed; the summary's values, normals and attributes: %s)\n", in,
+                size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+    else
+        fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
+                        "works is --memory %s (the cloud and the summary's values: %s)\n", in,
+                size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+}
 
 /* --memory too small for the points a binary PLY or LAS header announces
  * (their coordinates, normals and the summary's values at least): said
- * before reading them.  1 when refused (message printed). */
+ * before reading them.  Returns 1 when refused (message printed), 2 when
+ * the coordinates do not fit but a binary PLY input can be read from the
+ * file as needed (*l its rows; out: not LAS, whose frame takes them all),
+ * else 0. */
 static int memory_precheck(const char *in, const char *fmt, unsigned long long memory, int quiet,
-                           size_t ncols, int threads, int kd)
+                           size_t ncols, int threads, int kd, int keep, const char *out,
+                           const char *out_fmt, jf_row_layout *l)
 {
-    size_t len = strlen(in);
+    size_t len = strlen(in), olen = strlen(out);
     int ply = len >= 4 && !strcasecmp(in + len - 4, ".ply"),
         las = len >= 4 && !strcasecmp(in + len - 4, ".las");
+    int las_out = out_fmt ? !strcasecmp(out_fmt, "las") || !strcasecmp(out_fmt, "laz")
+                          : olen >= 4 && (!strcasecmp(out + olen - 4, ".las") ||
+                                          !strcasecmp(out + olen - 4, ".laz"));
     if (!memory || fmt || !kd || !(ply || las)) return 0;
     FILE *f = fopen(in, "rb");
     if (!f) return 0; /* the reader says why */
@@ -297,18 +348,29 @@ static int memory_precheck(const char *in, const char *fmt, unsigned long long m
     size_t got = fread(buf, 1, sizeof buf, f);
     long long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
     fclose(f);
-    jf_row_layout l;
     jf_error e = {{0}};
-    if (size < 0 || (ply ? jf__ply_layout(buf, got, (uint64_t)size, in, &l, &e)
-                         : jf__las_layout(buf, got, (uint64_t)size, in, &l, &e)) != JF_OK)
+    if (size < 0 || (ply ? jf__ply_layout(buf, got, (uint64_t)size, in, l, &e)
+                         : jf__las_layout(buf, got, (uint64_t)size, in, l, &e)) != JF_OK)
         return 0;
-    size_t n = (size_t)l.count, need_min = 0;
-    size_t held = n * (24 + (l.has_normals ? 24 : 0) + (quiet ? 0 : 8));
+    size_t n = (size_t)l->count, need_min = 0, need_ooc = 0;
+    size_t held = n * (24 + (l->has_normals ? 24 : 0) + (quiet ? 0 : 8));
+    if (ply && !las_out && !l->laz) {
+        /* the kept attributes are at most a row a point: if the cloud
+         * fits in memory with that, it is read whole; else their size is
+         * known once read (then: in memory if it fits, else from the
+         * file); --keep none: exact now */
+        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, memory, NULL, NULL))
+            return 0;
+        if (keep) return 2;
+        if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
+        if (jf__parts_plan_ooc(n, held - n * 24, ncols, threads, l->row, memory, &need_ooc))
+            return 2;
+        memory_refused(in, memory, n, need_ooc < need_min ? need_ooc : need_min,
+                       need_ooc < need_min ? held - n * 24 : held, need_ooc < need_min);
+        return 1;
+    }
     if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
-    char given[32], least[32], cloud[32];
-    fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that works "
-                    "is --memory %s (the cloud and the summary's values: %s)\n", in,
-            size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+    memory_refused(in, memory, n, need_min, held, 0);
     return 1;
 }
 
@@ -339,7 +401,17 @@ static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, j
     return JF_OK;
 }
 
+static int estimate(int argc, char **argv, int *fd);
+
 int jf_cmd_estimate(int argc, char **argv)
+{
+    int fd = -1; /* --memory: the input, read as the parts need it */
+    int rc = estimate(argc, argv, &fd);
+    if (fd >= 0) close(fd);
+    return rc;
+}
+
+static int estimate(int argc, char **argv, int *fd)
 {
     jf_cli_estimate_cmd cmd;
     jf_cli_bad bad;
@@ -358,6 +430,9 @@ int jf_cmd_estimate(int argc, char **argv)
 
     double t0 = now_s();
     jf_cloud c = {0};
+    int ooc = 0; /* --memory: coordinates read from the input file as needed */
+    jf_row_layout lay;
+    memset(&lay, 0, sizeof lay);
     /* writing over the input would lose its other columns (and, renamed
      * over it, the input itself) */
     if (jf_same_file(in, out)) {
@@ -369,10 +444,12 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_column pc[JF_RESULT_MAX_COLS];
         const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
                        o.orient != JF_ORIENT_MST;
-        if (memory_precheck(in, cmd.in_fmt, memory, quiet,
-                            jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
-                            o.threads > 0 ? o.threads : jf_default_threads(NULL), kd))
-            return 1;
+        ooc = memory_precheck(in, cmd.in_fmt, memory, quiet,
+                              jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
+                              o.threads > 0 ? o.threads : jf_default_threads(NULL), kd, keep,
+                              out, cmd.out_fmt, &lay);
+        if (ooc == 1) return 1;
+        ooc = ooc == 2;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
     e.ro.threads = o.threads; /* text input parsed in blocks on them */
@@ -384,7 +461,35 @@ int jf_cmd_estimate(int argc, char **argv)
     e.ro.progress_user = &pg;
     if (o.threads > 0)
         omp_set_num_threads(o.threads); /* the LAZ reader decodes chunks on them */
-    jf_status st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);
+    jf_status st = JF_ERR_UNSUPPORTED;
+    if (ooc) { /* everything but the coordinates; a PLY that does not qualify: read whole */
+        struct stat sb;
+        *fd = open(in, O_RDONLY);
+        if (*fd >= 0 && fstat(*fd, &sb) == 0 && S_ISREG(sb.st_mode))
+            st = jf__read_ply_chunked_noxyz(*fd, (size_t)sb.st_size, in, &e.ro, &c, &err);
+        if (st != JF_OK && *fd >= 0) close(*fd), *fd = -1;
+        if (st == JF_OK && c.n != lay.count) {
+            jf_cloud_free(&c);
+            st = JF_ERR_UNSUPPORTED; /* the file changed since its header was read */
+        }
+        ooc = st == JF_OK;
+    }
+    if (ooc) {
+        /* the attributes known: the cloud read whole when it fits (no
+         * reads per part), else parts with the coordinates on disk */
+        const int pt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
+        jf_column pc[JF_RESULT_MAX_COLS];
+        const size_t nc = jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc);
+        size_t held = c.n * ((c.nrm ? 24 : 0) + (quiet ? 0 : 8)) +
+                      (c.attrs.rec ? c.n * c.attrs.stride : 0);
+        if (jf__parts_plan(c.n, held + 24 * c.n, nc, pt, memory, NULL, NULL)) {
+            jf_cloud_free(&c);
+            close(*fd);
+            *fd = -1;
+            ooc = 0;
+        }
+    }
+    if (!ooc) st = jf_cli_cloud_read(in, cmd.in_fmt, &e.ro, &c, &err);
     if (st != JF_OK) {
         jf_cli_progress_end(&pg);
         fprintf(stderr, "jetfit: %s\n", err.msg[0] ? err.msg : jf_strerror(st));
@@ -418,14 +523,25 @@ int jf_cmd_estimate(int argc, char **argv)
     int plan = 1;
     {
         const int pt = o.threads > 0 ? o.threads : jf_default_threads(NULL);
-        size_t held = c.n * (24 + (c.nrm ? 24 : 0) + (c.scan ? 4 : 0) + (quiet ? 0 : 8)) +
+        size_t held = c.n * ((c.xyz ? 24 : 0) + (c.nrm ? 24 : 0) + (c.scan ? 4 : 0) + (quiet ? 0 : 8)) +
                       (c.attrs.rec ? c.n * c.attrs.stride : 0) + c.nfaces * 20;
         size_t need_whole = 0, need_min = 0;
         const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
                        o.orient != JF_ORIENT_MST;
         plan = jf__parts_plan(c.n, held, ncols, pt, memory ? memory : mem_available(), &need_whole,
                               &need_min);
-        if (plan != 1 && !kd) {
+        if (ooc) { /* no coordinates held: parts only */
+            size_t need_ooc = 0;
+            plan = jf__parts_plan_ooc(c.n, held, ncols, pt, lay.row, memory, &need_ooc);
+            if (!plan) { /* the smaller of the two leasts */
+                need_min = jf__parts_plan(c.n, held + 24 * c.n, ncols, pt, memory, NULL, &need_min)
+                               ? 0 : need_min;
+                memory_refused(in, memory, c.n, need_ooc < need_min ? need_ooc : need_min,
+                               need_ooc < need_min ? held : held + 24 * c.n, need_ooc < need_min);
+                jf_cloud_free(&c);
+                return 1;
+            }
+        } else if (plan != 1 && !kd) {
             if (!quiet)
                 fprintf(stderr, "jetfit: note: %zu points exceed --memory %lluM, but rings, "
                                 "natural and mst need the whole cloud: fitting it whole\n",
@@ -478,7 +594,7 @@ int jf_cmd_estimate(int argc, char **argv)
         jf_cloud_free(&c);
         return 1;
     }
-    if (!(keep && c.attrs.las_head) &&
+    if (!(keep && c.attrs.las_head) && !ooc && /* ooc: never a LAS output */
         jf_writer_las_frame_given(w, c.xyz, c.n, cmd.las_scale_set ? cmd.las_scale : NULL,
                                   cmd.las_offset_set ? cmd.las_offset : NULL) != JF_OK) {
         st = jf_writer_commit(w, &err); /* removes the temporary, says why */
@@ -532,8 +648,10 @@ int jf_cmd_estimate(int argc, char **argv)
     o.phase_user = &pg;
     jf_writer_progress(w, jf_cli_progress_phase, &pg);
     int nparts = plan > 1 ? plan : 1;
-    st = nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
-                    : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
+    const jf_xyz_src src = {NULL, *fd, &lay};
+    st = ooc          ? jf__estimate_parts_src(&c, &src, &o, nparts, sink_block_xyz, &sk, &err)
+         : nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
+                      : jf_estimate_blocks(&c, &o, sink_block, &sk, &err);
     free(sk.rows);
     jf_cli_progress_end(&pg); /* the fit's line ends before any message */
     if (st != JF_OK) {
@@ -564,8 +682,9 @@ int jf_cmd_estimate(int argc, char **argv)
     if (c.n && unfit == c.n) {
         jf_writer_abort(w);
         double big = 0;
-        for (size_t i = 0; i < 3 * c.n; i++)
+        for (size_t i = 0; c.xyz && i < 3 * c.n; i++)
             if (isfinite(c.xyz[i]) && fabs(c.xyz[i]) > big) big = fabs(c.xyz[i]);
+        for (int k = 0; k < nt; k++) big = sk.tl[k].big > big ? sk.tl[k].big : big;
         fprintf(stderr, "jetfit: %s: no point could be fitted (%zu non-finite, %zu failed)%s; "
                         "nothing written\n", in, nonfin, c.n - nonfin,
                 big > 1e150 ? ": coordinates near 1e150 or beyond overflow the fit (rescale "

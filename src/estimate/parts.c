@@ -481,8 +481,10 @@ static double part_bytes(size_t n, int P)
     return m * JF_PLAN_PART_PT;
 }
 
-int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
-                   size_t *need_min)
+/* The plan's figures: *whole, *least (the most parts) and, for a budget,
+ * the fewest parts that fit (2..pmax) or 0. */
+static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t budget,
+                        double *whole, double *least)
 {
     /* the writer: its file buffer (1 MiB), the sink's rows (a block per
      * thread) and jf_writer_rows' formatting (4096 rows of up to 32
@@ -490,18 +492,15 @@ int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, s
     const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
                           (double)nt * 4096.0 * 32.0 * (double)ncols;
     const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
-    const double whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
+    *whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
                          (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);
     /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
     size_t pmax = n / JF_PLAN_PART_MIN;
     pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;
-    const double least = fixed + part_bytes(n, (int)pmax);
-    if (need_whole) *need_whole = (size_t)whole;
-    if (need_min) *need_min = (size_t)(least < whole ? least : whole);
-    if ((double)budget >= whole || n < 2) return 1;
-    if ((double)budget < least) return 0;
+    *least = fixed + part_bytes(n, (int)pmax);
+    if ((double)budget < *least) return 0;
     /* the fewest parts that fit: each costs a scan of the cloud */
     int lo = 2, hi = (int)pmax;
     while (lo < hi) {
@@ -510,4 +509,27 @@ int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, s
         else lo = mid + 1;
     }
     return lo;
+}
+
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
+                   size_t *need_min)
+{
+    double whole, least;
+    const int p = plan_figures(n, held, ncols, nt, budget, &whole, &least);
+    if (need_whole) *need_whole = (size_t)whole;
+    if (need_min) *need_min = (size_t)(least < whole ? least : whole);
+    if ((double)budget >= whole || n < 2) return 1;
+    return p;
+}
+
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, size_t budget,
+                       size_t *need_min)
+{
+    /* the read buffers: raw rows and their coordinates, per thread; never
+     * the whole cloud (its tree would hold the coordinates) */
+    held += (size_t)(nt > 0 ? nt : 1) * JF_SRC_CHUNK * (24 + row);
+    double whole, least;
+    const int p = plan_figures(n, held, ncols, nt, budget, &whole, &least);
+    if (need_min) *need_min = (size_t)least;
+    return n < 2 ? 0 : p;
 }

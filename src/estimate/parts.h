@@ -24,6 +24,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "io/io_internal.h"
 #include "jetfit.h"
 #include "spatial/order_internal.h"
 
@@ -96,6 +97,38 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
                                   workspaces, grids) stay small          */
 int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
                    size_t *need_min);
+
+/* Where the bounded-memory estimate reads the coordinates (issue 28): an
+ * array in memory, or the rows of the input file itself (a binary PLY or
+ * LAS file's fixed-size rows, decoded by jf__layout_rows exactly as the
+ * reader decodes them), read a chunk at a time on every scan, so that the
+ * cloud's coordinates are never held (24 bytes a point). */
+typedef struct {
+    const double *xyz;      /* in memory: 3n coordinates; NULL: on disk  */
+    int fd;                 /* on disk: the input file, read by pread(2) */
+    const jf_row_layout *l; /* ... its rows                              */
+} jf_xyz_src;
+#define JF_SRC_CHUNK 4096   /* points a thread reads at once from disk   */
+
+/* A sink that also gets the points' coordinates (3m, as read). */
+typedef jf_status (*jf__block_xyz_fn)(void *user, const uint32_t *idx, const double *xyz,
+                                      jf_result *res, size_t m);
+
+/* jf_estimate_parts over n points whose coordinates come from src (c
+ * gives n and what stays in memory: normals, scan ids; c->xyz unused).
+ * The same rows as jf_estimate_parts, bit for bit.  Besides its errors:
+ * JF_ERR_IO with err "read failed at vertex R: reason" when the
+ * file cannot be read.  Memory beyond jf_estimate_parts's per part:
+ * threads x JF_SRC_CHUNK x (24 + row) bytes of read buffers. */
+jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
+                                 const jf_estimate_opts *o, int nparts, jf__block_xyz_fn sink,
+                                 void *user, jf_error *err);
+
+/* jf__parts_plan's parts for an estimate whose coordinates stay on disk
+ * (held: without them; the read buffers added here): P >= 2, or 0 when
+ * even the most parts do not fit; *need_min as jf__parts_plan's. */
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, size_t budget,
+                       size_t *need_min);
 
 /* Bits of the parts' occupancy and halo grids for n points (<= 2^26). */
 size_t jf__parts_grid_bits(size_t n);

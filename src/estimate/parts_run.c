@@ -32,10 +32,12 @@
  *  handed over first.  Every step runs on the threads; per part: two index
  *  builds (own, own + halo) and three scans of the coordinates.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <omp.h>
 
@@ -49,10 +51,12 @@ static void set_err(jf_error *err, const char *msg)
     if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
 }
 
-/* The sink of one part: local indices back to input indices. */
+/* The sink of one part: local indices back to input indices, with the
+ * points' coordinates (the part's copy). */
 typedef struct {
     const uint32_t *ids; /* local -> input index                       */
-    jf_block_fn sink;
+    const double *xyz;   /* the part's coordinates (local)             */
+    jf__block_xyz_fn sink;
     void *user;
 } relay;
 
@@ -60,44 +64,129 @@ static jf_status relay_block(void *user, const uint32_t *idx, jf_result *res, si
 {
     const relay *r = user;
     uint32_t g[256];
+    double x[3 * 256];
     if (m > 256) return JF_ERR_INVALID;
-    for (size_t j = 0; j < m; j++) g[j] = r->ids[idx[j]];
-    return r->sink(r->user, g, res, m);
+    for (size_t j = 0; j < m; j++) {
+        g[j] = r->ids[idx[j]];
+        memcpy(x + 3 * j, r->xyz + 3 * (size_t)idx[j], sizeof(double[3]));
+    }
+    return r->sink(r->user, g, x, res, m);
 }
 
-static int cmp_u32(const void *a, const void *b)
+/* The coordinates' reader (jf_xyz_src): every scan walks the cloud in
+ * chunks of JF_SRC_CHUNK points on the threads, each thread reading its
+ * chunk into its own buffers (in memory: a pointer, no copy).  The first
+ * failed read is kept; the scans then skip, and the caller returns it. */
+typedef struct {
+    const jf_xyz_src *s;
+    size_t n, nch;         /* points, chunks                            */
+    double **xyz;          /* per thread: JF_SRC_CHUNK x 3              */
+    unsigned char **raw;   /* per thread: JF_SRC_CHUNK rows             */
+    int nt;
+    int fail;              /* a read failed: io_row, io_errno           */
+    size_t io_row;
+    int io_errno;
+} reader;
+
+static size_t chunk_len(const reader *rd, size_t ch)
 {
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
+    const size_t first = ch * JF_SRC_CHUNK;
+    return rd->n - first < JF_SRC_CHUNK ? rd->n - first : JF_SRC_CHUNK;
+}
+
+/* Chunk ch's coordinates (chunk_len points), or NULL after a failure. */
+static const double *chunk_xyz(reader *rd, size_t ch)
+{
+    const size_t first = ch * JF_SRC_CHUNK, m = chunk_len(rd, ch);
+    if (rd->s->xyz) return rd->s->xyz + 3 * first;
+    if (__atomic_load_n(&rd->fail, __ATOMIC_RELAXED)) return NULL;
+    const int t = omp_get_thread_num();
+    const jf_row_layout *l = rd->s->l;
+    unsigned char *p = rd->raw[t];
+    size_t left = m * l->row;
+    uint64_t at = l->vertex_off + (uint64_t)first * l->row;
+    while (left) {
+        ssize_t k = pread(rd->s->fd, p, left, (off_t)at);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) {
+#pragma omp critical(jf_parts_reader)
+            if (!rd->fail) {
+                rd->fail = 1;
+                rd->io_row = first + (size_t)(at - l->vertex_off - (uint64_t)first * l->row) / l->row;
+                rd->io_errno = k < 0 ? errno : 0;
+            }
+            return NULL;
+        }
+        p += k, left -= (size_t)k, at += (uint64_t)k;
+    }
+    jf__layout_rows(rd->raw[t], m, l, rd->xyz[t], NULL);
+    return rd->xyz[t];
+}
+
+static jf_status reader_open(reader *rd, const jf_xyz_src *s, size_t n, int nt)
+{
+    memset(rd, 0, sizeof *rd);
+    rd->s = s, rd->n = n, rd->nt = nt;
+    rd->nch = (n + JF_SRC_CHUNK - 1) / JF_SRC_CHUNK;
+    if (s->xyz) return JF_OK;
+    rd->xyz = calloc((size_t)nt, sizeof *rd->xyz);
+    rd->raw = calloc((size_t)nt, sizeof *rd->raw);
+    if (!rd->xyz || !rd->raw) return JF_ERR_NOMEM;
+    for (int t = 0; t < nt; t++) {
+        rd->xyz[t] = malloc(JF_SRC_CHUNK * 3 * sizeof(double));
+        rd->raw[t] = malloc(JF_SRC_CHUNK * s->l->row);
+        if (!rd->xyz[t] || !rd->raw[t]) return JF_ERR_NOMEM;
+    }
+    return JF_OK;
+}
+
+static void reader_close(reader *rd)
+{
+    for (int t = 0; rd->xyz && t < rd->nt; t++) free(rd->xyz[t]);
+    for (int t = 0; rd->raw && t < rd->nt; t++) free(rd->raw[t]);
+    free(rd->xyz);
+    free(rd->raw);
+}
+
+/* JF_ERR_IO with the file, the vertex and the reason after a failed read. */
+static jf_status reader_status(const reader *rd, jf_error *err)
+{
+    if (!rd->fail) return JF_OK;
+    if (err)
+        snprintf(err->msg, sizeof err->msg, "read failed at vertex %zu: %s", rd->io_row,
+                 rd->io_errno ? strerror(rd->io_errno) : "the file shrank while it was read");
+    return JF_ERR_IO;
 }
 
 /* The points of part a (input order) and their coordinates. */
-static size_t gather(const jf_cloud *c, const int32_t *part, int32_t a, uint32_t *ids,
-                     double *xyz, int nt)
+static size_t gather(reader *rd, const int32_t *part, int32_t a, uint32_t *ids, double *xyz,
+                     size_t *cnt)
 {
-    /* on the threads, in input order: count per slice, then fill from
-     * each slice's offset */
-    enum { SLICES = 64 };
-    size_t cnt[SLICES + 1] = {0};
-    const size_t n = c->n, per = (n + SLICES - 1) / SLICES;
-#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
-    for (int t = 0; t < SLICES; t++) {
-        size_t k = 0, end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
-        for (size_t i = (size_t)t * per; i < end; i++) k += part[i] == a;
-        cnt[t + 1] = k;
+    /* on the threads, in input order: count per chunk, then fill from
+     * each chunk's offset (cnt: nch + 1 entries) */
+    const size_t nch = rd->nch;
+    cnt[0] = 0;
+#pragma omp parallel for num_threads(rd->nt) schedule(dynamic, 16)
+    for (size_t ch = 0; ch < nch; ch++) {
+        size_t k = 0, beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+        for (size_t i = beg; i < end; i++) k += part[i] == a;
+        cnt[ch + 1] = k;
     }
-    for (int t = 0; t < SLICES; t++) cnt[t + 1] += cnt[t];
-#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
-    for (int t = 0; t < SLICES; t++) {
-        size_t m = cnt[t], end = (size_t)(t + 1) * per < n ? (size_t)(t + 1) * per : n;
-        for (size_t i = (size_t)t * per; i < end; i++)
+    for (size_t ch = 0; ch < nch; ch++) cnt[ch + 1] += cnt[ch];
+#pragma omp parallel for num_threads(rd->nt) schedule(dynamic, 1)
+    for (size_t ch = 0; ch < nch; ch++) {
+        if (cnt[ch + 1] == cnt[ch]) continue; /* none of a's: not read */
+        const double *x = chunk_xyz(rd, ch);
+        if (!x) continue;
+        size_t m = cnt[ch], beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+        for (size_t i = beg; i < end; i++)
             if (part[i] == a) {
                 ids[m] = (uint32_t)i;
-                memcpy(xyz + 3 * m, c->xyz + 3 * i, sizeof(double[3]));
+                memcpy(xyz + 3 * m, x + 3 * (i - beg), sizeof(double[3]));
                 m++;
             }
     }
-    return cnt[SLICES];
+    return cnt[nch];
 }
 
 typedef struct {
@@ -121,24 +210,6 @@ static int rvec_push(rvec *v, request x)
         v->cap = nc;
     }
     v->r[v->n++] = x;
-    return 1;
-}
-
-typedef struct {
-    uint32_t *v;
-    size_t n, cap;
-} uvec;
-
-static int uvec_push(uvec *a, uint32_t x)
-{
-    if (a->n == a->cap) {
-        size_t nc = a->cap ? 2 * a->cap : 1024;
-        uint32_t *nv = realloc(a->v, nc * sizeof *nv);
-        if (!nv) return 0;
-        a->v = nv;
-        a->cap = nc;
-    }
-    a->v[a->n++] = x;
     return 1;
 }
 
@@ -250,8 +321,8 @@ static int occ_free(const occgrid *g, const double p[3], double r, double probe)
 /* Marks the cells of the finite points of the parts near part a: those
  * whose box comes within reach of a's (reach: 16 cells); a ball wider
  * than that is never called free, so the parts left out cannot matter. */
-static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t a,
-                     const double *box, int P, int nt)
+static void occ_mark(occgrid *g, reader *rd, const int32_t *part, int32_t a,
+                     const double *box, int P)
 {
     g->reach = 16 * g->s;
     const double *ba = box + 6 * a;
@@ -263,14 +334,54 @@ static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t
         g->near[b] = (uint8_t)near;
     }
     memset(g->bits, 0, (g->dim[0] * g->dim[1] * g->dim[2] + 63) / 64 * sizeof *g->bits);
-#pragma omp parallel for num_threads(nt) schedule(static, 65536)
-    for (size_t i = 0; i < c->n; i++) {
-        if (part[i] < 0 || !g->near[part[i]]) continue;
-        size_t cix = occ_cell(g, c->xyz + 3 * i);
-        uint64_t bit = (uint64_t)1 << (cix % 64);
-        if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
-            __atomic_fetch_or(&g->bits[cix / 64], bit, __ATOMIC_RELAXED);
+#pragma omp parallel for num_threads(rd->nt) schedule(dynamic, 4)
+    for (size_t ch = 0; ch < rd->nch; ch++) {
+        const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+        size_t i = beg;
+        while (i < end && (part[i] < 0 || !g->near[part[i]])) i++;
+        if (i == end) continue; /* no near part's point: not read */
+        const double *x = chunk_xyz(rd, ch);
+        if (!x) continue;
+        for (; i < end; i++) {
+            if (part[i] < 0 || !g->near[part[i]]) continue;
+            size_t cix = occ_cell(g, x + 3 * (i - beg));
+            uint64_t bit = (uint64_t)1 << (cix % 64);
+            if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
+                __atomic_fetch_or(&g->bits[cix / 64], bit, __ATOMIC_RELAXED);
+        }
     }
+}
+
+/* A halo point: input index and coordinates, as the scan read them. */
+typedef struct {
+    uint32_t id;
+    double x[3];
+} hpoint;
+
+typedef struct {
+    hpoint *v;
+    size_t n, cap;
+} hvec;
+
+static int hvec_push(hvec *a, uint32_t id, const double *x)
+{
+    if (a->n == a->cap) {
+        size_t nc = a->cap ? 2 * a->cap : 1024;
+        hpoint *nv = realloc(a->v, nc * sizeof *nv);
+        if (!nv) return 0;
+        a->v = nv;
+        a->cap = nc;
+    }
+    a->v[a->n].id = id;
+    memcpy(a->v[a->n].x, x, sizeof(double[3]));
+    a->n++;
+    return 1;
+}
+
+static int cmp_hpoint(const void *a, const void *b)
+{
+    uint32_t x = ((const hpoint *)a)->id, y = ((const hpoint *)b)->id;
+    return (x > y) - (x < y);
 }
 
 #define FAR_FINITE 16           /* finite-bound requests answered by a scan */
@@ -291,17 +402,17 @@ static void occ_mark(occgrid *g, const jf_cloud *c, const int32_t *part, int32_t
  * the k smallest distances in the scan, and a second scan takes the
  * points within its k-th: a superset too.  Cost: two index-free passes
  * over the cloud's coordinates, no other part indexed. */
-static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *box, int P,
+static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int P,
                          const occgrid *occ, int32_t a,
                          const jf_index *own,
                          const double *xyz, size_t m, const jf_part_query *q, int nt,
-                         uint32_t **halo, size_t *nhalo)
+                         hpoint **halo, size_t *nhalo)
 {
     const size_t scratch = (q->cap > q->min_count ? q->cap : q->min_count) + 1;
-    const size_t n = c->n;
+    const size_t n = rd->n;
     const int knn = q->nb.kind == JF_NB_KNN;
     rvec *trq = calloc((size_t)nt, sizeof *trq);
-    uvec *th = calloc((size_t)nt, sizeof *th);
+    hvec *th = calloc((size_t)nt, sizeof *th);
     request *rq = NULL, *far = NULL;
     double *bs = NULL, *heaps = NULL;
     size_t *hn = NULL;
@@ -467,15 +578,19 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
             const size_t t = (size_t)omp_get_thread_num();
             double *hp = heaps + t * nfar * kmax;
             size_t *hc = hn + t * nfar;
-#pragma omp for schedule(static, 65536)
-            for (size_t i = 0; i < n; i++) {
-                if (part[i] < 0 || part[i] == a) continue;
-                const double *x = c->xyz + 3 * i;
-                for (size_t f = 0; f < nfar; f++) {
-                    const double *p = xyz + 3 * (size_t)far[f].pt;
-                    const double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
-                    const double d = dx * dx + dy * dy + dz * dz;
-                    if (d <= far[f].req.bound) heap_push(hp + f * kmax, &hc[f], far[f].req.k, d);
+#pragma omp for schedule(dynamic, 4)
+            for (size_t ch = 0; ch < rd->nch; ch++) {
+                const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+                const double *xc = chunk_xyz(rd, ch);
+                for (size_t i = beg; xc && i < end; i++) {
+                    if (part[i] < 0 || part[i] == a) continue;
+                    const double *x = xc + 3 * (i - beg);
+                    for (size_t f = 0; f < nfar; f++) {
+                        const double *p = xyz + 3 * (size_t)far[f].pt;
+                        const double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
+                        const double d = dx * dx + dy * dy + dz * dz;
+                        if (d <= far[f].req.bound) heap_push(hp + f * kmax, &hc[f], far[f].req.k, d);
+                    }
                 }
             }
         }
@@ -515,12 +630,17 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
         int fail = 0;
 #pragma omp parallel num_threads(nt)
         {
-            uvec *mine = &th[omp_get_thread_num()];
+            hvec *mine = &th[omp_get_thread_num()];
             int ok = 1;
-#pragma omp for schedule(static, 65536)
-            for (size_t i = 0; i < n; i++) {
+#pragma omp for schedule(dynamic, 4)
+            for (size_t ch = 0; ch < rd->nch; ch++) {
+              const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+              size_t i0 = beg;
+              while (i0 < end && (part[i0] < 0 || !scan[part[i0]])) i0++;
+              const double *xc = ok && i0 < end ? chunk_xyz(rd, ch) : NULL;
+              for (size_t i = i0; xc && i < end; i++) {
                 if (!ok || part[i] < 0 || !scan[part[i]]) continue;
-                const double *x = c->xyz + 3 * i;
+                const double *x = xc + 3 * (i - beg);
                 int keep = 0;
                 if (nrq && x[0] >= glo[0] && x[0] <= ghi[0] && x[1] >= glo[1] && x[1] <= ghi[1] &&
                     x[2] >= glo[2] && x[2] <= ghi[2]) {
@@ -538,7 +658,8 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
                     const double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
                     keep = dx * dx + dy * dy + dz * dz <= far[f].req.bound;
                 }
-                if (keep) ok = uvec_push(mine, (uint32_t)i);
+                if (keep) ok = hvec_push(mine, (uint32_t)i, x);
+              }
             }
             if (!ok) {
 #pragma omp atomic write
@@ -550,8 +671,8 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
     free(bits);
     free(far);
     free(scan);
-    /* the threads' lists are in ascending order, one range each */
-    uint32_t *hv = NULL;
+    /* the threads' lists, each ascending: one array in input order */
+    hpoint *hv = NULL;
     size_t nh = 0;
     for (int t = 0; st == JF_OK && t < nt; t++) nh += th[t].n;
     if (st == JF_OK && !(hv = malloc((nh ? nh : 1) * sizeof *hv))) st = JF_ERR_NOMEM;
@@ -561,7 +682,7 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
             if (th[t].n) memcpy(hv + w, th[t].v, th[t].n * sizeof *hv);
             w += th[t].n;
         }
-        qsort(hv, nh, sizeof *hv, cmp_u32); /* static schedule: already near sorted */
+        qsort(hv, nh, sizeof *hv, cmp_hpoint);
     }
     for (int t = 0; t < nt; t++) free(th[t].v);
     free(th);
@@ -572,6 +693,45 @@ static jf_status halo_of(const jf_cloud *c, const int32_t *part, const double *b
     *halo = hv;
     *nhalo = nh;
     return JF_OK;
+}
+
+/* A sampled point: its Morton key and input index (parts.c's order). */
+typedef struct {
+    uint64_t key;
+    uint32_t id;
+} keyed_pt;
+
+static int keyed_pt_cmp(const void *a, const void *b)
+{
+    const keyed_pt *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+/* Rank of (key, id) among the sorted cuts: how many are <= it. */
+static int32_t keyed_pt_rank(const keyed_pt *cut, int ncut, uint64_t key, uint32_t id)
+{
+    int lo = 0, hi = ncut;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (cut[mid].key < key || (cut[mid].key == key && cut[mid].id <= id)) lo = mid + 1;
+        else hi = mid;
+    }
+    return (int32_t)lo;
+}
+
+/* jf_estimate_parts's sink without the coordinates. */
+typedef struct {
+    jf_block_fn sink;
+    void *user;
+} plain;
+
+static jf_status plain_block(void *user, const uint32_t *idx, const double *xyz, jf_result *res,
+                             size_t m)
+{
+    (void)xyz;
+    const plain *p = user;
+    return p->sink(p->user, idx, res, m);
 }
 
 jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int nparts,
@@ -591,76 +751,237 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
     }
     if (st != JF_OK || nparts == 1 || c->n == 0)
         return jf_estimate_blocks(c, o, sink, user, err); /* its own checks */
+    const jf_xyz_src src = {c->xyz, -1, NULL};
+    plain pl = {sink, user};
+    return jf__estimate_parts_src(c, &src, o, nparts, plain_block, &pl, err);
+}
+
+/* Step 1 on the reader: the bounding box and finite counts (one scan),
+ * the sample (a second), part[] with each part's box and count (a third):
+ * the same parts as jf__parts_split_sampled (same sample, same keys), the
+ * boxes the same min and max. */
+static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *count,
+                       double gbox[6], size_t *nfinite)
+{
+    const size_t n = rd->n, nch = rd->nch;
+    const int nt = rd->nt;
+    size_t *fc = calloc(nch + 1, sizeof *fc);
+    double *tb = malloc((size_t)nt * 6 * (size_t)(P > 1 ? P : 1) * sizeof *tb);
+    size_t *tc = calloc((size_t)nt * (size_t)P, sizeof *tc);
+    keyed_pt *smp = NULL, *cut = NULL;
+    jf_status st = fc && tb && tc ? JF_OK : JF_ERR_NOMEM;
+    if (st != JF_OK) goto out;
+    for (size_t j = 0; j < (size_t)nt * (size_t)P; j++)
+        for (int k = 0; k < 3; k++) tb[6 * j + k] = INFINITY, tb[6 * j + 3 + k] = -INFINITY;
+    /* 1. box (tb's first nt boxes) and finite points per chunk */
+#pragma omp parallel num_threads(nt)
+    {
+        double *bx = tb + 6 * (size_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 4)
+        for (size_t ch = 0; ch < nch; ch++) {
+            const double *x = chunk_xyz(rd, ch);
+            const size_t m = chunk_len(rd, ch);
+            size_t f = 0;
+            for (size_t j = 0; x && j < m; j++) {
+                const double *p = x + 3 * j;
+                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+                f++;
+                for (int d = 0; d < 3; d++) {
+                    if (p[d] < bx[d]) bx[d] = p[d];
+                    if (p[d] > bx[3 + d]) bx[3 + d] = p[d];
+                }
+            }
+            fc[ch + 1] = f;
+        }
+    }
+    if (rd->fail) goto out;
+    for (int k = 0; k < 3; k++) gbox[k] = INFINITY, gbox[3 + k] = -INFINITY;
+    for (int t = 0; t < nt; t++)
+        for (int d = 0; d < 3; d++) {
+            if (tb[6 * t + d] < gbox[d]) gbox[d] = tb[6 * t + d];
+            if (tb[6 * t + 3 + d] > gbox[3 + d]) gbox[3 + d] = tb[6 * t + 3 + d];
+        }
+    for (size_t ch = 0; ch < nch; ch++) fc[ch + 1] += fc[ch];
+    const size_t nf = fc[nch];
+    *nfinite = nf;
+    const double scale = jf__morton_scale(gbox);
+    /* 2. every stride-th finite point in input order (parts.c's rule) */
+    const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
+    const size_t ns = nf ? (nf + stride - 1) / stride : 0;
+    smp = malloc((ns ? ns : 1) * sizeof *smp);
+    cut = malloc((size_t)P * sizeof *cut);
+    if (!smp || !cut) {
+        st = JF_ERR_NOMEM;
+        goto out;
+    }
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 4)
+    for (size_t ch = 0; ch < nch; ch++) {
+        size_t seen = fc[ch];
+        if (fc[ch + 1] == seen) continue;
+        /* the chunk's first finite rank divisible by stride */
+        if ((seen + stride - 1) / stride * stride >= fc[ch + 1]) continue;
+        const double *x = chunk_xyz(rd, ch);
+        const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+        for (size_t j = 0; x && j < m; j++) {
+            const double *p = x + 3 * j;
+            if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+            if (seen % stride == 0)
+                smp[seen / stride] = (keyed_pt){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
+            seen++;
+        }
+    }
+    if (rd->fail) goto out;
+    qsort(smp, ns, sizeof *smp, keyed_pt_cmp);
+    int ncut = 0;
+    for (int r = 1; r < P && ns; r++) cut[ncut++] = smp[(size_t)r * ns / (size_t)P];
+    /* 3. part[], the parts' boxes and counts (per thread, then merged) */
+#pragma omp parallel num_threads(nt)
+    {
+        const size_t t = (size_t)omp_get_thread_num();
+        double *bx = tb + 6 * (size_t)P * t;
+        size_t *cn = tc + (size_t)P * t;
+#pragma omp for schedule(dynamic, 4)
+        for (size_t ch = 0; ch < nch; ch++) {
+            const double *x = chunk_xyz(rd, ch);
+            const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+            for (size_t j = 0; x && j < m; j++) {
+                const double *p = x + 3 * j;
+                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) {
+                    part[beg + j] = -1;
+                    continue;
+                }
+                const int32_t a = keyed_pt_rank(cut, ncut, jf__morton_key(p, gbox, scale),
+                                                (uint32_t)(beg + j));
+                part[beg + j] = a;
+                double *b = bx + 6 * a;
+                for (int d = 0; d < 3; d++) {
+                    if (p[d] < b[d]) b[d] = p[d];
+                    if (p[d] > b[3 + d]) b[3 + d] = p[d];
+                }
+                cn[a]++;
+            }
+        }
+    }
+    if (rd->fail) goto out;
+    for (int a = 0; a < P; a++) {
+        double *b = box + 6 * a;
+        for (int k = 0; k < 3; k++) b[k] = INFINITY, b[3 + k] = -INFINITY;
+        count[a] = 0;
+        for (int t = 0; t < nt; t++) {
+            const double *s = tb + 6 * ((size_t)P * (size_t)t + (size_t)a);
+            for (int d = 0; d < 3; d++) {
+                if (s[d] < b[d]) b[d] = s[d];
+                if (s[3 + d] > b[3 + d]) b[3 + d] = s[3 + d];
+            }
+            count[a] += tc[(size_t)P * (size_t)t + (size_t)a];
+        }
+    }
+out:
+    free(fc);
+    free(tb);
+    free(tc);
+    free(smp);
+    free(cut);
+    (void)n;
+    return st;
+}
+
+/* The non-finite points' rows (NaN, NONFINITE), with the coordinates
+ * read: chunks holding one are read, on the calling thread. */
+static jf_status nonfinite_rows(reader *rd, const int32_t *part, jf__block_xyz_fn sink,
+                                void *user)
+{
+    jf_result blk[64];
+    uint32_t id[64];
+    double xs[3 * 64];
+    size_t mm = 0;
+    jf_status st = JF_OK;
+    for (size_t ch = 0; st == JF_OK && ch < rd->nch; ch++) {
+        const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+        size_t i = beg;
+        while (i < end && part[i] >= 0) i++;
+        if (i == end) continue;
+        const double *x = chunk_xyz(rd, ch);
+        if (!x) return JF_ERR_IO;
+        for (; st == JF_OK && i < end; i++) {
+            if (part[i] >= 0) continue;
+            jf_result *r = &blk[mm];
+            memset(r, 0, sizeof *r);
+            r->status = JF_PT_NONFINITE;
+            r->cond = r->residual = NAN;
+            for (int j = 0; j < 3; j++) r->pca_eval[j] = NAN;
+            jf__result_nan(r);
+            memcpy(xs + 3 * mm, x + 3 * (i - beg), sizeof(double[3]));
+            id[mm++] = (uint32_t)i;
+            if (mm == 64) {
+                st = sink(user, id, xs, blk, mm);
+                mm = 0;
+            }
+        }
+    }
+    if (st == JF_OK && mm) st = sink(user, id, xs, blk, mm);
+    return st;
+}
+
+jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
+                                 const jf_estimate_opts *o, int nparts, jf__block_xyz_fn sink,
+                                 void *user, jf_error *err)
+{
+    if (err) err->msg[0] = '\0';
+    if (!c || !src || !o || !sink || (c->n && !src->xyz && (src->fd < 0 || !src->l)) ||
+        nparts < 2 || nparts > JF_PARTS_MAX) {
+        set_err(err, "jf__estimate_parts_src: NULL argument or nparts out of 2..65536");
+        return JF_ERR_INVALID;
+    }
+    jf_part_query q;
+    jf_status st = jf__part_query_init(o, &q);
+    if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
+        set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
+                     "orientation (not mst)");
+        return JF_ERR_UNSUPPORTED;
+    }
+    if (st != JF_OK) {
+        set_err(err, "invalid parameters");
+        return st;
+    }
     /* the whole cloud's checks first (a bad option fails before any work);
      * the parts then share one resolved orientation */
     jf_estimate_opts use;
     if ((st = jf__estimate_check(c, o, &use, err)) != JF_OK) return st;
     o = &use;
     const size_t n = c->n;
+    if (n == 0) return JF_OK;
     const int P = nparts, nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
     int32_t *part = malloc(n * sizeof *part);
-    size_t *count = calloc((size_t)P, sizeof *count), cmax = 0;
+    size_t *count = calloc((size_t)P, sizeof *count), cmax = 0, nf = 0;
     double *box = malloc((size_t)P * 6 * sizeof *box);
-    uint32_t *ids = NULL, *halo = NULL;
+    uint32_t *ids = NULL;
+    hpoint *halo = NULL;
     double *sxyz = NULL, *snrm = NULL;
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
+    size_t *ccnt = NULL;
     occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, NULL};
-    if (!part || !count || !box) {
+    reader rd;
+    double gb[6];
+    if ((st = reader_open(&rd, src, n, nt)) != JF_OK) goto out;
+    if (!part || !count || !box || !(ccnt = malloc((rd.nch + 1) * sizeof *ccnt))) {
         st = JF_ERR_NOMEM;
         goto out;
     }
-    if ((st = jf__parts_split_sampled(c->xyz, n, P, nt, part)) != JF_OK) goto out;
-    for (int b = 0; b < P; b++)
-        for (int k = 0; k < 3; k++) box[6 * b + k] = INFINITY, box[6 * b + 3 + k] = -INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        if (part[i] < 0) continue;
-        double *bx = box + 6 * part[i];
-        for (int k = 0; k < 3; k++) {
-            const double v = c->xyz[3 * i + (size_t)k];
-            bx[k] = v < bx[k] ? v : bx[k];
-            bx[3 + k] = v > bx[3 + k] ? v : bx[3 + k];
-        }
-        count[part[i]]++;
-    }
-    /* the non-finite points' rows */
-    {
-        jf_result blk[64];
-        uint32_t id[64];
-        size_t mm = 0;
-        for (size_t i = 0; st == JF_OK && i <= n; i++) {
-            if (i < n && part[i] >= 0) continue;
-            if (i < n) {
-                jf_result *r = &blk[mm];
-                memset(r, 0, sizeof *r);
-                r->status = JF_PT_NONFINITE;
-                r->cond = r->residual = NAN;
-                for (int j = 0; j < 3; j++) r->pca_eval[j] = NAN;
-                jf__result_nan(r);
-                id[mm++] = (uint32_t)i;
-            }
-            if (mm && (mm == 64 || i == n)) {
-                st = sink(user, id, blk, mm);
-                mm = 0;
-            }
-        }
-        if (st != JF_OK) goto out;
+    if ((st = split(&rd, P, part, box, count, gb, &nf)) != JF_OK) goto out;
+    if ((st = reader_status(&rd, err)) != JF_OK) goto out;
+    if (nf < n && (st = nonfinite_rows(&rd, part, sink, user)) != JF_OK) {
+        if (rd.fail) st = reader_status(&rd, err);
+        goto out;
     }
     for (int b = 0; b < P; b++) cmax = count[b] > cmax ? count[b] : cmax;
-    {
-        double gb[6];
-        jf__parts_bbox(c->xyz, n, gb);
-        occ_setup(&occ, gb, jf__parts_grid_bits(n));
-        occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
-        occ.near = malloc((size_t)P);
-        if (!occ.bits || !occ.near) {
-            st = JF_ERR_NOMEM;
-            goto out;
-        }
-    }
+    occ_setup(&occ, gb, jf__parts_grid_bits(n));
+    occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
+    occ.near = malloc((size_t)P);
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
-    if (!ids || !sxyz) {
+    if (!occ.bits || !occ.near || !ids || !sxyz) {
         st = JF_ERR_NOMEM;
         goto out;
     }
@@ -674,15 +995,19 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
             goto out;
         }
         /* step 2: own index, requests, halo */
-        size_t m = gather(c, part, a, ids, sxyz, nt), nh = 0;
+        size_t m = gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
+        if ((st = reader_status(&rd, err)) != JF_OK) goto out;
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        occ_mark(&occ, c, part, a, box, P, nt);
-        st = halo_of(c, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
+        occ_mark(&occ, &rd, part, a, box, P);
+        st = rd.fail ? JF_ERR_IO
+                     : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
         jf_index_free(own);
+        if (rd.fail) st = reader_status(&rd, err);
         if (st != JF_OK) break;
-        /* step 3: own + halo in input order */
-        size_t ms = m + nh, u = 0, v = 0, k = 0;
+        /* step 3: own + halo in input order, merged from the back into
+         * sxyz (the own coordinates stay ahead of the write) */
+        size_t ms = m + nh, u = m, v = nh, k = ms;
         uint32_t *sid = malloc(ms * sizeof *sid);
         double *nx = realloc(sxyz, 3 * (ms > cmax ? ms : cmax) * sizeof *nx);
         mask = malloc(ms);
@@ -693,13 +1018,19 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
             break;
         }
         sxyz = nx;
-        while (u < m || v < nh) {
-            int own_next = v == nh || (u < m && ids[u] < halo[v]);
-            uint32_t g = own_next ? ids[u++] : halo[v++];
-            sid[k] = g;
+        while (k > 0) {
+            int own_next = v == 0 || (u > 0 && ids[u - 1] > halo[v - 1].id);
+            k--;
+            if (own_next) {
+                u--;
+                sid[k] = ids[u];
+                memmove(sxyz + 3 * k, sxyz + 3 * u, sizeof(double[3]));
+            } else {
+                v--;
+                sid[k] = halo[v].id;
+                memcpy(sxyz + 3 * k, halo[v].x, sizeof(double[3]));
+            }
             mask[k] = (uint8_t)own_next;
-            memcpy(sxyz + 3 * k, c->xyz + 3 * (size_t)g, sizeof(double[3]));
-            k++;
         }
         free(halo);
         halo = NULL;
@@ -720,7 +1051,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         sc.scan = sscan;
         sc.scanner = c->scanner;
         sc.nscans = c->nscans;
-        relay rl = {sid, sink, user};
+        relay rl = {sid, sxyz, sink, user};
         st = jf__estimate_blocks_masked(&sc, &po, mask, relay_block, &rl, err);
         free(sid);
         free(snrm);
@@ -735,6 +1066,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
 out:
     if (st != JF_OK && err && !err->msg[0])
         set_err(err, st == JF_ERR_NOMEM ? "out of memory (parts)" : jf_strerror(st));
+    reader_close(&rd);
     free(part);
     free(count);
     free(box);
@@ -744,6 +1076,7 @@ out:
     free(snrm);
     free(sscan);
     free(mask);
+    free(ccnt);
     free(occ.bits);
     free(occ.near);
     return st;

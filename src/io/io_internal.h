@@ -100,6 +100,11 @@ jf_status jf_read_e57(const char *buf, size_t len, const char *name, const jf_re
  * whole.  Otherwise JF_OK, or JF_ERR_IO / _NOMEM with err set. */
 jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *o,
                                jf_cloud *c, jf_error *err);
+/* The same without the coordinates (c->xyz NULL; n, normals, attributes
+ * read): the bounded-memory estimate reads them from the file as it goes
+ * (src/estimate/parts.h, jf_xyz_src). */
+jf_status jf__read_ply_chunked_noxyz(int fd, size_t len, const char *name,
+                                     const jf_read_opts *o, jf_cloud *c, jf_error *err);
 
 /* Where the point rows of a binary PLY (io_ply.c) or a LAS file
  * (io_las.c) are -- fixed-size rows, the file's length as its header says

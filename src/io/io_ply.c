@@ -747,8 +747,23 @@ static int pread_all(int fd, unsigned char *p, size_t n, uint64_t at, int *e)
     return 1;
 }
 
+static jf_status read_chunked(int fd, size_t len, const char *name, const jf_read_opts *ro,
+                              jf_cloud *c, jf_error *err, int with_xyz);
+
 jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_read_opts *ro,
                                jf_cloud *c, jf_error *err)
+{
+    return read_chunked(fd, len, name, ro, c, err, 1);
+}
+
+jf_status jf__read_ply_chunked_noxyz(int fd, size_t len, const char *name,
+                                     const jf_read_opts *ro, jf_cloud *c, jf_error *err)
+{
+    return read_chunked(fd, len, name, ro, c, err, 0);
+}
+
+static jf_status read_chunked(int fd, size_t len, const char *name, const jf_read_opts *ro,
+                              jf_cloud *c, jf_error *err, int with_xyz)
 {
     size_t got = len < HEAD_MAX ? len : HEAD_MAX;
     unsigned char *buf = malloc(got > CHUNK_BYTES ? got : CHUNK_BYTES);
@@ -782,18 +797,19 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
     if (ix < 0 || iy < 0 || iz < 0)
         goto out;
     size_t n = (size_t)el->count;
-    double *xyz = malloc((n ? n : 1) * 3 * sizeof(double)), *nrm = NULL;
+    double *xyz = with_xyz ? malloc((n ? n : 1) * 3 * sizeof(double)) : NULL, *nrm = NULL;
     int has_n = inx >= 0 && iny >= 0 && inz >= 0;
     if (has_n)
         nrm = malloc((n ? n : 1) * 3 * sizeof(double));
-    if (!xyz || (has_n && !nrm)) {
+    if ((with_xyz && !xyz) || (has_n && !nrm)) {
         free(xyz);
         free(nrm);
         st = jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for %zu vertices", n);
         goto out;
     }
     double *dst[MAX_PROPS] = {0};
-    dst[ix] = xyz, dst[iy] = xyz + 1, dst[iz] = xyz + 2;
+    if (with_xyz)
+        dst[ix] = xyz, dst[iy] = xyz + 1, dst[iz] = xyz + 2;
     if (has_n)
         dst[inx] = nrm, dst[iny] = nrm + 1, dst[inz] = nrm + 2;
     /* the attributes, as the whole-file path describes them */
@@ -834,7 +850,9 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
         jf_attrs_free(&ta);
         goto out; /* a row over the chunk: the whole-file path */
     }
-    for (size_t r0 = 0; r0 < n; r0 += per) {
+    /* without coordinates, normals or attributes: nothing to read */
+    const size_t nrows = with_xyz || has_n || ta.nattrs ? n : 0;
+    for (size_t r0 = 0; r0 < nrows; r0 += per) {
         size_t m = n - r0 < per ? n - r0 : per;
         if (!pread_all(fd, buf, m * vrow, at + r0 * vrow, &e)) {
             free(xyz);

@@ -5,6 +5,7 @@
  * in parts give the bytes of the unbounded run for every k-d tree
  * neighbourhood and text or binary output. */
 #include <check.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,6 +108,75 @@ START_TEST(small_budgets_same_bytes)
 }
 END_TEST
 
+/* A binary PLY written here, so the test knows every byte: n points of a
+ * wavy sheet (x y z doubles), a per-point uchar and float the estimate
+ * keeps, and every 997th point NaN (a nonfinite row). */
+static void write_sheet(const char *path, size_t n, uint64_t seed)
+{
+    FILE *f = fopen(path, "wb");
+    ck_assert_msg(f != NULL, "%s", path);
+    fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %zu\nproperty double x\n"
+               "property double y\nproperty double z\nproperty uchar label\n"
+               "property float intensity\nend_header\n", n);
+    for (size_t i = 0; i < n; i++) {
+        double x = jf_unit(jf_splitmix64(&seed)), y = jf_unit(jf_splitmix64(&seed));
+        double p[3] = {x, y, 0.1 * sin(6 * x) * cos(5 * y) + 1e-4 * jf_unit(jf_splitmix64(&seed))};
+        if (i % 997 == 13) p[1] = NAN;
+        unsigned char label = (unsigned char)(i % 7);
+        float in = (float)(i % 1000) / 3.0f;
+        ck_assert_uint_eq(fwrite(p, sizeof p, 1, f), 1); /* the test machine is little endian */
+        ck_assert_uint_eq(fwrite(&label, 1, 1, f), 1);
+        ck_assert_uint_eq(fwrite(&in, sizeof in, 1, f), 1);
+    }
+    fclose(f);
+}
+
+/* --memory below what the coordinates need in memory: the parts read them
+ * from the input file as they go (docs/scale.md), the refusal says so, and
+ * the rows are the unbounded run's, byte for byte: knn, radius, knn+radius
+ * and auto neighbourhoods, the input's attributes kept, non-finite points,
+ * binary PLY and CSV (through the spool) outputs. */
+START_TEST(coordinates_on_disk_same_bytes)
+{
+    write_sheet(cli_path("in.ply"), 30000, 5);
+    static const struct {
+        const char *nb, *ext, *keep;
+    } runs[] = {{"knn:16", "ply", "all"},        {"radius:0.02", "csv", "all"},
+                {"knn:12,radius:0.015", "ply", "none"}, {"auto", "ply", "all"}};
+    for (size_t k = 0; k < sizeof runs / sizeof *runs; k++) {
+        char w[32], p[32];
+        snprintf(w, sizeof w, "w%zu.%s", k, runs[k].ext);
+        snprintf(p, sizeof p, "p%zu.%s", k, runs[k].ext);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(w), "--neighbors",
+                                 runs[k].nb, "--threads", "2", "--keep", runs[k].keep, NULL),
+                         0);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+                                 runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
+                                 "1K", NULL),
+                         1);
+        ck_assert_msg(strstr(cli_err, "with the coordinates read from the file as needed"), "%s",
+                      cli_err);
+        ck_assert_int_eq(cli_exists(cli_path(p)), 0);
+        const unsigned long long least = least_named();
+        ck_assert_msg(least > 0, "%s", cli_err);
+        char mem[32];
+        snprintf(mem, sizeof mem, "%lluK", (least >> 10) - 1);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+                                 runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
+                                 mem, NULL),
+                         1);
+        ck_assert_uint_eq(least_named(), least);
+        snprintf(mem, sizeof mem, "%lluK", least >> 10);
+        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+                                 runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
+                                 mem, NULL),
+                         0);
+        ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
+        same_bytes(cli_path(w), cli_path(p));
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_memory");
@@ -115,6 +185,7 @@ int main(void)
     tcase_set_timeout(tc, 900);
     tcase_add_test(tc, too_small_is_refused_with_the_least);
     tcase_add_test(tc, small_budgets_same_bytes);
+    tcase_add_test(tc, coordinates_on_disk_same_bytes);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
