@@ -199,19 +199,32 @@ jf_status jf_tmpfile_commit(jf_tmpfile *t, const char *final, jf_error *err)
         close(t->fd);
         t->fd = -1;
     }
+    /* a second descriptor holds our inode until the check after the
+     * rename: closed, a replaced temporary's inode number could be reused
+     * by the link put in its place, which the check would then take for ours */
+    const int hold = t->fd >= 0 ? dup(t->fd) : -1;
     if (t->fd >= 0 && close(t->fd) != 0)
         st = jf_io_fail(err, JF_ERR_IO, name, 0, "close failed: %s", strerror(errno));
     t->fd = -1;
+    if (st == JF_OK && known && hold < 0)
+        st = jf_io_fail(err, JF_ERR_IO, name, 0, "cannot duplicate its descriptor: %s",
+                        strerror(errno));
     if (st == JF_OK && rename(t->tmp, t->target) != 0)
         st = jf_io_fail(err, JF_ERR_IO, name, 0, "cannot rename the finished file onto it: %s",
                         strerror(errno));
     /* the name may have been swapped between the check and the rename:
      * then what the rename put in place is not our file, and it goes */
     struct stat c;
-    if (st == JF_OK && known && (lstat(t->target, &c) != 0 || c.st_dev != a.st_dev || c.st_ino != a.st_ino)) {
+    if (st == JF_OK && known &&
+        (lstat(t->target, &c) != 0 || !S_ISREG(c.st_mode) || c.st_dev != a.st_dev ||
+         c.st_ino != a.st_ino)) {
         unlink(t->target);
         st = jf_io_fail(err, JF_ERR_IO, name, 0,
                         "its temporary %s was replaced by another process", t->tmp);
+    }
+    if (hold >= 0 && close(hold) != 0 && st == JF_OK) { /* the last close: NFS reports here */
+        unlink(t->target);
+        st = jf_io_fail(err, JF_ERR_IO, name, 0, "close failed: %s", strerror(errno));
     }
     if (st != JF_OK)
         unlink(t->tmp);
