@@ -273,8 +273,8 @@ static jf_status las_header(const unsigned char *b, size_t have, uint64_t size, 
                           fmt_byte, fmt_byte);
     if (fmt_byte & 0xc0)
         return jf_io_fail(err, JF_ERR_UNSUPPORTED, name, 0,
-                          "compressed LAS (LAZ) is not read: decompress it first, e.g. "
-                          "`pdal translate in.laz out.las` or `las2las -i in.laz -o out.las`");
+                          "header: byte 104 (0x%02X) flags compressed points where the "
+                          "plain LAS records were expected", fmt_byte);
     unsigned fmt = fmt_byte & 0x3f;
     if (hsize < 227 || hsize > size || hsize > have)
         return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
