@@ -397,14 +397,9 @@ out:
 
 /* ------------------------------------------- partition from a sample */
 
-typedef struct {
-    uint64_t key;
-    uint32_t id;
-} keyed;
-
-static int keyed_cmp(const void *a, const void *b)
+int jf__keyed_cmp(const void *a, const void *b)
 {
-    const keyed *x = a, *y = b;
+    const jf__keyed *x = a, *y = b;
     if (x->key != y->key) return x->key < y->key ? -1 : 1;
     return (x->id > y->id) - (x->id < y->id);
 }
@@ -415,8 +410,7 @@ size_t jf__parts_sample_size(size_t nf)
     return s < JF_PARTS_SAMPLE ? s : JF_PARTS_SAMPLE;
 }
 
-/* Rank of (key, id) among the sorted cuts: how many are <= it. */
-static int32_t cut_rank(const keyed *cut, int ncut, uint64_t key, uint32_t id)
+int32_t jf__keyed_rank(const jf__keyed *cut, int ncut, uint64_t key, uint32_t id)
 {
     int lo = 0, hi = ncut;
     while (lo < hi) {
@@ -439,8 +433,8 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
     /* every stride-th finite point, in input order: about JF_PARTS_SAMPLE */
     const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
     size_t ns = nf ? (nf + stride - 1) / stride : 0, got = 0, seen = 0;
-    keyed *s = malloc((ns ? ns : 1) * sizeof *s);
-    keyed *cut = malloc((size_t)nparts * sizeof *cut);
+    jf__keyed *s = malloc((ns ? ns : 1) * sizeof *s);
+    jf__keyed *cut = malloc((size_t)nparts * sizeof *cut);
     if (!s || !cut) {
         free(s);
         free(cut);
@@ -448,9 +442,10 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
     }
     for (size_t i = 0; i < n && got < ns; i++) {
         if (!finite3(xyz + 3 * i)) continue;
-        if (seen++ % stride == 0) s[got++] = (keyed){jf__morton_key(xyz + 3 * i, box, scale), (uint32_t)i};
+        if (seen++ % stride == 0)
+            s[got++] = (jf__keyed){jf__morton_key(xyz + 3 * i, box, scale), (uint32_t)i};
     }
-    qsort(s, got, sizeof *s, keyed_cmp);
+    qsort(s, got, sizeof *s, jf__keyed_cmp);
     /* cut r (1..P-1) is the sample's r/P quantile: part r starts there */
     int ncut = 0;
     for (int r = 1; r < nparts && got; r++) cut[ncut++] = s[(size_t)r * got / (size_t)nparts];
@@ -459,7 +454,8 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
 #pragma omp parallel for num_threads(nt) schedule(static, 65536)
     for (size_t i = 0; i < n; i++) {
         const double *p = xyz + 3 * i;
-        part[i] = finite3(p) ? cut_rank(cut, ncut, jf__morton_key(p, box, scale), (uint32_t)i) : -1;
+        part[i] = finite3(p) ? jf__keyed_rank(cut, ncut, jf__morton_key(p, box, scale), (uint32_t)i)
+                             : -1;
     }
     free(cut);
     return JF_OK;

@@ -69,6 +69,15 @@ jf_status jf__parts_split(const double *xyz, size_t n, int nparts, int32_t *part
  * points.  Parts are near equal, not exactly (the sample's error, about
  * sqrt(P / JF_PARTS_SAMPLE) of a part); memory: 16 bytes per sampled
  * point, not 12+ per point as the sort.  Same errors as jf__parts_split. */
+/* A sampled point: its Morton key and input index, ordered by (key,
+ * index) (jf__keyed_cmp, for qsort); jf__keyed_rank: how many of the
+ * ncut sorted cuts are <= (key, id), the part of that point. */
+typedef struct {
+    uint64_t key;
+    uint32_t id;
+} jf__keyed;
+int jf__keyed_cmp(const void *a, const void *b);
+int32_t jf__keyed_rank(const jf__keyed *cut, int ncut, uint64_t key, uint32_t id);
 #define JF_PARTS_SAMPLE ((size_t)1 << 16)
 /* The sample's size for nf finite points: nf / 16, in 256..2^16. */
 size_t jf__parts_sample_size(size_t nf);

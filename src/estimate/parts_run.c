@@ -695,31 +695,6 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     return JF_OK;
 }
 
-/* A sampled point: its Morton key and input index (parts.c's order). */
-typedef struct {
-    uint64_t key;
-    uint32_t id;
-} keyed_pt;
-
-static int keyed_pt_cmp(const void *a, const void *b)
-{
-    const keyed_pt *x = a, *y = b;
-    if (x->key != y->key) return x->key < y->key ? -1 : 1;
-    return (x->id > y->id) - (x->id < y->id);
-}
-
-/* Rank of (key, id) among the sorted cuts: how many are <= it. */
-static int32_t keyed_pt_rank(const keyed_pt *cut, int ncut, uint64_t key, uint32_t id)
-{
-    int lo = 0, hi = ncut;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (cut[mid].key < key || (cut[mid].key == key && cut[mid].id <= id)) lo = mid + 1;
-        else hi = mid;
-    }
-    return (int32_t)lo;
-}
-
 /* jf_estimate_parts's sink without the coordinates. */
 typedef struct {
     jf_block_fn sink;
@@ -768,7 +743,7 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     size_t *fc = calloc(nch + 1, sizeof *fc);
     double *tb = malloc((size_t)nt * 6 * (size_t)(P > 1 ? P : 1) * sizeof *tb);
     size_t *tc = calloc((size_t)nt * (size_t)P, sizeof *tc);
-    keyed_pt *smp = NULL, *cut = NULL;
+    jf__keyed *smp = NULL, *cut = NULL;
     jf_status st = fc && tb && tc ? JF_OK : JF_ERR_NOMEM;
     if (st != JF_OK) goto out;
     for (size_t j = 0; j < (size_t)nt * (size_t)P; j++)
@@ -826,12 +801,13 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
             const double *p = x + 3 * j;
             if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
             if (seen % stride == 0)
-                smp[seen / stride] = (keyed_pt){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
+                smp[seen / stride] =
+                    (jf__keyed){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
             seen++;
         }
     }
     if (rd->fail) goto out;
-    qsort(smp, ns, sizeof *smp, keyed_pt_cmp);
+    qsort(smp, ns, sizeof *smp, jf__keyed_cmp);
     int ncut = 0;
     for (int r = 1; r < P && ns; r++) cut[ncut++] = smp[(size_t)r * ns / (size_t)P];
     /* 3. part[], the parts' boxes and counts (per thread, then merged) */
@@ -850,7 +826,7 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
                     part[beg + j] = -1;
                     continue;
                 }
-                const int32_t a = keyed_pt_rank(cut, ncut, jf__morton_key(p, gbox, scale),
+                const int32_t a = jf__keyed_rank(cut, ncut, jf__morton_key(p, gbox, scale),
                                                 (uint32_t)(beg + j));
                 part[beg + j] = a;
                 double *b = bx + 6 * a;

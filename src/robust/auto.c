@@ -470,17 +470,6 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
     moments(p, nbr, k, fr, H, d, &mk);
     const mom *mo = &mk;
     if (!(mo->hmean > 0.0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
-    static const unsigned char gpos[NMON][NMON] = {
-        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9},
-        {1, 3, 4, 6, 7, 8, 10, 11, 12, 13},
-        {2, 4, 5, 7, 8, 9, 11, 12, 13, 14},
-        {3, 6, 7, 10, 11, 12, 15, 16, 17, 18},
-        {4, 7, 8, 11, 12, 13, 16, 17, 18, 19},
-        {5, 8, 9, 12, 13, 14, 17, 18, 19, 20},
-        {6, 10, 11, 15, 16, 17, 21, 22, 23, 24},
-        {7, 11, 12, 16, 17, 18, 22, 23, 24, 25},
-        {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
-        {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
     const double h = mo->hmean, sc = H / h, sp[4] = {1.0, sc, sc * sc, sc * sc * sc};
     const size_t m = mo->m;
     unsigned flags = 0;
