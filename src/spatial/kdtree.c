@@ -130,15 +130,18 @@ typedef struct {
     double *pts;
     uint32_t *id;
     kd_node *nodes;
+    uint32_t *minid; /* each node's smallest input index (the tie rule's) */
 } kd_builder;
 
 #define KD_TASK_MIN 65536 /* subtrees at least this big build as OpenMP tasks */
+#define KD_COPY_BLOCK 65536 /* input points a thread copies into the tree at a time */
 
 /* Builds node ni over [begin, end); its descendants take the node slots
  * from `next` on, in depth-first order (children side by side, the left
  * subtree's before the right's), so the layout does not depend on which
  * thread builds which subtree.  Large subtrees run as OpenMP tasks. */
-static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end, size_t next)
+static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end, size_t next,
+                       const double *box)
 {
     kd_node *nd = &b->nodes[ni];
     size_t cnt = end - begin;
@@ -146,17 +149,24 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
         nd->lo = nd->hi = 0.0;
         nd->first = (uint32_t)begin;
         nd->dim = KD_IS_LEAF | (uint32_t)(cnt << 2);
+        uint32_t mn = UINT32_MAX;
+        for (size_t j = begin; j < end; j++) mn = b->id[j] < mn ? b->id[j] : mn;
+        b->minid[ni] = mn;
         return;
     }
     double lo[3], hi[3];
     const double *p = b->pts;
-    for (int d = 0; d < 3; d++) lo[d] = hi[d] = p[3 * begin + d];
-    for (size_t i = begin + 1; i < end; i++)
-        for (int d = 0; d < 3; d++) {
-            double v = p[3 * i + d];
-            if (v < lo[d]) lo[d] = v;
-            if (v > hi[d]) hi[d] = v;
-        }
+    if (box) { /* the root: the cloud's box, found by the threads */
+        for (int d = 0; d < 3; d++) lo[d] = box[d], hi[d] = box[3 + d];
+    } else {
+        for (int d = 0; d < 3; d++) lo[d] = hi[d] = p[3 * begin + d];
+        for (size_t i = begin + 1; i < end; i++)
+            for (int d = 0; d < 3; d++) {
+                double v = p[3 * i + d];
+                if (v < lo[d]) lo[d] = v;
+                if (v > hi[d]) hi[d] = v;
+            }
+    }
     int dim = 0;
     for (int d = 1; d < 3; d++)
         if (hi[d] - lo[d] > hi[dim] - lo[dim]) dim = d;
@@ -172,9 +182,10 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
     nd->dim = (uint32_t)dim;
     size_t right_next = child + 2 + count_nodes(mid - begin) - 1;
 #pragma omp task if (cnt >= KD_TASK_MIN) default(none) firstprivate(b, child, begin, mid)
-    build_node(b, child, begin, mid, child + 2);
-    build_node(b, child + 1, mid, end, right_next);
+    build_node(b, child, begin, mid, child + 2, NULL);
+    build_node(b, child + 1, mid, end, right_next, NULL);
 #pragma omp taskwait
+    b->minid[ni] = b->minid[child] < b->minid[child + 1] ? b->minid[child] : b->minid[child + 1];
 }
 
 static int finite3(const double *p)
@@ -197,8 +208,24 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     jf_index *ix = calloc(1, sizeof *ix);
     if (!ix) return JF_ERR_NOMEM;
     ix->n = n;
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++) m += finite3(xyz + 3 * i) ? 1 : 0;
+    /* the finite points in input order, on the threads: counted per block,
+     * each block then copied at its offset with its box (issue 28.3) */
+    const int nt = threads > 0 ? threads : jf_default_threads(NULL);
+    const size_t nblk = (n + KD_COPY_BLOCK - 1) / KD_COPY_BLOCK;
+    size_t *off = calloc(nblk + 1, sizeof *off);
+    double *bb = malloc((nblk ? nblk : 1) * 6 * sizeof *bb);
+    if (!off || !bb) {
+        free(off), free(bb), free(ix);
+        return JF_ERR_NOMEM;
+    }
+#pragma omp parallel for num_threads(nt) schedule(static) if (nblk > 1)
+    for (size_t k = 0; k < nblk; k++) {
+        size_t c = 0, e = (k + 1) * KD_COPY_BLOCK < n ? (k + 1) * KD_COPY_BLOCK : n;
+        for (size_t i = k * KD_COPY_BLOCK; i < e; i++) c += finite3(xyz + 3 * i) ? 1 : 0;
+        off[k + 1] = c;
+    }
+    for (size_t k = 0; k < nblk; k++) off[k + 1] += off[k];
+    size_t m = off[nblk];
     ix->m = m;
     ix->nnodes = m ? count_nodes(m) : 0;
     ix->pts = malloc((m ? m : 1) * 3 * sizeof *ix->pts);
@@ -206,44 +233,46 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);
     ix->minid = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->minid);
     if (!ix->pts || !ix->id || !ix->nodes || !ix->minid) {
+        free(off), free(bb);
         jf_index_free(ix);
         return JF_ERR_NOMEM;
     }
-    size_t j = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (!finite3(xyz + 3 * i)) continue;
-        memcpy(ix->pts + 3 * j, xyz + 3 * i, 3 * sizeof(double));
-        ix->id[j++] = (uint32_t)i;
+#pragma omp parallel for num_threads(nt) schedule(static) if (nblk > 1)
+    for (size_t k = 0; k < nblk; k++) {
+        size_t j = off[k], e = (k + 1) * KD_COPY_BLOCK < n ? (k + 1) * KD_COPY_BLOCK : n;
+        double *q = bb + 6 * k;
+        for (size_t i = k * KD_COPY_BLOCK; i < e; i++) {
+            const double *p = xyz + 3 * i;
+            if (!finite3(p)) continue;
+            if (j == off[k])
+                for (int d = 0; d < 3; d++) q[d] = q[3 + d] = p[d];
+            for (int d = 0; d < 3; d++) {
+                if (p[d] < q[d]) q[d] = p[d];
+                if (p[d] > q[3 + d]) q[3 + d] = p[d];
+            }
+            memcpy(ix->pts + 3 * j, p, 3 * sizeof(double));
+            ix->id[j++] = (uint32_t)i;
+        }
     }
-    for (int d = 0; d < 3; d++) {
-        ix->bbox[d] = m ? ix->pts[d] : 0.0;
-        ix->bbox[3 + d] = m ? ix->pts[d] : 0.0;
-    }
-    for (size_t i = 1; i < m; i++)
+    /* blocks in input order, the first of equal values kept, as one pass would */
+    for (int d = 0; d < 6; d++) ix->bbox[d] = 0.0;
+    for (size_t k = 0, any = 0; k < nblk; k++) {
+        if (off[k + 1] == off[k]) continue;
+        const double *q = bb + 6 * k;
         for (int d = 0; d < 3; d++) {
-            double v = ix->pts[3 * i + d];
-            if (v < ix->bbox[d]) ix->bbox[d] = v;
-            if (v > ix->bbox[3 + d]) ix->bbox[3 + d] = v;
+            if (!any || q[d] < ix->bbox[d]) ix->bbox[d] = q[d];
+            if (!any || q[3 + d] > ix->bbox[3 + d]) ix->bbox[3 + d] = q[3 + d];
         }
+        any = 1;
+    }
+    free(off), free(bb);
     if (m) {
-        const kd_builder b = {ix->pts, ix->id, ix->nodes};
+        const kd_builder b = {ix->pts, ix->id, ix->nodes, ix->minid};
         const kd_builder *bp = &b;
-        const int nt = threads > 0 ? threads : jf_default_threads(NULL);
-#pragma omp parallel if (m >= 2 * KD_TASK_MIN) num_threads(nt) default(none) shared(bp, m)
+        const double *box = ix->bbox;
+#pragma omp parallel if (m >= 2 * KD_TASK_MIN) num_threads(nt) default(none) shared(bp, m, box)
 #pragma omp single
-        build_node(bp, 0, 0, m, 1);
-        /* children come after their parent: one pass from the last node */
-        for (size_t ni = ix->nnodes; ni-- > 0;) {
-            const kd_node *nd = &ix->nodes[ni];
-            uint32_t mn = UINT32_MAX;
-            if ((nd->dim & 3u) == KD_IS_LEAF)
-                for (uint32_t j = nd->first, e = nd->first + (nd->dim >> 2); j < e; j++)
-                    mn = ix->id[j] < mn ? ix->id[j] : mn;
-            else
-                mn = ix->minid[nd->first] < ix->minid[nd->first + 1] ? ix->minid[nd->first]
-                                                                     : ix->minid[nd->first + 1];
-            ix->minid[ni] = mn;
-        }
+        build_node(bp, 0, 0, m, 1, box);
     }
     *out = ix;
     return JF_OK;
