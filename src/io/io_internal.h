@@ -423,4 +423,8 @@ jf_status jf__lazw_finish(jf_lazw *z, jf_wfile *f);
 int jf__lazw_write_prefix(int fd, const jf_las_out *L, const jf_lazw *z);
 void jf__lazw_free(jf_lazw *z);
 
+/* io_spool.c: n bytes at offset at, through short writes and EINTR; 0 or
+ * the errno (EIO for a write that wrote nothing). */
+int jf__pwrite_all(int fd, const void *buf, size_t n, size_t at);
+
 #endif /* JF_IO_INTERNAL_H */

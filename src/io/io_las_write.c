@@ -577,17 +577,10 @@ unsigned char *jf__las_prefix(const jf_las_out *L, size_t *lenp)
 
 int jf__las_write_prefix(int fd, const jf_las_out *L)
 {
-    size_t len, done = 0;
+    size_t len;
     unsigned char *b = jf__las_prefix(L, &len);
     if (!b) return -1;
-    while (done < len) {
-        ssize_t w = pwrite(fd, b + done, len - done, (off_t)done);
-        if (w <= 0) {
-            free(b);
-            return -1;
-        }
-        done += (size_t)w;
-    }
+    int e = jf__pwrite_all(fd, b, len, 0);
     free(b);
-    return 0;
+    return e ? -1 : 0;
 }

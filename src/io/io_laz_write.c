@@ -274,15 +274,7 @@ int jf__lazw_write_prefix(int fd, const jf_las_out *L, const jf_lazw *z)
         p16(q + 38 + 6 * i, z->items[i].version);
     }
     p64(b + total - 8, z->table);
-    size_t done = 0;
-    while (done < total) {
-        ssize_t w = pwrite(fd, b + done, total - done, (off_t)done);
-        if (w <= 0) {
-            free(b);
-            return -1;
-        }
-        done += (size_t)w;
-    }
+    int e = jf__pwrite_all(fd, b, total, 0);
     free(b);
-    return 0;
+    return e ? -1 : 0;
 }

@@ -53,8 +53,9 @@ struct jf_spool {
     int err;           /* first failure: errno, -1 bad row (atomic)     */
 };
 
-static int pwrite_all(int fd, const char *p, size_t n, size_t at)
+int jf__pwrite_all(int fd, const void *buf, size_t n, size_t at)
 {
+    const char *p = buf;
     while (n) {
         ssize_t k = pwrite(fd, p, n, (off_t)at);
         if (k < 0 && errno == EINTR)
@@ -158,7 +159,7 @@ static int flush_bucket(jf_spool *s, size_t k)
     size_t cap = rows_in(s, k) * s->entry;
     if (b->written + b->used > cap)
         return -1; /* a row given twice: more entries than rows */
-    int e = pwrite_all(s->t.fd, b->stage, b->used, k * s->per * s->entry + b->written);
+    int e = jf__pwrite_all(s->t.fd, b->stage, b->used, k * s->per * s->entry + b->written);
     b->written += b->used;
     b->used = 0;
     return e;
