@@ -15,9 +15,8 @@ works on the same array, and whose peak memory is its own:
     curvatures, principal directions (the whole call: options, the
     library's estimate, the Result's arrays);
   - the command's in-memory part: `jetfit estimate FILE -o OUT --neighbors
-    knn:16 --threads T` run on a pseudo-terminal, its jf_estimate time
-    taken from its progress line (N / the final points/s, counted from
-    just before jf_estimate to the last point fitted); its whole wall time
+    knn:16 --threads T`, its jf_estimate time taken from the tree and fit
+    times of its summary's `phases:` line; its whole wall time
     (read, estimate, write) and peak RSS are printed beside;
   - Open3D's PointCloud.estimate_normals(KDTreeSearchParamKNN(16)) (normals
     only; the Vector3dVector copy of the array is not timed), OpenMP
@@ -90,31 +89,21 @@ def run_child(kind, path, threads):
 
 
 def run_command(jetfit_bin, path, out, threads, n):
-    """The command on a pty: (jf_estimate seconds, whole wall seconds, its
-    peak RSS in KiB)."""
-    import pty
-    master, slave = pty.openpty()
+    """The command: (jf_estimate seconds, whole wall seconds, its peak RSS
+    in KiB).  The jf_estimate part is the tree and fit phases of the
+    summary's `phases:` line (read and write left out)."""
     t0 = time.perf_counter()
     p = subprocess.Popen([jetfit_bin, "estimate", path, "-o", out, "--neighbors", "knn:16",
-                          "--threads", str(threads)], stdout=subprocess.DEVNULL, stderr=slave)
-    os.close(slave)
-    text = b""
-    while True:
-        try:
-            chunk = os.read(master, 65536)
-        except OSError:  # EIO once the command closed the terminal
-            break
-        if not chunk:
-            break
-        text += chunk
+                          "--threads", str(threads)], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE)
+    text = p.stderr.read()
     _, status, ru = os.wait4(p.pid, 0)
     p.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - t0
-    os.close(master)
-    rates = re.findall(rb"%d/%d points\s+([0-9]+) points/s" % (n, n), text)
-    if p.returncode != 0 or not rates:
+    m = re.search(rb"phases: .*tree ([0-9.]+) s, fit ([0-9.]+) s", text)
+    if p.returncode != 0 or not m:
         raise RuntimeError("jetfit estimate failed: %r" % text[-300:])
-    return n / float(rates[-1]), wall, ru.ru_maxrss
+    return float(m.group(1)) + float(m.group(2)), wall, ru.ru_maxrss
 
 
 def main():
