@@ -572,6 +572,11 @@ typedef struct {
     uint8_t shift, bits; /* bits > 0: an unsigned bit field of the byte
                             at offset, (b >> shift) & (2^bits - 1)
                             (LAS return numbers, flags); type U8        */
+    double scale_factor, add_offset; /* scale_factor != 0: the value
+                            is raw * scale_factor + add_offset (a LAS
+                            Extra Byte with the scale or offset option;
+                            netCDF's names), written out as a double;
+                            0: the raw value                            */
 } jf_attr;
 
 typedef struct {

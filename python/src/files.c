@@ -37,7 +37,8 @@ static PyObject *file_error(jf_status st, const jf_error *err, const char *path)
 }
 
 /* {name: (n,) array} of the attribute table, each in its input type
- * (LAS bit fields as uint8), in the file's order. */
+ * (LAS bit fields as uint8, scaled LAS Extra Bytes as float64), in the
+ * file's order. */
 static PyObject *attrs_dict(const jf_attrs *a, size_t n)
 {
     static const int npy[10] = {NPY_INT8,  NPY_UINT8,  NPY_INT16, NPY_UINT16, NPY_INT32,
@@ -48,7 +49,7 @@ static PyObject *attrs_dict(const jf_attrs *a, size_t n)
     PyObject *d = PyDict_New();
     for (size_t j = 0; d && j < a->nattrs; j++) {
         const jf_attr *at = &a->attr[j];
-        int t = at->bits ? JF_ATTR_U8 : (int)at->type;
+        int t = at->bits ? JF_ATTR_U8 : at->scale_factor != 0 ? JF_ATTR_F64 : (int)at->type;
         npy_intp dims[1] = {(npy_intp)n};
         PyObject *arr = PyArray_SimpleNew(1, dims, little ? npy[t] : NPY_FLOAT64);
         if (!arr) {
@@ -58,7 +59,8 @@ static PyObject *attrs_dict(const jf_attrs *a, size_t n)
         unsigned char *o = PyArray_DATA((PyArrayObject *)arr);
         for (size_t i = 0; i < n; i++) {
             const unsigned char *r = a->rec + i * a->stride + at->offset;
-            if (!little) { /* the records are little endian: values as doubles */
+            if (!little || at->scale_factor != 0) { /* big-endian host, or a scaled LAS
+                                                 Extra Byte: values as doubles */
                 double v = jf_attr_get(a, j, i);
                 memcpy(o + 8 * i, &v, 8);
             } else if (at->bits) {

@@ -190,6 +190,26 @@ def test_read_attributes_las(tmp_path, cmd):
     assert attrs2["degree"].dtype == np.int32 and attrs2["nx"].dtype == np.float64
 
 
+def test_read_las_scaled_extra_bytes(tmp_path, cmd):
+    """An Extra Byte with the scale and offset options (LAS 1.4 R15 table
+    24): read as raw * scale + offset, float64."""
+    src = os.path.join(TOP, "tests", "data", "las", "simple.las")
+    cmd("estimate", src, "-o", tmp_path / "o.las", "--quiet", "--neighbors", "knn:10")
+    raw = bytearray(open(tmp_path / "o.las", "rb").read())
+    _, _, _, plain = jetfit.read(tmp_path / "o.las")
+    off, = struct.unpack_from("<I", raw, 96)
+    d = raw.index(b"degree\0", 0, off) - 4  # its 192-byte description
+    assert raw[d + 2] == 6 and plain["degree"].dtype == np.int32
+    raw[d + 3] |= 8 | 16
+    struct.pack_into("<d", raw, d + 112, 0.5)
+    struct.pack_into("<d", raw, d + 136, 3.0)
+    open(tmp_path / "s.las", "wb").write(raw)
+    _, _, _, attrs = jetfit.read(tmp_path / "s.las")
+    assert attrs["degree"].dtype == np.float64
+    assert np.array_equal(attrs["degree"], plain["degree"] * 0.5 + 3.0)
+    assert np.array_equal(attrs["nx"], plain["nx"])
+
+
 def test_write_las_then_read_its_normals(tmp_path):
     """issue 31: write() sets the LAS frame itself (it failed naming an
     internal function), and the nx ny nz Extra Bytes read back as normals."""

@@ -69,6 +69,11 @@ static attr_val value_of(const jf_attr *at, const unsigned char *rec)
     default:
         v.u = b;
     }
+    if (at->scale_factor != 0) { /* LAS Extra Bytes: raw * scale + offset (R15 table 24) */
+        double raw = v.kind == 0 ? (double)v.i : v.kind == 1 ? (double)v.u : v.d;
+        v.kind = 2;
+        v.d = raw * at->scale_factor + at->add_offset;
+    }
     return v;
 }
 
@@ -197,7 +202,7 @@ int jf__attrs_names(const jf_attrs *a, char *const *cols, size_t ncols, char (*o
 
 jf_attr_type jf__attr_out_type(const jf_attr *at)
 {
-    return at->bits ? JF_ATTR_U8 : at->type;
+    return at->bits ? JF_ATTR_U8 : at->scale_factor != 0 ? JF_ATTR_F64 : at->type;
 }
 
 const char *jf__attr_ply_type(const jf_attr *at)
@@ -240,8 +245,10 @@ char *jf__attrs_put(const jf_attrs *a, size_t row, int mode, char sep, char *o)
         if (at->bits) {
             attr_val v = value_of(at, rec);
             *o++ = (char)(unsigned char)v.u;
-        } else if (mode != JF__ATTR_LAS && (t == JF_ATTR_I64 || t == JF_ATTR_U64)) {
-            /* PLY has no 64-bit integers: a double (exact up to 2^53) */
+        } else if (at->scale_factor != 0 ||
+                   (mode != JF__ATTR_LAS && (t == JF_ATTR_I64 || t == JF_ATTR_U64))) {
+            /* a scaled value, or a 64-bit integer (PLY has none): a double
+             * (exact up to 2^53) */
             double d = jf_attr_get(a, j, row);
             uint64_t b;
             memcpy(&b, &d, 8);

@@ -20,6 +20,7 @@
  * outside 0-10, two disagreeing point counts and whole records past the
  * count are refused too (issue 30.1, 33.7), never read as something else.
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -136,11 +137,14 @@ static unsigned eb_size(unsigned dt, unsigned options)
 }
 
 /* The Extra Bytes described by the VLRs in [hsize, data_off) (VLR
- * "LASF_Spec", record 4): scalar ones become attributes at base_len on;
- * a description that runs past the record ends the list (what follows is
- * kept in the record, undescribed). */
-static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, size_t data_off,
-                           uint32_t nvlr, unsigned base, unsigned rec_len)
+ * "LASF_Spec", record 4): scalar ones become attributes at base_len on,
+ * with their scale and offset when the options say so (bits 3 and 4; the
+ * doubles at bytes 112 and 136 of the 192, R15 table 24); a description
+ * that runs past the record ends the list (what follows is kept in the
+ * record, undescribed). */
+static jf_status add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize,
+                                 size_t data_off, uint32_t nvlr, unsigned base,
+                                 unsigned rec_len, const char *name, jf_error *err)
 {
     static const jf_attr_type eb_type[10] = {JF_ATTR_U8,  JF_ATTR_I8,  JF_ATTR_U16, JF_ATTR_I16,
                                              JF_ATTR_U32, JF_ATTR_I32, JF_ATTR_U64, JF_ATTR_I64,
@@ -160,16 +164,32 @@ static int add_extra_bytes(jf_attrs *a, const unsigned char *b, size_t hsize, si
                 if (dt >= 1 && dt <= 10) {
                     const char *nm = (const char *)b + d + 4;
                     size_t nl = strnlen(nm, 32);
+                    unsigned opt = b[d + 3];
+                    double sc = opt & 8 ? f64(b + d + 112) : 1;
+                    double of = opt & 16 ? f64(b + d + 136) : 0;
+                    if (!isfinite(sc) || !isfinite(of) || sc == 0) {
+                        char shown[64]; /* the name's control bytes not echoed */
+                        jf__attr_name(shown, nm, nl);
+                        return jf_io_fail(err, JF_ERR_FORMAT, name, 0,
+                                          "Extra Bytes description %zu (\"%s\", byte %zu): "
+                                          "scale %g, offset %g: the scale must be nonzero "
+                                          "and both finite",
+                                          (d - p - 54) / 192, shown, d, sc, of);
+                    }
                     if (!jf__attrs_add(a, nm, nl, eb_type[dt - 1], off, 0, 0))
-                        return 0;
+                        return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+                    if (opt & 24) {
+                        jf_attr *at = &a->attr[a->nattrs - 1];
+                        at->scale_factor = sc, at->add_offset = of;
+                    }
                 }
                 off += sz;
             }
-            return 1; /* one Extra Bytes VLR */
+            return JF_OK; /* one Extra Bytes VLR */
         }
         p += 54 + rl;
     }
-    return 1;
+    return JF_OK;
 }
 
 /* Normals in Extra Bytes (a LAS file jetfit wrote: nx ny nz; PDAL's
@@ -195,8 +215,8 @@ static int las_normal_fields(const unsigned char *b, size_t hsize, size_t end, u
                 char nm[33] = {0};
                 for (int k = 0; k < 32 && b[d + 4 + k]; k++)
                     nm[k] = (char)(b[d + 4 + k] | (b[d + 4 + k] >= 'A' && b[d + 4 + k] <= 'Z' ? 0x20 : 0));
-                for (int a = 0; a < 3; a++)
-                    if ((dt == 9 || dt == 10) && (!strcmp(nm, names[0][a]) || !strcmp(nm, names[1][a]))) {
+                for (int a = 0; a < 3; a++) /* scaled ones stay attributes */
+                    if ((dt == 9 || dt == 10) && !(b[d + 3] & 24) && (!strcmp(nm, names[0][a]) || !strcmp(nm, names[1][a]))) {
                         at[a] = off, dts[a] = (int)dt;
                         found |= 1 << a;
                     }
@@ -402,10 +422,10 @@ static jf_status las_fill(const unsigned char *b, const las_hdr *h, const unsign
             return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the EVLRs");
         memcpy(at->las_evlr, ev, at->las_evlr_len);
     }
-    if (!add_dims(at, fmt) ||
-        !add_extra_bytes(at, b, h->hsize, data_off, u32(b + 100), base_len[fmt], rec_len))
+    if (!add_dims(at, fmt))
         return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
-    return JF_OK;
+    return add_extra_bytes(at, b, h->hsize, data_off, u32(b + 100), base_len[fmt], rec_len,
+                           name, err);
 }
 
 /* LAZ: decoded (io_laz.c) straight into the attribute table; the header

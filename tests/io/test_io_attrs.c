@@ -438,6 +438,65 @@ START_TEST(las_records_kept)
 }
 END_TEST
 
+/* Extra Bytes with the scale and offset options (bits 3 and 4; the doubles
+ * at bytes 112 and 136 of a description, LAS 1.4 R15 table 24): the value
+ * is raw * scale + offset, written as a double to PLY and text, kept raw
+ * with its description in a LAS output of the same records. */
+START_TEST(las_eb_scale)
+{
+    unsigned char *in;
+    size_t inlen = make_las(1, &in);
+    unsigned char *d0 = in + 227 + 54 + GEOKEYS + 54 + sizeof WKT + 54, *d1 = d0 + 192;
+    ck_assert(!memcmp(d0 + 4, "amp", 4) && !memcmp(d1 + 4, "nx", 3));
+    d0[3] = 8 | 16, putd(d0 + 112, 2.0), putd(d0 + 136, -1.0); /* amp = 0.5 i -> i - 1 */
+    d1[3] = 16, putd(d1 + 136, 10.0);                           /* nx = 10 - i/8 */
+    jf_cloud c, r;
+    jf_error e;
+    ck_assert_msg(jf_cloud_read(fixture("in.las", in, inlen), NULL, &c, &e) == JF_OK, "%s", e.msg);
+    int amp = jf_attr_find(&c.attrs, "amp"), nx = jf_attr_find(&c.attrs, "nx");
+    ck_assert(amp >= 0 && nx == amp + 1);
+    for (size_t i = 0; i < NL; i++) {
+        ck_assert(jf_attr_get(&c.attrs, (size_t)amp, i) == (double)i - 1);
+        ck_assert(jf_attr_get(&c.attrs, (size_t)nx, i) == 10 - 0.125 * (double)i);
+    }
+    /* PLY and CSV: the scaled values, a PLY as double properties */
+    const char *outs[2] = {"out.ply", "out.csv"};
+    for (int k = 0; k < 2; k++) {
+        write_table(path_of(outs[k]), &c, 0, 0, NULL);
+        ck_assert_msg(jf_cloud_read(path_of(outs[k]), NULL, &r, &e) == JF_OK, "%s", e.msg);
+        same_attrs(&c, &r, outs[k], 0);
+        if (k == 0)
+            ck_assert(r.attrs.attr[jf_attr_find(&r.attrs, "amp")].type == JF_ATTR_F64 &&
+                      r.attrs.attr[jf_attr_find(&r.attrs, "nx")].type == JF_ATTR_F64);
+        jf_cloud_free(&r);
+    }
+    /* LAS: the records and the descriptions as they were; read back the same */
+    write_table(path_of("out.las"), &c, 0, 0, NULL);
+    size_t len;
+    unsigned char *b = jf_test_slurp(path_of("out.las"), &len);
+    const unsigned char *v = b + 375 + 54 + GEOKEYS + 54 + sizeof WKT, *o0 = v + 54;
+    ck_assert(!memcmp(v + 2, "LASF_Spec", 10) && g16(v + 18) == 4);
+    ck_assert(!memcmp(o0, d0, 192) && !memcmp(o0 + 192, d1, 192));
+    for (size_t i = 0; i < NL; i++)
+        ck_assert(!memcmp(b + g32(b + 96) + i * 43, in + g32(in + 96) + i * 43, 43));
+    ck_assert_msg(jf_cloud_read(path_of("out.las"), NULL, &r, &e) == JF_OK, "%s", e.msg);
+    same_attrs(&c, &r, "las -> las", 1);
+    jf_cloud_free(&r);
+    free(b);
+    jf_cloud_free(&c);
+    /* a scale of 0, a NaN offset: refused, naming the file and the description */
+    putd(d0 + 112, 0.0);
+    ck_assert_int_eq(jf_cloud_read(fixture("bad.las", in, inlen), NULL, &c, &e), JF_ERR_FORMAT);
+    ck_assert_msg(strstr(e.msg, "bad.las") && strstr(e.msg, "description 0 (\"amp\"") &&
+                      strstr(e.msg, "scale 0"), "%s", e.msg);
+    putd(d0 + 112, 2.0), putd(d1 + 136, NAN);
+    ck_assert_int_eq(jf_cloud_read(fixture("bad.las", in, inlen), NULL, &c, &e), JF_ERR_FORMAT);
+    ck_assert_msg(strstr(e.msg, "description 1 (\"nx\"") && strstr(e.msg, "offset nan"), "%s",
+                  e.msg);
+    free(in);
+}
+END_TEST
+
 /* The dimensions of a format 3 record, decoded against the spec's bits. */
 START_TEST(las_dimensions)
 {
@@ -520,6 +579,7 @@ int main(void)
     tcase_add_test(tc, csv_columns);
     tcase_add_test(tc, rename_clash);
     tcase_add_test(tc, las_records_kept);
+    tcase_add_test(tc, las_eb_scale);
     tcase_add_test(tc, las_dimensions);
     tcase_add_test(tc, las_13_short_header);
     suite_add_tcase(s, tc);
