@@ -871,6 +871,8 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
                     store_attr(adst[j] + r * ta.stride, el->props[j].type,
                                load(p + off[j], el->props[j].type, swap));
             }
+        if (ro && ro->progress) /* bytes read so far, on the calling thread */
+            ro->progress(ro->progress_user, JF_PHASE_READ, (size_t)(at + (r0 + m) * vrow), len);
     }
     c->n = n;
     c->xyz = xyz;

@@ -121,6 +121,15 @@ static void check_same(const unsigned char *bytes, size_t len)
     jf_cloud_free(&b);
 }
 
+/* Read progress, in bytes: non-decreasing, from 0 to the file's length. */
+static size_t nrep, reps[64][2];
+static void on_read(void *user, jf_phase ph, size_t done, size_t total)
+{
+    (void)user;
+    ck_assert_int_eq(ph, JF_PHASE_READ);
+    if (nrep < 64) reps[nrep][0] = done, reps[nrep++][1] = total;
+}
+
 START_TEST(chunked_equals_whole)
 {
     tmpdir_setup("/tmp/jf_io_chunked_XXXXXX");
@@ -143,6 +152,23 @@ START_TEST(chunked_equals_whole)
             ck_assert(c.xyz[3 * 249999 + 2] == 1e-3 * 249999.0);
             if (normals) ck_assert(c.nrm[3 * 249999 + 2] == (double)(float)249999);
             jf_cloud_free(&c);
+            /* progress chunk by chunk (4 MiB), not only at the start and end */
+            jf_read_opts ro;
+            jf_read_opts_init(&ro);
+            ro.progress = on_read;
+            nrep = 0;
+            ck_assert_int_eq(jf_cloud_read(fixture("c.ply", b, len), &ro, &c, &err), JF_OK);
+            jf_cloud_free(&c);
+            size_t mid = 0;
+            for (size_t k = 0; k < nrep; k++) {
+                ck_assert_uint_eq(reps[k][1], len);
+                if (k) ck_assert_uint_ge(reps[k][0], reps[k - 1][0]);
+                mid += reps[k][0] > 0 && reps[k][0] < len;
+            }
+            ck_assert_uint_ge(nrep, 3);
+            ck_assert_uint_eq(reps[0][0], 0);
+            ck_assert_uint_eq(reps[nrep - 1][0], len);
+            ck_assert_uint_ge(mid, 1);
             free(b);
         }
     /* a trailing newline is tolerated; more bytes than a row are not */
