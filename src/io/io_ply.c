@@ -17,6 +17,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <omp.h>
+
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
 static const char *const type_names[][2] = {
     {"", ""},          {"char", "int8"},   {"uchar", "uint8"},
@@ -797,10 +799,11 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
     if (ix < 0 || iy < 0 || iz < 0)
         goto out;
     size_t n = (size_t)el->count;
-    double *xyz = with_xyz ? malloc((n ? n : 1) * 3 * sizeof(double)) : NULL, *nrm = NULL;
+    /* huge pages: first-touch faults were most of the read (io_bigalloc.c) */
+    double *xyz = with_xyz ? jf__big_alloc((n ? n : 1) * 3 * sizeof(double)) : NULL, *nrm = NULL;
     int has_n = inx >= 0 && iny >= 0 && inz >= 0;
     if (has_n)
-        nrm = malloc((n ? n : 1) * 3 * sizeof(double));
+        nrm = jf__big_alloc((n ? n : 1) * 3 * sizeof(double));
     if ((with_xyz && !xyz) || (has_n && !nrm)) {
         free(xyz);
         free(nrm);
@@ -825,7 +828,7 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
         }
         ta.stride += type_size[el->props[j].type];
     }
-    if (ta.stride == SIZE_MAX || (ta.nattrs && !(ta.rec = malloc(n * ta.stride)))) {
+    if (ta.stride == SIZE_MAX || (ta.nattrs && !(ta.rec = jf__big_alloc(n * ta.stride)))) {
         free(xyz);
         free(nrm);
         jf_attrs_free(&ta);
@@ -852,27 +855,53 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
     }
     /* without coordinates, normals or attributes: nothing to read */
     const size_t nrows = with_xyz || has_n || ta.nattrs ? n : 0;
-    for (size_t r0 = 0; r0 < nrows; r0 += per) {
-        size_t m = n - r0 < per ? n - r0 : per;
-        if (!pread_all(fd, buf, m * vrow, at + r0 * vrow, &e)) {
-            free(xyz);
-            free(nrm);
-            jf_attrs_free(&ta);
-            st = jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
-                            e ? strerror(e) : "the file shrank while it was read");
-            goto out;
-        }
-        const unsigned char *p = buf;
-        for (size_t r = r0; r < r0 + m; r++, p += vrow)
-            for (int j = 0; j < el->nprops; j++) {
-                if (dst[j])
-                    dst[j][3 * r] = load(p + off[j], el->props[j].type, swap);
-                if (adst[j])
-                    store_attr(adst[j] + r * ta.stride, el->props[j].type,
-                               load(p + off[j], el->props[j].type, swap));
+    const size_t nchunks = (nrows + per - 1) / per, cap = per * vrow;
+    const int nt = ro && ro->threads > 0 ? ro->threads : jf_default_threads(NULL);
+    size_t rows_done = 0;     /* atomic: progress, read by the calling thread */
+    int failed = 0, fail_e = 0, nomem = 0;
+    /* chunks read and decoded on the threads, each into its own rows (the
+     * decode, not the copy from the page cache, is most of the time) */
+#pragma omp parallel num_threads(nt) if (nchunks > 1)
+    {
+        const int tid = omp_get_thread_num();
+        unsigned char *tb = tid == 0 ? buf : malloc(cap);
+        if (!tb) __atomic_store_n(&nomem, 1, __ATOMIC_RELAXED);
+#pragma omp for schedule(dynamic, 1)
+        for (size_t ch = 0; ch < nchunks; ch++) {
+            if (__atomic_load_n(&failed, __ATOMIC_RELAXED) || !tb) continue;
+            size_t r0 = ch * per, m = n - r0 < per ? n - r0 : per;
+            int pe = 0;
+            if (!pread_all(fd, tb, m * vrow, at + r0 * vrow, &pe)) {
+#pragma omp critical(jf_ply_chunk_fail)
+                if (!__atomic_load_n(&failed, __ATOMIC_RELAXED)) {
+                    fail_e = pe;
+                    __atomic_store_n(&failed, 1, __ATOMIC_RELAXED);
+                }
+                continue;
             }
-        if (ro && ro->progress) /* bytes read so far, on the calling thread */
-            ro->progress(ro->progress_user, JF_PHASE_READ, (size_t)(at + (r0 + m) * vrow), len);
+            const unsigned char *p = tb;
+            for (size_t r = r0; r < r0 + m; r++, p += vrow)
+                for (int j = 0; j < el->nprops; j++) {
+                    if (dst[j])
+                        dst[j][3 * r] = load(p + off[j], el->props[j].type, swap);
+                    if (adst[j])
+                        store_attr(adst[j] + r * ta.stride, el->props[j].type,
+                                   load(p + off[j], el->props[j].type, swap));
+                }
+            size_t d = __atomic_add_fetch(&rows_done, m, __ATOMIC_RELAXED);
+            if (tid == 0 && ro && ro->progress) /* bytes read so far */
+                ro->progress(ro->progress_user, JF_PHASE_READ, (size_t)(at + d * vrow), len);
+        }
+        if (tid != 0) free(tb);
+    }
+    if (failed || nomem) {
+        free(xyz);
+        free(nrm);
+        jf_attrs_free(&ta);
+        st = nomem ? jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory for the read buffers")
+                   : jf_io_fail(err, JF_ERR_IO, name, 0, "read failed: %s",
+                                fail_e ? strerror(fail_e) : "the file shrank while it was read");
+        goto out;
     }
     c->n = n;
     c->xyz = xyz;
