@@ -67,7 +67,7 @@
  * docs/robustness.md "Neighbourhood auto"). */
 const jf__knobs jf__knob_defaults = {
     JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
-    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0};
+    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, NULL};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -130,6 +130,15 @@ int jf__robust_tune(jf_fitter *f, const char *name, double v)
     else if (!strcmp(name, "auto_gl")) k->auto_gl = (int)v;
     else if (!strcmp(name, "auto_nest")) k->auto_nest = v;
     else return -1;
+    return 0;
+}
+
+/* Bench-only: auto's candidates out (robust_internal.h). */
+int jf__auto_diag_attach(jf_fitter *f, jf__auto_diag *dg)
+{
+    ws_state *b = ws_get(f);
+    if (!b) return -1;
+    b->knob.auto_diag = dg;
     return 0;
 }
 
