@@ -27,6 +27,7 @@ typedef struct {
     double auto_tau, auto_blob, auto_sdmax, auto_clean, auto_varw; /* auto.c */
     int auto_gl;
     double auto_nest; /* auto.c: > 0: Lepski on nested variances (dropped) */
+    double auto_lof, auto_s2floor; /* auto_rule.c (off: 0; dropped) */
     struct jf__auto_diag *auto_diag; /* bench-only: auto's candidates out */
 } jf__knobs;
 extern const jf__knobs jf__knob_defaults;
