@@ -16,7 +16,7 @@
  *     least and the noise is still well sampled; the next larger K where
  *     that exceeds auto_blob x the radius (a blob of noise, whose cubic
  *     follows it).  It is what `sigma` reports.
- *  3. Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
+ *  3. (Steps 3-4: auto_rule.c.) Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
  *     intersection of confidence intervals of Katkovnik 1999; the K that
  *     balances noise and curvature for normals: Mitra, Nguyen & Guibas
  *     2004): grow K while the
