@@ -16,7 +16,7 @@
  *     least and the noise is still well sampled; the next larger K where
  *     that exceeds auto_blob x the radius (a blob of noise, whose cubic
  *     follows it).  It is what `sigma` reports.
- *  3. Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
+ *  3. (Steps 3-4: auto_rule.c.) Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
  *     intersection of confidence intervals of Katkovnik 1999; the K that
  *     balances noise and curvature for normals: Mitra, Nguyen & Guibas
  *     2004): grow K while the
@@ -47,7 +47,7 @@ typedef double v2d __attribute__((vector_size(16)));
 typedef long long v2l __attribute__((vector_size(16)));
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
-#define NCAND 10
+#define NCAND JF_AUTO_NCAND
 #define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
@@ -59,13 +59,7 @@ static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
 /* total degree of monomial j (order 1, x, y, x^2, xy, y^2, x^3, ...) */
 static const int mdeg[NMON] = {0, 1, 1, 2, 2, 2, 3, 3, 3, 3};
 
-typedef struct {
-    int ok;
-    double nrm[3]; /* world normal                                  */
-    double tr;     /* sd^2 of the normal's angle per unit noise var  */
-    double s2;     /* unbiased residual variance                     */
-    double h;      /* radius (farthest planar distance)              */
-} cand_fit;
+typedef jf__auto_cand cand_fit; /* robust_internal.h */
 
 /* The power sums of one candidate K (step 1) and what its fit needs. */
 typedef struct {
@@ -249,31 +243,6 @@ static void solve_k2(const mom *ma, const mom *mb, double H, double ha, double h
     }
     put_fit(a1[0], a2[0], var[0], rss[0], ma->m, NMON, ha, fr, &oa[1]);
     put_fit(a1[1], a2[1], var[1], rss[1], mb->m, NMON, hb, fr, &ob[1]);
-}
-
-/* Lepski / ICI over the candidates of one degree: the last K whose normal
- * agrees with every smaller accepted K's (within tau (sd_j + sd_K), or with
- * nest > 0 within nest sqrt(|sd_j^2 - sd_K^2|): the difference of nested
- * least-squares estimates has the variance difference).  Returns its
- * index or -1. */
-static int lepski(const cand_fit *c, int nc, double s2, double tau, double sdmax, double nest)
-{
-    int acc[NCAND], na = 0, best = -1;
-    for (int i = 0; i < nc; i++) {
-        if (!c[i].ok) continue;
-        double sdi = sqrt(s2 * c[i].tr);
-        int okk = 1;
-        for (int j = 0; j < na && okk; j++) {
-            double sdj = sqrt(s2 * c[acc[j]].tr);
-            if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
-            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <=
-                  (nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
-        }
-        if (!okk) break;
-        acc[na++] = i;
-        best = i;
-    }
-    return best;
 }
 
 static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
@@ -637,59 +606,22 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= hc * hc)) cf[1][i].ok = 0;
     }
 
-    if (kn->auto_gl) {
-        /* Goldenshluger-Lepski over every (K, degree): the squared bias of a
-         * candidate is its largest excess move against each less biased
-         * one (smaller K, or the cubic at the same K), less what noise of
-         * variance |sd_a^2 - sd_b^2| explains; cost = bias^2 + varw sd^2 */
-        int bd = -1, bc = -1;
-        double bcost = INFINITY;
+    /* steps 3-4 (auto_rule.c): the candidate and the degree */
+    jf__auto_cands C;
+    C.nc = nc;
+    C.s2 = s2;
+    memcpy(C.ks, ks, sizeof ks);
+    memcpy(C.cf, cf, sizeof cf);
+    int d = 2, ci = jf__auto_rule(kn, &C, &d);
+    if (kn->auto_diag) { /* bench-only: every candidate's own fit */
+        jf__auto_diag *dg = kn->auto_diag;
+        dg->c = C;
+        dg->ci = ci;
+        dg->d = d;
         for (int i = 0; i < nc; i++)
-            for (int d = 0; d < 2; d++) {
-                const cand_fit *a = &cf[d][i];
-                if (!a->ok) continue;
-                double va = s2 * a->tr, b2 = 0.0;
-                for (int j = 0; j <= i; j++)
-                    for (int e = 0; e < 2; e++) {
-                        const cand_fit *b = &cf[e][j];
-                        if (!b->ok || (j == i && e <= d)) continue;
-                        double vb = s2 * b->tr;
-                        if (!(vb < kn->auto_sdmax * kn->auto_sdmax)) continue;
-                        double x = jf__angle(a->nrm, b->nrm) - kn->auto_tau * sqrt(fabs(vb - va));
-                        if (x > 0.0 && x * x > b2) b2 = x * x;
-                    }
-                double cost = b2 + kn->auto_varw * va;
-                if (cost < bcost) {
-                    bcost = cost;
-                    bd = d;
-                    bc = i;
-                }
-            }
-        if (bc < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
-        return direct_fit(f, pr, p, nbr, ks[bc], &mo[bc], H, fr, bd ? 3 : 2, sigma, out);
-    }
-    /* step 3: Lepski per degree */
-    double tau = kn->auto_tau;
-    int c2 = lepski(cf[0], nc, s2, tau, kn->auto_sdmax, kn->auto_nest),
-        c3 = lepski(cf[1], nc, s2, tau, kn->auto_sdmax, kn->auto_nest);
-    /* step 4: the degree */
-    int d = 3, ci = c3;
-    if (c3 < 0) {
-        d = 2;
-        ci = c2;
-    } else {
-        /* the quadric at the largest K of its chain that agrees with the
-         * cubic at the same K, if its sd is below the cubic's choice */
-        double sd3 = sqrt(s2 * cf[1][c3].tr);
-        for (int i = c2; i >= 0; i--) {
-            if (!cf[0][i].ok || !cf[1][i].ok) continue;
-            if (jf__angle(cf[0][i].nrm, cf[1][i].nrm) > tau * sqrt(s2 * cf[1][i].tr)) continue;
-            if (sqrt(s2 * cf[0][i].tr) < sd3) {
-                d = 2;
-                ci = i;
-            }
-            break;
-        }
+            for (int e = 0; e < 2; e++)
+                if (direct_fit(f, pr, p, nbr, ks[i], &mo[i], H, fr, e + 2, sigma, &dg->res[e][i]) != JF_OK)
+                    dg->res[e][i].status = JF_PT_FAILED;
     }
     if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
     return direct_fit(f, pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);

@@ -64,10 +64,14 @@
  * on 16-24 points; auto_gl 1 = Goldenshluger-Lepski over every (K, degree);
  * auto_nest T > 0: Lepski against T sqrt(sd_j^2 - sd_K^2), the sd of the
  * difference of nested least-squares normals (both worse on PCPNet:
- * docs/robustness.md "Neighbourhood auto"). */
+ * docs/robustness.md "Neighbourhood auto"); auto_lof z > 0: a K whose
+ * residual variance stays within 1 + z sqrt(2 / (K - 6)) of the noise's
+ * passes Lepski's test; auto_s2floor c > 0: the noise variance at least
+ * the cubic's at K = 48 where it exceeds (c x radius)^2 (auto_rule.c;
+ * both off: docs/robustness.md). */
 const jf__knobs jf__knob_defaults = {
     JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
-    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0};
+    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, 0.0, 0.0, NULL};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -129,7 +133,18 @@ int jf__robust_tune(jf_fitter *f, const char *name, double v)
     else if (!strcmp(name, "auto_clean")) k->auto_clean = v;
     else if (!strcmp(name, "auto_gl")) k->auto_gl = (int)v;
     else if (!strcmp(name, "auto_nest")) k->auto_nest = v;
+    else if (!strcmp(name, "auto_lof")) k->auto_lof = v;
+    else if (!strcmp(name, "auto_s2floor")) k->auto_s2floor = v;
     else return -1;
+    return 0;
+}
+
+/* Bench-only: auto's candidates out (robust_internal.h). */
+int jf__auto_diag_attach(jf_fitter *f, jf__auto_diag *dg)
+{
+    ws_state *b = ws_get(f);
+    if (!b) return -1;
+    b->knob.auto_diag = dg;
     return 0;
 }
 

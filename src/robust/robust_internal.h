@@ -27,6 +27,8 @@ typedef struct {
     double auto_tau, auto_blob, auto_sdmax, auto_clean, auto_varw; /* auto.c */
     int auto_gl;
     double auto_nest; /* auto.c: > 0: Lepski on nested variances (dropped) */
+    double auto_lof, auto_s2floor; /* auto_rule.c (off: 0; dropped) */
+    struct jf__auto_diag *auto_diag; /* bench-only: auto's candidates out */
 } jf__knobs;
 extern const jf__knobs jf__knob_defaults;
 
@@ -71,4 +73,33 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
  * (nearest first) and the degree; fills out->sigma. */
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out);
+
+/* neighbors auto's candidates (auto.c step 1-2, read by auto_rule.c). */
+#define JF_AUTO_NCAND 10
+typedef struct {
+    int ok;
+    double nrm[3]; /* world normal (in step 1's frame)               */
+    double tr;     /* sd^2 of the normal's angle per unit noise var  */
+    double s2;     /* unbiased residual variance                     */
+    double h;      /* radius (farthest planar distance)              */
+} jf__auto_cand;
+typedef struct {
+    int nc;                              /* candidates                */
+    size_t ks[JF_AUTO_NCAND];            /* their K, increasing       */
+    jf__auto_cand cf[2][JF_AUTO_NCAND]; /* [0] quadric, [1] cubic    */
+    double s2;                           /* the noise variance (step 2) */
+} jf__auto_cands;
+/* Steps 3-4 (auto_rule.c): the chosen candidate's index (-1: none) and
+ * its degree (*d, 2 or 3). */
+int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
+
+/* Bench-only (tests/bench/bench_auto_diag.c): with jf__auto_diag_attach,
+ * every auto fit of f also fills *dg: the candidates, the choice, and each
+ * candidate's reported fit (res[degree - 2][i], as knn:K --degree d). */
+typedef struct jf__auto_diag {
+    jf__auto_cands c;
+    int ci, d;
+    jf_result res[2][JF_AUTO_NCAND];
+} jf__auto_diag;
+int jf__auto_diag_attach(jf_fitter *f, jf__auto_diag *dg);
 #endif
