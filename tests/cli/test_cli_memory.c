@@ -177,6 +177,33 @@ START_TEST(coordinates_on_disk_same_bytes)
 }
 END_TEST
 
+/* Nothing held beside the parts (--quiet: no summary values; --keep none;
+ * no normals): the refusal does not name a size of nothing ("0K"). */
+START_TEST(refusal_names_no_empty_size)
+{
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "300000", "--seed", "6", "-o",
+                             cli_path("in.ply"), NULL),
+                     0);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--threads",
+                             "1", "--quiet", "--keep", "none", "--memory", "1K", NULL),
+                     1);
+    const char *tail = "(with the coordinates read from the file as needed)\n";
+    size_t le = strlen(cli_err), lt = strlen(tail);
+    ck_assert_msg(le > lt && !strcmp(cli_err + le - lt, tail), "%s", cli_err);
+    ck_assert_msg(!strstr(cli_err, " 0K"), "%s", cli_err);
+    ck_assert_uint_gt(least_named(), 0);
+    ck_assert_int_eq(cli_exists(cli_path("p.ply")), 0);
+    /* with the summary's values (8 bytes a point), their size is named */
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--threads",
+                             "1", "--keep", "none", "--memory", "1K", NULL),
+                     1);
+    char want[128];
+    snprintf(want, sizeof want, "; the summary's values, normals and attributes: %dK)\n",
+             (300000 * 8 + 1023) / 1024);
+    ck_assert_msg(strstr(cli_err, want), "%s", cli_err);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("cli_memory");
@@ -186,6 +213,7 @@ int main(void)
     tcase_add_test(tc, too_small_is_refused_with_the_least);
     tcase_add_test(tc, small_budgets_same_bytes);
     tcase_add_test(tc, coordinates_on_disk_same_bytes);
+    tcase_add_test(tc, refusal_names_no_empty_size);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
