@@ -13,22 +13,6 @@
 #include "test_cli_util.h"
 #include "jf_test.h"
 
-static void same_bytes(const char *a, const char *b)
-{
-    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
-    ck_assert_msg(f && g, "%s or %s missing", a, b);
-    long at = 0;
-    int x, y;
-    do {
-        x = fgetc(f);
-        y = fgetc(g);
-        ck_assert_msg(x == y, "%s and %s differ at byte %ld", a, b, at);
-        at++;
-    } while (x != EOF);
-    fclose(f);
-    fclose(g);
-}
-
 /* The least SIZE the refusal names, in bytes (K or M), or 0. */
 static unsigned long long least_named(void)
 {
@@ -75,7 +59,7 @@ START_TEST(too_small_is_refused_with_the_least)
     ck_assert_uint_eq(least_named(), least);
     ck_assert_int_eq(run_budget("p.ply", "knn:16", least), 0);
     ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-    same_bytes(cli_path("w.ply"), cli_path("p.ply"));
+    jf_test_assert_same_files("the least, in parts", cli_path("w.ply"), cli_path("p.ply"));
 }
 END_TEST
 
@@ -102,7 +86,7 @@ START_TEST(small_budgets_same_bytes)
         for (unsigned long long extra = 0; extra <= (256ULL << 10); extra += 256ULL << 10) {
             ck_assert_int_eq(run_budget(p, runs[k].nb, least + extra), 0);
             ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-            same_bytes(cli_path(w), cli_path(p));
+            jf_test_assert_same_files(runs[k].nb, cli_path(w), cli_path(p));
         }
     }
 }
@@ -172,7 +156,7 @@ START_TEST(coordinates_on_disk_same_bytes)
                                  mem, NULL),
                          0);
         ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-        same_bytes(cli_path(w), cli_path(p));
+        jf_test_assert_same_files(runs[k].nb, cli_path(w), cli_path(p));
     }
 }
 END_TEST
