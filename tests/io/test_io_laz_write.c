@@ -329,7 +329,6 @@ START_TEST(codec_fuzz)
         char msg[160];
         ck_assert_msg(lazrt_roundtrip(fmt, extra, rec, n, back, msg, sizeof msg) == 0,
                       "trial %d (format %u, %u points): %s", t, fmt, n, msg);
-        lz_enc_free(&o);
         free(rec);
         free(back);
     }
