@@ -5,6 +5,7 @@
  * command's output file byte for byte (same columns, rows, temporary then
  * rename: a failed write leaves an existing file untouched). */
 #include "jfpy.h"
+#include "io/io_internal.h" /* jf__las_columns: .laz columns as the command writes them */
 
 /* ---- read ---------------------------------------------------------------- */
 
@@ -270,6 +271,7 @@ PyObject *jf_py_write(PyObject *self, PyObject *args, PyObject *kw)
     jf_column cols[JF_RESULT_MAX_COLS];
     size_t ncols = jf_py_result_columns(result, cols);
     const char *path = PyBytes_AS_STRING(pathobj);
+    jf__las_columns(path, 0, cols, ncols); /* .laz: compact, as the command */
     jf_error err = {{0}};
     jf_writer *w = NULL;
     jf_status st;

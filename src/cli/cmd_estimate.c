@@ -308,70 +308,23 @@ static jf_status sink_block_xyz(void *user, const uint32_t *idx, const double *x
 
 /* ---- the command ---------------------------------------------------------- */
 
-/* The refusal of a --memory too small, in one line; ooc: the least with
- * the coordinates read from the file as needed. */
-static void memory_refused(const char *in, unsigned long long memory, size_t n, size_t need_min,
-                           size_t held, int ooc)
+/* The refusal of a --memory too small (jf__memory_precheck's figures),
+ * in one line; r->ooc: the least with the coordinates read from the file
+ * as needed.  What else the run holds is named when it is not nothing. */
+static void memory_refused(const char *in, unsigned long long memory, const jf_memchk *r)
 {
-    char given[32], least[32], cloud[32];
-    if (ooc)
-        fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
-                        "works is --memory %s (with the coordinates read from the file as "
-                        "needed; the summary's values, normals and attributes: %s)\n", in,
-                size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
+    char given[32], least[32], held[32], what[160];
+    if (!r->ooc)
+        snprintf(what, sizeof what, "the cloud and the summary's values: %s",
+                 size_str(r->held, held));
+    else if (r->held)
+        snprintf(what, sizeof what, "with the coordinates read from the file as needed; the "
+                 "summary's values, normals and attributes: %s", size_str(r->held, held));
     else
-        fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that "
-                        "works is --memory %s (the cloud and the summary's values: %s)\n", in,
-                size_str(memory, given), n, size_str(need_min, least), size_str(held, cloud));
-}
-
-/* --memory too small for the points a binary PLY or LAS header announces
- * (their coordinates, normals and the summary's values at least): said
- * before reading them.  Returns 1 when refused (message printed), 2 when
- * the coordinates do not fit but a binary PLY input can be read from the
- * file as needed (*l its rows; out: not LAS, whose frame takes them all),
- * else 0. */
-static int memory_precheck(const char *in, const char *fmt, unsigned long long memory, int quiet,
-                           size_t ncols, int threads, int kd, int keep, const char *out,
-                           const char *out_fmt, jf_row_layout *l)
-{
-    size_t len = strlen(in), olen = strlen(out);
-    int ply = len >= 4 && !strcasecmp(in + len - 4, ".ply"),
-        las = len >= 4 && !strcasecmp(in + len - 4, ".las");
-    int las_out = out_fmt ? !strcasecmp(out_fmt, "las") || !strcasecmp(out_fmt, "laz")
-                          : olen >= 4 && (!strcasecmp(out + olen - 4, ".las") ||
-                                          !strcasecmp(out + olen - 4, ".laz"));
-    if (!memory || fmt || !kd || !(ply || las)) return 0;
-    FILE *f = fopen(in, "rb");
-    if (!f) return 0; /* the reader says why */
-    static char buf[1 << 16];
-    size_t got = fread(buf, 1, sizeof buf, f);
-    long long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    fclose(f);
-    jf_error e = {{0}};
-    if (size < 0 || (ply ? jf__ply_layout(buf, got, (uint64_t)size, in, l, &e)
-                         : jf__las_layout(buf, got, (uint64_t)size, in, l, &e)) != JF_OK)
-        return 0;
-    size_t n = (size_t)l->count, need_min = 0, need_ooc = 0;
-    size_t held = n * (24 + (l->has_normals ? 24 : 0) + (quiet ? 0 : 8));
-    if (ply && !las_out && !l->laz) {
-        /* the kept attributes are at most a row a point: if the cloud
-         * fits in memory with that, it is read whole; else their size is
-         * known once read (then: in memory if it fits, else from the
-         * file); --keep none: exact now */
-        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, memory, NULL, NULL))
-            return 0;
-        if (keep) return 2;
-        if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
-        if (jf__parts_plan_ooc(n, held - n * 24, ncols, threads, l->row, memory, &need_ooc))
-            return 2;
-        memory_refused(in, memory, n, need_ooc < need_min ? need_ooc : need_min,
-                       need_ooc < need_min ? held - n * 24 : held, need_ooc < need_min);
-        return 1;
-    }
-    if (jf__parts_plan(n, held, ncols, threads, memory, NULL, &need_min)) return 0;
-    memory_refused(in, memory, n, need_min, held, 0);
-    return 1;
+        snprintf(what, sizeof what, "with the coordinates read from the file as needed");
+    fprintf(stderr, "jetfit: %s: --memory %s is too small for %zu points: the least that works is "
+                    "--memory %s (%s)\n", in, size_str(memory, given), r->n,
+            size_str(r->need_min, least), what);
 }
 
 /* --las-columns: the Extra Bytes type of jetfit's real-valued columns in a
@@ -444,12 +397,16 @@ static int estimate(int argc, char **argv, int *fd)
         jf_column pc[JF_RESULT_MAX_COLS];
         const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
                        o.orient != JF_ORIENT_MST;
-        ooc = memory_precheck(in, cmd.in_fmt, memory, quiet,
-                              jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
-                              o.threads > 0 ? o.threads : jf_default_threads(NULL), kd, keep,
-                              out, cmd.out_fmt, &lay);
-        if (ooc == 1) return 1;
-        ooc = ooc == 2;
+        jf_memchk mc;
+        ooc = jf__memory_precheck(in, cmd.in_fmt, memory, !quiet,
+                                  jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
+                                  o.threads > 0 ? o.threads : jf_default_threads(NULL), kd, keep,
+                                  out, cmd.out_fmt, &lay, &mc);
+        if (ooc == JF_MEMCHK_REFUSED) {
+            memory_refused(in, memory, &mc);
+            return 1;
+        }
+        ooc = ooc == JF_MEMCHK_OOC;
     }
     e.ro.no_attrs = !keep; /* --keep none: not even read */
     e.ro.threads = o.threads; /* text input parsed in blocks on them */
@@ -536,8 +493,9 @@ static int estimate(int argc, char **argv, int *fd)
             if (!plan) { /* the smaller of the two leasts */
                 need_min = jf__parts_plan(c.n, held + 24 * c.n, ncols, pt, memory, NULL, &need_min)
                                ? 0 : need_min;
-                memory_refused(in, memory, c.n, need_ooc < need_min ? need_ooc : need_min,
-                               need_ooc < need_min ? held : held + 24 * c.n, need_ooc < need_min);
+                const int o1 = need_ooc < need_min;
+                memory_refused(in, memory, &(jf_memchk){c.n, o1 ? need_ooc : need_min,
+                                                        o1 ? held : held + 24 * c.n, o1});
                 jf_cloud_free(&c);
                 return 1;
             }

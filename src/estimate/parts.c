@@ -26,7 +26,9 @@
  */
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include <omp.h>
 
@@ -528,4 +530,57 @@ int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, 
     const int p = plan_figures(n, held, ncols, nt, budget, &whole, &least);
     if (need_min) *need_min = (size_t)least;
     return n < 2 ? 0 : p;
+}
+
+static int ends_with(const char *s, const char *ext)
+{
+    size_t n = strlen(s), e = strlen(ext);
+    return n >= e && !strcasecmp(s + n - e, ext);
+}
+
+int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
+                        size_t ncols, int threads, int kd, int keep, const char *out,
+                        const char *out_fmt, jf_row_layout *l, jf_memchk *r)
+{
+    memset(r, 0, sizeof *r);
+    const int ply = ends_with(in, ".ply"), las = ends_with(in, ".las");
+    const int las_out = out_fmt ? !strcasecmp(out_fmt, "las") || !strcasecmp(out_fmt, "laz")
+                                : ends_with(out, ".las") || ends_with(out, ".laz");
+    if (!budget || in_fmt || !kd || !(ply || las)) return JF_MEMCHK_OK;
+    FILE *f = fopen(in, "rb");
+    if (!f) return JF_MEMCHK_OK; /* the reader says why */
+    const size_t cap = 1 << 16;
+    char *buf = malloc(cap);
+    size_t got = buf ? fread(buf, 1, cap, f) : 0;
+    long long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    fclose(f);
+    jf_error e = {{0}};
+    jf_status st = !buf || size < 0 ? JF_ERR_IO
+                   : ply ? jf__ply_layout(buf, got, (uint64_t)size, in, l, &e)
+                         : jf__las_layout(buf, got, (uint64_t)size, in, l, &e);
+    free(buf);
+    if (st != JF_OK) return JF_MEMCHK_OK;
+    const size_t n = (size_t)l->count, coords = n * 24;
+    size_t need_min = 0, need_ooc = 0;
+    const size_t held = coords + n * ((l->has_normals ? 24 : 0) + (cond_held ? 8 : 0));
+    r->n = n;
+    if (ply && !las_out && !l->laz) {
+        /* the kept attributes are at most a row a point: if the cloud
+         * fits in memory with that, it is read whole; else their size is
+         * known once read (then: in memory if it fits, else from the
+         * file); --keep none: exact now */
+        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, budget, NULL, NULL))
+            return JF_MEMCHK_OK;
+        if (keep) return JF_MEMCHK_OOC;
+        if (jf__parts_plan(n, held, ncols, threads, budget, NULL, &need_min)) return JF_MEMCHK_OK;
+        if (jf__parts_plan_ooc(n, held - coords, ncols, threads, l->row, budget, &need_ooc))
+            return JF_MEMCHK_OOC;
+        r->ooc = need_ooc < need_min;
+        r->need_min = r->ooc ? need_ooc : need_min;
+        r->held = r->ooc ? held - coords : held;
+        return JF_MEMCHK_REFUSED;
+    }
+    if (jf__parts_plan(n, held, ncols, threads, budget, NULL, &need_min)) return JF_MEMCHK_OK;
+    r->need_min = need_min, r->held = held;
+    return JF_MEMCHK_REFUSED;
 }

@@ -139,6 +139,27 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
 int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, size_t budget,
                        size_t *need_min);
 
+/* --memory's check before the input is read (jetfit estimate): for a
+ * binary PLY or LAS input (in_fmt NULL, path ending .ply or .las), whose
+ * header gives the point count, the least budget the run can take -- the
+ * coordinates, normals and (cond_held) the summary's condition numbers
+ * at least -- against `budget` bytes.  JF_MEMCHK_OOC: the coordinates do
+ * not fit but the binary PLY can be read from the file as needed (not
+ * for a LAS or LAZ output, whose frame takes them all: out_fmt, else out's
+ * ending); *l its rows.  JF_MEMCHK_REFUSED: too small, with r's figures.
+ * JF_MEMCHK_OK otherwise (fits; budget 0; not kd; another input; a header
+ * the reader will name).  Reads the file's first 64 KiB; prints nothing. */
+typedef struct {
+    size_t n;        /* the points the header announces                   */
+    size_t need_min; /* refused: the least budget that works              */
+    size_t held;     /* refused: what the run holds beside the parts      */
+    int ooc;         /* refused: that least reads the coordinates from the file */
+} jf_memchk;
+enum { JF_MEMCHK_OK = 0, JF_MEMCHK_REFUSED = 1, JF_MEMCHK_OOC = 2 };
+int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
+                        size_t ncols, int threads, int kd, int keep, const char *out,
+                        const char *out_fmt, jf_row_layout *l, jf_memchk *r);
+
 /* Bits of the parts' occupancy and halo grids for n points (<= 2^26). */
 size_t jf__parts_grid_bits(size_t n);
 

@@ -51,6 +51,21 @@ static void set_err(jf_error *err, const char *msg)
     if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
 }
 
+/* The query of the parts from o (jf__part_query_init), the one check both
+ * entry points make: JF_ERR_UNSUPPORTED with its message where parts
+ * cannot serve (not a k-d tree query; mst, which orients along the whole
+ * cloud's graph); JF_ERR_INVALID without one (each caller says it). */
+static jf_status parts_query(const jf_estimate_opts *o, jf_part_query *q, jf_error *err)
+{
+    jf_status st = jf__part_query_init(o, q);
+    if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
+        set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
+                     "orientation (not mst)");
+        return JF_ERR_UNSUPPORTED;
+    }
+    return st;
+}
+
 /* The sink of one part: local indices back to input indices, with the
  * points' coordinates (the part's copy). */
 typedef struct {
@@ -718,12 +733,8 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
         return JF_ERR_INVALID;
     }
     jf_part_query q;
-    jf_status st = jf__part_query_init(o, &q);
-    if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
-        set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
-                     "orientation (not mst)");
-        return JF_ERR_UNSUPPORTED;
-    }
+    jf_status st = parts_query(o, &q, err);
+    if (st == JF_ERR_UNSUPPORTED) return st;
     if (st != JF_OK || nparts == 1 || c->n == 0)
         return jf_estimate_blocks(c, o, sink, user, err); /* its own checks */
     const jf_xyz_src src = {c->xyz, -1, NULL};
@@ -910,12 +921,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         return JF_ERR_INVALID;
     }
     jf_part_query q;
-    jf_status st = jf__part_query_init(o, &q);
-    if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
-        set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
-                     "orientation (not mst)");
-        return JF_ERR_UNSUPPORTED;
-    }
+    jf_status st = parts_query(o, &q, err);
+    if (st == JF_ERR_UNSUPPORTED) return st;
     if (st != JF_OK) {
         set_err(err, "invalid parameters");
         return st;

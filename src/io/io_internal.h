@@ -106,6 +106,12 @@ jf_status jf__read_ply_chunked(int fd, size_t len, const char *name, const jf_re
 jf_status jf__read_ply_chunked_noxyz(int fd, size_t len, const char *name,
                                      const jf_read_opts *o, jf_cloud *c, jf_error *err);
 
+/* The types of a .las or .laz output's real-valued columns (las_columns.c;
+ * the command's --las-columns): mode 0 by path (.laz compact, else
+ * double), or one of these; columns 0-2 (x y z) and integers untouched. */
+enum { JF_LASCOL_DOUBLE = 1, JF_LASCOL_FLOAT = 2, JF_LASCOL_COMPACT = 3 };
+void jf__las_columns(const char *path, int mode, jf_column *cols, size_t ncols);
+
 /* Where the point rows of a binary PLY (io_ply.c) or a LAS file
  * (io_las.c) are -- fixed-size rows, the file's length as its header says
  * -- for readers of a byte range of them (jetfit-mpi: each rank its own

@@ -149,6 +149,18 @@ void lz_encode_lazy(lz_enc *e, lz_sym *m, uint32_t nsym, uint32_t sym)
     lz_encode_sym(e, m, sym);
 }
 
+void lz_encode_slot(lz_enc *e, lz_sym **slot, uint32_t nsym, uint32_t sym)
+{
+    if (!*slot) {
+        if (!e->arena || !(*slot = lz_alloc(e->arena, sizeof **slot))) {
+            e->nomem = 1;
+            return;
+        }
+        memset(*slot, 0, sizeof **slot);
+    }
+    lz_encode_lazy(e, *slot, nsym, sym);
+}
+
 void lz_write_bits(lz_enc *e, uint32_t bits, uint32_t sym)
 {
     if (bits > 19) {

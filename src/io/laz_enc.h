@@ -45,6 +45,18 @@ void lz_write_int(lz_enc *e, uint32_t v);
 /* real as pred + a corrector in context ctx (ic set up by lz_ic_init). */
 void lz_ic_encode(lz_enc *e, lz_ic *ic, int32_t pred, int32_t real, uint32_t ctx);
 
+/* *slot's model of nsym symbols, made on first use (the decoder's
+ * lz_sym_lazy), then sym with it. */
+void lz_encode_slot(lz_enc *e, lz_sym **slot, uint32_t nsym, uint32_t sym);
+
+/* The item coders both chunk encoders use (laz_v2_enc.c): the time t
+ * with g (u = 1: GPSTIME11, with the "unchanged" code; u = 0: POINT14's),
+ * the mirror of laz_internal.h's lz_gps_decode; the colour v against the
+ * last l, the mirror of lz_rgb_decode. */
+void jf__lz_gps_encode(lz_gps *g, lz_enc *e, uint64_t t, unsigned u);
+void jf__lz_rgb_encode(lz_enc *e, lz_sym *used, lz_sym *diff, const uint16_t *l,
+                       const unsigned *v);
+
 /* One chunk of `count` records (rec_len bytes each, the items' sizes
  * summing to rec_len) appended to out as LASzip writes it: pointwise
  * (laz_v2_enc.c) or layered (laz_v3_enc.c).  0, or -1 out of memory. */

@@ -30,43 +30,29 @@ const uint8_t jf__lz_return_level[8][8] = {
     {3, 2, 1, 0, 1, 2, 3, 4}, {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2},
     {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
 
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-static void wr16(uint8_t *p, uint32_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
-static void wr32(uint8_t *p, uint32_t v) { wr16(p, v), wr16(p + 2, v >> 16); }
-
 /* ---- POINT10 -------------------------------------------------------- */
 
 typedef struct {
     uint32_t x, y, z;
     uint16_t intensity, psid;
     uint8_t bits, cls, sar, ud;
-    uint16_t last_int[16];
-    lz_med mx[16], my[16];
-    int32_t last_h[8];
-    lz_sym changed, sar_m[2];
     lz_sym *bitm[256], *clsm[256], *udm[256];
-    lz_ic ic_int, ic_psid, ic_dx, ic_dy, ic_z;
+    lz_p10 m;
 } p10;
 
 static int p10_init(p10 *s, lz_arena *a, const uint8_t *r)
 {
     memset(s, 0, sizeof *s);
-    s->x = rd32(r), s->y = rd32(r + 4), s->z = rd32(r + 8);
+    s->x = lz_rd32(r), s->y = lz_rd32(r + 4), s->z = lz_rd32(r + 8);
     s->bits = r[14], s->cls = r[15], s->sar = r[16], s->ud = r[17];
-    s->psid = (uint16_t)(r[18] | r[19] << 8);
-    for (int k = 0; k < 16; k++)
-        lz_med_init(&s->mx[k]), lz_med_init(&s->my[k]);
-    return lz_ic_init(&s->ic_int, a, 16, 4, 8, 0) &&
-           lz_ic_init(&s->ic_psid, a, 16, 1, 8, 0) && lz_ic_init(&s->ic_dx, a, 32, 2, 8, 0) &&
-           lz_ic_init(&s->ic_dy, a, 32, 22, 8, 0) && lz_ic_init(&s->ic_z, a, 32, 20, 8, 0);
+    s->psid = lz_rd16(r + 18);
+    return lz_p10_init(&s->m, a);
 }
 
 static int p10_decode(p10 *s, lz_dec *d, lz_arena *a, uint8_t *r)
 {
-    uint32_t cv = lz_decode_lazy(d, &s->changed, 64);
+    lz_p10 *q = &s->m;
+    uint32_t cv = lz_decode_lazy(d, &q->changed, 64);
     unsigned rn, nr, m, l;
     if (cv) {
         lz_sym *mod;
@@ -78,147 +64,50 @@ static int p10_decode(p10 *s, lz_dec *d, lz_arena *a, uint8_t *r)
         rn = s->bits & 7, nr = (s->bits >> 3) & 7;
         m = jf__lz_return_map[nr][rn], l = jf__lz_return_level[nr][rn];
         if (cv & 16)
-            s->last_int[m] = (uint16_t)lz_ic_decode(d, &s->ic_int, s->last_int[m], m < 3 ? m : 3);
+            q->last_int[m] = (uint16_t)lz_ic_decode(d, &q->ic_int, q->last_int[m], m < 3 ? m : 3);
         if (cv & 8) {
             if (!(mod = lz_sym_lazy(&s->clsm[s->cls], a, 256)))
                 return 0;
             s->cls = (uint8_t)lz_decode_sym(d, mod);
         }
         if (cv & 4)
-            s->sar = (uint8_t)(lz_decode_lazy(d, &s->sar_m[(s->bits >> 6) & 1], 256) + s->sar);
+            s->sar = (uint8_t)(lz_decode_lazy(d, &q->sar_m[(s->bits >> 6) & 1], 256) + s->sar);
         if (cv & 2) {
             if (!(mod = lz_sym_lazy(&s->udm[s->ud], a, 256)))
                 return 0;
             s->ud = (uint8_t)lz_decode_sym(d, mod);
         }
         if (cv & 1)
-            s->psid = (uint16_t)lz_ic_decode(d, &s->ic_psid, s->psid, 0);
+            s->psid = (uint16_t)lz_ic_decode(d, &q->ic_psid, s->psid, 0);
     } else {
         rn = s->bits & 7, nr = (s->bits >> 3) & 7;
         m = jf__lz_return_map[nr][rn], l = jf__lz_return_level[nr][rn];
     }
-    s->intensity = s->last_int[m];
+    s->intensity = q->last_int[m];
     /* x, y: median prediction; the contexts of y and z from x's (and y's) k */
-    int32_t diff = lz_ic_decode(d, &s->ic_dx, s->mx[m].v[2], nr == 1);
+    int32_t diff = lz_ic_decode(d, &q->ic_dx, q->mx[m].v[2], nr == 1);
     s->x += (uint32_t)diff;
-    lz_med_add(&s->mx[m], diff);
-    uint32_t k = s->ic_dx.k;
-    diff = lz_ic_decode(d, &s->ic_dy, s->my[m].v[2], (nr == 1) + (k < 20 ? k & ~1u : 20));
+    lz_med_add(&q->mx[m], diff);
+    diff = lz_ic_decode(d, &q->ic_dy, q->my[m].v[2], lz_p10_y_ctx(q, nr));
     s->y += (uint32_t)diff;
-    lz_med_add(&s->my[m], diff);
-    k = (s->ic_dx.k + s->ic_dy.k) / 2;
-    s->z = (uint32_t)lz_ic_decode(d, &s->ic_z, s->last_h[l], (nr == 1) + (k < 18 ? k & ~1u : 18));
-    s->last_h[l] = (int32_t)s->z;
-    wr32(r, s->x), wr32(r + 4, s->y), wr32(r + 8, s->z);
-    wr16(r + 12, s->intensity);
+    lz_med_add(&q->my[m], diff);
+    s->z = (uint32_t)lz_ic_decode(d, &q->ic_z, q->last_h[l], lz_p10_z_ctx(q, nr));
+    q->last_h[l] = (int32_t)s->z;
+    lz_wr32(r, s->x), lz_wr32(r + 4, s->y), lz_wr32(r + 8, s->z);
+    lz_wr16(r + 12, s->intensity);
     r[14] = s->bits, r[15] = s->cls, r[16] = s->sar, r[17] = s->ud;
-    wr16(r + 18, s->psid);
+    lz_wr16(r + 18, s->psid);
     return 1;
 }
 
-/* ---- GPSTIME11 ------------------------------------------------------ */
+/* ---- GPSTIME11 (laz_internal.h's lz_gps, with the "unchanged" code) -- */
 
-#define GPS_MULTI 500
-#define GPS_MULTI_MINUS (-10)
-#define GPS_UNCHANGED (GPS_MULTI - GPS_MULTI_MINUS + 1)
-#define GPS_CODE_FULL (GPS_MULTI - GPS_MULTI_MINUS + 2)
-#define GPS_TOTAL (GPS_MULTI - GPS_MULTI_MINUS + 6)
-
-typedef struct {
-    uint64_t t[4];
-    int32_t diff[4];
-    uint32_t extreme[4];
-    unsigned last, next;
-    lz_sym multi, zero;
-    lz_ic ic;
-} gps11;
-
-static int gps_init(gps11 *s, lz_arena *a, const uint8_t *r)
+static int gps_decode(lz_gps *s, lz_dec *d, uint8_t *r)
 {
-    memset(s, 0, sizeof *s);
-    s->t[0] = rd32(r) | (uint64_t)rd32(r + 4) << 32;
-    return lz_ic_init(&s->ic, a, 32, 9, 8, 0);
-}
-
-static int32_t mul32(int32_t a, int32_t b) { return (int32_t)((uint32_t)a * (uint32_t)b); }
-
-/* A new sequence: the high 32 bits predicted from the current one's. */
-static void gps_full(gps11 *s, lz_dec *d)
-{
-    s->next = (s->next + 1) & 3;
-    int32_t hi = lz_ic_decode(d, &s->ic, (int32_t)(s->t[s->last] >> 32), 8);
-    s->t[s->next] = (uint64_t)(uint32_t)hi << 32 | lz_read_int(d);
-    s->last = s->next;
-    s->diff[s->last] = 0;
-    s->extreme[s->last] = 0;
-}
-
-/* The extreme multipliers: after 4 in a row the difference is adopted. */
-static void gps_extreme(gps11 *s, int32_t diff)
-{
-    if (++s->extreme[s->last] > 3) {
-        s->diff[s->last] = diff;
-        s->extreme[s->last] = 0;
-    }
-}
-
-static int gps_decode(gps11 *s, lz_dec *d, uint8_t *r)
-{
-    /* a switch to another sequence is followed by that sequence's code;
-     * the encoder never switches twice in a row */
-    for (int hops = 0;; hops++) {
-        if (hops > 1)
-            return 0;
-        unsigned L = s->last;
-        if (s->diff[L] == 0) {
-            uint32_t multi = lz_decode_lazy(d, &s->zero, 6);
-            if (multi == 1) {
-                s->diff[L] = lz_ic_decode(d, &s->ic, 0, 0);
-                s->t[L] += (uint64_t)(int64_t)s->diff[L];
-                s->extreme[L] = 0;
-            } else if (multi == 2) {
-                gps_full(s, d);
-            } else if (multi > 2) {
-                s->last = (L + multi - 2) & 3;
-                continue;
-            }
-        } else {
-            uint32_t multi = lz_decode_lazy(d, &s->multi, GPS_TOTAL);
-            if (multi == 1) {
-                s->t[L] += (uint64_t)(int64_t)lz_ic_decode(d, &s->ic, s->diff[L], 1);
-                s->extreme[L] = 0;
-            } else if (multi < GPS_UNCHANGED) {
-                int32_t diff;
-                if (multi == 0) {
-                    diff = lz_ic_decode(d, &s->ic, 0, 7);
-                    gps_extreme(s, diff);
-                } else if (multi < GPS_MULTI) {
-                    diff = lz_ic_decode(d, &s->ic, mul32((int32_t)multi, s->diff[L]),
-                                        multi < 10 ? 2 : 3);
-                } else if (multi == GPS_MULTI) {
-                    diff = lz_ic_decode(d, &s->ic, mul32(GPS_MULTI, s->diff[L]), 4);
-                    gps_extreme(s, diff);
-                } else {
-                    int32_t mm = GPS_MULTI - (int32_t)multi;
-                    if (mm > GPS_MULTI_MINUS) {
-                        diff = lz_ic_decode(d, &s->ic, mul32(mm, s->diff[L]), 5);
-                    } else {
-                        diff = lz_ic_decode(d, &s->ic, mul32(GPS_MULTI_MINUS, s->diff[L]), 6);
-                        gps_extreme(s, diff);
-                    }
-                }
-                s->t[L] += (uint64_t)(int64_t)diff;
-            } else if (multi == GPS_CODE_FULL) {
-                gps_full(s, d);
-            } else if (multi > GPS_CODE_FULL) {
-                s->last = (L + multi - GPS_CODE_FULL) & 3;
-                continue;
-            }
-        }
-        break;
-    }
-    wr32(r, (uint32_t)s->t[s->last]);
-    wr32(r + 4, (uint32_t)(s->t[s->last] >> 32));
+    if (!lz_gps_decode(s, d, 1))
+        return 0;
+    lz_wr32(r, (uint32_t)s->t[s->last]);
+    lz_wr32(r + 4, (uint32_t)(s->t[s->last] >> 32));
     return 1;
 }
 
@@ -229,51 +118,13 @@ typedef struct {
     lz_sym used, diff[6];
 } rgb12;
 
-static int rgb_init(rgb12 *s, lz_arena *a, const uint8_t *r)
-{
-    memset(s, 0, sizeof *s);
-    for (int c = 0; c < 3; c++)
-        s->rgb[c] = (uint16_t)(r[2 * c] | r[2 * c + 1] << 8);
-    (void)a; /* the models are made on first use */
-    return 1;
-}
-
-static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v; }
-
-/* Green and blue predicted from red's change, byte by byte. */
 static void rgb_decode(rgb12 *s, lz_dec *d, uint8_t *r)
 {
-    const uint16_t *l = s->rgb;
-    unsigned sym = lz_decode_lazy(d, &s->used, 128), v[3];
-    v[0] = sym & 1 ? (lz_decode_lazy(d, &s->diff[0], 256) + (l[0] & 0xFF)) & 0xFF : l[0] & 0xFF;
-    v[0] |= sym & 2 ? ((lz_decode_lazy(d, &s->diff[1], 256) + (l[0] >> 8)) & 0xFF) << 8 : l[0] & 0xFF00;
-    if (sym & 64) {
-        int diff = (int)(v[0] & 0xFF) - (l[0] & 0xFF);
-        v[1] = sym & 4 ? (lz_decode_lazy(d, &s->diff[2], 256) + clamp8(diff + (l[1] & 0xFF))) & 0xFF
-                       : l[1] & 0xFF;
-        if (sym & 16) {
-            diff = (diff + (int)(v[1] & 0xFF) - (l[1] & 0xFF)) / 2;
-            v[2] = (lz_decode_lazy(d, &s->diff[4], 256) + clamp8(diff + (l[2] & 0xFF))) & 0xFF;
-        } else {
-            v[2] = l[2] & 0xFF;
-        }
-        diff = (int)(v[0] >> 8) - (l[0] >> 8);
-        if (sym & 8)
-            v[1] |= ((lz_decode_lazy(d, &s->diff[3], 256) + clamp8(diff + (l[1] >> 8))) & 0xFF) << 8;
-        else
-            v[1] |= l[1] & 0xFF00;
-        if (sym & 32) {
-            diff = (diff + (int)(v[1] >> 8) - (l[1] >> 8)) / 2;
-            v[2] |= ((lz_decode_lazy(d, &s->diff[5], 256) + clamp8(diff + (l[2] >> 8))) & 0xFF) << 8;
-        } else {
-            v[2] |= l[2] & 0xFF00;
-        }
-    } else {
-        v[1] = v[2] = v[0];
-    }
+    unsigned v[3];
+    lz_rgb_decode(d, &s->used, s->diff, s->rgb, v);
     for (int c = 0; c < 3; c++) {
         s->rgb[c] = (uint16_t)v[c];
-        wr16(r + 2 * c, v[c]);
+        lz_wr16(r + 2 * c, v[c]);
     }
 }
 
@@ -281,26 +132,14 @@ static void rgb_decode(rgb12 *s, lz_dec *d, uint8_t *r)
 
 typedef struct {
     unsigned n;
-    uint8_t *last;
-    lz_sym *m;
+    lz_bytes b;
 } byte2;
-
-static int byte_init(byte2 *s, lz_arena *a, const uint8_t *r, unsigned n)
-{
-    s->n = n;
-    s->last = lz_alloc(a, n);
-    s->m = lz_alloc(a, sizeof(lz_sym) * n);
-    if (!s->last || !s->m)
-        return 0;
-    memcpy(s->last, r, n);
-    memset(s->m, 0, sizeof(lz_sym) * n); /* made on first use */
-    return 1;
-}
 
 static void byte_decode(byte2 *s, lz_dec *d, uint8_t *r)
 {
+    uint8_t *last = s->b.last;
     for (unsigned k = 0; k < s->n; k++)
-        r[k] = s->last[k] = (uint8_t)(s->last[k] + lz_decode_lazy(d, &s->m[k], 256));
+        r[k] = last[k] = (uint8_t)(last[k] + lz_decode_lazy(d, &s->b.m[k], 256));
 }
 
 /* ---- the chunk ------------------------------------------------------ */
@@ -331,13 +170,19 @@ static int v2_chunk(const lz_item *items, unsigned nitems, unsigned rec_len,
             ok = (st[i] = calloc(1, sizeof(p10))) && p10_init(st[i], &a, r);
             break;
         case LZ_GPSTIME11:
-            ok = (st[i] = calloc(1, sizeof(gps11))) && gps_init(st[i], &a, r);
+            ok = (st[i] = calloc(1, sizeof(lz_gps))) && lz_gps_init(st[i], &a, lz_rd64(r));
             break;
         case LZ_RGB12:
-            ok = (st[i] = calloc(1, sizeof(rgb12))) && rgb_init(st[i], &a, r);
+            ok = (st[i] = calloc(1, sizeof(rgb12))) != NULL;
+            for (int c = 0; ok && c < 3; c++)
+                ((rgb12 *)st[i])->rgb[c] = lz_rd16(r + 2 * c);
             break;
         default: /* LZ_BYTE: io_laz.c admits nothing else */
-            ok = (st[i] = calloc(1, sizeof(byte2))) && byte_init(st[i], &a, r, items[i].size);
+            ok = (st[i] = calloc(1, sizeof(byte2))) != NULL;
+            if (ok) {
+                ((byte2 *)st[i])->n = items[i].size;
+                ok = lz_bytes_init(&((byte2 *)st[i])->b, &a, r, items[i].size);
+            }
         }
     }
     int rc = 0;

@@ -72,23 +72,6 @@ START_TEST(auto_columns_and_summary)
 }
 END_TEST
 
-static void same_bytes(const char *a, const char *b)
-{
-    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
-    ck_assert_ptr_nonnull(f);
-    ck_assert_ptr_nonnull(g);
-    int x, y;
-    long at = 0;
-    do {
-        x = fgetc(f);
-        y = fgetc(g);
-        ck_assert_msg(x == y, "%s and %s differ at byte %ld", a, b, at);
-        at++;
-    } while (x != EOF);
-    fclose(f);
-    fclose(g);
-}
-
 START_TEST(auto_parts_threads)
 {
     write_noisy(cli_path("in.xyz"));
@@ -105,11 +88,11 @@ START_TEST(auto_parts_threads)
     ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
                              "auto", "--threads", "2", "--memory", mem, "--quiet", NULL),
                      0);
-    same_bytes(cli_path("w.ply"), cli_path("p.ply"));
+    jf_test_assert_same_files("auto, in parts", cli_path("w.ply"), cli_path("p.ply"));
     ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("t.ply"), "--neighbors",
                              "auto", "--threads", "1", "--quiet", NULL),
                      0);
-    same_bytes(cli_path("w.ply"), cli_path("t.ply"));
+    jf_test_assert_same_files("auto, one thread", cli_path("w.ply"), cli_path("t.ply"));
 }
 END_TEST
 

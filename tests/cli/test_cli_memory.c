@@ -13,22 +13,6 @@
 #include "test_cli_util.h"
 #include "jf_test.h"
 
-static void same_bytes(const char *a, const char *b)
-{
-    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
-    ck_assert_msg(f && g, "%s or %s missing", a, b);
-    long at = 0;
-    int x, y;
-    do {
-        x = fgetc(f);
-        y = fgetc(g);
-        ck_assert_msg(x == y, "%s and %s differ at byte %ld", a, b, at);
-        at++;
-    } while (x != EOF);
-    fclose(f);
-    fclose(g);
-}
-
 /* The least SIZE the refusal names, in bytes (K or M), or 0. */
 static unsigned long long least_named(void)
 {
@@ -75,7 +59,7 @@ START_TEST(too_small_is_refused_with_the_least)
     ck_assert_uint_eq(least_named(), least);
     ck_assert_int_eq(run_budget("p.ply", "knn:16", least), 0);
     ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-    same_bytes(cli_path("w.ply"), cli_path("p.ply"));
+    jf_test_assert_same_files("the least, in parts", cli_path("w.ply"), cli_path("p.ply"));
 }
 END_TEST
 
@@ -102,7 +86,7 @@ START_TEST(small_budgets_same_bytes)
         for (unsigned long long extra = 0; extra <= (256ULL << 10); extra += 256ULL << 10) {
             ck_assert_int_eq(run_budget(p, runs[k].nb, least + extra), 0);
             ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-            same_bytes(cli_path(w), cli_path(p));
+            jf_test_assert_same_files(runs[k].nb, cli_path(w), cli_path(p));
         }
     }
 }
@@ -172,8 +156,35 @@ START_TEST(coordinates_on_disk_same_bytes)
                                  mem, NULL),
                          0);
         ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
-        same_bytes(cli_path(w), cli_path(p));
+        jf_test_assert_same_files(runs[k].nb, cli_path(w), cli_path(p));
     }
+}
+END_TEST
+
+/* Nothing held beside the parts (--quiet: no summary values; --keep none;
+ * no normals): the refusal does not name a size of nothing ("0K"). */
+START_TEST(refusal_names_no_empty_size)
+{
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "300000", "--seed", "6", "-o",
+                             cli_path("in.ply"), NULL),
+                     0);
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--threads",
+                             "1", "--quiet", "--keep", "none", "--memory", "1K", NULL),
+                     1);
+    const char *tail = "(with the coordinates read from the file as needed)\n";
+    size_t le = strlen(cli_err), lt = strlen(tail);
+    ck_assert_msg(le > lt && !strcmp(cli_err + le - lt, tail), "%s", cli_err);
+    ck_assert_msg(!strstr(cli_err, " 0K"), "%s", cli_err);
+    ck_assert_uint_gt(least_named(), 0);
+    ck_assert_int_eq(cli_exists(cli_path("p.ply")), 0);
+    /* with the summary's values (8 bytes a point), their size is named */
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("p.ply"), "--threads",
+                             "1", "--keep", "none", "--memory", "1K", NULL),
+                     1);
+    char want[128];
+    snprintf(want, sizeof want, "; the summary's values, normals and attributes: %dK)\n",
+             (300000 * 8 + 1023) / 1024);
+    ck_assert_msg(strstr(cli_err, want), "%s", cli_err);
 }
 END_TEST
 
@@ -186,6 +197,7 @@ int main(void)
     tcase_add_test(tc, too_small_is_refused_with_the_least);
     tcase_add_test(tc, small_budgets_same_bytes);
     tcase_add_test(tc, coordinates_on_disk_same_bytes);
+    tcase_add_test(tc, refusal_names_no_empty_size);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }

@@ -301,6 +301,18 @@ START_TEST(masked_estimate_equals_whole)
 }
 END_TEST
 
+static jf_status refuse_sink(void *u, const uint32_t *idx, jf_result *r, size_t m)
+{
+    (void)u, (void)idx, (void)r, (void)m;
+    return JF_ERR_INVALID; /* never called: the options are refused first */
+}
+static jf_status refuse_xyz_sink(void *u, const uint32_t *idx, const double *xyz, jf_result *r,
+                                 size_t m)
+{
+    (void)xyz;
+    return refuse_sink(u, idx, r, m);
+}
+
 START_TEST(refused_kinds)
 {
     jf_estimate_opts o;
@@ -312,6 +324,21 @@ START_TEST(refused_kinds)
     ck_assert_int_eq(jf__part_query_init(&o, &q), JF_ERR_UNSUPPORTED);
     int32_t part[1];
     double p[3] = {0, 0, 0};
+    /* both entry points refuse rings and mst with the same one line */
+    jf_cloud c = {0};
+    c.xyz = p, c.n = 1;
+    const jf_xyz_src src = {p, -1, NULL};
+    for (int k = 0; k < 2; k++) {
+        jf_estimate_opts_init(&o);
+        if (k) o.orient = JF_ORIENT_MST;
+        else o.nb.kind = JF_NB_RINGS;
+        jf_error e1, e2;
+        ck_assert_int_eq(jf_estimate_parts(&c, &o, 2, refuse_sink, NULL, &e1), JF_ERR_UNSUPPORTED);
+        ck_assert_int_eq(jf__estimate_parts_src(&c, &src, &o, 2, refuse_xyz_sink, NULL, &e2),
+                         JF_ERR_UNSUPPORTED);
+        ck_assert_str_eq(e1.msg, e2.msg);
+        ck_assert_ptr_nonnull(strstr(e1.msg, "not mst"));
+    }
     ck_assert_int_eq(jf__parts_split(p, 1, 0, part), JF_ERR_INVALID);
     ck_assert_int_eq(jf__parts_split(p, 1, JF_PARTS_MAX + 1, part), JF_ERR_INVALID);
 }
