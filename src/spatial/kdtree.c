@@ -43,6 +43,8 @@
 #define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
 #endif
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
+#define KD_APP_MAX (2 * KD_SORTED_MAX + KD_LEAF) /* append buffer (mode 3) */
+_Static_assert(KD_APP_MAX <= KD_BUF_MAX, "mode 3 uses the buffer of mode 2");
 
 typedef struct {
     double lo;        /* inner: max coordinate of the left child          */
@@ -311,13 +313,17 @@ size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t *
 /* The candidates are kept as positions in the tree's storage (so their
  * coordinates can be copied from it at the end) and compared in the order
  * of (d2, original index): the index is looked up only on equal d2. */
+typedef double kd_v2d __attribute__((vector_size(16)));
+typedef long long kd_v2l __attribute__((vector_size(16)));
+
 typedef struct {
     const jf_index *ix;
     double q[3];
     double *hd;       /* heap keys: squared distances                     */
     uint32_t *hp;     /* heap values: positions in tree order             */
     size_t cap, cnt;
-    int sorted;       /* 1: sorted array (small k); 2: buffer (buf_push); 0: heap */
+    int sorted;       /* 1: sorted array; 2: buffer (buf_push); 0: heap;
+                         3: append buffer (small k, app_leaf)              */
     double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
     uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
     jf__kd_scan *scan; /* when not NULL: the leaves read, the cells passed */
@@ -517,6 +523,101 @@ static void buf_push(kd_query *s, double d, uint32_t pos)
     s->worst_p = s->hp[s->cap - 1];
 }
 
+/* Mode 3's bound, lowered while at least k candidates stay within it: a
+ * factor at a time, each step one counting pass and one filtering pass,
+ * neither with a data-dependent branch.  Exact: the k nearest are among
+ * k points at d2 <= the bound (ties included: the bound is inclusive and
+ * names no point, worst_p = none). */
+#define KD_SHRINK 0.7
+static void app_shrink(kd_query *s)
+{
+    double *hd = s->hd;
+    uint32_t *hp = s->hp;
+    size_t c = s->cnt;
+    double w = s->worst_d;
+    if (!(w < INFINITY)) { /* no bound yet: the farthest candidate's */
+        w = 0;
+        for (size_t j = 0; j < c; j++) w = hd[j] > w ? hd[j] : w;
+    }
+    for (;;) {
+        const double v = w * KD_SHRINK;
+        size_t n = 0;
+        for (size_t j = 0; j < c; j++) n += hd[j] <= v;
+        if (n < s->cap || !(v < w)) break;
+        w = v;
+    }
+    size_t m = 0;
+    for (size_t j = 0; j < c; j++) {
+        const double d = hd[j];
+        hd[m] = d;
+        hp[m] = hp[j];
+        m += d <= w;
+    }
+    s->cnt = m;
+    if (w < s->worst_d) s->worst_d = w, s->worst_p = UINT32_MAX;
+}
+
+/* Small k without a scan record: every point of a leaf within the bound
+ * is appended without a branch (store always, advance on d <= worst), a
+ * superset of what the (d2, index) rule admits; from 2k candidates on,
+ * app_shrink lowers the bound.  The sorted insertion this replaces spent
+ * ~30% of a knn:16 query in mispredicted shifts.  Should the bound not
+ * come down (many equal d2), a quickselect keeps the k least. */
+static void app_leaf(kd_query *s, const kd_node *nd)
+{
+    const uint32_t first = nd->first, cnt = nd->dim >> 2;
+    const double *p = s->ix->pts + 3 * (size_t)first;
+    const double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2], w = s->worst_d;
+    double *hd = s->hd;
+    uint32_t *hp = s->hp;
+    size_t c = s->cnt;
+    for (uint32_t j = 0; j < cnt; j++, p += 3) {
+        const double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+        const double d = dx * dx + dy * dy + dz * dz;
+        hd[c] = d;
+        hp[c] = first + j;
+        c += d <= w;
+    }
+    s->cnt = c;
+    if (c < 2 * s->cap) return;
+    app_shrink(s);
+    if (s->cnt + KD_LEAF <= KD_APP_MAX) return;
+    buf_select(s->ix->id, hd, hp, 0, s->cnt, s->cap - 1);
+    s->cnt = s->cap;
+    s->worst_d = hd[s->cap - 1];
+    s->worst_p = hp[s->cap - 1];
+}
+
+/* The k least of mode 3's cnt candidates, nearest first, into (od, op):
+ * each candidate's rank in the (d2, index) order is the count of those
+ * before it (d2 compared for all pairs at once, vectorised; the index only
+ * where d2 ties), so the order is the heap's without a data-dependent
+ * branch.  app_shrink leaves cnt near k, so the cnt^2 pairs are few. */
+static size_t app_finish(const uint32_t *id, double *hd, const uint32_t *hp, size_t cnt,
+                         size_t k, double *od, uint32_t *op)
+{
+    hd[cnt] = INFINITY; /* pads the last pair: never below, equal only to an infinite d2 */
+    for (size_t i = 0; i < cnt; i++) {
+        const double d = hd[i];
+        const kd_v2d dv = {d, d};
+        kd_v2l vlt = {0, 0}, vle = {0, 0};
+        for (size_t j = 0; j < cnt; j += 2) {
+            kd_v2d v;
+            memcpy(&v, hd + j, sizeof v);
+            vlt -= (kd_v2l)(v < dv); /* -1 where true */
+            vle -= (kd_v2l)(v <= dv);
+        }
+        long long lt = vlt[0] + vlt[1], le = vle[0] + vle[1];
+        if (le > lt + 1) /* equal d2 (besides itself): by index */
+            for (size_t j = 0; j < cnt; j++) lt += hd[j] == d && id[hp[j]] < id[hp[i]];
+        if ((size_t)lt < k) {
+            od[lt] = d;
+            op[lt] = hp[i];
+        }
+    }
+    return cnt < k ? cnt : k;
+}
+
 static void scan_leaf(kd_query *s, const kd_node *nd)
 {
     const uint32_t first = nd->first, cnt = nd->dim >> 2;
@@ -582,7 +683,8 @@ static void search(kd_query *s, const double g0[3])
             top++;
             continue;
         }
-        scan_leaf(s, nd);
+        if (s->sorted == 3) app_leaf(s, nd);
+        else scan_leaf(s, nd);
         /* next deferred cell whose bound can still beat the worst */
         for (;;) {
             if (!top) return;
@@ -617,7 +719,8 @@ static void run_query(kd_query *s)
     double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (bound <= s->worst_d) search(s, g);
     else if (s->scan) s->scan->rc2 = bound;
-    if (s->sorted == 1) return;
+    if (s->sorted == 3 && s->cnt > s->cap) app_shrink(s); /* fewer to sort */
+    if (s->sorted == 1 || s->sorted == 3) return;
     if (s->sorted == 2) {
         double td[KD_BUF_MAX];
         uint32_t tp[KD_BUF_MAX];
@@ -650,16 +753,16 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     double stack_keys[KD_STACK_KEYS];
     double *keys = d2;
     /* the 2k buffer of buf_push, on the stack */
-    int mode = k <= KD_SORTED_MAX ? 1 : 2 * k <= KD_BUF_MAX ? 2 : 0;
+    int mode = k <= KD_SORTED_MAX ? (scan ? 1 : 3) : 2 * k <= KD_BUF_MAX ? 2 : 0;
     double buf_keys[KD_BUF_MAX];
     uint32_t buf_pos[KD_BUF_MAX];
-    if (mode == 2) keys = buf_keys;
+    if (mode >= 2) keys = buf_keys; /* KD_APP_MAX <= KD_BUF_MAX */
     else if (!keys) {
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
     /* idx holds positions during the search, indices after */
-    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode == 2 ? buf_pos : idx,
+    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode >= 2 ? buf_pos : idx,
                   k,     0, mode, bound, UINT32_MAX, scan};
     if (scan) scan->n = 0, scan->rc2 = INFINITY;
     if (mode == 2 && !scan && bound == INFINITY && k >= 8 * KD_PROBE_MIN) {
@@ -686,7 +789,10 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
             run_query(&s);
     } else
         run_query(&s);
-    if (mode == 2) {
+    if (mode == 3) {
+        s.cnt = app_finish(ix->id, buf_keys, buf_pos, s.cnt, k, d2 ? d2 : stack_keys, idx);
+        keys = d2;
+    } else if (mode == 2) {
         if (d2) memcpy(d2, buf_keys, s.cnt * sizeof *d2);
         memcpy(idx, buf_pos, s.cnt * sizeof *idx);
         keys = d2;
