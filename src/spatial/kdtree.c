@@ -31,6 +31,7 @@
 #include <omp.h>
 
 #include "index_internal.h"
+#include "io_internal.h" /* jf__big_alloc */
 #include "jetfit.h"
 
 #define KD_LEAF 24          /* largest leaf: 12..24 points (measured best
@@ -230,8 +231,9 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     size_t m = off[nblk];
     ix->m = m;
     ix->nnodes = m ? count_nodes(m) : 0;
-    ix->pts = malloc((m ? m : 1) * 3 * sizeof *ix->pts);
-    ix->id = malloc((m ? m : 1) * sizeof *ix->id);
+    /* written whole: huge pages, one fault per 2 MiB (io_bigalloc.c) */
+    ix->pts = jf__big_alloc((m ? m : 1) * 3 * sizeof *ix->pts);
+    ix->id = jf__big_alloc((m ? m : 1) * sizeof *ix->id);
     ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);
     ix->minid = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->minid);
     if (!ix->pts || !ix->id || !ix->nodes || !ix->minid) {
