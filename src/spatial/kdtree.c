@@ -4,12 +4,14 @@
  *  - build: the finite points are copied, permuted, into one contiguous array
  *    (24 bytes/point) beside their original indices (4 bytes/point).  Each
  *    node splits its range at the median of the axis of largest extent
- *    (quickselect, Hoare partition: O(n log n) total); ranges of at most
- *    KD_LEAF points are leaves.  An inner node keeps the largest coordinate
+ *    (quickselect, a branch-free Lomuto partition: O(n log n) total);
+ *    ranges of at most KD_LEAF points are leaves (their sets depend only
+ *    on the (coordinate, index) order; their inner order on the partition).  An inner node keeps the largest coordinate
  *    of its left half and the smallest of its right half along its axis
  *    (as nanoflann does), so the gap between the halves prunes too.
  *  - query: depth first, nearer child first; a bounded max-heap (or, for
- *    k up to 512, a 2k buffer cut back to k by quickselect) of
+ *    k up to 512, a 2k buffer cut back to k by quickselect; for k up to
+ *    48, a buffer appended to without branches, ranked at the end) of
  *    (d2, position in tree order) pairs lives in the caller's buffers,
  *    positions turned into original indices at the end (and, for the
  *    pipeline, the points' coordinates copied from the tree's storage:
@@ -98,7 +100,7 @@ static int key_less(const double *pts, const uint32_t *id, size_t a, size_t b, i
     return x < y || (x == y && id[a] < id[b]);
 }
 
-/* Quickselect (median of three, Hoare partition) on (coordinate d, index):
+/* Quickselect (median of three, Lomuto partition) on (coordinate d, index):
  * afterwards every point in [lo, nth) is before nth and every one in
  * (nth, hi) after it in that order, so coordinates in [lo, nth) <= that
  * of nth <= those in (nth, hi).  The keys are distinct: O(n) expected. */
@@ -110,20 +112,32 @@ static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
         if (key_less(pts, id, mid, lo, d)) swap_pt(pts, id, mid, lo);
         if (key_less(pts, id, last, lo, d)) swap_pt(pts, id, last, lo);
         if (key_less(pts, id, last, mid, d)) swap_pt(pts, id, last, mid);
-        const double pc = pts[3 * mid + d];
-        const uint32_t pi = id[mid];
-        size_t i = lo, j = last;
-        for (;;) {
-            while (pts[3 * i + d] < pc || (pts[3 * i + d] == pc && id[i] < pi)) i++;
-            while (pts[3 * j + d] > pc || (pts[3 * j + d] == pc && id[j] > pi)) j--;
-            if (i >= j) break;
-            swap_pt(pts, id, i, j);
-            i++;
-            j--;
+        /* Lomuto without a branch on the data: every element is swapped
+         * with the boundary, which advances past those before the pivot
+         * (Hoare's two scans mispredicted about one element in two) */
+        swap_pt(pts, id, mid, last); /* the pivot, out of the way */
+        const double pc = pts[3 * last + d];
+        const uint32_t pi = id[last];
+        size_t st = lo;
+        for (size_t i = lo; i < last; i++) {
+            const double x0 = pts[3 * i], x1 = pts[3 * i + 1], x2 = pts[3 * i + 2];
+            const uint32_t xi = id[i];
+            const double x = pts[3 * i + d];
+            const size_t less = (x < pc) | ((x == pc) & (xi < pi));
+            pts[3 * i] = pts[3 * st];
+            pts[3 * i + 1] = pts[3 * st + 1];
+            pts[3 * i + 2] = pts[3 * st + 2];
+            id[i] = id[st];
+            pts[3 * st] = x0;
+            pts[3 * st + 1] = x1;
+            pts[3 * st + 2] = x2;
+            id[st] = xi;
+            st += less;
         }
-        /* [lo, j] <= pivot <= [j+1, hi) */
-        if (nth <= j) hi = j + 1;
-        else lo = j + 1;
+        swap_pt(pts, id, st, last); /* [lo, st) < pivot at st < (st, hi) */
+        if (nth == st) return;
+        if (nth < st) hi = st;
+        else lo = st + 1;
     }
     if (hi - lo == 2 && key_less(pts, id, lo + 1, lo, d))
         swap_pt(pts, id, lo, lo + 1);
