@@ -178,10 +178,10 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
     } else {
         for (int d = 0; d < 3; d++) lo[d] = hi[d] = p[3 * begin + d];
         for (size_t i = begin + 1; i < end; i++)
-            for (int d = 0; d < 3; d++) {
-                double v = p[3 * i + d];
-                if (v < lo[d]) lo[d] = v;
-                if (v > hi[d]) hi[d] = v;
+            for (int d = 0; d < 3; d++) { /* finite: min/max without branches */
+                const double v = p[3 * i + d];
+                lo[d] = v < lo[d] ? v : lo[d];
+                hi[d] = v > hi[d] ? v : hi[d];
             }
     }
     int dim = 0;
@@ -190,8 +190,7 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
     size_t mid = begin + cnt / 2;
     select_nth(b->pts, b->id, begin, end, mid, dim);
     double lmax = p[3 * begin + dim];
-    for (size_t i = begin + 1; i < mid; i++)
-        if (p[3 * i + dim] > lmax) lmax = p[3 * i + dim];
+    for (size_t i = begin + 1; i < mid; i++) lmax = p[3 * i + dim] > lmax ? p[3 * i + dim] : lmax;
     size_t child = next;
     nd->lo = lmax;
     nd->hi = p[3 * mid + dim]; /* the selected element is the right minimum */
