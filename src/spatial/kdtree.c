@@ -543,7 +543,7 @@ static void buf_push(kd_query *s, double d, uint32_t pos)
  * neither with a data-dependent branch.  Exact: the k nearest are among
  * k points at d2 <= the bound (ties included: the bound is inclusive and
  * names no point, worst_p = none). */
-#define KD_SHRINK 0.7
+#define KD_SHRINK 0.8
 static void app_shrink(kd_query *s)
 {
     double *hd = s->hd;
