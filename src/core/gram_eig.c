@@ -158,8 +158,9 @@ static inline __attribute__((always_inline)) void extremes_x2(v2d *d, v2d *e, si
     v2l dh = {0, 0}, dl = {0, 0};
     int it = 0;
     for (; it < GE_ITERS && !(dh[0] && dh[1] && dl[0] && dl[1]); it++) {
-        xh = laguerre(d, e, n, xh, 1, &dh);
-        xl = laguerre(d, e, n, xl, 0, &dl);
+        /* a side done in both lanes would only keep them: skipped */
+        if (!(dh[0] && dh[1])) xh = laguerre(d, e, n, xh, 1, &dh);
+        if (!(dl[0] && dl[1])) xl = laguerre(d, e, n, xl, 0, &dl);
     }
     *lmax = xh * isc;
     *lmin = xl * isc;

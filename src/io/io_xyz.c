@@ -867,8 +867,8 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
             s.cap = (len + 1) / (2 * (size_t)(t.maxcol + 1));
             s.cap = s.cap < lines ? s.cap : lines;
             s.cap = s.cap < JF_MAX_POINTS ? s.cap : JF_MAX_POINTS;
-            c->xyz = malloc(s.cap * 3 * sizeof(double));
-            c->nrm = s.have_nrm ? malloc(s.cap * 3 * sizeof(double)) : NULL;
+            c->xyz = jf__big_alloc(s.cap * 3 * sizeof(double)); /* written whole */
+            c->nrm = s.have_nrm ? jf__big_alloc(s.cap * 3 * sizeof(double)) : NULL;
             if (!c->xyz || (s.have_nrm && !c->nrm))
                 return jf_io_fail(err, JF_ERR_NOMEM, name, 0,
                                   "out of memory for %zu points", s.cap);

@@ -4,12 +4,14 @@
  *  - build: the finite points are copied, permuted, into one contiguous array
  *    (24 bytes/point) beside their original indices (4 bytes/point).  Each
  *    node splits its range at the median of the axis of largest extent
- *    (quickselect, Hoare partition: O(n log n) total); ranges of at most
- *    KD_LEAF points are leaves.  An inner node keeps the largest coordinate
+ *    (quickselect, a branch-free Lomuto partition: O(n log n) total);
+ *    ranges of at most KD_LEAF points are leaves (their sets depend only
+ *    on the (coordinate, index) order; their inner order on the partition).  An inner node keeps the largest coordinate
  *    of its left half and the smallest of its right half along its axis
  *    (as nanoflann does), so the gap between the halves prunes too.
  *  - query: depth first, nearer child first; a bounded max-heap (or, for
- *    k up to 512, a 2k buffer cut back to k by quickselect) of
+ *    k up to 512, a 2k buffer cut back to k by quickselect; for k up to
+ *    48, a buffer appended to without branches, ranked at the end) of
  *    (d2, position in tree order) pairs lives in the caller's buffers,
  *    positions turned into original indices at the end (and, for the
  *    pipeline, the points' coordinates copied from the tree's storage:
@@ -31,6 +33,7 @@
 #include <omp.h>
 
 #include "index_internal.h"
+#include "io_internal.h" /* jf__big_alloc */
 #include "jetfit.h"
 
 #define KD_LEAF 24          /* largest leaf: 12..24 points (measured best
@@ -43,6 +46,8 @@
 #define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
 #endif
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
+#define KD_APP_MAX (2 * KD_SORTED_MAX + KD_LEAF) /* append buffer (mode 3) */
+_Static_assert(KD_APP_MAX <= KD_BUF_MAX, "mode 3 uses the buffer of mode 2");
 
 typedef struct {
     double lo;        /* inner: max coordinate of the left child          */
@@ -95,7 +100,7 @@ static int key_less(const double *pts, const uint32_t *id, size_t a, size_t b, i
     return x < y || (x == y && id[a] < id[b]);
 }
 
-/* Quickselect (median of three, Hoare partition) on (coordinate d, index):
+/* Quickselect (median of three, Lomuto partition) on (coordinate d, index):
  * afterwards every point in [lo, nth) is before nth and every one in
  * (nth, hi) after it in that order, so coordinates in [lo, nth) <= that
  * of nth <= those in (nth, hi).  The keys are distinct: O(n) expected. */
@@ -107,20 +112,32 @@ static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
         if (key_less(pts, id, mid, lo, d)) swap_pt(pts, id, mid, lo);
         if (key_less(pts, id, last, lo, d)) swap_pt(pts, id, last, lo);
         if (key_less(pts, id, last, mid, d)) swap_pt(pts, id, last, mid);
-        const double pc = pts[3 * mid + d];
-        const uint32_t pi = id[mid];
-        size_t i = lo, j = last;
-        for (;;) {
-            while (pts[3 * i + d] < pc || (pts[3 * i + d] == pc && id[i] < pi)) i++;
-            while (pts[3 * j + d] > pc || (pts[3 * j + d] == pc && id[j] > pi)) j--;
-            if (i >= j) break;
-            swap_pt(pts, id, i, j);
-            i++;
-            j--;
+        /* Lomuto without a branch on the data: every element is swapped
+         * with the boundary, which advances past those before the pivot
+         * (Hoare's two scans mispredicted about one element in two) */
+        swap_pt(pts, id, mid, last); /* the pivot, out of the way */
+        const double pc = pts[3 * last + d];
+        const uint32_t pi = id[last];
+        size_t st = lo;
+        for (size_t i = lo; i < last; i++) {
+            const double x0 = pts[3 * i], x1 = pts[3 * i + 1], x2 = pts[3 * i + 2];
+            const uint32_t xi = id[i];
+            const double x = pts[3 * i + d];
+            const size_t less = (x < pc) | ((x == pc) & (xi < pi));
+            pts[3 * i] = pts[3 * st];
+            pts[3 * i + 1] = pts[3 * st + 1];
+            pts[3 * i + 2] = pts[3 * st + 2];
+            id[i] = id[st];
+            pts[3 * st] = x0;
+            pts[3 * st + 1] = x1;
+            pts[3 * st + 2] = x2;
+            id[st] = xi;
+            st += less;
         }
-        /* [lo, j] <= pivot <= [j+1, hi) */
-        if (nth <= j) hi = j + 1;
-        else lo = j + 1;
+        swap_pt(pts, id, st, last); /* [lo, st) < pivot at st < (st, hi) */
+        if (nth == st) return;
+        if (nth < st) hi = st;
+        else lo = st + 1;
     }
     if (hi - lo == 2 && key_less(pts, id, lo + 1, lo, d))
         swap_pt(pts, id, lo, lo + 1);
@@ -161,10 +178,10 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
     } else {
         for (int d = 0; d < 3; d++) lo[d] = hi[d] = p[3 * begin + d];
         for (size_t i = begin + 1; i < end; i++)
-            for (int d = 0; d < 3; d++) {
-                double v = p[3 * i + d];
-                if (v < lo[d]) lo[d] = v;
-                if (v > hi[d]) hi[d] = v;
+            for (int d = 0; d < 3; d++) { /* finite: min/max without branches */
+                const double v = p[3 * i + d];
+                lo[d] = v < lo[d] ? v : lo[d];
+                hi[d] = v > hi[d] ? v : hi[d];
             }
     }
     int dim = 0;
@@ -173,8 +190,7 @@ static void build_node(const kd_builder *b, size_t ni, size_t begin, size_t end,
     size_t mid = begin + cnt / 2;
     select_nth(b->pts, b->id, begin, end, mid, dim);
     double lmax = p[3 * begin + dim];
-    for (size_t i = begin + 1; i < mid; i++)
-        if (p[3 * i + dim] > lmax) lmax = p[3 * i + dim];
+    for (size_t i = begin + 1; i < mid; i++) lmax = p[3 * i + dim] > lmax ? p[3 * i + dim] : lmax;
     size_t child = next;
     nd->lo = lmax;
     nd->hi = p[3 * mid + dim]; /* the selected element is the right minimum */
@@ -228,8 +244,9 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     size_t m = off[nblk];
     ix->m = m;
     ix->nnodes = m ? count_nodes(m) : 0;
-    ix->pts = malloc((m ? m : 1) * 3 * sizeof *ix->pts);
-    ix->id = malloc((m ? m : 1) * sizeof *ix->id);
+    /* written whole: huge pages, one fault per 2 MiB (io_bigalloc.c) */
+    ix->pts = jf__big_alloc((m ? m : 1) * 3 * sizeof *ix->pts);
+    ix->id = jf__big_alloc((m ? m : 1) * sizeof *ix->id);
     ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);
     ix->minid = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->minid);
     if (!ix->pts || !ix->id || !ix->nodes || !ix->minid) {
@@ -311,13 +328,17 @@ size_t jf__index_points(const jf_index *ix, const double **pts, const uint32_t *
 /* The candidates are kept as positions in the tree's storage (so their
  * coordinates can be copied from it at the end) and compared in the order
  * of (d2, original index): the index is looked up only on equal d2. */
+typedef double kd_v2d __attribute__((vector_size(16)));
+typedef long long kd_v2l __attribute__((vector_size(16)));
+
 typedef struct {
     const jf_index *ix;
     double q[3];
     double *hd;       /* heap keys: squared distances                     */
     uint32_t *hp;     /* heap values: positions in tree order             */
     size_t cap, cnt;
-    int sorted;       /* 1: sorted array (small k); 2: buffer (buf_push); 0: heap */
+    int sorted;       /* 1: sorted array; 2: buffer (buf_push); 0: heap;
+                         3: append buffer (small k, app_leaf)              */
     double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
     uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
     jf__kd_scan *scan; /* when not NULL: the leaves read, the cells passed */
@@ -517,6 +538,101 @@ static void buf_push(kd_query *s, double d, uint32_t pos)
     s->worst_p = s->hp[s->cap - 1];
 }
 
+/* Mode 3's bound, lowered while at least k candidates stay within it: a
+ * factor at a time, each step one counting pass and one filtering pass,
+ * neither with a data-dependent branch.  Exact: the k nearest are among
+ * k points at d2 <= the bound (ties included: the bound is inclusive and
+ * names no point, worst_p = none). */
+#define KD_SHRINK 0.8
+static void app_shrink(kd_query *s)
+{
+    double *hd = s->hd;
+    uint32_t *hp = s->hp;
+    size_t c = s->cnt;
+    double w = s->worst_d;
+    if (!(w < INFINITY)) { /* no bound yet: the farthest candidate's */
+        w = 0;
+        for (size_t j = 0; j < c; j++) w = hd[j] > w ? hd[j] : w;
+    }
+    for (;;) {
+        const double v = w * KD_SHRINK;
+        size_t n = 0;
+        for (size_t j = 0; j < c; j++) n += hd[j] <= v;
+        if (n < s->cap || !(v < w)) break;
+        w = v;
+    }
+    size_t m = 0;
+    for (size_t j = 0; j < c; j++) {
+        const double d = hd[j];
+        hd[m] = d;
+        hp[m] = hp[j];
+        m += d <= w;
+    }
+    s->cnt = m;
+    if (w < s->worst_d) s->worst_d = w, s->worst_p = UINT32_MAX;
+}
+
+/* Small k without a scan record: every point of a leaf within the bound
+ * is appended without a branch (store always, advance on d <= worst), a
+ * superset of what the (d2, index) rule admits; from 2k candidates on,
+ * app_shrink lowers the bound.  The sorted insertion this replaces spent
+ * ~30% of a knn:16 query in mispredicted shifts.  Should the bound not
+ * come down (many equal d2), a quickselect keeps the k least. */
+static void app_leaf(kd_query *s, const kd_node *nd)
+{
+    const uint32_t first = nd->first, cnt = nd->dim >> 2;
+    const double *p = s->ix->pts + 3 * (size_t)first;
+    const double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2], w = s->worst_d;
+    double *hd = s->hd;
+    uint32_t *hp = s->hp;
+    size_t c = s->cnt;
+    for (uint32_t j = 0; j < cnt; j++, p += 3) {
+        const double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+        const double d = dx * dx + dy * dy + dz * dz;
+        hd[c] = d;
+        hp[c] = first + j;
+        c += d <= w;
+    }
+    s->cnt = c;
+    if (c < 2 * s->cap) return;
+    app_shrink(s);
+    if (s->cnt + KD_LEAF <= KD_APP_MAX) return;
+    buf_select(s->ix->id, hd, hp, 0, s->cnt, s->cap - 1);
+    s->cnt = s->cap;
+    s->worst_d = hd[s->cap - 1];
+    s->worst_p = hp[s->cap - 1];
+}
+
+/* The k least of mode 3's cnt candidates, nearest first, into (od, op):
+ * each candidate's rank in the (d2, index) order is the count of those
+ * before it (d2 compared for all pairs at once, vectorised; the index only
+ * where d2 ties), so the order is the heap's without a data-dependent
+ * branch.  app_shrink leaves cnt near k, so the cnt^2 pairs are few. */
+static size_t app_finish(const uint32_t *id, double *hd, const uint32_t *hp, size_t cnt,
+                         size_t k, double *od, uint32_t *op)
+{
+    hd[cnt] = INFINITY; /* pads the last pair: never below, equal only to an infinite d2 */
+    for (size_t i = 0; i < cnt; i++) {
+        const double d = hd[i];
+        const kd_v2d dv = {d, d};
+        kd_v2l vlt = {0, 0}, vle = {0, 0};
+        for (size_t j = 0; j < cnt; j += 2) {
+            kd_v2d v;
+            memcpy(&v, hd + j, sizeof v);
+            vlt -= (kd_v2l)(v < dv); /* -1 where true */
+            vle -= (kd_v2l)(v <= dv);
+        }
+        long long lt = vlt[0] + vlt[1], le = vle[0] + vle[1];
+        if (le > lt + 1) /* equal d2 (besides itself): by index */
+            for (size_t j = 0; j < cnt; j++) lt += hd[j] == d && id[hp[j]] < id[hp[i]];
+        if ((size_t)lt < k) {
+            od[lt] = d;
+            op[lt] = hp[i];
+        }
+    }
+    return cnt < k ? cnt : k;
+}
+
 static void scan_leaf(kd_query *s, const kd_node *nd)
 {
     const uint32_t first = nd->first, cnt = nd->dim >> 2;
@@ -582,7 +698,8 @@ static void search(kd_query *s, const double g0[3])
             top++;
             continue;
         }
-        scan_leaf(s, nd);
+        if (s->sorted == 3) app_leaf(s, nd);
+        else scan_leaf(s, nd);
         /* next deferred cell whose bound can still beat the worst */
         for (;;) {
             if (!top) return;
@@ -617,7 +734,8 @@ static void run_query(kd_query *s)
     double bound = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (bound <= s->worst_d) search(s, g);
     else if (s->scan) s->scan->rc2 = bound;
-    if (s->sorted == 1) return;
+    if (s->sorted == 3 && s->cnt > s->cap) app_shrink(s); /* fewer to sort */
+    if (s->sorted == 1 || s->sorted == 3) return;
     if (s->sorted == 2) {
         double td[KD_BUF_MAX];
         uint32_t tp[KD_BUF_MAX];
@@ -650,16 +768,16 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     double stack_keys[KD_STACK_KEYS];
     double *keys = d2;
     /* the 2k buffer of buf_push, on the stack */
-    int mode = k <= KD_SORTED_MAX ? 1 : 2 * k <= KD_BUF_MAX ? 2 : 0;
+    int mode = k <= KD_SORTED_MAX ? (scan ? 1 : 3) : 2 * k <= KD_BUF_MAX ? 2 : 0;
     double buf_keys[KD_BUF_MAX];
     uint32_t buf_pos[KD_BUF_MAX];
-    if (mode == 2) keys = buf_keys;
+    if (mode >= 2) keys = buf_keys; /* KD_APP_MAX <= KD_BUF_MAX */
     else if (!keys) {
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
     /* idx holds positions during the search, indices after */
-    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode == 2 ? buf_pos : idx,
+    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode >= 2 ? buf_pos : idx,
                   k,     0, mode, bound, UINT32_MAX, scan};
     if (scan) scan->n = 0, scan->rc2 = INFINITY;
     if (mode == 2 && !scan && bound == INFINITY && k >= 8 * KD_PROBE_MIN) {
@@ -686,7 +804,10 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
             run_query(&s);
     } else
         run_query(&s);
-    if (mode == 2) {
+    if (mode == 3) {
+        s.cnt = app_finish(ix->id, buf_keys, buf_pos, s.cnt, k, d2 ? d2 : stack_keys, idx);
+        keys = d2;
+    } else if (mode == 2) {
         if (d2) memcpy(d2, buf_keys, s.cnt * sizeof *d2);
         memcpy(idx, buf_pos, s.cnt * sizeof *idx);
         keys = d2;

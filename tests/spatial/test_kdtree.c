@@ -554,6 +554,75 @@ START_TEST(order_morton_cube)
 }
 END_TEST
 
+/* Small k (the append buffer, its bound lowered as candidates come in)
+ * at every point in the tree's walk, each bounded as the pipeline bounds
+ * it (the farthest of the previous point's k nearest, or none), against
+ * brute force: a sphere-like surface with a cluster of exact duplicates
+ * (more equal d2 than the buffer holds), a grid plane (equidistant ties)
+ * and a cloud whose squared distances overflow to infinity. */
+static void check_walk(const double *xyz, size_t n, size_t k)
+{
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
+    const double *tp;
+    const uint32_t *tid;
+    size_t m = jf__index_points(ix, &tp, &tid);
+    pair *ref = malloc(n * sizeof *ref);
+    uint32_t *idx = malloc(k * sizeof *idx);
+    double *d2 = malloc(k * sizeof *d2), *pts = malloc(3 * k * sizeof *pts),
+           *prev = malloc(3 * k * sizeof *prev);
+    size_t prev_n = 0;
+    for (size_t t = 0; t < m; t += 1 + (t % 3)) {
+        const double *q = tp + 3 * t;
+        double b = INFINITY;
+        if (prev_n == k) {
+            b = 0;
+            for (size_t j = 0; j < k; j++) {
+                const double dx = q[0] - prev[3 * j], dy = q[1] - prev[3 * j + 1],
+                             dz = q[2] - prev[3 * j + 2], d = dx * dx + dy * dy + dz * dz;
+                b = d > b ? d : b;
+            }
+        }
+        size_t all = brute(xyz, n, q, ref), want = k < all ? k : all, found = 99;
+        ck_assert_int_eq(jf__index_query(ix, q, k, b, idx, d2, pts, &found), JF_OK);
+        if (found < want) /* the bound rounded low: the pipeline asks again */
+            ck_assert_int_eq(jf__index_query(ix, q, k, INFINITY, idx, d2, pts, &found), JF_OK);
+        ck_assert_uint_eq(found, want);
+        for (size_t j = 0; j < found; j++) {
+            ck_assert_uint_eq(idx[j], ref[j].i);
+            ck_assert(d2[j] == ref[j].d || (isnan(d2[j]) && isnan(ref[j].d)));
+            ck_assert(memcmp(pts + 3 * j, xyz + 3 * (size_t)idx[j], sizeof(double[3])) == 0);
+        }
+        memcpy(prev, pts, 3 * found * sizeof *prev);
+        prev_n = found;
+    }
+    free(ref), free(idx), free(d2), free(pts), free(prev);
+    jf_index_free(ix);
+}
+
+START_TEST(knn_small_k_walk)
+{
+    size_t n = 2400;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    for (size_t i = 0; i < n; i++) { /* a sphere, 200 copies of one point */
+        double u = 2 * urand() - 1, a = 6.283185307179586 * urand(), r = sqrt(1 - u * u);
+        if (i % 12 == 5) u = 1, r = 0, a = 0;
+        xyz[3 * i] = r * cos(a), xyz[3 * i + 1] = r * sin(a), xyz[3 * i + 2] = u;
+    }
+    const size_t ks[] = {1, 5, 16, 24, 48};
+    for (size_t t = 0; t < sizeof ks / sizeof ks[0]; t++) check_walk(xyz, n, ks[t]);
+    for (size_t i = 0; i < n; i++) { /* a 40 x 60 grid plane */
+        xyz[3 * i] = (double)(i % 40), xyz[3 * i + 1] = (double)(i / 40), xyz[3 * i + 2] = 3.0;
+    }
+    check_walk(xyz, n, 16);
+    check_walk(xyz, 30, 16); /* fewer than 2k points */
+    check_walk(xyz, 7, 16);  /* fewer than k */
+    for (size_t i = 0; i < 3 * n; i++) xyz[i] = (urand() - 0.5) * 4e154; /* d2 up to inf */
+    check_walk(xyz, 300, 16);
+    free(xyz);
+}
+END_TEST
+
 static Suite *kdtree_suite(void)
 {
     Suite *s = suite_create("kdtree");
@@ -566,6 +635,7 @@ static Suite *kdtree_suite(void)
     tcase_add_test(tc, knn_nonfinite_points);
     tcase_add_test(tc, knn_edge_cases);
     tcase_add_test(tc, knn_large_k_without_d2);
+    tcase_add_test(tc, knn_small_k_walk);
     tcase_add_test(tc, knn_threads_agree);
     tcase_add_test(tc, knn_scan_record);
     tcase_add_test(tc, knn_identical_points_read_few_leaves);
