@@ -327,12 +327,8 @@ static void memory_refused(const char *in, unsigned long long memory, const jf_m
             size_str(r->need_min, least), what);
 }
 
-/* --las-columns: the Extra Bytes type of jetfit's real-valued columns in a
- * .las or .laz output (LAS 1.4 R15 table 24: 10 double, 9 float).  A .laz
- * takes compact unless told -- floats, the unit vectors' components
- * (nx ... d2z) rounded to multiples of 2^-16 -- because LASzip codes each
- * extra byte as a difference from the previous point's, and low mantissa
- * bytes are noise (docs/formats.md#laz). */
+/* --las-columns: checked here, applied by the library's rule
+ * (jf__las_columns, the Python binding's too: .laz compact unless told). */
 static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, jf_column *cols,
                              size_t ncols, jf_error *err)
 {
@@ -343,14 +339,7 @@ static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, j
                  cmd->out);
         return JF_ERR_INVALID;
     }
-    int mode = cmd->las_columns ? cmd->las_columns : laz ? 3 : 1;
-    for (size_t j = 3; mode > 1 && j < ncols; j++) {
-        const char *n = cols[j].name;
-        int unit = (n[0] == 'n' && n[1] && strchr("xyz", n[1]) && !n[2]) ||
-                   (n[0] == 'd' && (n[1] == '1' || n[1] == '2') && n[2] && strchr("xyz", n[2]) &&
-                    !n[3]);
-        if (cols[j].type == JF_COL_F64) cols[j].type = mode == 3 && unit ? JF_COL_F32_Q16 : JF_COL_F32;
-    }
+    jf__las_columns(path, cmd->las_columns, cols, ncols);
     return JF_OK;
 }
 
