@@ -26,7 +26,7 @@
 #include "index_internal.h"
 
 #define SH_AHEAD 16 /* walk points looked at for a search's centre */
-#define KSHARE 2 /* candidates: KSHARE x k (2k: the tree's fast buffer mode) */
+#define KSHARE 4 /* candidates: KSHARE x k (up to 1024: the tree's buffer mode) */
 
 struct jf__knn_share {
     size_t k, kc;  /* asked, candidates searched                       */
