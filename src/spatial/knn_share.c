@@ -89,7 +89,7 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     s->cd2 = malloc(s->kc * sizeof *s->cd2);
     s->sel = malloc(s->kc * sizeof *s->sel);
     s->bkt = malloc(s->kc * sizeof *s->bkt);
-    s->start = malloc((s->kc + 1) * sizeof *s->start);
+    s->start = malloc((2 * s->kc + 1) * sizeof *s->start);
     s->td = malloc(s->kc * sizeof *s->td);
     s->tp = malloc(s->kc * sizeof *s->tp);
     if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
@@ -194,43 +194,51 @@ again:;
         goto again;
     }
     if (n < s->k || !(b2 > 0.0)) return 0;
-    /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
-     * the first k into td, tp (locals: the stores below alias nothing) */
+    /* bucket sort by d2 into 2n monotone buckets (mostly one point or
+     * none), then one insertion sort by (d2, index) of the buckets up to
+     * the k-th's: it moves only the few bucket mates out of order (a
+     * loop per bucket mispredicted on every bucket size) */
     uint32_t *start = s->start, *tp = s->tp, *bkt = s->bkt;
     double *td = s->td;
     const double *sd = s->d2;
     const uint32_t *sel = s->sel, *cid = s->cid;
-    const double scale = (double)n / b2;
+    const size_t nb = 2 * n;
+    const double scale = (double)nb / b2;
     if (!isfinite(scale)) return 0; /* b2 subnormal: the buckets would overflow */
-    memset(start, 0, (n + 1) * sizeof *start);
+    memset(start, 0, (nb + 1) * sizeof *start);
     for (size_t j = 0; j < n; j++) {
         size_t bk = (size_t)(sd[j] * scale);
-        bkt[j] = (uint32_t)(bk < n ? bk : n - 1);
+        bkt[j] = (uint32_t)(bk < nb ? bk : nb - 1);
         start[bkt[j] + 1]++;
     }
-    for (size_t bk = 0; bk < n; bk++) start[bk + 1] += start[bk];
+    for (size_t bk = 0; bk < nb; bk++) start[bk + 1] += start[bk];
     for (size_t j = 0; j < n; j++) {
         uint32_t at = start[bkt[j]]++;
         td[at] = sd[j];
         tp[at] = sel[j];
     }
+    /* start[bk] is now the end of bucket bk: the first end >= k closes
+     * the k-th's bucket */
     const size_t k = s->k;
-    size_t lo = 0;
-    for (size_t bk = 0; bk < n && lo < k; bk++) {
-        size_t end = start[bk];
-        for (size_t i = lo + 1; i < end; i++) { /* insertion sort of the bucket */
-            double d = td[i];
-            uint32_t p = tp[i], pid = cid[p];
-            size_t j = i;
-            while (j > lo && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]])) {
-                td[j] = td[j - 1];
-                tp[j] = tp[j - 1];
-                j--;
-            }
-            td[j] = d;
-            tp[j] = p;
-        }
-        lo = end;
+    size_t bl = 0, bh = nb - 1;
+    while (bl < bh) {
+        size_t mid = bl + (bh - bl) / 2;
+        if (start[mid] >= k) bh = mid;
+        else bl = mid + 1;
+    }
+    const size_t end = start[bl];
+    for (size_t i = 1; i < end; i++) {
+        double d = td[i];
+        if (!SH_LESS(d, cid[tp[i]], td[i - 1], cid[tp[i - 1]])) continue;
+        uint32_t p = tp[i], pid = cid[p];
+        size_t j = i;
+        do {
+            td[j] = td[j - 1];
+            tp[j] = tp[j - 1];
+            j--;
+        } while (j > 0 && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]]));
+        td[j] = d;
+        tp[j] = p;
     }
     /* every point within t = |q - k-th| of q is within t + delta of c:
      * a candidate if that is below R (else a point beyond the candidates
