@@ -40,14 +40,15 @@
                                in random query order at 1M points)     */
 #define KD_STACK_KEYS 1024  /* d2 scratch on the stack when d2 == NULL    */
 #define KD_SORTED_MAX 48    /* k up to this: sorted array, else heap      */
-#define KD_BUF_MAX 1024     /* 2k up to this: buffer and quickselect      */
+#define KD_BUF_MAX 2048     /* 2k up to this: buffer and quickselect      */
+#define KD_BUF_STACK 1024   /* its scratch on the stack up to this 2k     */
 #define KD_PROBE_MIN 8      /* k >= 8 x this: a k/8 probe bounds the search */
 #ifndef KD_PROBE_GROW
 #define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
 #endif
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
 #define KD_APP_MAX (2 * KD_SORTED_MAX + KD_LEAF) /* append buffer (mode 3) */
-_Static_assert(KD_APP_MAX <= KD_BUF_MAX, "mode 3 uses the buffer of mode 2");
+_Static_assert(KD_APP_MAX <= KD_BUF_STACK, "mode 3 uses the stack buffer of mode 2");
 
 typedef struct {
     double lo;        /* inner: max coordinate of the left child          */
@@ -342,6 +343,8 @@ typedef struct {
     double worst_d;   /* (worst_d, worst_p): the pair a candidate must beat */
     uint32_t worst_p; /* UINT32_MAX: none (an index above every index)    */
     jf__kd_scan *scan; /* when not NULL: the leaves read, the cells passed */
+    double *td;       /* buffer mode: buf_finish's scratch (2 cap slots, */
+    uint32_t *tp, *start; /* start 2 cap + 1)                           */
 } kd_query;
 
 /* (d, position p) < (da, position pa) in the (distance, index) order */
@@ -483,9 +486,9 @@ static void buf_sort(const uint32_t *id, double *hd, uint32_t *hp, size_t lo, si
  * bucket on a surface, where d2 grows with the area), each bucket then
  * sorted by (d2, index) -- the bucket of a key is monotone in it, so the
  * order is exactly the heap's, in O(cnt) instead of a comparison sort's
- * unpredictable branches.  tmp: 2 cnt slots. */
+ * unpredictable branches.  td, tp: cnt slots; start: cnt + 1. */
 static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt, size_t k,
-                       double *td, uint32_t *tp)
+                       double *td, uint32_t *tp, uint32_t *start)
 {
     double mx = 0.0;
     for (size_t i = 0; i < cnt; i++)
@@ -495,7 +498,6 @@ static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt,
         buf_sort(id, hd, hp, 0, cnt < k ? cnt : k);
         return;
     }
-    uint32_t start[KD_BUF_MAX + 1];
     const double scale = (double)cnt / mx;
     if (!isfinite(scale)) { /* mx subnormal: the buckets would overflow */
         if (cnt > k) buf_select(id, hd, hp, 0, cnt, k - 1);
@@ -737,9 +739,7 @@ static void run_query(kd_query *s)
     if (s->sorted == 3 && s->cnt > s->cap) app_shrink(s); /* fewer to sort */
     if (s->sorted == 1 || s->sorted == 3) return;
     if (s->sorted == 2) {
-        double td[KD_BUF_MAX];
-        uint32_t tp[KD_BUF_MAX];
-        buf_finish(ix->id, s->hd, s->hp, s->cnt, s->cap, td, tp);
+        buf_finish(ix->id, s->hd, s->hp, s->cnt, s->cap, s->td, s->tp, s->start);
         if (s->cnt > s->cap) s->cnt = s->cap;
         return;
     }
@@ -769,16 +769,28 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     double *keys = d2;
     /* the 2k buffer of buf_push, on the stack */
     int mode = k <= KD_SORTED_MAX ? (scan ? 1 : 3) : 2 * k <= KD_BUF_MAX ? 2 : 0;
-    double buf_keys[KD_BUF_MAX];
-    uint32_t buf_pos[KD_BUF_MAX];
-    if (mode >= 2) keys = buf_keys; /* KD_APP_MAX <= KD_BUF_MAX */
+    double buf_keys[KD_BUF_STACK], buf_td[KD_BUF_STACK];
+    uint32_t buf_pos[KD_BUF_STACK], buf_tp[KD_BUF_STACK], buf_start[KD_BUF_STACK + 1];
+    double *bk = buf_keys, *btd = buf_td;
+    uint32_t *bp = buf_pos, *btp = buf_tp, *bst = buf_start;
+    void *heap = NULL; /* 2k above KD_BUF_STACK: the scratch on the heap */
+    if (mode == 2 && 2 * k > KD_BUF_STACK) {
+        if (!(heap = malloc(2 * k * (2 * sizeof(double) + 3 * sizeof(uint32_t)) + sizeof(uint32_t))))
+            return JF_ERR_NOMEM;
+        bk = heap;
+        btd = bk + 2 * k;
+        bp = (uint32_t *)(btd + 2 * k);
+        btp = bp + 2 * k;
+        bst = btp + 2 * k;
+    }
+    if (mode >= 2) keys = bk; /* mode 3: KD_APP_MAX <= KD_BUF_STACK */
     else if (!keys) {
         if (k <= KD_STACK_KEYS) keys = stack_keys;
         else if (!(keys = malloc(k * sizeof *keys))) return JF_ERR_NOMEM;
     }
     /* idx holds positions during the search, indices after */
-    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode >= 2 ? buf_pos : idx,
-                  k,     0, mode, bound, UINT32_MAX, scan};
+    kd_query s = {ix,    {q[0], q[1], q[2]}, keys,  mode >= 2 ? bp : idx,
+                  k,     0, mode, bound, UINT32_MAX, scan, btd, btp, bst};
     if (scan) scan->n = 0, scan->rc2 = INFINITY;
     if (mode == 2 && !scan && bound == INFINITY && k >= 8 * KD_PROBE_MIN) {
         /* Probe: the k/8 nearest give a radius that, grown as on a surface
@@ -788,7 +800,7 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
         size_t k1 = k / 8 < KD_SORTED_MAX ? k / 8 : KD_SORTED_MAX;
         double pd[KD_SORTED_MAX];
         uint32_t pp[KD_SORTED_MAX];
-        kd_query s1 = {ix, {q[0], q[1], q[2]}, pd, pp, k1, 0, 1, INFINITY, UINT32_MAX, NULL};
+        kd_query s1 = {ix, {q[0], q[1], q[2]}, pd, pp, k1, 0, 1, INFINITY, UINT32_MAX, NULL, NULL, NULL, NULL};
         run_query(&s1);
         if (s1.cnt == k1) {
             double r2 = pd[k1 - 1] * ((double)k / (double)k1) * KD_PROBE_GROW;
@@ -805,12 +817,13 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     } else
         run_query(&s);
     if (mode == 3) {
-        s.cnt = app_finish(ix->id, buf_keys, buf_pos, s.cnt, k, d2 ? d2 : stack_keys, idx);
+        s.cnt = app_finish(ix->id, bk, bp, s.cnt, k, d2 ? d2 : stack_keys, idx);
         keys = d2;
     } else if (mode == 2) {
-        if (d2) memcpy(d2, buf_keys, s.cnt * sizeof *d2);
-        memcpy(idx, buf_pos, s.cnt * sizeof *idx);
+        if (d2) memcpy(d2, bk, s.cnt * sizeof *d2);
+        memcpy(idx, bp, s.cnt * sizeof *idx);
         keys = d2;
+        free(heap);
     }
     if (scan && scan->n > JF_KD_SCAN_LEAVES) scan->rc2 = 0; /* not all kept */
     if (keys != d2 && keys != stack_keys) free(keys);

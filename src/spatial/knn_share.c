@@ -4,7 +4,10 @@
  * design:
  *  1. At a query point c, one search for its KSHARE x k nearest (the
  *     candidates), with rk = |c - k-th| and R = |c - last candidate|:
- *     every point nearer c than R is a candidate.
+ *     every point nearer c than R is a candidate.  4k, not 2k: where the
+ *     noise is thicker than the spacing R / rk is 4^(1/3), not 2^(1/3),
+ *     and a search serves 13 points, not 2 (10^6 noisy torus).  The
+ *     search is bounded by a prediction from the last one (rebuild).
  *  2. A later query q, delta = |q - c|: c's k nearest lie within
  *     rk + delta of q, so q's k nearest are among the candidates within
  *     that of q (a prefix of them: within rk + 2 delta of c).  Sorted by
@@ -26,7 +29,8 @@
 #include "index_internal.h"
 
 #define SH_AHEAD 16 /* walk points looked at for a search's centre */
-#define KSHARE 2 /* candidates: KSHARE x k (2k: the tree's fast buffer mode) */
+#define KSHARE 4 /* candidates: KSHARE x k (up to 1024: the tree's buffer mode) */
+#define SH_MARGIN 1.3 /* on the squared radius a search predicts (rebuild) */
 
 struct jf__knn_share {
     size_t k, kc;  /* asked, candidates searched                       */
@@ -45,6 +49,7 @@ struct jf__knn_share {
     size_t nahead;
     double rk_last;      /* rk of the last search (0: none yet)          */
     double t_last;       /* the last query's k-th distance               */
+    double expo;         /* log2 of the last search's d2, last / middle (0: none) */
 };
 
 void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n)
@@ -84,7 +89,7 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     s->cd2 = malloc(s->kc * sizeof *s->cd2);
     s->sel = malloc(s->kc * sizeof *s->sel);
     s->bkt = malloc(s->kc * sizeof *s->bkt);
-    s->start = malloc((s->kc + 1) * sizeof *s->start);
+    s->start = malloc((2 * s->kc + 1) * sizeof *s->start);
     s->td = malloc(s->kc * sizeof *s->td);
     s->tp = malloc(s->kc * sizeof *s->tp);
     if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
@@ -103,9 +108,31 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
                          double *d2, double *xyz, size_t *found)
 {
     size_t f = 0;
+    /* the tree's own bound for a large k assumes a surface (d2 ~ k); in
+     * noise thicker than the spacing the cloud is locally 3-D and that
+     * bound reads twice the points.  The candidates held count exactly the
+     * m points within R - |q - c| of q; d2 grows from there to the kc-th
+     * as the last search's did, (kc / m)^expo (expo from its last and
+     * middle d2).  Exact either way: too few inside, the search runs
+     * unbounded (SH_MARGIN 1.3: 2% of them on a 10^6 noisy torus) */
+    double bound = INFINITY;
+    if (s->nc == s->kc && s->expo > 0.0) {
+        double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
+        double rin = s->R - sqrt(e0 * e0 + e1 * e1 + e2 * e2), rin2 = rin * rin;
+        size_t m = 0;
+        for (size_t j = 0; rin > 0.0 && j < s->nc; j++) {
+            double dx = q[0] - s->cx[j], dy = q[1] - s->cy[j], dz = q[2] - s->cz[j];
+            m += dx * dx + dy * dy + dz * dz <= rin2;
+        }
+        double b = m >= s->kc / 16 ? rin2 * pow((double)s->kc / (double)m, s->expo) * SH_MARGIN : -1.0;
+        if (b >= 0.0 && b < INFINITY) bound = b;
+    }
     s->nc = 0;
-    jf_status st = jf__index_query(ix, q, s->kc, INFINITY, s->cid, s->cd2, s->cxyz, &f);
+    jf_status st = jf__index_query(ix, q, s->kc, bound, s->cid, s->cd2, s->cxyz, &f);
+    if (st == JF_OK && f < s->kc && bound < INFINITY)
+        st = jf__index_query(ix, q, s->kc, INFINITY, s->cid, s->cd2, s->cxyz, &f);
     if (st != JF_OK) return st;
+    s->expo = f == s->kc && s->cd2[f / 2 - 1] > 0.0 ? log2(s->cd2[f - 1] / s->cd2[f / 2 - 1]) : 0.0;
     size_t m = f < s->k ? f : s->k;
     memcpy(idx, s->cid, m * sizeof *idx);
     if (d2) memcpy(d2, s->cd2, m * sizeof *d2);
@@ -167,43 +194,51 @@ again:;
         goto again;
     }
     if (n < s->k || !(b2 > 0.0)) return 0;
-    /* bucket sort by d2 (monotone buckets), each bucket by (d2, index),
-     * the first k into td, tp (locals: the stores below alias nothing) */
+    /* bucket sort by d2 into 2n monotone buckets (mostly one point or
+     * none), then one insertion sort by (d2, index) of the buckets up to
+     * the k-th's: it moves only the few bucket mates out of order (a
+     * loop per bucket mispredicted on every bucket size) */
     uint32_t *start = s->start, *tp = s->tp, *bkt = s->bkt;
     double *td = s->td;
     const double *sd = s->d2;
     const uint32_t *sel = s->sel, *cid = s->cid;
-    const double scale = (double)n / b2;
+    const size_t nb = 2 * n;
+    const double scale = (double)nb / b2;
     if (!isfinite(scale)) return 0; /* b2 subnormal: the buckets would overflow */
-    memset(start, 0, (n + 1) * sizeof *start);
+    memset(start, 0, (nb + 1) * sizeof *start);
     for (size_t j = 0; j < n; j++) {
         size_t bk = (size_t)(sd[j] * scale);
-        bkt[j] = (uint32_t)(bk < n ? bk : n - 1);
+        bkt[j] = (uint32_t)(bk < nb ? bk : nb - 1);
         start[bkt[j] + 1]++;
     }
-    for (size_t bk = 0; bk < n; bk++) start[bk + 1] += start[bk];
+    for (size_t bk = 0; bk < nb; bk++) start[bk + 1] += start[bk];
     for (size_t j = 0; j < n; j++) {
         uint32_t at = start[bkt[j]]++;
         td[at] = sd[j];
         tp[at] = sel[j];
     }
+    /* start[bk] is now the end of bucket bk: the first end >= k closes
+     * the k-th's bucket */
     const size_t k = s->k;
-    size_t lo = 0;
-    for (size_t bk = 0; bk < n && lo < k; bk++) {
-        size_t end = start[bk];
-        for (size_t i = lo + 1; i < end; i++) { /* insertion sort of the bucket */
-            double d = td[i];
-            uint32_t p = tp[i], pid = cid[p];
-            size_t j = i;
-            while (j > lo && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]])) {
-                td[j] = td[j - 1];
-                tp[j] = tp[j - 1];
-                j--;
-            }
-            td[j] = d;
-            tp[j] = p;
-        }
-        lo = end;
+    size_t bl = 0, bh = nb - 1;
+    while (bl < bh) {
+        size_t mid = bl + (bh - bl) / 2;
+        if (start[mid] >= k) bh = mid;
+        else bl = mid + 1;
+    }
+    const size_t end = start[bl];
+    for (size_t i = 1; i < end; i++) {
+        double d = td[i];
+        if (!SH_LESS(d, cid[tp[i]], td[i - 1], cid[tp[i - 1]])) continue;
+        uint32_t p = tp[i], pid = cid[p];
+        size_t j = i;
+        do {
+            td[j] = td[j - 1];
+            tp[j] = tp[j - 1];
+            j--;
+        } while (j > 0 && SH_LESS(d, pid, td[j - 1], cid[tp[j - 1]]));
+        td[j] = d;
+        tp[j] = p;
     }
     /* every point within t = |q - k-th| of q is within t + delta of c:
      * a candidate if that is below R (else a point beyond the candidates

@@ -76,7 +76,7 @@ static void check_query(const jf_index *ix, const double *xyz, size_t n,
     double *d2 = malloc((n + 8) * sizeof *d2);
     double *pts = malloc(3 * (n + 8) * sizeof *pts);
     size_t m = brute(xyz, n, q, ref);
-    const size_t ks[] = {1, 2, 5, 16, 33, 64, 100, 256, 500, n, n + 7};
+    const size_t ks[] = {1, 2, 5, 16, 33, 64, 100, 256, 500, 600, 1024, n, n + 7};
     for (size_t t = 0; t < sizeof ks / sizeof ks[0]; t++) {
         size_t k = ks[t], found = 99;
         ck_assert_int_eq(jf_index_knn(ix, q, k, idx, d2, &found), JF_OK);
