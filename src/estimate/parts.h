@@ -243,4 +243,10 @@ jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *
                                      const uint8_t *fit, jf_block_fn sink, void *user,
                                      jf_error *err);
 
+/* jf_estimate_blocks handing the sink each block's coordinates too (the
+ * walk's, bit for bit those of c->xyz), so that it need not read them
+ * by input index.  Defined in estimate/pipeline.c. */
+jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
+                                  jf__block_xyz_fn sink, void *user, jf_error *err);
+
 #endif /* JF_PARTS_H */

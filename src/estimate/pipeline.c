@@ -358,6 +358,7 @@ typedef struct {
     jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
     jf__knn_share *share; /* auto: the shared k-NN search               */
     uint32_t *bidx;       /* and their input indices                    */
+    double *bxyz;         /* and coordinates (sinkx: the walk's, in order) */
     const double *hint;   /* knn: the last query's neighbours (coords or */
     size_t hint_n;        /* coords2) and their count, for knn_hinted    */
 } worker;
@@ -375,6 +376,7 @@ static void worker_free(worker *w)
     free(w->raw2);
     free(w->blk);
     free(w->bidx);
+    free(w->bxyz);
     jf__knn_share_free(w->share);
     memset(w, 0, sizeof *w);
 }
@@ -400,7 +402,8 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
     if (st == JF_OK && blocks) {
         w->blk = malloc(CHUNK * sizeof *w->blk);
         w->bidx = malloc(CHUNK * sizeof *w->bidx);
-        if (!w->blk || !w->bidx) st = JF_ERR_NOMEM;
+        w->bxyz = malloc(3 * CHUNK * sizeof *w->bxyz);
+        if (!w->blk || !w->bidx || !w->bxyz) st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && p->auto_select && x->nb->kind == JF_NB_KNN && x->nb->k >= 128)
         st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
@@ -560,6 +563,7 @@ typedef struct {
     const uint8_t *fit;   /* fit only where fit[i] (NULL: all; parts.h) */
     jf_result *out;
     jf_block_fn sink;
+    jf__block_xyz_fn sinkx; /* instead of sink: the coordinates too  */
     void *user;
     int collect;          /* mst pass 1: fill vn, vs (and x->graph)    */
     double *vn;
@@ -571,7 +575,8 @@ typedef struct {
 /* A block of m results (input indices idx) leaves: kept for mst, or
  * oriented point by point and handed to the sink.  Thread-safe as far as
  * the sink is. */
-static jf_status deliver(const runctx *R, const uint32_t *idx, jf_result *res, size_t m)
+static jf_status deliver(const runctx *R, const uint32_t *idx, const double *xyz, jf_result *res,
+                         size_t m)
 {
     const jf_estimate_opts *o = R->o;
     const jf_cloud *c = R->c;
@@ -601,7 +606,9 @@ static jf_status deliver(const runctx *R, const uint32_t *idx, jf_result *res, s
         default: break;
         }
     }
-    return R->sink(R->user, idx, res, m);
+    /* sinkx: the block's coordinates as walked (in tree order, from the
+     * tree's copy), so the sink's rows need no gather by input index */
+    return R->sinkx ? R->sinkx(R->user, idx, xyz, res, m) : R->sink(R->user, idx, res, m);
 }
 
 /* natural: what nb_query reads of point i by input index (its flags and
@@ -651,12 +658,12 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                     k++;
                     continue;
                 }
-                if (blocks) w.bidx[m] = (uint32_t)i;
+                if (blocks) w.bidx[m] = (uint32_t)i, memcpy(w.bxyz + 3 * m, pt, 3 * sizeof *pt);
                 jf_result *d0 = blocks ? &w.blk[m++] : &R->out[i];
                 if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
                     const size_t i1 = walk[k + 1];
                     const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : R->c->xyz + 3 * i1;
-                    if (blocks) w.bidx[m] = (uint32_t)i1;
+                    if (blocks) w.bidx[m] = (uint32_t)i1, memcpy(w.bxyz + 3 * m, pt1, 3 * sizeof *pt1);
                     wst = fit_two(&w, x, i, pt, i1, pt1, d0,
                                   blocks ? &w.blk[m++] : &R->out[i1]);
                     k += 2;
@@ -667,7 +674,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                 }
             }
             _mm_sfence(); /* the streamed rows (store_row), before anyone reads them */
-            if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.blk, m);
+            if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.bxyz, w.blk, m);
             if (wst != JF_OK) {
 #pragma omp atomic write
                 failed = wst;
@@ -697,6 +704,7 @@ static jf_status nonfinite_rows(const runctx *R, size_t n)
 {
     jf_result blk[64];
     uint32_t idx[64];
+    double bxyz[3 * 64];
     size_t m = 0;
     jf_status st = JF_OK;
     for (size_t i = 0; i < n && st == JF_OK; i++) {
@@ -706,13 +714,14 @@ static jf_status nonfinite_rows(const runctx *R, size_t n)
             continue;
         }
         nonfinite_row(R->x, i, &blk[m]);
+        memcpy(bxyz + 3 * m, R->c->xyz + 3 * i, sizeof(double[3]));
         idx[m++] = (uint32_t)i;
         if (m == 64 || i + 1 == n) {
-            st = deliver(R, idx, blk, m);
+            st = deliver(R, idx, bxyz, blk, m);
             m = 0;
         }
     }
-    if (st == JF_OK && m) st = deliver(R, idx, blk, m);
+    if (st == JF_OK && m) st = deliver(R, idx, bxyz, blk, m);
     return st;
 }
 
@@ -775,11 +784,12 @@ void jf__nb_auto_opts(jf_estimate_opts *o)
 /* jf_estimate (out != NULL) and jf_estimate_blocks (sink != NULL); fit:
  * parts.h's mask (NULL: every point). */
 static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const uint8_t *fit,
-                          jf_result *out, jf_block_fn sink, void *user, jf_error *err)
+                          jf_result *out, jf_block_fn sink, jf__block_xyz_fn sinkx, void *user,
+                          jf_error *err)
 {
     if (err) err->msg[0] = '\0';
-    if (!c || !o_in || (c->n && (!c->xyz || (!out && !sink)))) {
-        set_err(err, out || !sink ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
+    if (!c || !o_in || (c->n && (!c->xyz || (!out && !sink && !sinkx)))) {
+        set_err(err, out || !(sink || sinkx) ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
         return JF_ERR_INVALID;
     }
     jf_estimate_opts use;
@@ -828,7 +838,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     }
 
     const int mst_blocks = !out && o->orient == JF_ORIENT_MST;
-    runctx R = {c, o, &x, fit, out, sink, user, mst_blocks, NULL, NULL, NULL, 0, mst_blocks ? 2 * n : n};
+    runctx R = {c, o, &x, fit, out, sink, sinkx, user, mst_blocks, NULL, NULL, NULL, 0, mst_blocks ? 2 * n : n};
     jf_status st = JF_OK;
     jf_index *ix = NULL;
     uint32_t *order = NULL;
@@ -975,25 +985,31 @@ out:
 jf_status jf_estimate(const jf_cloud *c, const jf_estimate_opts *o, jf_result *out,
                       jf_error *err)
 {
-    return estimate(c, o, NULL, out, NULL, NULL, err);
+    return estimate(c, o, NULL, out, NULL, NULL, NULL, err);
 }
 
 /* parts.h: the points of a part's halo are neighbours, not fitted */
 jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o, const uint8_t *fit,
                               jf_result *out, jf_error *err)
 {
-    return estimate(c, o, fit, out, NULL, NULL, err);
+    return estimate(c, o, fit, out, NULL, NULL, NULL, err);
 }
 
 jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o, jf_block_fn sink,
                              void *user, jf_error *err)
 {
-    return estimate(c, o, NULL, NULL, sink, user, err);
+    return estimate(c, o, NULL, NULL, sink, NULL, user, err);
 }
 
 jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
                                      const uint8_t *fit, jf_block_fn sink, void *user,
                                      jf_error *err)
 {
-    return estimate(c, o, fit, NULL, sink, user, err);
+    return estimate(c, o, fit, NULL, sink, NULL, user, err);
+}
+
+jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
+                                  jf__block_xyz_fn sink, void *user, jf_error *err)
+{
+    return estimate(c, o, NULL, NULL, NULL, sink, user, err);
 }
