@@ -418,7 +418,7 @@ jf_status jf__pieces_next(jf_pieces *p, jf_error *err)
             size_t nc = p->cap ? 2 * p->cap : p->piece + (p->piece >> 2);
             while (nc < p->have + want)
                 nc *= 2;
-            char *nb = realloc(p->buf, nc);
+            char *nb = p->buf ? realloc(p->buf, nc) : jf__big_alloc(nc);
             if (!nb) {
                 p->len = p->got;
                 return jf_io_fail(err, JF_ERR_NOMEM, p->name, 0,
