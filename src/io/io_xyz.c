@@ -793,7 +793,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                           "columns: give all of x,y,z (and of nx,ny,nz) or "
                           "none");
     const char *const buf0 = buf;
-    const size_t total = len;
+    const size_t total = src ? src->len : len;
     /* upper bound on data rows: the lines, and the bytes (a row of m
      * needed fields takes at least 2m, separators and newline included) */
     /* a UTF-8 byte order mark (spreadsheet exports) is not data */

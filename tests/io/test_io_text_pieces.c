@@ -257,6 +257,44 @@ START_TEST(late_start_and_counts)
 }
 END_TEST
 
+static void hook(void *user, jf_phase ph, size_t done, size_t total)
+{
+    size_t *v = user; /* last done, total, calls, 1 if ever backwards */
+    ck_assert_int_eq(ph, JF_PHASE_READ);
+    v[3] |= done < v[0] || done > total;
+    v[0] = done;
+    v[1] = total;
+    v[2]++;
+}
+
+/* The read's progress in bytes of the file: never backwards, to its end. */
+START_TEST(progress_in_bytes)
+{
+    text t = make_text(3, 50000, 0);
+    const char *path = fixture("prog.xyz", t.s, t.n);
+    size_t v[4] = {0, 0, 0, 0};
+    jf_read_opts o;
+    jf_read_opts_init(&o);
+    o.threads = 1;
+    o.bad_rows = 1;
+    o.progress = hook;
+    o.progress_user = v;
+    jf__xyz_piece_bytes(4096);
+    jf__xyz_block_bytes(1000);
+    jf_cloud c;
+    jf_error e;
+    ck_assert_int_eq(jf_cloud_read(path, &o, &c, &e), JF_OK);
+    jf__xyz_piece_bytes(0);
+    jf__xyz_block_bytes(0);
+    ck_assert_uint_eq(v[3], 0);
+    ck_assert_uint_eq(v[0], t.n);
+    ck_assert_uint_eq(v[1], t.n);
+    ck_assert_uint_gt(v[2], 12); /* a call a block at least */
+    jf_cloud_free(&c);
+    free(t.s);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("io_text_pieces");
@@ -267,6 +305,7 @@ int main(void)
     tcase_add_test(tc, bad_line_at_piece_end);
     tcase_add_test(tc, nul_after_bad_row);
     tcase_add_test(tc, late_start_and_counts);
+    tcase_add_test(tc, progress_in_bytes);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
