@@ -8,8 +8,9 @@
  * reading past the end.  A binary PLY point cloud is read in chunks
  * straight into the coordinates instead (io_ply.c, jf__read_ply_chunked),
  * so that a 10^8-point file is not held twice; a large text table in
- * pieces of whole lines (jf_pieces, io_xyz.c's jf__read_xyz_fd).  Counts read from headers are checked
- * against the bytes left before anything is allocated from them.
+ * pieces of whole lines (jf_pieces, io_xyz.c's jf__read_xyz_fd).  Counts
+ * read from headers are checked against the bytes left before anything
+ * is allocated from them.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
