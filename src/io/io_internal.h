@@ -57,6 +57,32 @@ jf_status jf_read_off(const char *buf, size_t len, const char *name,
                       jf_cloud *c, jf_error *err);
 jf_status jf_read_las(const char *buf, size_t len, const char *name,
                       const jf_read_opts *o, jf_cloud *c, jf_error *err);
+/* io_read.c: a text file read in pieces of whole lines into one reused
+ * buffer (no image of the whole file: its fresh pages cost the kernel a
+ * zeroing each).  region [buf, buf + re) holds whole lines (all the rest
+ * at the end of the file); off is the file offset of buf[0]. */
+typedef struct {
+    int fd;
+    const char *name;
+    size_t len, piece;   /* the file's size; bytes read at a time         */
+    char *buf;
+    size_t cap, have;    /* buf's size; bytes in it                       */
+    size_t re, off, got; /* region end; buf's offset; bytes read in all   */
+} jf_pieces;
+/* The next region (empty at the end of the file); an I/O error, a short
+ * read or a NUL byte is the error of the whole file (as jf_cloud_read). */
+jf_status jf__pieces_next(jf_pieces *p, jf_error *err);
+/* After a parse error: reads the rest, so that an I/O error or a NUL byte
+ * later in the file is the one reported, as for a whole read; JF_OK keeps
+ * the parse error. */
+jf_status jf__pieces_drain(jf_pieces *p, jf_error *err);
+/* io_xyz.c: a text table of len bytes read from fd in pieces; *declined:
+ * a file of at most two pieces, or whose first lines do not settle the
+ * columns within the first piece (the caller reads the whole file; c is
+ * zeroed).  Tests make pieces small (jf__xyz_piece_bytes; 0: 8 MiB). */
+jf_status jf__read_xyz_fd(int fd, size_t len, jf_format fmt, const char *name,
+                          const jf_read_opts *o, jf_cloud *c, jf_error *err, int *declined);
+void jf__xyz_piece_bytes(size_t bytes);
 /* io_bigalloc.c: malloc of a large buffer about to be written whole,
  * asked (on Linux) to be backed by huge pages; free() frees it. */
 void *jf__big_alloc(size_t bytes);

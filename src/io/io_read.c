@@ -7,8 +7,10 @@
  * parses the byte range in place: no copy, no allocation per token, no
  * reading past the end.  A binary PLY point cloud is read in chunks
  * straight into the coordinates instead (io_ply.c, jf__read_ply_chunked),
- * so that a 10^8-point file is not held twice.  Counts read from headers are checked
- * against the bytes left before anything is allocated from them.
+ * so that a 10^8-point file is not held twice; a large text table in
+ * pieces of whole lines (jf_pieces, io_xyz.c's jf__read_xyz_fd).  Counts
+ * read from headers are checked against the bytes left before anything
+ * is allocated from them.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "io_internal.h"
@@ -325,6 +327,134 @@ int jf_zvec_reserve(size_t **v, size_t *cap, size_t want)
     return grow((void **)v, cap, want, sizeof **v);
 }
 
+/* ---- a text file in pieces (jf_pieces, io_internal.h) ----------------- */
+
+/* Reads n bytes at offset off into b: 0, or the errno (-1: the file ended). */
+static int read_at(int fd, char *b, size_t n, size_t off, size_t *got)
+{
+    size_t g = 0;
+    while (g < n) {
+        ssize_t r = pread(fd, b + g, n - g > (1u << 30) ? (1u << 30) : n - g, (off_t)(off + g));
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            *got = g;
+            return r < 0 ? (errno ? errno : EIO) : -1;
+        }
+        g += (size_t)r;
+    }
+    *got = g;
+    return 0;
+}
+
+static jf_status io_error(jf_pieces *p, int e, jf_error *err)
+{
+    jf_status st = e > 0 ? jf_io_fail(err, JF_ERR_IO, p->name, 0, "read failed: %s",
+                                      strerror(e))
+                         : jf_io_fail(err, JF_ERR_IO, p->name, 0,
+                                      "the file shrank while it was read (%zu of %zu bytes)",
+                                      p->got, p->len);
+    p->len = p->got; /* nothing more is read */
+    return st;
+}
+
+/* The line of the NUL at file offset z: the file's '\n' before it, read
+ * again (a message only). */
+static size_t nul_line(int fd, size_t z)
+{
+    char b[65536];
+    size_t line = 1, g;
+    for (size_t off = 0; off < z; off += sizeof b) {
+        size_t n = z - off < sizeof b ? z - off : sizeof b;
+        (void)read_at(fd, b, n, off, &g);
+        for (const char *q = b; (q = memchr(q, '\n', (size_t)(b + g - q))) != NULL; q++)
+            line++;
+    }
+    return line;
+}
+
+/* The rest of the file through b (n bytes of room): an I/O error first,
+ * then the first NUL (*z: its offset, or SIZE_MAX). */
+static int read_rest(jf_pieces *p, char *b, size_t n, size_t *z)
+{
+    while (p->got < p->len) {
+        size_t want = p->len - p->got < n ? p->len - p->got : n, g;
+        int e = read_at(p->fd, b, want, p->got, &g);
+        const char *q = *z == SIZE_MAX ? memchr(b, '\0', g) : NULL;
+        if (q)
+            *z = p->got + (size_t)(q - b);
+        p->got += g;
+        if (e)
+            return e;
+    }
+    return 0;
+}
+
+jf_status jf__pieces_drain(jf_pieces *p, jf_error *err)
+{
+    if (p->got >= p->len || !p->buf)
+        return JF_OK;
+    size_t z = SIZE_MAX;
+    int e = read_rest(p, p->buf, p->cap, &z);
+    if (e)
+        return io_error(p, e, err);
+    if (z != SIZE_MAX)
+        return jf_io_fail(err, JF_ERR_FORMAT, p->name, nul_line(p->fd, z),
+                          "a NUL byte (binary data in a text file?)");
+    return JF_OK;
+}
+
+jf_status jf__pieces_next(jf_pieces *p, jf_error *err)
+{
+    /* the partial last line to the front */
+    size_t keep = p->have - p->re;
+    if (p->re) {
+        memmove(p->buf, p->buf + p->re, keep);
+        p->off += p->re;
+    }
+    p->have = keep;
+    p->re = 0;
+    while (p->got < p->len) {
+        size_t want = p->len - p->got < p->piece ? p->len - p->got : p->piece, g;
+        if (p->have + want > p->cap) { /* a line longer than a piece */
+            size_t nc = p->cap ? 2 * p->cap : p->piece + (p->piece >> 2);
+            while (nc < p->have + want)
+                nc *= 2;
+            char *nb = p->buf ? realloc(p->buf, nc) : jf__big_alloc(nc);
+            if (!nb) {
+                p->len = p->got;
+                return jf_io_fail(err, JF_ERR_NOMEM, p->name, 0,
+                                  "out of memory reading %zu bytes", nc);
+            }
+            p->buf = nb;
+            p->cap = nc;
+        }
+        char *b = p->buf + p->have;
+        int e = read_at(p->fd, b, want, p->got, &g);
+        p->got += g;
+        if (e)
+            return io_error(p, e, err);
+        /* a NUL is named as such (jf_cloud_read_mem), after the read of
+         * the whole file succeeds */
+        const char *q = memchr(b, '\0', want);
+        if (q) {
+            size_t z = p->got - want + (size_t)(q - b);
+            if ((e = read_rest(p, p->buf, p->cap, &z)) != 0)
+                return io_error(p, e, err);
+            return jf_io_fail(err, JF_ERR_FORMAT, p->name, nul_line(p->fd, z),
+                              "a NUL byte (binary data in a text file?)");
+        }
+        p->have += want;
+        for (size_t i = p->have; i > p->have - want; i--)
+            if (p->buf[i - 1] == '\n') {
+                p->re = i;
+                return JF_OK;
+            }
+    }
+    p->re = p->have; /* the end of the file: the rest */
+    return JF_OK;
+}
+
 /* ---- entry points ----------------------------------------------------- */
 
 jf_status jf_cloud_read_mem(const char *buf, size_t len, jf_format fmt,
@@ -440,6 +570,15 @@ jf_status jf_cloud_read(const char *path, const jf_read_opts *o,
             if (cs == JF_OK && o && o->progress)
                 o->progress(o->progress_user, JF_PHASE_READ, len, len);
             return cs;
+        }
+    }
+    if (fmt == JF_FMT_XYZ || fmt == JF_FMT_PTS || fmt == JF_FMT_CSV) {
+        /* text tables in pieces, without an image of the file (io_xyz.c) */
+        int declined = 0;
+        jf_status xs = jf__read_xyz_fd(fd, len, fmt, path, o, c, err, &declined);
+        if (!declined) {
+            close(fd);
+            return xs;
         }
     }
     char *buf = jf__big_alloc(len);

@@ -65,6 +65,8 @@ typedef struct {
     size_t rows_cap;
     unsigned char *text;/* per attribute: a field that is not a number
                            was seen (the column is dropped)            */
+    char *own;          /* in pieces: the names copied (the buffer is
+                           reused)                                     */
 } text_attrs;
 
 typedef struct {
@@ -707,7 +709,7 @@ static jf_status merge_block(const tab *t, xstate *s, const xblock *b, int skip,
  * other threads parse the next ones; no round barrier. */
 static jf_status read_blocks(const tab *t, xstate *s, const char *p, const char *end, int nt,
                              int skip, jf_cloud *c, const jf_read_opts *o, const char *buf0,
-                             size_t total)
+                             size_t off0, size_t total)
 {
     const int na = t->ta ? t->ta->na : 0;
     size_t nblk = 0, cap = 0;
@@ -759,8 +761,8 @@ static jf_status read_blocks(const tab *t, xstate *s, const char *p, const char 
 #pragma omp atomic write
                     stop = 1;
                 } else if (tid == 0 && o->progress) { /* the calling thread */
-                    o->progress(o->progress_user, JF_PHASE_READ, (size_t)(cut[i + 1] - buf0),
-                                total);
+                    o->progress(o->progress_user, JF_PHASE_READ,
+                                off0 + (size_t)(cut[i + 1] - buf0), total);
                 }
             }
         }
@@ -774,7 +776,7 @@ static jf_status read_blocks(const tab *t, xstate *s, const char *p, const char 
 
 static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                          const char *name, const jf_read_opts *o, jf_cloud *c,
-                         jf_error *err, text_attrs *ta)
+                         jf_error *err, text_attrs *ta, jf_pieces *src, int *declined)
 {
     tab t = {name, err, fmt == JF_FMT_CSV, {-1, -1, -1, -1, -1, -1}, -1, ta, NULL, NULL};
     int setx = 0, setn = 0;
@@ -791,7 +793,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
                           "columns: give all of x,y,z (and of nx,ny,nz) or "
                           "none");
     const char *const buf0 = buf;
-    const size_t total = len;
+    const size_t total = src ? src->len : len;
     /* upper bound on data rows: the lines, and the bytes (a row of m
      * needed fields takes at least 2m, separators and newline included) */
     /* a UTF-8 byte order mark (spreadsheet exports) is not data */
@@ -809,6 +811,14 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         crs += count_byte(q, (size_t)(e - q), '\r');
     }
     lines += crs;
+    /* in pieces (src: buf is the first): the rows estimated from the first
+     * piece's lines, the arrays grow past it; the lines bounded by bytes */
+    size_t est = lines;
+    if (src) {
+        est = (size_t)((double)lines * ((double)src->len / (double)(len ? len : 1)) * 1.0625) +
+              1024;
+        lines = src->len + 1;
+    }
     /* no '\r' anywhere: the per-line search for it is skipped */
     t.tend = buf + len;
     jf_text tx = {buf, buf + len, 0, crs == 0};
@@ -818,7 +828,7 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
     const int skip = o->bad_rows == 1;
     for (size_t r = 0;; r++) {
         /* the columns and width are known: the rest in parallel blocks */
-        if (nt > 1 && s.nf0 >= 0 && (size_t)(tx.end - tx.p) > 2 * block_bytes)
+        if ((nt > 1 || src) && s.nf0 >= 0 && (src || (size_t)(tx.end - tx.p) > 2 * block_bytes))
             break;
         if (!jf_text_line(&tx, &ls, &le))
             break;
@@ -864,8 +874,8 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
             }
             set_maxcol(&t);
             s.have_nrm = t.col[3] >= 0;
-            s.cap = (len + 1) / (2 * (size_t)(t.maxcol + 1));
-            s.cap = s.cap < lines ? s.cap : lines;
+            s.cap = ((src ? src->len : len) + 1) / (2 * (size_t)(t.maxcol + 1));
+            s.cap = s.cap < est ? s.cap : est;
             s.cap = s.cap < JF_MAX_POINTS ? s.cap : JF_MAX_POINTS;
             c->xyz = jf__big_alloc(s.cap * 3 * sizeof(double)); /* written whole */
             c->nrm = s.have_nrm ? jf__big_alloc(s.cap * 3 * sizeof(double)) : NULL;
@@ -914,10 +924,36 @@ static jf_status read_xyz(const char *buf, size_t len, jf_format fmt,
         s.since_count++;
     }
     s.line = tx.line;
+    if (src && s.nf0 < 0 && (src->got < src->len || src->re < src->have)) {
+        *declined = 1; /* the first piece did not settle the columns */
+        return JF_OK;
+    }
+    if (src && ta) { /* the header's names outlive the first piece */
+        size_t all = 1;
+        for (int j = 0; j < ta->ncols; j++)
+            all += ta->nml[j];
+        if (!(ta->own = malloc(all)))
+            return jf_io_fail(err, JF_ERR_NOMEM, name, 0, "out of memory");
+        char *q = ta->own;
+        for (int j = 0; j < ta->ncols; q += ta->nml[j++]) {
+            memcpy(q, ta->nm[j], ta->nml[j]);
+            ta->nm[j] = q;
+        }
+    }
     if (tx.p < tx.end) {
-        jf_status st = read_blocks(&t, &s, tx.p, tx.end, nt, skip, c, o, buf0, total);
+        jf_status st = read_blocks(&t, &s, tx.p, tx.end, nt, skip, c, o, buf0, 0, total);
         if (st != JF_OK)
             return st;
+    }
+    while (src) { /* the next pieces' whole lines, in order */
+        jf_status st = jf__pieces_next(src, err);
+        if (st == JF_OK && src->re)
+            st = read_blocks(&t, &s, src->buf, src->buf + src->re, nt, skip, c, o, src->buf,
+                             src->off, src->len);
+        if (st != JF_OK)
+            return st;
+        if (!src->re)
+            break;
     }
     size_t n = s.n;
     if (s.counted && s.since_count != s.last_count)
@@ -943,11 +979,65 @@ jf_status jf_read_xyz(const char *buf, size_t len, jf_format fmt,
 {
     text_attrs ta = {0};
     ta.maxcol = -1;
-    jf_status st = read_xyz(buf, len, fmt, name, o, c, err, o->no_attrs ? NULL : &ta);
+    jf_status st = read_xyz(buf, len, fmt, name, o, c, err, o->no_attrs ? NULL : &ta, NULL,
+                            NULL);
     free(ta.nm);
     free(ta.nml);
     free(ta.acol);
     free(ta.v);
     free(ta.text);
+    return st;
+}
+
+/* ---- in pieces ---------------------------------------------------------
+ * design: a large text file is read a piece of whole lines at a time into
+ * one reused buffer (jf_pieces), the partial last line carried to the
+ * next; the first piece goes through the serial start (header, columns,
+ * first data row), every later line through read_blocks, whose rows and
+ * messages are those of the whole-buffer read.  No image of the file: its
+ * fresh pages were a zeroing by the kernel of as many bytes as the file. */
+
+static size_t piece_bytes = (size_t)8 << 20;
+
+void jf__xyz_piece_bytes(size_t bytes)
+{
+    piece_bytes = bytes ? bytes : (size_t)8 << 20;
+}
+
+jf_status jf__read_xyz_fd(int fd, size_t len, jf_format fmt, const char *name,
+                          const jf_read_opts *o, jf_cloud *c, jf_error *err, int *declined)
+{
+    *declined = len <= 2 * piece_bytes;
+    if (*declined)
+        return JF_OK;
+    jf_read_opts def;
+    if (!o) {
+        jf_read_opts_init(&def);
+        o = &def;
+    }
+    if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, 0, len);
+    jf_pieces p = {fd, name, len, piece_bytes, NULL, 0, 0, 0, 0, 0};
+    text_attrs ta = {0};
+    ta.maxcol = -1;
+    jf_status st = jf__pieces_next(&p, err);
+    if (st == JF_OK)
+        st = read_xyz(p.buf, p.re, fmt, name, o, c, err, o->no_attrs ? NULL : &ta, &p,
+                      declined);
+    free(ta.nm);
+    free(ta.nml);
+    free(ta.acol);
+    free(ta.v);
+    free(ta.text);
+    free(ta.own);
+    if (st != JF_OK) { /* an I/O error or a NUL later in the file comes first */
+        jf_status ds = jf__pieces_drain(&p, err);
+        st = ds != JF_OK ? ds : st;
+    }
+    free(p.buf);
+    if (st != JF_OK || *declined)
+        jf_cloud_free(c);
+    else if (o->progress)
+        o->progress(o->progress_user, JF_PHASE_READ, len, len);
     return st;
 }

@@ -6,11 +6,15 @@
  * a file the strict read accepts reads the same, bit for bit, under skip
  * with nothing skipped; a skip read keeps a parsable row, lists its bad
  * lines in increasing order, and every bad row is NaN.  Both modes are
- * also read on one thread and on three in blocks of a few bytes: the
- * same status, message and cloud.
+ * also read on one thread and on three in blocks of a few bytes, and
+ * from a file in pieces of a few bytes: the same status, message and
+ * cloud.
  */
 #include "fuzz_common.h"
 #include "io_internal.h"
+
+#include <stdio.h>
+#include <unistd.h>
 
 /* One thread against three with blocks of a few bytes (io_xyz.c's
  * parallel blocks): the same status, message and cloud, bit for bit. */
@@ -38,6 +42,51 @@ static void same_threads(const uint8_t *d, size_t n, jf_format f, jf_read_opts o
     jf_cloud_free(&b);
 }
 
+/* The file read in pieces of a few bytes (jf_cloud_read, io_xyz.c's
+ * jf__read_xyz_fd) against the whole read of its bytes: the same status,
+ * message and cloud, bit for bit. */
+static void same_pieces(const uint8_t *d, size_t n, jf_format f, jf_read_opts o)
+{
+    static const char *const ext[3] = {"xyz", "pts", "csv"};
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/fuzz_xyz_%d.%s", (int)getpid(),
+             ext[f == JF_FMT_XYZ ? 0 : f == JF_FMT_PTS ? 1 : 2]);
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return;
+    size_t w = fwrite(d, 1, n, fp);
+    if (fclose(fp) != 0 || w != n)
+        return;
+    jf_cloud a, b;
+    jf_error ea, eb;
+    o.threads = 1 + (int)(n % 2);
+    jf__xyz_piece_bytes(1 + n % 23);
+    jf__xyz_block_bytes(8 + n % 61);
+    jf_status sa = jf_cloud_read(path, &o, &a, &ea);
+    jf__xyz_piece_bytes(0);
+    jf__xyz_block_bytes(0);
+    o.threads = 1;
+    jf_status sb = n ? jf_cloud_read_mem((const char *)d, n, f, path, &o, &b, &eb)
+                     : jf_cloud_read(path, &o, &b, &eb);
+    remove(path);
+    if (sa != sb || (sa != JF_OK && strcmp(ea.msg, eb.msg)))
+        abort();
+    if (sa != JF_OK)
+        return;
+    if (a.n != b.n || a.nbad != b.nbad || memcmp(a.bad_line, b.bad_line, sizeof a.bad_line) ||
+        memcmp(a.xyz, b.xyz, 3 * a.n * sizeof(double)) || !!a.nrm != !!b.nrm ||
+        (a.nrm && memcmp(a.nrm, b.nrm, 3 * a.n * sizeof(double))) ||
+        a.attrs.nattrs != b.attrs.nattrs || a.attrs.stride != b.attrs.stride ||
+        (a.attrs.nattrs && memcmp(a.attrs.rec, b.attrs.rec, a.n * a.attrs.stride)))
+        abort();
+    for (size_t k = 0; k < a.attrs.nattrs; k++)
+        if (strcmp(a.attrs.attr[k].name, b.attrs.attr[k].name) ||
+            a.attrs.attr[k].type != b.attrs.attr[k].type)
+            abort();
+    jf_cloud_free(&a);
+    jf_cloud_free(&b);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1)
@@ -56,7 +105,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     same_threads(data + 1, size - 1, fmts[sel % 3], o);
     o.bad_rows = 1;
     same_threads(data + 1, size - 1, fmts[sel % 3], o);
+    same_pieces(data + 1, size - 1, fmts[sel % 3], o);
     o.bad_rows = 0;
+    same_pieces(data + 1, size - 1, fmts[sel % 3], o);
 
     jf_cloud a, b;
     jf_error e;
