@@ -7,6 +7,7 @@
 #ifndef JF_IO_INTERNAL_H
 #define JF_IO_INTERNAL_H
 
+#include "core/bigalloc.h" /* jf__big_alloc, for the readers */
 #include "jetfit.h"
 
 #include <math.h>
@@ -83,9 +84,6 @@ jf_status jf__pieces_drain(jf_pieces *p, jf_error *err);
 jf_status jf__read_xyz_fd(int fd, size_t len, jf_format fmt, const char *name,
                           const jf_read_opts *o, jf_cloud *c, jf_error *err, int *declined);
 void jf__xyz_piece_bytes(size_t bytes);
-/* io_bigalloc.c: malloc of a large buffer about to be written whole,
- * asked (on Linux) to be backed by huge pages; free() frees it. */
-void *jf__big_alloc(size_t bytes);
 /* io_laz.c: a LAZ file image decoded into the plain LAS file it stands
  * for (*img, *img_len: malloc'd, the caller frees; the laszip VLR dropped,
  * the compression bits cleared).  err "NAME: reason" naming the chunk. */

@@ -799,7 +799,7 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
     if (ix < 0 || iy < 0 || iz < 0)
         goto out;
     size_t n = (size_t)el->count;
-    /* huge pages: first-touch faults were most of the read (io_bigalloc.c) */
+    /* huge pages: first-touch faults were most of the read (core/bigalloc.c) */
     double *xyz = with_xyz ? jf__big_alloc((n ? n : 1) * 3 * sizeof(double)) : NULL, *nrm = NULL;
     int has_n = inx >= 0 && iny >= 0 && inz >= 0;
     if (has_n)

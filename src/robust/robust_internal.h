@@ -93,7 +93,7 @@ typedef struct {
  * its degree (*d, 2 or 3). */
 int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
 
-/* Bench-only (tests/bench/bench_auto_diag.c): with jf__auto_diag_attach,
+/* Bench-only (tests/bench/bench_auto_diag.cpp): with jf__auto_diag_attach,
  * every auto fit of f also fills *dg: the candidates, the choice, and each
  * candidate's reported fit (res[degree - 2][i], as knn:K --degree d). */
 typedef struct jf__auto_diag {

@@ -33,7 +33,7 @@
 #include <omp.h>
 
 #include "index_internal.h"
-#include "io_internal.h" /* jf__big_alloc */
+#include "bigalloc.h" /* jf__big_alloc */
 #include "jetfit.h"
 
 #define KD_LEAF 24          /* largest leaf: 12..24 points (measured best
@@ -245,7 +245,7 @@ jf_status jf__index_build_threads(const double *xyz, size_t n, int threads, jf_i
     size_t m = off[nblk];
     ix->m = m;
     ix->nnodes = m ? count_nodes(m) : 0;
-    /* written whole: huge pages, one fault per 2 MiB (io_bigalloc.c) */
+    /* written whole: huge pages, one fault per 2 MiB (core/bigalloc.c) */
     ix->pts = jf__big_alloc((m ? m : 1) * 3 * sizeof *ix->pts);
     ix->id = jf__big_alloc((m ? m : 1) * sizeof *ix->id);
     ix->nodes = malloc((ix->nnodes ? ix->nnodes : 1) * sizeof *ix->nodes);

@@ -1,6 +1,6 @@
 /*
- * io_bigalloc.c -- the large buffers a read fills whole (the file image,
- * records, coordinates), asked for huge pages.
+ * bigalloc.c -- the large buffers filled whole (a read's records and
+ * coordinates, the k-d tree's copy of the points), asked for huge pages.
  *
  * design: a fresh malloc'ed buffer of many MiB comes from mmap and takes a
  * page fault every 4 KiB on first write; on a virtual machine such a fault
@@ -17,7 +17,7 @@
 #include <sys/mman.h>
 #endif
 
-#include "io_internal.h"
+#include "bigalloc.h"
 
 void *jf__big_alloc(size_t bytes)
 {
