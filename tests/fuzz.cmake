@@ -9,8 +9,10 @@ if(JF_FUZZ)
   # every file of src/io (the readers and what they call, e.g. the writers'
   # helpers): a new reader file cannot break the fuzz build's link again
   file(GLOB JF_FUZZ_READER_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/io/*.c)
-  # the writers' default thread count (jf_default_threads)
-  list(APPEND JF_FUZZ_READER_SOURCES ${PROJECT_SOURCE_DIR}/src/core/threads.c)
+  # the writers' default thread count (jf_default_threads), the readers'
+  # huge-page buffers (jf__big_alloc)
+  list(APPEND JF_FUZZ_READER_SOURCES ${PROJECT_SOURCE_DIR}/src/core/threads.c
+       ${PROJECT_SOURCE_DIR}/src/core/bigalloc.c)
   set(JF_FUZZ_FLAGS -fsanitize=fuzzer,address,undefined
       -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
   foreach(reader ply xyz off las ptx ply_layout e57 laz laz_rt)

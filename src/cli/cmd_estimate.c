@@ -262,25 +262,39 @@ typedef struct {
     jf_cli_progress *pg; /* counts the points fitted (parts too)        */
 } sinkctx;
 
-static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
+/* The rows of one fitted block into the writer: point j's coordinates at
+ * xyz + 3 idx[j] (by_index: the cloud's, in input order) or xyz + 3 j
+ * (handed over in the block's order); track_big: the largest finite
+ * coordinate kept for the "nothing fitted" message (the cloud not held). */
+static inline __attribute__((always_inline)) jf_status
+put_rows(sinkctx *s, const uint32_t *idx, const double *xyz, int by_index, int track_big,
+         jf_result *res, size_t m)
 {
-    sinkctx *s = user;
     int t = omp_get_thread_num();
     if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
     double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
     for (size_t j = 0; j < m; j++) {
         if (j + 8 < m) { /* input order: a cache miss each, asked for early */
-            __builtin_prefetch(s->xyz + 3 * (size_t)idx[j + 8]);
+            if (by_index) __builtin_prefetch(xyz + 3 * (size_t)idx[j + 8]);
             if (s->cond) __builtin_prefetch(s->cond + idx[j + 8], 1);
         }
-        jf_result_row(s->xyz + 3 * (size_t)idx[j], &res[j], s->monge, s->sigma, v + j * s->ncols);
+        const double *p = xyz + 3 * (by_index ? (size_t)idx[j] : j);
+        jf_result_row(p, &res[j], s->monge, s->sigma, v + j * s->ncols);
         tally_add(&s->tl[t], &res[j]);
         if (s->cond) s->cond[idx[j]] = res[j].cond;
+        for (int k = 0; track_big && k < 3; k++)
+            if (isfinite(p[k]) && fabs(p[k]) > s->tl[t].big) s->tl[t].big = fabs(p[k]);
     }
     jf_status st = jf_writer_put(s->w, idx, v, m);
     if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
     if (s->pg) jf_cli_progress_fitted(s->pg, m);
     return st;
+}
+
+static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
+{
+    sinkctx *s = user;
+    return put_rows(s, idx, s->xyz, 1, 0, res, m);
 }
 
 /* The same with the block's coordinates handed over by the fit (its
@@ -289,20 +303,7 @@ static jf_status sink_block(void *user, const uint32_t *idx, jf_result *res, siz
 static jf_status sink_block_walk(void *user, const uint32_t *idx, const double *xyz,
                                  jf_result *res, size_t m)
 {
-    sinkctx *s = user;
-    int t = omp_get_thread_num();
-    if (t >= s->nt) return JF_ERR_INVALID; /* more threads than planned */
-    double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
-    for (size_t j = 0; j < m; j++) {
-        if (s->cond && j + 8 < m) __builtin_prefetch(s->cond + idx[j + 8], 1);
-        jf_result_row(xyz + 3 * j, &res[j], s->monge, s->sigma, v + j * s->ncols);
-        tally_add(&s->tl[t], &res[j]);
-        if (s->cond) s->cond[idx[j]] = res[j].cond;
-    }
-    jf_status st = jf_writer_put(s->w, idx, v, m);
-    if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
-    if (s->pg) jf_cli_progress_fitted(s->pg, m);
-    return st;
+    return put_rows(user, idx, xyz, 0, 0, res, m);
 }
 
 /* The same with the coordinates handed over (--memory with the
@@ -310,22 +311,7 @@ static jf_status sink_block_walk(void *user, const uint32_t *idx, const double *
 static jf_status sink_block_xyz(void *user, const uint32_t *idx, const double *xyz, jf_result *res,
                                 size_t m)
 {
-    sinkctx *s = user;
-    int t = omp_get_thread_num();
-    if (t >= s->nt) return JF_ERR_INVALID;
-    double *v = s->rows + (size_t)t * JF_BLOCK_MAX * s->ncols;
-    for (size_t j = 0; j < m; j++) {
-        jf_result_row(xyz + 3 * j, &res[j], s->monge, s->sigma, v + j * s->ncols);
-        tally_add(&s->tl[t], &res[j]);
-        if (s->cond) s->cond[idx[j]] = res[j].cond;
-        for (int k = 0; k < 3; k++)
-            if (isfinite(xyz[3 * j + k]) && fabs(xyz[3 * j + k]) > s->tl[t].big)
-                s->tl[t].big = fabs(xyz[3 * j + k]);
-    }
-    jf_status st = jf_writer_put(s->w, idx, v, m);
-    if (st != JF_OK) __atomic_store_n(&s->wfail, 1, __ATOMIC_RELAXED);
-    if (s->pg) jf_cli_progress_fitted(s->pg, m);
-    return st;
+    return put_rows(user, idx, xyz, 0, 1, res, m);
 }
 
 /* ---- the command ---------------------------------------------------------- */

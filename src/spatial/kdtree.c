@@ -121,18 +121,9 @@ static void select_nth(double *pts, uint32_t *id, size_t lo, size_t hi,
         const uint32_t pi = id[last];
         size_t st = lo;
         for (size_t i = lo; i < last; i++) {
-            const double x0 = pts[3 * i], x1 = pts[3 * i + 1], x2 = pts[3 * i + 2];
-            const uint32_t xi = id[i];
             const double x = pts[3 * i + d];
-            const size_t less = (x < pc) | ((x == pc) & (xi < pi));
-            pts[3 * i] = pts[3 * st];
-            pts[3 * i + 1] = pts[3 * st + 1];
-            pts[3 * i + 2] = pts[3 * st + 2];
-            id[i] = id[st];
-            pts[3 * st] = x0;
-            pts[3 * st + 1] = x1;
-            pts[3 * st + 2] = x2;
-            id[st] = xi;
+            const size_t less = (x < pc) | ((x == pc) & (id[i] < pi));
+            swap_pt(pts, id, i, st);
             st += less;
         }
         swap_pt(pts, id, st, last); /* [lo, st) < pivot at st < (st, hi) */

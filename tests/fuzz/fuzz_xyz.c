@@ -16,6 +16,30 @@
 #include <stdio.h>
 #include <unistd.h>
 
+/* Aborts unless both reads gave the same status and message, or the
+ * same cloud bit for bit (names: the attributes' names and types too);
+ * frees both clouds. */
+static void same_result(jf_status sa, jf_status sb, jf_cloud *a, jf_cloud *b,
+                        const jf_error *ea, const jf_error *eb, int names)
+{
+    if (sa != sb || (sa != JF_OK && strcmp(ea->msg, eb->msg)))
+        abort();
+    if (sa != JF_OK)
+        return;
+    if (a->n != b->n || a->nbad != b->nbad ||
+        memcmp(a->bad_line, b->bad_line, sizeof a->bad_line) || memcmp(a->xyz, b->xyz, 3 * a->n * sizeof(double)) || !!a->nrm != !!b->nrm ||
+        (a->nrm && memcmp(a->nrm, b->nrm, 3 * a->n * sizeof(double))) ||
+        a->attrs.nattrs != b->attrs.nattrs || a->attrs.stride != b->attrs.stride ||
+        (a->attrs.nattrs && memcmp(a->attrs.rec, b->attrs.rec, a->n * a->attrs.stride)))
+        abort();
+    for (size_t k = 0; names && k < a->attrs.nattrs; k++)
+        if (strcmp(a->attrs.attr[k].name, b->attrs.attr[k].name) ||
+            a->attrs.attr[k].type != b->attrs.attr[k].type)
+            abort();
+    jf_cloud_free(a);
+    jf_cloud_free(b);
+}
+
 /* One thread against three with blocks of a few bytes (io_xyz.c's
  * parallel blocks): the same status, message and cloud, bit for bit. */
 static void same_threads(const uint8_t *d, size_t n, jf_format f, jf_read_opts o)
@@ -28,18 +52,7 @@ static void same_threads(const uint8_t *d, size_t n, jf_format f, jf_read_opts o
     jf__xyz_block_bytes(8 + n % 61);
     jf_status sb = jf_cloud_read_mem((const char *)d, n, f, "fuzz", &o, &b, &eb);
     jf__xyz_block_bytes(0);
-    if (sa != sb || (sa != JF_OK && strcmp(ea.msg, eb.msg)))
-        abort();
-    if (sa != JF_OK)
-        return;
-    if (a.n != b.n || a.nbad != b.nbad || memcmp(a.bad_line, b.bad_line, sizeof a.bad_line) ||
-        memcmp(a.xyz, b.xyz, 3 * a.n * sizeof(double)) || !!a.nrm != !!b.nrm ||
-        (a.nrm && memcmp(a.nrm, b.nrm, 3 * a.n * sizeof(double))) ||
-        a.attrs.nattrs != b.attrs.nattrs || a.attrs.stride != b.attrs.stride ||
-        (a.attrs.nattrs && memcmp(a.attrs.rec, b.attrs.rec, a.n * a.attrs.stride)))
-        abort();
-    jf_cloud_free(&a);
-    jf_cloud_free(&b);
+    same_result(sa, sb, &a, &b, &ea, &eb, 0);
 }
 
 /* The file read in pieces of a few bytes (jf_cloud_read, io_xyz.c's
@@ -69,22 +82,7 @@ static void same_pieces(const uint8_t *d, size_t n, jf_format f, jf_read_opts o)
     jf_status sb = n ? jf_cloud_read_mem((const char *)d, n, f, path, &o, &b, &eb)
                      : jf_cloud_read(path, &o, &b, &eb);
     remove(path);
-    if (sa != sb || (sa != JF_OK && strcmp(ea.msg, eb.msg)))
-        abort();
-    if (sa != JF_OK)
-        return;
-    if (a.n != b.n || a.nbad != b.nbad || memcmp(a.bad_line, b.bad_line, sizeof a.bad_line) ||
-        memcmp(a.xyz, b.xyz, 3 * a.n * sizeof(double)) || !!a.nrm != !!b.nrm ||
-        (a.nrm && memcmp(a.nrm, b.nrm, 3 * a.n * sizeof(double))) ||
-        a.attrs.nattrs != b.attrs.nattrs || a.attrs.stride != b.attrs.stride ||
-        (a.attrs.nattrs && memcmp(a.attrs.rec, b.attrs.rec, a.n * a.attrs.stride)))
-        abort();
-    for (size_t k = 0; k < a.attrs.nattrs; k++)
-        if (strcmp(a.attrs.attr[k].name, b.attrs.attr[k].name) ||
-            a.attrs.attr[k].type != b.attrs.attr[k].type)
-            abort();
-    jf_cloud_free(&a);
-    jf_cloud_free(&b);
+    same_result(sa, sb, &a, &b, &ea, &eb, 1);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

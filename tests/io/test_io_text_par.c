@@ -16,32 +16,9 @@
 #include "jetfit.h"
 
 #include "jf_test.h"
+#include "test_text_gen.h"
 
 #define NROWS 6000
-
-/* A growing text. */
-typedef struct {
-    char *s;
-    size_t n, cap;
-} text;
-
-static void put(text *t, const char *fmt, ...)
-{
-    va_list ap, aq;
-    va_start(ap, fmt);
-    va_copy(aq, ap);
-    int k = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    ck_assert_int_gt(k, 0);
-    if (t->n + (size_t)k + 1 > t->cap) {
-        t->cap = 2 * (t->n + (size_t)k + 1);
-        t->s = realloc(t->s, t->cap);
-        ck_assert_ptr_nonnull(t->s);
-    }
-    vsnprintf(t->s + t->n, (size_t)k + 1, fmt, aq);
-    va_end(aq);
-    t->n += (size_t)k;
-}
 
 /* What the generator meant: rows (NaN for a bad one), intensity, the
  * lines of the bad rows, and the first bad row's line and row. */
@@ -121,25 +98,6 @@ static jf_status read_with(const text *t, jf_format fmt, int threads, size_t byt
     return st;
 }
 
-/* a and b the same cloud, bit for bit (NaN rows included). */
-static void same_cloud(const jf_cloud *a, const jf_cloud *b)
-{
-    ck_assert_uint_eq(a->n, b->n);
-    ck_assert_uint_eq(a->nbad, b->nbad);
-    ck_assert_int_eq(memcmp(a->bad_line, b->bad_line, sizeof a->bad_line), 0);
-    ck_assert_int_eq(memcmp(a->xyz, b->xyz, 3 * a->n * sizeof(double)), 0);
-    ck_assert_int_eq(!a->nrm, !b->nrm);
-    if (a->nrm)
-        ck_assert_int_eq(memcmp(a->nrm, b->nrm, 3 * a->n * sizeof(double)), 0);
-    ck_assert_uint_eq(a->attrs.nattrs, b->attrs.nattrs);
-    ck_assert_uint_eq(a->attrs.stride, b->attrs.stride);
-    for (size_t k = 0; k < a->attrs.nattrs; k++) {
-        ck_assert_str_eq(a->attrs.attr[k].name, b->attrs.attr[k].name);
-        ck_assert_int_eq(a->attrs.attr[k].type, b->attrs.attr[k].type);
-    }
-    if (a->attrs.nattrs)
-        ck_assert_int_eq(memcmp(a->attrs.rec, b->attrs.rec, a->n * a->attrs.stride), 0);
-}
 
 /* --bad-rows skip: every thread count and block size gives the rows the
  * generator wrote, the bad ones NaN, their lines, the intensity column. */
