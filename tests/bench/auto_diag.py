@@ -8,7 +8,13 @@ fixed (K, degree) with the least squared error in each bin -- a quantity
 that predicts the best K has bins whose best K differ, the same way on
 every cloud (docs/robustness.md, "Neighbourhood auto").  Pure Python.
 
-usage: python3 auto_diag.py FILE...
+With --sweep (needs numpy): auto's rule re-run on the candidates (it
+reproduces the file's own choices: "rule matches") with Lepski's
+threshold tau and a largest K, over a grid, and the best grid cell per
+cloud -- an upper bound for any retuning of the rule's two knobs, even one
+that knew each cloud's noise.
+
+usage: python3 auto_diag.py [--sweep] FILE...
 """
 import math
 import sys
@@ -122,6 +128,89 @@ FEATURES = [
 ]
 
 
+def _sweep_arrays(pts):
+    import numpy as np
+    full = [p for p in pts if len(p['c']) == 10]
+    keys = ('ok', 'tr')
+    A = {k: np.array([[[c[e][k] for e in range(2)] for c in p['c']] for p in full], float) for k in keys}
+    A['n'] = np.array([[[c[e]['n'] for e in range(2)] for c in p['c']] for p in full], float)
+    A['err'] = np.array([[[c[e]['err'] for e in range(2)] for c in p['c']] for p in full], float)
+    A['s2'] = np.array([p['s2'] for p in full])
+    A['auto'] = np.array([(p['ci'], p['d']) for p in full])
+    A['K'] = [c[0]['K'] for c in full[0]['c']]
+    return A
+
+
+def _np_ang(a, b):
+    import numpy as np
+    c = np.abs((a * b).sum(-1)) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
+    return np.arccos(np.clip(c, 0.0, 1.0))
+
+
+def _np_lepski(A, e, tau, kmax, sdmax=0.3):
+    """src/robust/auto_rule.c's chain for degree 2 + e, candidates 0..kmax"""
+    import numpy as np
+    ok = (A['ok'][:, :, e] > 0) & (np.arange(10) <= kmax)
+    sd = np.sqrt(A['s2'][:, None] * A['tr'][:, :, e])
+    n = A['n'][:, :, e]
+    N = ok.shape[0]
+    acc = np.zeros((N, 10), bool)
+    alive = np.ones(N, bool)
+    best = np.full(N, -1)
+    for i in range(10):
+        cand = alive & ok[:, i]
+        fail = np.zeros(N, bool)
+        for j in range(i):
+            fail |= acc[:, j] & (sd[:, j] < sdmax) & (_np_ang(n[:, i], n[:, j]) > tau * (sd[:, i] + sd[:, j]))
+        acc[:, i] = cand & ~fail
+        alive &= ~(cand & fail)
+        best = np.where(acc[:, i], i, best)
+    return best, sd
+
+
+def np_rule(A, tau=2.0, kmax=9):
+    """auto's choice (candidate, degree) per point: the cubic's Lepski K
+    unless the quadric, at the largest K of its chain where it agrees with
+    the cubic, has the smaller sd"""
+    import numpy as np
+    b2, sd2 = _np_lepski(A, 0, tau, kmax)
+    b3, sd3 = _np_lepski(A, 1, tau, kmax)
+    N = b2.shape[0]
+    d = np.where(b3 >= 0, 3, 2)
+    ci = np.where(b3 >= 0, b3, b2)
+    ok = A['ok'] > 0
+    aqc = _np_ang(A['n'][:, :, 0], A['n'][:, :, 1])
+    sdb3 = sd3[np.arange(N), np.maximum(b3, 0)]
+    done = np.zeros(N, bool)
+    for i in range(9, -1, -1):
+        cand = (b3 >= 0) & ~done & (i <= b2) & ok[:, i, 0] & ok[:, i, 1] & ~(aqc[:, i] > tau * sd3[:, i])
+        sw = cand & (sd2[:, i] < sdb3)
+        d = np.where(sw, 2, d)
+        ci = np.where(sw, i, ci)
+        done |= cand
+    return ci, d
+
+
+def sweep(path, pts):
+    import numpy as np
+    A = _sweep_arrays(pts)
+    N = len(A['s2'])
+    ci, d = np_rule(A)
+    print('## %s: rule matches %d of %d choices' % (path, int(((ci == A['auto'][:, 0]) & (d == A['auto'][:, 1])).sum()), N))
+    fixed = min(rms(list(A['err'][:, k, e])) for k in range(10) for e in range(2))
+    best = None
+    for tau in (0.5, 1, 1.5, 2, 3, 4):
+        for kmax in range(1, 10):
+            ci, d = np_rule(A, tau, kmax)
+            err = np.where(ci < 0, 90.0, A['err'][np.arange(N), np.maximum(ci, 0), d - 2])
+            r = rms(list(err))
+            if best is None or r < best[0]:
+                best = (r, tau, A['K'][kmax])
+    print('best (tau, largest K) %.3f at tau %g, K <= %d; best fixed candidate %.3f: x%.3f' %
+          (best[0], best[1], best[2], fixed, best[0] / fixed))
+
+
 if __name__ == '__main__':
-    for path in sys.argv[1:]:
-        summary(path, load(path))
+    do_sweep = '--sweep' in sys.argv[1:]
+    for path in (a for a in sys.argv[1:] if a != '--sweep'):
+        (sweep if do_sweep else summary)(path, load(path))
