@@ -351,6 +351,14 @@ static jf_status las_columns(const jf_cli_estimate_cmd *cmd, const char *path, j
     return JF_OK;
 }
 
+/* fd's file as it was (sb): same size and modification time. */
+static int same_file_state(int fd, const struct stat *sb)
+{
+    struct stat now;
+    return fstat(fd, &now) == 0 && now.st_size == sb->st_size &&
+           now.st_mtim.tv_sec == sb->st_mtim.tv_sec && now.st_mtim.tv_nsec == sb->st_mtim.tv_nsec;
+}
+
 static int estimate(int argc, char **argv, int *fd);
 
 int jf_cmd_estimate(int argc, char **argv)
@@ -383,6 +391,8 @@ static int estimate(int argc, char **argv, int *fd)
     int ooc = 0; /* --memory: coordinates read from the input file as needed */
     jf_row_layout lay;
     memset(&lay, 0, sizeof lay);
+    struct stat isb; /* the input when opened: a change by the end spoils the parts' reads */
+    memset(&isb, 0, sizeof isb);
     /* writing over the input would lose its other columns (and, renamed
      * over it, the input itself) */
     if (jf_same_file(in, out)) {
@@ -417,10 +427,9 @@ static int estimate(int argc, char **argv, int *fd)
         omp_set_num_threads(o.threads); /* the LAZ reader decodes chunks on them */
     jf_status st = JF_ERR_UNSUPPORTED;
     if (ooc) { /* everything but the coordinates; a PLY that does not qualify: read whole */
-        struct stat sb;
         *fd = open(in, O_RDONLY);
-        if (*fd >= 0 && fstat(*fd, &sb) == 0 && S_ISREG(sb.st_mode))
-            st = jf__read_ply_chunked_noxyz(*fd, (size_t)sb.st_size, in, &e.ro, &c, &err);
+        if (*fd >= 0 && fstat(*fd, &isb) == 0 && S_ISREG(isb.st_mode))
+            st = jf__read_ply_chunked_noxyz(*fd, (size_t)isb.st_size, in, &e.ro, &c, &err);
         if (st != JF_OK && *fd >= 0) close(*fd), *fd = -1;
         if (st == JF_OK && c.n != lay.count) {
             jf_cloud_free(&c);
@@ -607,6 +616,13 @@ static int estimate(int argc, char **argv, int *fd)
     st = ooc          ? jf__estimate_parts_src(&c, &src, &o, nparts, sink_block_xyz, &sk, &err)
          : nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)
                       : jf__estimate_blocks_xyz(&c, &o, sink_block_walk, &sk, &err);
+    if (st == JF_OK && ooc && !same_file_state(*fd, &isb)) {
+        /* each part re-read the coordinates: written to in place during
+         * the run, the parts may have seen different points */
+        st = JF_ERR_IO;
+        snprintf(err.msg, sizeof err.msg, "the file was modified while it was read (--memory "
+                                          "reads it again for every part); nothing written");
+    }
     free(sk.rows);
     jf_cli_progress_end(&pg); /* the fit's line ends before any message */
     if (st != JF_OK) {

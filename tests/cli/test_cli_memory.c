@@ -5,10 +5,14 @@
  * in parts give the bytes of the unbounded run for every k-d tree
  * neighbourhood and text or binary output. */
 #include <check.h>
+#include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "test_cli_util.h"
 #include "jf_test.h"
@@ -161,6 +165,51 @@ START_TEST(coordinates_on_disk_same_bytes)
 }
 END_TEST
 
+/* The input written to in place during a run whose parts read it again
+ * and again: an error naming the file, nothing written (before: the parts
+ * could fit different points, silently); untouched, the same run passes. */
+static volatile int toggle_stop;
+static void *toggler(void *arg)
+{
+    int fd = open(arg, O_RDWR);
+    struct stat sb;
+    unsigned char b0;
+    if (fd < 0 || fstat(fd, &sb) != 0 || pread(fd, &b0, 1, sb.st_size - 13) != 1) return NULL;
+    for (unsigned k = 1; !toggle_stop; k++) { /* the last z's lowest byte (rows of 29 bytes) */
+        const unsigned char b = b0 ^ (unsigned char)(k & 1);
+        if (pwrite(fd, &b, 1, sb.st_size - 13) != 1) break;
+        usleep(200);
+    }
+    if (pwrite(fd, &b0, 1, sb.st_size - 13) != 1) {}
+    close(fd);
+    return arg;
+}
+
+START_TEST(input_modified_during_run_refused)
+{
+    write_sheet(cli_path("in.ply"), 30000, 7);
+    ck_assert_int_eq(run_budget("p.ply", "knn:16", 1024), 1);
+    const unsigned long long least = least_named();
+    ck_assert_msg(least > 0 && strstr(cli_err, "read from the file as needed"), "%s", cli_err);
+    pthread_t th;
+    toggle_stop = 0;
+    ck_assert_int_eq(pthread_create(&th, NULL, toggler, (void *)cli_path("in.ply")), 0);
+    const int rc = run_budget("p.ply", "knn:16", least);
+    toggle_stop = 1;
+    void *ran = NULL;
+    pthread_join(th, &ran);
+    ck_assert_ptr_nonnull(ran);
+    ck_assert_int_eq(rc, 1);
+    char want[600];
+    snprintf(want, sizeof want, "jetfit: %s: the file was modified while it was read",
+             cli_path("in.ply"));
+    ck_assert_msg(strstr(cli_err, want), "%s", cli_err);
+    ck_assert_int_eq(cli_exists(cli_path("p.ply")), 0);
+    ck_assert_int_eq(run_budget("p.ply", "knn:16", least), 0);
+    ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
+}
+END_TEST
+
 /* Nothing held beside the parts (--quiet: no summary values; --keep none;
  * no normals): the refusal does not name a size of nothing ("0K"). */
 START_TEST(refusal_names_no_empty_size)
@@ -198,6 +247,7 @@ int main(void)
     tcase_add_test(tc, small_budgets_same_bytes);
     tcase_add_test(tc, coordinates_on_disk_same_bytes);
     tcase_add_test(tc, refusal_names_no_empty_size);
+    tcase_add_test(tc, input_modified_during_run_refused);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
