@@ -188,8 +188,12 @@ static inline v2d sqrt2(v2d x) { return (v2d)_mm_sqrt_pd((__m128d)x); }
 static inline v2d sqrt2(v2d x) { return (v2d){sqrt(x[0]), sqrt(x[1])}; }
 #endif
 
-void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
-                 double eval1[3], double evec1[9])
+/* The rotations of jf__eig3_x2: the diagonalised matrices and the
+ * rotations' products, lane by lane, into al[lane], vl[lane]. */
+static inline __attribute__((always_inline)) void eig3_x2_sweeps(const double a0[9],
+                                                                 const double a1[9],
+                                                                 double al[2][3][3],
+                                                                 double vl[2][3][3])
 {
     v2d a[3][3], v[3][3];
     for (int i = 0; i < 3; i++)
@@ -205,7 +209,11 @@ void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double
         v2d diag = abs2(a[0][0]) + abs2(a[1][1]) + abs2(a[2][2]);
         live &= ~((v2l)(off == zero) | (v2l)(off <= DBL_EPSILON * DBL_EPSILON * diag));
         if (!live[0] && !live[1]) break;
+        /* unrolled: constant indices keep a and v in registers (the loop
+         * kept them on the stack, a store and reload in the chain) */
+#pragma GCC unroll 2
         for (int p = 0; p < 2; p++) {
+#pragma GCC unroll 2
             for (int q = p + 1; q < 3; q++) {
                 const v2l on = live & ~(v2l)(a[p][q] == zero);
                 if (!on[0] && !on[1]) continue;
@@ -234,13 +242,32 @@ void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double
             }
         }
     }
-    double al[3][3], vl[3][3];
-    for (int lane = 0; lane < 2; lane++) {
+    for (int lane = 0; lane < 2; lane++)
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++) {
-                al[i][j] = a[i][j][lane];
-                vl[i][j] = v[i][j][lane];
+                al[lane][i][j] = a[i][j][lane];
+                vl[lane][i][j] = v[i][j][lane];
             }
-        eig3_sorted(al, vl, lane ? eval1 : eval0, lane ? evec1 : evec0);
-    }
+}
+
+#if JF_AVX_PATH
+JF_AVX_FN static void eig3_x2_avx(const double a0[9], const double a1[9], double al[2][3][3],
+                                  double vl[2][3][3])
+{
+    eig3_x2_sweeps(a0, a1, al, vl);
+    JF_AVX_LEAVE();
+}
+#endif
+
+void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
+                 double eval1[3], double evec1[9])
+{
+    double al[2][3][3], vl[2][3][3];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) eig3_x2_avx(a0, a1, al, vl);
+    else
+#endif
+        eig3_x2_sweeps(a0, a1, al, vl);
+    eig3_sorted(al[0], vl[0], eval0, evec0);
+    eig3_sorted(al[1], vl[1], eval1, evec1);
 }

@@ -113,8 +113,8 @@ qr_norms(const double *a, size_t rows, size_t cols, int *perm, double *nrm, doub
     }
 }
 
-static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *perm,
-                           double *nrm, double *nrm0)
+static inline __attribute__((always_inline)) void
+householder_qr(double *a, double *b, size_t rows, size_t cols, int *perm, double *nrm, double *nrm0)
 {
     qr_norms(a, rows, cols, perm, nrm, nrm0);
     for (size_t k = 0; k < cols; k++) qr_step(a, b, rows, cols, k, perm, nrm, nrm0);
@@ -126,8 +126,8 @@ static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *
 #define QR_PRAGMA(x) _Pragma(#x)
 #define QR_UNROLL(C) QR_PRAGMA(GCC unroll C)
 #define QR_FIXED(R, C)                                                                     \
-    static void householder_qr_##R##_##C(double *a, double *b, int *perm, double *nrm,     \
-                                         double *nrm0)                                     \
+    static inline __attribute__((always_inline)) void householder_qr_##R##_##C(            \
+        double *a, double *b, int *perm, double *nrm, double *nrm0)                        \
     {                                                                                      \
         qr_norms(a, R, C, perm, nrm, nrm0);                                                \
         QR_UNROLL(C) for (size_t k = 0; k < C; k++)                                        \
@@ -381,7 +381,7 @@ static int svd_rest(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
 int jf__fixed_sizes = 1;
 
-int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
+static inline __attribute__((always_inline)) int qr_gram(jf_fitter *f, size_t rows, size_t cols)
 {
     /* knn:16 and knn:32 at degree 2 (6 columns) and knn:32 at degree 3 (10):
      * the same code with constant sizes, which the compiler unrolls; the
@@ -405,6 +405,25 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
 #else
     return 0;
 #endif
+}
+
+/* qr_gram in the AVX build (fitter_internal.h): dot()'s four partial
+ * sums in one register, the same bits */
+#if JF_AVX_PATH
+JF_AVX_FN static int qr_gram_avx(jf_fitter *f, size_t rows, size_t cols)
+{
+    int r = qr_gram(f, rows, cols);
+    JF_AVX_LEAVE();
+    return r;
+}
+#endif
+
+int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
+{
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) return qr_gram_avx(f, rows, cols);
+#endif
+    return qr_gram(f, rows, cols);
 }
 
 int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond)
