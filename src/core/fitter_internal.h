@@ -110,6 +110,9 @@ void jf__frame_axes(const double evec[9], jf_frame_mode mode, double r[9]);
 void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
                  double eval1[3], double evec1[9]);
 
+/* jf__eig3 of a[0..3] at once (SIMD lanes), bit for bit the same. */
+void jf__eig3_x4(const double *const a[4], double *const eval[4], double *const evec[4]);
+
 /* monge.c */
 /* Differential quantities of the jet A (fitting frame, degree deg, rows of
  * r = frame axes in world coordinates) into out: normal, k1, k2, d1, d2,
@@ -128,6 +131,11 @@ void jf__result_nan(jf_result *out);
 jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0, size_t n0,
                            jf_result *out0, jf_fitter *f1, const double p1[3],
                            const double *nbr1, size_t n1, jf_result *out1);
+
+/* jf__fit_point_x2 for four (distinct fitters f[k]): the same results,
+ * bit for bit, as the four calls. */
+jf_status jf__fit_point_x4(jf_fitter *const f[4], const double *const p[4],
+                           const double *const nbr[4], const size_t n[4], jf_result *const out[4]);
 
 /* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
@@ -162,6 +170,8 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
 extern int jf__fixed_sizes;
 int jf__eigvals(jf_fitter *f, size_t cols);
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
+/* jf__eigvals_x4: the same for four fitters (same cols) at once. */
+void jf__eigvals_x4(jf_fitter *const f[4], size_t cols, int ok[4]);
 int jf__sym_eigvals(double *a, size_t n, double *d, double *e);
 /* jf__gram_extremes (gram_eig.c): the largest and least eigenvalues of
  * the symmetric cols x cols g (2 <= cols <= 10), as jf__eigvals; 1 ok. */

@@ -474,6 +474,64 @@ jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0
     return JF_OK;
 }
 
+jf_status jf__fit_point_x4(jf_fitter *const f[4], const double *const p[4],
+                           const double *const nbr[4], const size_t n[4], jf_result *const out[4])
+{
+    for (int k = 0; k < 4; k++) {
+        int clash = 0;
+        for (int l = 0; l < k; l++) clash |= f[l] == f[k];
+        if (clash || check_args(f[k], p[k], nbr[k], NULL, n[k], out[k]) != JF_OK) {
+            jf_status st = JF_OK;
+            for (int l = 0; l < 4 && st == JF_OK; l++) st = jf_fit_point(f[l], p[l], nbr[l], n[l], out[l]);
+            return st;
+        }
+    }
+    fit_job j[4];
+    int st[4], live = -1;
+    double evec[4][9];
+    for (int k = 0; k < 4; k++)
+        if ((st[k] = job_begin(&j[k], f[k], p[k], nbr[k], NULL, n[k], out[k]))) live = k;
+    if (live < 0) return JF_OK;
+    /* the four covariances side by side; a finished fit's lane computes a
+     * live one's again, into scratch (lanes do not mix) */
+    {
+        const double *a[4];
+        double *ev[4], *vec[4], spare_ev[4][3], spare_vec[4][9];
+        for (int k = 0; k < 4; k++) {
+            a[k] = st[k] ? j[k].cov : j[live].cov;
+            ev[k] = st[k] ? out[k]->pca_eval : spare_ev[k];
+            vec[k] = st[k] ? evec[k] : spare_vec[k];
+        }
+        jf__eig3_x4(a, ev, vec);
+    }
+    for (int k = 0; k < 4; k++)
+        if (st[k]) st[k] = job_frame(&j[k], evec[k]);
+    /* the first systems of the same size side by side (the usual case:
+     * one degree, k-NN); the others' lanes repeat one of them, unused */
+    int first = -1;
+    for (int k = 0; k < 4 && first < 0; k++)
+        if (st[k] == 1) first = k;
+    if (first >= 0) {
+        jf_fitter *g[4];
+        int in[4], ok[4], d = j[first].d;
+        for (int k = 0; k < 4; k++) {
+            in[k] = st[k] == 1 && j[k].d == d;
+            g[k] = in[k] ? f[k] : f[first];
+        }
+        /* a repeated fitter's lane writes its eigenvalues again, the same */
+        jf__eigvals_x4(g, jf_jet_size(d), ok);
+        for (int k = 0; k < 4; k++)
+            if (in[k]) st[k] = job_solved(&j[k], job_solve(&j[k], st[k], ok[k]));
+    }
+    for (int k = 0; k < 4; k++)
+        while (st[k]) {
+            jf_fitter *fk = j[k].f;
+            st[k] = job_solved(&j[k], job_solve(&j[k], st[k],
+                                                st[k] == 1 && jf__eigvals(fk, jf_jet_size(j[k].d))));
+        }
+    return JF_OK;
+}
+
 jf_status jf_fit_point(jf_fitter *f, const double p[3], const double *nbr, size_t n,
                        jf_result *out)
 {
