@@ -380,6 +380,7 @@ static int fast_finish(jf_fitter *f, size_t rows, size_t cols, double *cond)
 static int svd_rest(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
 int jf__fixed_sizes = 1;
+int jf__no_avx = 0;
 
 static inline __attribute__((always_inline)) int qr_gram(jf_fitter *f, size_t rows, size_t cols)
 {
