@@ -281,7 +281,7 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef long long v4l __attribute__((vector_size(32)));
 typedef void (*sqrt4_fn)(v4d *);
 /* all inlined: no call passes a v4d (GCC's ABI note does not apply) */
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__) /* clang too */
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 

@@ -224,7 +224,7 @@ typedef long long v4l __attribute__((vector_size(32)));
 typedef void (*sqrt4_fn)(v4d *);
 /* the helpers below are all inlined: no call passes a v4d, so GCC's
  * note that such a call's ABI differs without AVX does not apply */
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__) /* clang too */
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
