@@ -165,6 +165,9 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
  * jf__solve_after_eig: the rest (have_eig: the eigenvalues are in f->s);
  * returns as jf__svd_solve. */
 int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
+/* jf__qr_gram of four fitters (distinct, the same rows and cols) at
+ * once, the same bits; returns as jf__qr_gram (the same for all four). */
+int jf__qr_gram_x4(jf_fitter *const f[4], size_t rows, size_t cols);
 /* The QR, G's extremes and M' run the code of the common sizes (16 or 32
  * rows, 6 or 10 columns) with those sizes as constants, which the
  * compiler unrolls: the same operations, the same bits.  0 runs the
