@@ -70,25 +70,7 @@ static inline double jf__ldexp(double x, int e)
     return x * p.d;
 }
 
-/* The hot fit kernels have an AVX build beside the default (SSE2) one,
- * picked per call (JF_HAVE_AVX): VEX encodings and 4-lane registers, no
- * FMA (so no contraction): the same IEEE operations in the same order,
- * the same bits on every machine.  An AVX kernel calls nothing and ends
- * with JF_AVX_LEAVE (vzeroupper): GCC 12's target_clones omitted it
- * before a call, and the legacy-SSE code after ran 1.7x slower.  GCC on
- * x86-64 only (clang's fuzz build, other targets, -DJF_NO_CLONES: the
- * default build alone). */
-/* 1: the default build even where AVX is there (tests compare the two;
- * not thread-safe to change while fitting) */
-extern int jf__no_avx;
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
-#define JF_AVX_PATH 1
-#define JF_AVX_FN __attribute__((target("avx"), noinline))
-#define JF_AVX_LEAVE() __builtin_ia32_vzeroupper()
-#define JF_HAVE_AVX() (__builtin_cpu_supports("avx") && !jf__no_avx)
-#else
-#define JF_AVX_PATH 0
-#endif
+#include "avx_path.h" /* JF_AVX_PATH, JF_AVX_FN, JF_HAVE_AVX */
 
 /* frame.c */
 /* Eigen-decomposition of the symmetric 3x3 matrix a (row-major) by cyclic
