@@ -116,7 +116,7 @@ START_TEST(test_eig3_x4_bits)
     rng_state = 16;
     for (int avx = 0; avx < 2; avx++) {
         jf__no_avx = !avx;
-        for (int t = 0; t < 20000; t++) {
+        for (int t = 0; t < 10000; t++) {
             double a[4][9], ev[4][3], vec[4][9], ev1[3], vec1[9];
             for (int k = 0; k < 4; k++) {
                 int kind = (t + k * (t / 5 + 1)) % 5;
@@ -166,7 +166,7 @@ START_TEST(test_fit_x4_bits)
                 jf_fitter *f[4], *s0;
                 for (int k = 0; k < 4; k++) ck_assert_int_eq(jf_fitter_create(&p, &f[k]), JF_OK);
                 ck_assert_int_eq(jf_fitter_create(&p, &s0), JF_OK);
-                for (int t = 0; t < 300; t++) {
+                for (int t = 0; t < 200; t++) {
                     jf__no_avx = t % 2;
                     double nb[4][3 * MAXN], res[MAXN], ref_res[MAXN];
                     size_t n[4];
