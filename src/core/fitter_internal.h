@@ -70,6 +70,8 @@ static inline double jf__ldexp(double x, int e)
     return x * p.d;
 }
 
+#include "avx_path.h" /* JF_AVX_PATH, JF_AVX_FN, JF_HAVE_AVX */
+
 /* frame.c */
 /* Eigen-decomposition of the symmetric 3x3 matrix a (row-major) by cyclic
  * Jacobi: eval ascending, evec[3*k..] the unit eigenvector of eval[k]
@@ -93,6 +95,9 @@ void jf__frame_axes(const double evec[9], jf_frame_mode mode, double r[9]);
 void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
                  double eval1[3], double evec1[9]);
 
+/* jf__eig3 of a[0..3] at once (SIMD lanes), bit for bit the same. */
+void jf__eig3_x4(const double *const a[4], double *const eval[4], double *const evec[4]);
+
 /* monge.c */
 /* Differential quantities of the jet A (fitting frame, degree deg, rows of
  * r = frame axes in world coordinates) into out: normal, k1, k2, d1, d2,
@@ -111,6 +116,11 @@ void jf__result_nan(jf_result *out);
 jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0, size_t n0,
                            jf_result *out0, jf_fitter *f1, const double p1[3],
                            const double *nbr1, size_t n1, jf_result *out1);
+
+/* jf__fit_point_x2 for four (distinct fitters f[k]): the same results,
+ * bit for bit, as the four calls. */
+jf_status jf__fit_point_x4(jf_fitter *const f[4], const double *const p[4],
+                           const double *const nbr[4], const size_t n[4], jf_result *const out[4]);
 
 /* solve.c */
 /* Solves the weighted least-squares system rows x cols in f->m / f->rhs
@@ -137,6 +147,9 @@ int jf__svd_solve(jf_fitter *f, size_t rows, size_t cols, double *cond);
  * jf__solve_after_eig: the rest (have_eig: the eigenvalues are in f->s);
  * returns as jf__svd_solve. */
 int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
+/* jf__qr_gram of four fitters (distinct, the same rows and cols) at
+ * once, the same bits; returns as jf__qr_gram (the same for all four). */
+int jf__qr_gram_x4(jf_fitter *const f[4], size_t rows, size_t cols);
 /* The QR, G's extremes and M' run the code of the common sizes (16 or 32
  * rows, 6 or 10 columns) with those sizes as constants, which the
  * compiler unrolls: the same operations, the same bits.  0 runs the
@@ -145,6 +158,8 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols);
 extern int jf__fixed_sizes;
 int jf__eigvals(jf_fitter *f, size_t cols);
 void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2]);
+/* jf__eigvals_x4: the same for four fitters (same cols) at once. */
+void jf__eigvals_x4(jf_fitter *const f[4], size_t cols, int ok[4]);
 int jf__sym_eigvals(double *a, size_t n, double *d, double *e);
 /* jf__gram_extremes (gram_eig.c): the largest and least eigenvalues of
  * the symmetric cols x cols g (2 <= cols <= 10), as jf__eigvals; 1 ok. */

@@ -188,8 +188,12 @@ static inline v2d sqrt2(v2d x) { return (v2d)_mm_sqrt_pd((__m128d)x); }
 static inline v2d sqrt2(v2d x) { return (v2d){sqrt(x[0]), sqrt(x[1])}; }
 #endif
 
-void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
-                 double eval1[3], double evec1[9])
+/* The rotations of jf__eig3_x2: the diagonalised matrices and the
+ * rotations' products, lane by lane, into al[lane], vl[lane]. */
+static inline __attribute__((always_inline)) void eig3_x2_sweeps(const double a0[9],
+                                                                 const double a1[9],
+                                                                 double al[2][3][3],
+                                                                 double vl[2][3][3])
 {
     v2d a[3][3], v[3][3];
     for (int i = 0; i < 3; i++)
@@ -205,7 +209,11 @@ void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double
         v2d diag = abs2(a[0][0]) + abs2(a[1][1]) + abs2(a[2][2]);
         live &= ~((v2l)(off == zero) | (v2l)(off <= DBL_EPSILON * DBL_EPSILON * diag));
         if (!live[0] && !live[1]) break;
+        /* unrolled: constant indices keep a and v in registers (the loop
+         * kept them on the stack, a store and reload in the chain) */
+#pragma GCC unroll 2
         for (int p = 0; p < 2; p++) {
+#pragma GCC unroll 2
             for (int q = p + 1; q < 3; q++) {
                 const v2l on = live & ~(v2l)(a[p][q] == zero);
                 if (!on[0] && !on[1]) continue;
@@ -234,13 +242,139 @@ void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double
             }
         }
     }
-    double al[3][3], vl[3][3];
-    for (int lane = 0; lane < 2; lane++) {
+    for (int lane = 0; lane < 2; lane++)
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++) {
-                al[i][j] = a[i][j][lane];
-                vl[i][j] = v[i][j][lane];
+                al[lane][i][j] = a[i][j][lane];
+                vl[lane][i][j] = v[i][j][lane];
             }
-        eig3_sorted(al, vl, lane ? eval1 : eval0, lane ? evec1 : evec0);
+}
+
+#if JF_AVX_PATH
+JF_AVX_FN static void eig3_x2_avx(const double a0[9], const double a1[9], double al[2][3][3],
+                                  double vl[2][3][3])
+{
+    eig3_x2_sweeps(a0, a1, al, vl);
+    JF_AVX_LEAVE();
+}
+#endif
+
+void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double evec0[9],
+                 double eval1[3], double evec1[9])
+{
+    double al[2][3][3], vl[2][3][3];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) eig3_x2_avx(a0, a1, al, vl);
+    else
+#endif
+        eig3_x2_sweeps(a0, a1, al, vl);
+    eig3_sorted(al[0], vl[0], eval0, evec0);
+    eig3_sorted(al[1], vl[1], eval1, evec1);
+}
+
+/* ---- four at once ------------------------------------------------------
+ * jf__eig3_x2's rotations for four matrices in the four lanes of 32-byte
+ * vectors (one AVX register, two SSE2 ones in the default build): each
+ * lane the same operations, the bits of jf__eig3.  The sqrt of four lanes
+ * is a parameter (always inlined: vsqrtpd in the AVX build). */
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+typedef void (*sqrt4_fn)(v4d *);
+/* all inlined: no call passes a v4d (GCC's ABI note does not apply) */
+#if defined(__GNUC__) /* clang too */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+static inline v4d sel4(v4l m, v4d a, v4d b) { return (v4d)(((v4l)a & m) | ((v4l)b & ~m)); }
+static inline v4d abs4(v4d x) { return (v4d)((v4l)x & ~(v4l)(v4d){-0.0, -0.0, -0.0, -0.0}); }
+static inline int any4(v4l m) { return m[0] || m[1] || m[2] || m[3]; }
+static inline v4d vsqrt4(v4d x, sqrt4_fn sq)
+{
+    sq(&x);
+    return x;
+}
+static inline __attribute__((always_inline)) void sqrt4_sse(v4d *x)
+{
+    const v2d lo = sqrt2((v2d){(*x)[0], (*x)[1]}), hi = sqrt2((v2d){(*x)[2], (*x)[3]});
+    *x = (v4d){lo[0], lo[1], hi[0], hi[1]};
+}
+
+static inline __attribute__((always_inline)) void eig3_x4_sweeps(const double *const m[4],
+                                                                 double al[4][3][3],
+                                                                 double vl[4][3][3], sqrt4_fn sq)
+{
+    v4d a[3][3], v[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            for (int L = 0; L < 4; L++) a[i][j][L] = 0.5 * (m[L][3 * i + j] + m[L][3 * j + i]);
+            const double id = i == j ? 1.0 : 0.0;
+            v[i][j] = (v4d){id, id, id, id};
+        }
+    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    const v4d big = {1e150, 1e150, 1e150, 1e150};
+    v4l live = {-1, -1, -1, -1};
+    for (int sweep = 0; sweep < 50; sweep++) {
+        v4d off = abs4(a[0][1]) + abs4(a[0][2]) + abs4(a[1][2]);
+        v4d diag = abs4(a[0][0]) + abs4(a[1][1]) + abs4(a[2][2]);
+        live &= ~((v4l)(off == zero) | (v4l)(off <= DBL_EPSILON * DBL_EPSILON * diag));
+        if (!any4(live)) break;
+#pragma GCC unroll 2
+        for (int p = 0; p < 2; p++) {
+#pragma GCC unroll 2
+            for (int q = p + 1; q < 3; q++) {
+                const v4l on = live & ~(v4l)(a[p][q] == zero);
+                if (!any4(on)) continue;
+                v4d theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                v4d sg = sel4((v4l)(theta >= zero), one, -one);
+                v4d t = sel4((v4l)(abs4(theta) > big), one / (2.0 * theta),
+                             sg / (abs4(theta) + vsqrt4(theta * theta + one, sq)));
+                v4d c = one / vsqrt4(t * t + one, sq), s = t * c;
+                for (int k = 0; k < 3; k++) {
+                    v4d akp = a[k][p], akq = a[k][q];
+                    a[k][p] = sel4(on, c * akp - s * akq, akp);
+                    a[k][q] = sel4(on, s * akp + c * akq, akq);
+                }
+                for (int k = 0; k < 3; k++) {
+                    v4d apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = sel4(on, c * apk - s * aqk, apk);
+                    a[q][k] = sel4(on, s * apk + c * aqk, aqk);
+                }
+                a[p][q] = a[q][p] = sel4(on, zero, a[p][q]);
+                for (int k = 0; k < 3; k++) {
+                    v4d vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = sel4(on, c * vkp - s * vkq, vkp);
+                    v[k][q] = sel4(on, s * vkp + c * vkq, vkq);
+                }
+            }
+        }
     }
+    for (int L = 0; L < 4; L++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                al[L][i][j] = a[i][j][L];
+                vl[L][i][j] = v[i][j][L];
+            }
+}
+
+#if JF_AVX_PATH
+__attribute__((target("avx"), always_inline)) static inline void sqrt4_avx(v4d *x)
+{
+    *x = __builtin_ia32_sqrtpd256(*x);
+}
+JF_AVX_FN static void eig3_x4_avx(const double *const m[4], double al[4][3][3], double vl[4][3][3])
+{
+    eig3_x4_sweeps(m, al, vl, sqrt4_avx);
+    JF_AVX_LEAVE();
+}
+#endif
+
+void jf__eig3_x4(const double *const a[4], double *const eval[4], double *const evec[4])
+{
+    double al[4][3][3], vl[4][3][3];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) eig3_x4_avx(a, al, vl);
+    else
+#endif
+        eig3_x4_sweeps(a, al, vl, sqrt4_sse);
+    for (int L = 0; L < 4; L++) eig3_sorted(al[L], vl[L], eval[L], evec[L]);
 }

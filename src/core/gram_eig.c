@@ -213,6 +213,211 @@ void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
     ok[1] = rc[1] == 0;
 }
 
+/* ---- four at once -----------------------------------------------------
+ * The same steps for four fits in the four lanes of 32-byte vectors
+ * (one AVX register; two SSE2 registers in the default build): each lane
+ * does exactly the operations of the two-lane code above, so each gets
+ * the bits jf__eigvals gives.  The sqrt of four lanes is a parameter (an
+ * always-inlined call: vsqrtpd in the AVX build, two sqrtpd else). */
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+typedef void (*sqrt4_fn)(v4d *);
+/* the helpers below are all inlined: no call passes a v4d, so GCC's
+ * note that such a call's ABI differs without AVX does not apply */
+#if defined(__GNUC__) /* clang too */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+static inline v4d sel4(v4l m, v4d a, v4d b) { return (v4d)(((v4l)a & m) | ((v4l)b & ~m)); }
+static inline v4d abs4(v4d x) { return (v4d)((v4l)x & ~(v4l)(v4d){-0.0, -0.0, -0.0, -0.0}); }
+static inline int all4(v4l m) { return m[0] && m[1] && m[2] && m[3]; }
+static inline v4d vsqrt4(v4d x, sqrt4_fn sq)
+{
+    sq(&x);
+    return x;
+}
+static inline __attribute__((always_inline)) void sqrt4_sse(v4d *x)
+{
+    const v2d lo = sqrt2((v2d){(*x)[0], (*x)[1]}), hi = sqrt2((v2d){(*x)[2], (*x)[3]});
+    *x = (v4d){lo[0], lo[1], hi[0], hi[1]};
+}
+
+static inline __attribute__((always_inline)) void tridiag_x4(v4d *a, size_t n, v4d *d, v4d *e,
+                                                             sqrt4_fn sq)
+{
+    const v4d zero = {0.0, 0.0, 0.0, 0.0};
+    for (size_t k = 0; k + 2 < n; k++) {
+        const size_t m = n - k - 1, o = k + 1;
+        v4d v[GE_MAX], p[GE_MAX], nx = zero;
+        for (size_t i = 0; i < m; i++) {
+            v[i] = a[(o + i) * n + k];
+            nx += v[i] * v[i];
+        }
+        d[k] = a[k * n + k];
+        e[k] = nx;
+        const v4l skip = (v4l)(nx == zero);
+        if (all4(skip)) continue;
+        const v4d x0 = v[0], rt = vsqrt4(nx, sq);
+        const v4d alpha = sel4((v4l)(x0 > zero), -rt, rt);
+        v[0] = x0 - alpha;
+        const v4d vv = 2.0 * (nx - x0 * alpha), beta = 2.0 / vv;
+        v4d vp = zero;
+        for (size_t i = 0; i < m; i++) {
+            const v4d *ai = a + (o + i) * n + o;
+            v4d t = zero;
+            for (size_t j = 0; j < m; j++) t += ai[j] * v[j];
+            p[i] = beta * t;
+            vp += v[i] * p[i];
+        }
+        const v4d kq = vp / vv;
+        for (size_t i = 0; i < m; i++) p[i] -= kq * v[i];
+        for (size_t i = 0; i < m; i++) {
+            v4d *ai = a + (o + i) * n + o;
+            for (size_t j = 0; j < m; j++) ai[j] = sel4(skip, ai[j], ai[j] - (v[i] * p[j] + p[i] * v[j]));
+        }
+    }
+    if (n >= 2) {
+        const v4d t = a[(n - 1) * n + n - 2];
+        d[n - 2] = a[(n - 2) * n + n - 2];
+        e[n - 2] = t * t;
+    }
+    d[n - 1] = a[(n - 1) * n + n - 1];
+    e[n - 1] = zero;
+}
+
+static inline __attribute__((always_inline)) void charpoly_x4(const v4d *d, const v4d *e, size_t n,
+                                                              v4d x, v4d *p, v4d *p1, v4d *p2)
+{
+    v4d a = d[0] - x, a1 = {-1.0, -1.0, -1.0, -1.0}, a2 = {0.0, 0.0, 0.0, 0.0};
+    v4d b = {1.0, 1.0, 1.0, 1.0}, b1 = {0.0, 0.0, 0.0, 0.0}, b2 = {0.0, 0.0, 0.0, 0.0};
+    for (size_t k = 1; k < n; k++) {
+        const v4d t = d[k] - x, s = e[k - 1];
+        const v4d c = t * a - s * b, c1 = t * a1 - s * b1 - a, c2 = t * a2 - s * b2 - 2.0 * a1;
+        b = a, b1 = a1, b2 = a2;
+        a = c, a1 = c1, a2 = c2;
+    }
+    *p = a, *p1 = a1, *p2 = a2;
+}
+
+static inline __attribute__((always_inline)) v4d laguerre_x4(const v4d *d, const v4d *e, size_t n,
+                                                             v4d x, int hi, v4l *done, sqrt4_fn sq)
+{
+    v4d p, p1, p2;
+    charpoly_x4(d, e, n, x, &p, &p1, &p2);
+    const v4d nn = {(double)n, (double)n, (double)n, (double)n}, zero = {0.0, 0.0, 0.0, 0.0};
+    const v4d one = {1.0, 1.0, 1.0, 1.0};
+    const v4d sp = hi && (n & 1) ? -p : p;
+    const v4l live = ~*done & (v4l)(sp > zero);
+    const v4d ps = sel4(live, p, one);
+    const v4d g = p1 / ps, h = g * g - p2 / ps;
+    v4d disc = (nn - 1.0) * (nn * h - g * g);
+    disc = vsqrt4(sel4((v4l)(disc > zero), disc, zero), sq);
+    const v4d den = hi ? g + disc : g - disc;
+    const v4d xn = x - nn / sel4((v4l)(den != zero), den, one);
+    const v4l ok = live & (v4l)(den != zero) & (v4l)(hi ? xn < x : xn > x);
+    const v4d tol = {GE_TOL, GE_TOL, GE_TOL, GE_TOL};
+    *done = ~ok | (v4l)(abs4(xn - x) <= tol);
+    return sel4(ok, xn, x);
+}
+
+static inline __attribute__((always_inline)) void extremes_x4(v4d *d, v4d *e, size_t n, v4d *lmax,
+                                                              v4d *lmin, int rc[4], sqrt4_fn sq)
+{
+    v4d ub = d[0], lb = d[0], bprev = {0.0, 0.0, 0.0, 0.0};
+    for (size_t k = 0; k < n; k++) {
+        const v4d b = vsqrt4(e[k], sq);
+        const v4d hi = d[k] + (bprev + b), lo = d[k] - (bprev + b);
+        ub = sel4((v4l)(hi > ub), hi, ub);
+        lb = sel4((v4l)(lo < lb), lo, lb);
+        bprev = b;
+    }
+    v4d sc, isc;
+    for (int L = 0; L < 4; L++) {
+        int q = 0;
+        frexp(fmax(fabs(ub[L]), fabs(lb[L])), &q);
+        sc[L] = ldexp(1.0, -q);
+        isc[L] = ldexp(1.0, q);
+    }
+    for (size_t k = 0; k < n; k++) {
+        d[k] *= sc;
+        e[k] *= sc * sc;
+    }
+    v4d xh = ub * sc, xl = lb * sc;
+    v4l dh = {0, 0, 0, 0}, dl = {0, 0, 0, 0};
+    int it = 0;
+    for (; it < GE_ITERS && !(all4(dh) && all4(dl)); it++) {
+        if (!all4(dh)) xh = laguerre_x4(d, e, n, xh, 1, &dh, sq);
+        if (!all4(dl)) xl = laguerre_x4(d, e, n, xl, 0, &dl, sq);
+    }
+    *lmax = xh * isc;
+    *lmin = xl * isc;
+    for (int L = 0; L < 4; L++)
+        rc[L] = dh[L] && dl[L] && isfinite((*lmax)[L]) && isfinite((*lmin)[L]) ? 0 : -1;
+}
+
+/* The extremes of the four Gram matrices g[0..3] (cols x cols), lane by
+ * lane, into hi[L], lo[L]; rc[L] as extremes_x2's. */
+static inline __attribute__((always_inline)) void extremes_of_x4(const double *const g[4],
+                                                                 size_t cols, double hi[4],
+                                                                 double lo[4], int rc[4],
+                                                                 sqrt4_fn sq)
+{
+    v4d a[GE_MAX * GE_MAX], d[GE_MAX], e[GE_MAX], h, l;
+    for (size_t i = 0; i < cols * cols; i++) a[i] = (v4d){g[0][i], g[1][i], g[2][i], g[3][i]};
+    tridiag_x4(a, cols, d, e, sq);
+    extremes_x4(d, e, cols, &h, &l, rc, sq);
+    for (int L = 0; L < 4; L++) hi[L] = h[L], lo[L] = l[L];
+}
+
+static inline __attribute__((always_inline)) void gram_extremes_x4(const double *const g[4],
+                                                                   size_t cols, double hi[4],
+                                                                   double lo[4], int rc[4],
+                                                                   sqrt4_fn sq)
+{
+    if (cols == 6 && jf__fixed_sizes) extremes_of_x4(g, 6, hi, lo, rc, sq);
+    else if (cols == 10 && jf__fixed_sizes) extremes_of_x4(g, 10, hi, lo, rc, sq);
+    else extremes_of_x4(g, cols, hi, lo, rc, sq);
+}
+
+#if JF_AVX_PATH
+__attribute__((target("avx"), always_inline)) static inline void sqrt4_avx(v4d *x)
+{
+    *x = __builtin_ia32_sqrtpd256(*x);
+}
+JF_AVX_FN static void gram_extremes_x4_avx(const double *const g[4], size_t cols, double hi[4],
+                                           double lo[4], int rc[4])
+{
+    gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_avx);
+    JF_AVX_LEAVE();
+}
+#endif
+
+/* f[L] may repeat (a lane whose result is not wanted): its lanes compute
+ * the same values. */
+void jf__eigvals_x4(jf_fitter *const f[4], size_t cols, int ok[4])
+{
+    if (cols > GE_MAX || cols < 2) { /* once per fitter: the QL destroys f->x */
+        for (int L = 0; L < 4; L++) {
+            int l = 0;
+            while (l < L && f[l] != f[L]) l++;
+            ok[L] = l < L ? ok[l] : jf__eigvals(f[L], cols);
+        }
+        return;
+    }
+    const double *g[4] = {f[0]->x, f[1]->x, f[2]->x, f[3]->x};
+    double hi[4], lo[4];
+    int rc[4];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) gram_extremes_x4_avx(g, cols, hi, lo, rc);
+    else
+#endif
+        gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_sse);
+    for (int L = 0; L < 4; L++) {
+        put(f[L], cols, hi[L], lo[L]);
+        ok[L] = rc[L] == 0;
+    }
+}
+
 int jf__eigvals(jf_fitter *f, size_t cols)
 {
     if (cols > GE_MAX || cols < 2) return jf__sym_eigvals(f->x, cols, f->s, f->work) == 0;

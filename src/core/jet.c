@@ -251,6 +251,7 @@ static inline __attribute__((always_inline)) void design(jf_fitter *f, size_t ro
 }
 
 static int job_system(fit_job *j);
+static int job_system_ex(fit_job *j, int defer);
 
 /* h, the mean distance of the rows to the z axis (§2.3's scale), then M'
  * and B of degree d scaled by it (design); returns h, and leaves M' unmade
@@ -280,8 +281,8 @@ static double scaled_system_any(jf_fitter *f, size_t rows, int d)
 
 /* The rest of step 2 (the frame from the eigenvectors evec of j->cov;
  * out->pca_eval holds the eigenvalues), then the first system of step 3.
- * Returns as job_system. */
-static int job_frame(fit_job *j, const double evec[9])
+ * Returns as job_system_ex. */
+static int job_frame_ex(fit_job *j, const double evec[9], int defer)
 {
     jf_fitter *f = j->f;
     const size_t n = j->n;
@@ -324,14 +325,19 @@ static int job_frame(fit_job *j, const double evec[9])
         j->usable = kept;
     }
     j->d = f->p.degree;
-    return job_system(j);
+    return job_system_ex(j, defer);
 }
+
+static int job_frame(fit_job *j, const double evec[9]) { return job_frame_ex(j, evec, 0); }
 
 /* 3. adaptive degree: from degree j->d down, the first whose system can
  * be set up; its scaled M' and B, then the QR (jf__qr_gram).  Returns 1
  * (G = R^T R is in f->x for the eigenvalues), 2 (QR done, no eigenvalues
- * wanted), or 0 when no degree is left (out is final). */
-static int job_system(fit_job *j)
+ * wanted), or 0 when no degree is left (out is final); with defer, 3
+ * instead of the QR (M' and B made, j->rows set: the caller's QR). */
+static int job_system(fit_job *j) { return job_system_ex(j, 0); }
+
+static int job_system_ex(fit_job *j, int defer)
 {
     jf_fitter *f = j->f;
     jf_result *out = j->out;
@@ -351,6 +357,7 @@ static int job_system(fit_job *j)
         }
         j->rows = rows;
         j->h = h;
+        if (defer) return 3;
         return jf__qr_gram(f, rows, cols) ? 1 : 2;
     }
     fail_result(out, JF_PT_FAILED);
@@ -470,6 +477,74 @@ jf_status jf__fit_point_x2(jf_fitter *f0, const double p0[3], const double *nbr0
             jf_fitter *f = j[k].f;
             st[k] = job_solved(&j[k], job_solve(&j[k], st[k],
                                                 st[k] == 1 && jf__eigvals(f, jf_jet_size(j[k].d))));
+        }
+    return JF_OK;
+}
+
+jf_status jf__fit_point_x4(jf_fitter *const f[4], const double *const p[4],
+                           const double *const nbr[4], const size_t n[4], jf_result *const out[4])
+{
+    for (int k = 0; k < 4; k++) {
+        int clash = 0;
+        for (int l = 0; l < k; l++) clash |= f[l] == f[k];
+        if (clash || check_args(f[k], p[k], nbr[k], NULL, n[k], out[k]) != JF_OK) {
+            jf_status st = JF_OK;
+            for (int l = 0; l < 4 && st == JF_OK; l++) st = jf_fit_point(f[l], p[l], nbr[l], n[l], out[l]);
+            return st;
+        }
+    }
+    fit_job j[4];
+    int st[4], live = -1;
+    double evec[4][9];
+    for (int k = 0; k < 4; k++)
+        if ((st[k] = job_begin(&j[k], f[k], p[k], nbr[k], NULL, n[k], out[k]))) live = k;
+    if (live < 0) return JF_OK;
+    /* the four covariances side by side; a finished fit's lane computes a
+     * live one's again, into scratch (lanes do not mix) */
+    {
+        const double *a[4];
+        double *ev[4], *vec[4], spare_ev[4][3], spare_vec[4][9];
+        for (int k = 0; k < 4; k++) {
+            a[k] = st[k] ? j[k].cov : j[live].cov;
+            ev[k] = st[k] ? out[k]->pca_eval : spare_ev[k];
+            vec[k] = st[k] ? evec[k] : spare_vec[k];
+        }
+        jf__eig3_x4(a, ev, vec);
+    }
+    for (int k = 0; k < 4; k++)
+        if (st[k]) st[k] = job_frame_ex(&j[k], evec[k], 1);
+    /* the QRs: side by side when all four have the same size */
+    int same = 1;
+    for (int k = 0; k < 4; k++)
+        same &= st[k] == 3 && j[k].rows == j[0].rows && j[k].d == j[0].d;
+    if (same) {
+        const int r = jf__qr_gram_x4(f, j[0].rows, jf_jet_size(j[0].d)) ? 1 : 2;
+        for (int k = 0; k < 4; k++) st[k] = r;
+    } else
+        for (int k = 0; k < 4; k++)
+            if (st[k] == 3) st[k] = jf__qr_gram(f[k], j[k].rows, jf_jet_size(j[k].d)) ? 1 : 2;
+    /* the first systems of the same size side by side (the usual case:
+     * one degree, k-NN); the others' lanes repeat one of them, unused */
+    int first = -1;
+    for (int k = 0; k < 4 && first < 0; k++)
+        if (st[k] == 1) first = k;
+    if (first >= 0) {
+        jf_fitter *g[4];
+        int in[4], ok[4], d = j[first].d;
+        for (int k = 0; k < 4; k++) {
+            in[k] = st[k] == 1 && j[k].d == d;
+            g[k] = in[k] ? f[k] : f[first];
+        }
+        /* a repeated fitter's lane writes its eigenvalues again, the same */
+        jf__eigvals_x4(g, jf_jet_size(d), ok);
+        for (int k = 0; k < 4; k++)
+            if (in[k]) st[k] = job_solved(&j[k], job_solve(&j[k], st[k], ok[k]));
+    }
+    for (int k = 0; k < 4; k++)
+        while (st[k]) {
+            jf_fitter *fk = j[k].f;
+            st[k] = job_solved(&j[k], job_solve(&j[k], st[k],
+                                                st[k] == 1 && jf__eigvals(fk, jf_jet_size(j[k].d))));
         }
     return JF_OK;
 }

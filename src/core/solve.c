@@ -113,8 +113,8 @@ qr_norms(const double *a, size_t rows, size_t cols, int *perm, double *nrm, doub
     }
 }
 
-static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *perm,
-                           double *nrm, double *nrm0)
+static inline __attribute__((always_inline)) void
+householder_qr(double *a, double *b, size_t rows, size_t cols, int *perm, double *nrm, double *nrm0)
 {
     qr_norms(a, rows, cols, perm, nrm, nrm0);
     for (size_t k = 0; k < cols; k++) qr_step(a, b, rows, cols, k, perm, nrm, nrm0);
@@ -126,8 +126,8 @@ static void householder_qr(double *a, double *b, size_t rows, size_t cols, int *
 #define QR_PRAGMA(x) _Pragma(#x)
 #define QR_UNROLL(C) QR_PRAGMA(GCC unroll C)
 #define QR_FIXED(R, C)                                                                     \
-    static void householder_qr_##R##_##C(double *a, double *b, int *perm, double *nrm,     \
-                                         double *nrm0)                                     \
+    static inline __attribute__((always_inline)) void householder_qr_##R##_##C(            \
+        double *a, double *b, int *perm, double *nrm, double *nrm0)                        \
     {                                                                                      \
         qr_norms(a, R, C, perm, nrm, nrm0);                                                \
         QR_UNROLL(C) for (size_t k = 0; k < C; k++)                                        \
@@ -380,8 +380,9 @@ static int fast_finish(jf_fitter *f, size_t rows, size_t cols, double *cond)
 static int svd_rest(jf_fitter *f, size_t rows, size_t cols, double *cond);
 
 int jf__fixed_sizes = 1;
+int jf__no_avx = 0;
 
-int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
+static inline __attribute__((always_inline)) int qr_gram(jf_fitter *f, size_t rows, size_t cols)
 {
     /* knn:16 and knn:32 at degree 2 (6 columns) and knn:32 at degree 3 (10):
      * the same code with constant sizes, which the compiler unrolls; the
@@ -405,6 +406,78 @@ int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
 #else
     return 0;
 #endif
+}
+
+/* qr_gram in the AVX build (fitter_internal.h): dot()'s four partial
+ * sums in one register, the same bits */
+#if JF_AVX_PATH
+JF_AVX_FN static int qr_gram_avx(jf_fitter *f, size_t rows, size_t cols)
+{
+    int r = qr_gram(f, rows, cols);
+    JF_AVX_LEAVE();
+    return r;
+}
+#endif
+
+/* Four QRs of the same constant size, step k of each in turn: each
+ * fit's steps are one chain of dependent operations (norm, sqrt,
+ * division, then the reflections), and the four chains side by side keep
+ * the core busy where one left it waiting.  Each fit's operations are
+ * householder_qr's, in its order: the same bits. */
+#define QR_FIXED_X4(R, C)                                                                  \
+    static inline __attribute__((always_inline)) void householder_qr_##R##_##C##_x4(       \
+        jf_fitter *const f[4])                                                             \
+    {                                                                                      \
+        for (int L = 0; L < 4; L++)                                                        \
+            qr_norms(f[L]->m, R, C, f[L]->perm, f[L]->tmp, f[L]->work);                    \
+        QR_UNROLL(C) for (size_t k = 0; k < C; k++)                                        \
+            QR_UNROLL(1) for (int L = 0; L < 4; L++)                                       \
+                qr_step(f[L]->m, f[L]->rhs, R, C, k, f[L]->perm, f[L]->tmp, f[L]->work);   \
+        for (int L = 0; L < 4; L++) gram(f[L], R, C);                                      \
+    }
+QR_FIXED_X4(16, 6)
+QR_FIXED_X4(32, 6)
+QR_FIXED_X4(32, 10)
+
+static inline __attribute__((always_inline)) void qr_gram_x4(jf_fitter *const f[4], size_t rows,
+                                                             size_t cols)
+{
+    if (rows == 16 && cols == 6) householder_qr_16_6_x4(f);
+    else if (rows == 32 && cols == 6) householder_qr_32_6_x4(f);
+    else householder_qr_32_10_x4(f);
+}
+
+#if JF_AVX_PATH
+JF_AVX_FN static void qr_gram_x4_avx(jf_fitter *const f[4], size_t rows, size_t cols)
+{
+    qr_gram_x4(f, rows, cols);
+    JF_AVX_LEAVE();
+}
+#endif
+
+int jf__qr_gram_x4(jf_fitter *const f[4], size_t rows, size_t cols)
+{
+#if !defined(JF_GSL_SVD) && !defined(JF_SVD_GSLJ)
+    if (jf__fixed_sizes && ((rows == 16 && cols == 6) || (rows == 32 && (cols == 6 || cols == 10)))) {
+#if JF_AVX_PATH
+        if (JF_HAVE_AVX()) qr_gram_x4_avx(f, rows, cols);
+        else
+#endif
+            qr_gram_x4(f, rows, cols);
+        return 1;
+    }
+#endif
+    int r = 1;
+    for (int L = 0; L < 4; L++) r = jf__qr_gram(f[L], rows, cols);
+    return r;
+}
+
+int jf__qr_gram(jf_fitter *f, size_t rows, size_t cols)
+{
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) return qr_gram_avx(f, rows, cols);
+#endif
+    return qr_gram(f, rows, cols);
 }
 
 int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond)

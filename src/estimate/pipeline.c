@@ -351,6 +351,8 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, 
 
 typedef struct {
     jf_fitter *fit, *fit2; /* fit2: the second of a pair (jf__fit_point_x2) */
+    jf_fitter *fit3, *fit4; /* and of a quad (jf__fit_point_x4)          */
+    double *coords3, *coords4, *raw3, *raw4;
     jf_natural_ws *nws;
     uint32_t *idx;
     double *d2, *coords, *coords2;
@@ -367,6 +369,12 @@ static void worker_free(worker *w)
 {
     jf_fitter_free(w->fit);
     jf_fitter_free(w->fit2);
+    jf_fitter_free(w->fit3);
+    jf_fitter_free(w->fit4);
+    free(w->coords3);
+    free(w->coords4);
+    free(w->raw3);
+    free(w->raw4);
     jf_natural_ws_free(w->nws);
     free(w->idx);
     free(w->d2);
@@ -386,18 +394,25 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
     memset(w, 0, sizeof *w);
     jf_status st = jf_fitter_create(p, &w->fit);
     if (st == JF_OK) st = jf_fitter_create(p, &w->fit2);
+    if (st == JF_OK) st = jf_fitter_create(p, &w->fit3);
+    if (st == JF_OK) st = jf_fitter_create(p, &w->fit4);
     if (st == JF_OK && x->nt) st = jf_natural_ws_create(x->nt, &w->nws);
     if (st == JF_OK) {
         w->idx = malloc(x->cap * sizeof *w->idx);
         w->d2 = malloc(x->cap * sizeof *w->d2);
         w->coords = malloc(3 * x->cap * sizeof *w->coords);
         w->coords2 = malloc(3 * x->cap * sizeof *w->coords2);
-        if (!w->idx || !w->d2 || !w->coords || !w->coords2) st = JF_ERR_NOMEM;
+        w->coords3 = malloc(3 * x->cap * sizeof *w->coords3);
+        w->coords4 = malloc(3 * x->cap * sizeof *w->coords4);
+        if (!w->idx || !w->d2 || !w->coords || !w->coords2 || !w->coords3 || !w->coords4)
+            st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && x->fit_moved) {
         w->raw = malloc(3 * x->cap * sizeof *w->raw);
         w->raw2 = malloc(3 * x->cap * sizeof *w->raw2);
-        if (!w->raw || !w->raw2) st = JF_ERR_NOMEM;
+        w->raw3 = malloc(3 * x->cap * sizeof *w->raw3);
+        w->raw4 = malloc(3 * x->cap * sizeof *w->raw4);
+        if (!w->raw || !w->raw2 || !w->raw3 || !w->raw4) st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && blocks) {
         w->blk = malloc(CHUNK * sizeof *w->blk);
@@ -447,7 +462,10 @@ static void store_row(jf_result *out, const jf_result *r)
 
 static double *raw_of(const worker *w, const double *coords)
 {
-    return coords == w->coords ? w->raw : w->raw2;
+    return coords == w->coords    ? w->raw
+           : coords == w->coords2 ? w->raw2
+           : coords == w->coords3 ? w->raw3
+                                  : w->raw4;
 }
 
 /* fit_moved: the residual of the raw ring about the jet fitted to the
@@ -544,6 +562,40 @@ static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0,
     if (fit1) r1.status |= fl1;
     store_row(out0, &r0);
     store_row(out1, &r1);
+    return JF_OK;
+}
+
+/* Points i[0..3] (consecutive in the walk): four plain fits side by side
+ * in one jf__fit_point_x4 (its 4-lane eigen-solvers), the same bits. */
+static jf_status fit_four(worker *w, const nbctx *x, const size_t i[4], const double *const p[4],
+                          jf_result *const out[4])
+{
+    jf_result r[4];
+    size_t n[4] = {0, 0, 0, 0};
+    unsigned fl[4] = {0, 0, 0, 0};
+    int fit[4] = {0, 0, 0, 0};
+    double *const co[4] = {w->coords, w->coords2, w->coords3, w->coords4};
+    jf_fitter *const f[4] = {w->fit, w->fit2, w->fit3, w->fit4};
+    jf_status st = JF_OK;
+    for (int k = 0; k < 4 && st == JF_OK; k++)
+        st = prepare(w, x, i[k], p[k], co[k], &r[k], &n[k], &fl[k], &fit[k]);
+    if (st != JF_OK) return st;
+    if (fit[0] && fit[1] && fit[2] && fit[3]) {
+        const double *const cc[4] = {co[0], co[1], co[2], co[3]};
+        jf_result *const rr[4] = {&r[0], &r[1], &r[2], &r[3]};
+        st = jf__fit_point_x4(f, p, cc, n, rr);
+        for (int k = 0; k < 4; k++) raw_residual(w, x, f[k], co[k], n[k], &r[k]);
+    } else
+        for (int k = 0; k < 4 && st == JF_OK; k++)
+            if (fit[k]) {
+                st = jf_fit_point_full(w->fit, p[k], co[k], n[k], &r[k]);
+                raw_residual(w, x, w->fit, co[k], n[k], &r[k]);
+            }
+    if (st != JF_OK) return st;
+    for (int k = 0; k < 4; k++) {
+        if (fit[k]) r[k].status |= fl[k];
+        store_row(out[k], &r[k]);
+    }
     return JF_OK;
 }
 
@@ -650,8 +702,9 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
             size_t m = 0; /* block modes: results in w.blk */
             for (size_t k = beg; k < end && wst == JF_OK;) {
                 const size_t i = walk[k];
-                if (x->nt && k + PREFETCH + 1 < nwalk) /* k steps by 2 for pairs */
-                    prefetch_natural(x, walk[k + PREFETCH]), prefetch_natural(x, walk[k + PREFETCH + 1]);
+                if (x->nt) /* k steps by up to 4 (quads) */
+                    for (size_t q = k + PREFETCH; q < k + PREFETCH + 4 && q < nwalk; q++)
+                        prefetch_natural(x, walk[q]);
                 const double *pt = walk_xyz ? walk_xyz + 3 * k : R->c->xyz + 3 * i;
                 if (fit && !fit[i]) { /* a halo point: a neighbour only */
                     if (!blocks) nan_result(&R->out[i], JF_PT_NONFINITE);
@@ -660,7 +713,20 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                 }
                 if (blocks) w.bidx[m] = (uint32_t)i, memcpy(w.bxyz + 3 * m, pt, 3 * sizeof *pt);
                 jf_result *d0 = blocks ? &w.blk[m++] : &R->out[i];
-                if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
+                if (x->plain && k + 3 < end &&
+                    (!fit || (fit[walk[k + 1]] && fit[walk[k + 2]] && fit[walk[k + 3]]))) {
+                    size_t iq[4] = {i};
+                    const double *pq[4] = {pt};
+                    jf_result *oq[4] = {d0};
+                    for (int q = 1; q < 4; q++) {
+                        iq[q] = walk[k + q];
+                        pq[q] = walk_xyz ? walk_xyz + 3 * (k + q) : R->c->xyz + 3 * iq[q];
+                        if (blocks) w.bidx[m] = (uint32_t)iq[q], memcpy(w.bxyz + 3 * m, pq[q], 3 * sizeof *pt);
+                        oq[q] = blocks ? &w.blk[m++] : &R->out[iq[q]];
+                    }
+                    wst = fit_four(&w, x, iq, pq, oq);
+                    k += 4;
+                } else if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
                     const size_t i1 = walk[k + 1];
                     const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : R->c->xyz + 3 * i1;
                     if (blocks) w.bidx[m] = (uint32_t)i1, memcpy(w.bxyz + 3 * m, pt1, 3 * sizeof *pt1);

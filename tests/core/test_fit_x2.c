@@ -1,5 +1,6 @@
-/* test_fit_x2.c -- two fits side by side (jf__fit_point_x2, the SIMD
- * lanes of jf__eig3_x2 and the fast path's QL) give the bits of the
+/* test_fit_x2.c -- two or four fits side by side (jf__fit_point_x2 and
+ * _x4, the SIMD lanes of jf__eig3_x2/_x4 and of the Gram extremes; the
+ * AVX and the default builds of the kernels) give the bits of the
  * one-at-a-time path, and jf_estimate on the k-NN path (pairs, streamed
  * rows) gives the bits of the plain per-point loop this test keeps:
  * jf_index_knn then jf_fit_point, point by point; and jf__ldexp is
@@ -105,6 +106,103 @@ START_TEST(test_eig3_x2_bits)
                           "eig3 lane %d differs at %d", k, t);
         }
     }
+}
+END_TEST
+
+/* jf__eig3_x4's four lanes (each its own kind of matrix, or repeats of
+ * one) against jf__eig3, in the AVX build and in the default one. */
+START_TEST(test_eig3_x4_bits)
+{
+    rng_state = 16;
+    for (int avx = 0; avx < 2; avx++) {
+        jf__no_avx = !avx;
+        for (int t = 0; t < 10000; t++) {
+            double a[4][9], ev[4][3], vec[4][9], ev1[3], vec1[9];
+            for (int k = 0; k < 4; k++) {
+                int kind = (t + k * (t / 5 + 1)) % 5;
+                for (int i = 0; i < 3; i++)
+                    for (int j = i; j < 3; j++) {
+                        double v = 2 * urand() - 1;
+                        if (kind == 1 && i != j) v = 0;
+                        if (kind == 2) v = i == j ? 1.0 : (j == 2 ? 1e-9 * v : 0);
+                        if (kind == 3) v = 0;
+                        if (kind == 4 && i != j) v *= 1e-13;
+                        a[k][3 * i + j] = a[k][3 * j + i] = v;
+                    }
+            }
+            const double *in[4] = {a[0], a[1], a[2], a[t % 7 == 0 ? 0 : 3]};
+            double *const e[4] = {ev[0], ev[1], ev[2], ev[3]}, *const v[4] = {vec[0], vec[1], vec[2], vec[3]};
+            jf__eig3_x4(in, e, v);
+            for (int k = 0; k < 4; k++) {
+                jf__eig3(in[k], ev1, vec1);
+                ck_assert_msg(same_bits(ev[k], ev1, 3) && same_bits(vec[k], vec1, 9),
+                              "eig3_x4 lane %d differs at %d (avx %d)", k, t, avx);
+            }
+        }
+    }
+    jf__no_avx = 0;
+}
+END_TEST
+
+/* jf__fit_point_x4 against four jf_fit_point calls on another fitter:
+ * lanes of mixed kinds (some finished early, some lowered, some on the
+ * SVD path), degrees 1..4, both fits and frames, AVX and default builds. */
+START_TEST(test_fit_x4_bits)
+{
+    rng_state = 4004;
+    static const jf_fit_mode fits[2] = {JF_FIT_APPROX, JF_FIT_INTERP};
+    static const jf_frame_mode frames[2] = {JF_FRAME_PCA, JF_FRAME_AXIS};
+    size_t quads = 0, all_fast = 0;
+    for (int deg = 1; deg <= 4; deg++)
+        for (int fm = 0; fm < 2; fm++)
+            for (int fr = 0; fr < 2; fr++) {
+                jf_params p;
+                jf_params_init(&p);
+                p.degree = deg;
+                p.monge_degree = deg < 2 ? 2 : (deg < 4 ? deg : 4);
+                p.fit = fits[fm];
+                p.frame = frames[fr];
+                p.max_neighbors = MAXN;
+                jf_fitter *f[4], *s0;
+                for (int k = 0; k < 4; k++) ck_assert_int_eq(jf_fitter_create(&p, &f[k]), JF_OK);
+                ck_assert_int_eq(jf_fitter_create(&p, &s0), JF_OK);
+                for (int t = 0; t < 200; t++) {
+                    jf__no_avx = t % 2;
+                    double nb[4][3 * MAXN], res[MAXN], ref_res[MAXN];
+                    size_t n[4];
+                    int kind[4];
+                    for (int k = 0; k < 4; k++) {
+                        kind[k] = (t / 4 + k * (t % 4 + 1)) % 9;
+                        if (t % 3) kind[k] = t % 2 ? 0 : 1; /* mostly the usual case */
+                        n[k] = make_nbhd(kind[k], nb[k]);
+                    }
+                    jf_result r[4], ref;
+                    const double *pp[4] = {nb[0], nb[1], nb[2], nb[3]};
+                    jf_result *const rr[4] = {&r[0], &r[1], &r[2], &r[3]};
+                    ck_assert_int_eq(jf__fit_point_x4(f, pp, pp, n, rr), JF_OK);
+                    jf__no_avx = 0;
+                    int fast = 1;
+                    for (int k = 0; k < 4; k++) {
+                        ck_assert_int_eq(jf_fit_point(s0, nb[k], nb[k], n[k], &ref), JF_OK);
+                        ck_assert_msg(same_result(&r[k], &ref),
+                                      "deg %d fit %d frame %d case %d lane %d (kind %d): "
+                                      "k1 %.17g vs %.17g, cond %.17g vs %.17g",
+                                      deg, fm, fr, t, k, kind[k], r[k].k1, ref.k1, r[k].cond,
+                                      ref.cond);
+                        ck_assert_int_eq(jf_fitter_residuals(f[k], res, n[k]), JF_OK);
+                        ck_assert_int_eq(jf_fitter_residuals(s0, ref_res, n[k]), JF_OK);
+                        ck_assert(same_bits(res, ref_res, n[k]));
+                        fast &= r[k].degree == deg && r[k].cond <= 1e3;
+                    }
+                    quads++;
+                    all_fast += fast;
+                }
+                for (int k = 0; k < 4; k++) jf_fitter_free(f[k]);
+                jf_fitter_free(s0);
+            }
+    jf__no_avx = 0;
+    ck_assert_uint_gt(all_fast, quads / 3);
+    ck_assert_uint_lt(all_fast, quads);
 }
 END_TEST
 
@@ -277,8 +375,9 @@ static void estimate_vs_loop(size_t k, int degree)
     ck_assert_int_eq(jf_index_build(xyz, n, &ix), JF_OK);
     jf_fitter *f;
     ck_assert_int_eq(jf_fitter_create(&o.params, &f), JF_OK);
-    for (int threads = 1; threads <= 2; threads++) {
-        o.threads = threads;
+    for (int threads = 1; threads <= 3; threads++) {
+        o.threads = threads < 3 ? threads : 1;
+        jf__no_avx = threads == 3; /* the default (SSE2) kernels too */
         jf_error err;
         ck_assert_int_eq(jf_estimate(&c, &o, out, &err), JF_OK);
         for (size_t i = 0; i < n; i++) {
@@ -294,6 +393,7 @@ static void estimate_vs_loop(size_t k, int degree)
                           k, degree, threads, i);
         }
     }
+    jf__no_avx = 0;
     jf_fitter_free(f);
     jf_index_free(ix);
     free(out);
@@ -315,6 +415,8 @@ int main(void)
     tcase_add_test(tc, test_ldexp_bits);
     tcase_add_test(tc, test_eig3_x2_bits);
     tcase_add_test(tc, test_fit_x2_bits);
+    tcase_add_test(tc, test_eig3_x4_bits);
+    tcase_add_test(tc, test_fit_x4_bits);
     tcase_add_test(tc, test_fixed_sizes_bits);
     tcase_add_test(tc, test_estimate_vs_loop);
     suite_add_tcase(s, tc);
