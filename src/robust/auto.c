@@ -280,13 +280,15 @@ typedef struct {
 
 static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
-/* Adds neighbours q[0..3] (NULL: none) to A: their frame coordinates x,
- * y (units of H: scaled by iH), z; x^i y^j for i + j <= top, x^i y^j z for
- * i + j <= deg, z^2, the count, the largest x^2 + y^2 and (rs) the sum of
- * sqrt(x^2 + y^2).  A non-finite neighbour weighs 0. */
-static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
-                                                           const double p[3], const double fr[9],
-                                                           double iH, int top, int deg, int rs)
+/* One quad of neighbours q[0..3] (NULL: none) in the frame: x, y (units
+ * of H: scaled by iH), z, and w = 1 (0: none or not finite). */
+typedef struct {
+    v4d x, y, z, w;
+} quad4;
+
+static inline __attribute__((always_inline)) void quad_load(quad4 *Q, const double *const q[4],
+                                                            const double p[3], const double fr[9],
+                                                            double iH)
 {
     const v4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
     v4d v0, v1, v2;
@@ -314,29 +316,78 @@ static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double
     v4d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
     /* finite: t - t == 0 (NaN for an infinity or a NaN) */
     v4l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero) & live;
-    x = (v4d)((v4l)x & ok);
-    y = (v4d)((v4l)y & ok);
-    z = (v4d)((v4l)z & ok);
-    v4d w = (v4d)((v4l)one & ok), xp[7], yp[7];
-    xp[0] = w;
-    yp[0] = one;
-    for (int e = 1; e <= top; e++) {
-        xp[e] = xp[e - 1] * x;
-        yp[e] = yp[e - 1] * y;
+    Q->x = (v4d)((v4l)x & ok);
+    Q->y = (v4d)((v4l)y & ok);
+    Q->z = (v4d)((v4l)z & ok);
+    Q->w = (v4d)((v4l)one & ok);
+}
+
+/* Adds nq (1 or 2) quads Q[0..nq) to A, in that order: x^i y^j for
+ * i + j <= top, x^i y^j z for i + j <= deg, z^2, the count, the largest
+ * x^2 + y^2 and (rs) the sum of sqrt(x^2 + y^2).  Two quads add to each
+ * sum one after the other in a register, (A + a) + b, the bits of two
+ * calls with one quad, with half the loads and stores of the ~40 sums
+ * (which do not fit in registers: the stores bounded the loop). */
+static inline __attribute__((always_inline)) void acc_quads(acc4 *A, const quad4 *Q, int nq, int top,
+                                                            int deg, int rs)
+{
+    const v4d one = {1.0, 1.0, 1.0, 1.0};
+    v4d xp[2][7], yp[2][7];
+    for (int u = 0; u < nq; u++) {
+        xp[u][0] = Q[u].w;
+        yp[u][0] = one;
+        for (int e = 1; e <= top; e++) {
+            xp[u][e] = xp[u][e - 1] * Q[u].x;
+            yp[u][e] = yp[u][e - 1] * Q[u].y;
+        }
     }
     int at = 0; /* PIDX order: degree t, then j = 0..t */
     for (int t = 0; t <= top; t++)
-        for (int j = 0; j <= t; j++) A->S[at++] += xp[t - j] * yp[j];
+        for (int j = 0; j <= t; j++, at++) {
+            v4d a = A->S[at];
+            for (int u = 0; u < nq; u++) a += xp[u][t - j] * yp[u][j];
+            A->S[at] = a;
+        }
     at = 0;
     for (int t = 0; t <= deg; t++)
-        for (int j = 0; j <= t; j++) A->T[at++] += xp[t - j] * yp[j] * z;
-    A->zz += w * z * z;
-    A->m += w;
-    v4d r2 = x * x + y * y;
-    v4l gt = (v4l)(r2 > A->rmax2);
-    A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
-    if (rs)
-        for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+        for (int j = 0; j <= t; j++, at++) {
+            v4d a = A->T[at];
+            for (int u = 0; u < nq; u++) a += xp[u][t - j] * yp[u][j] * Q[u].z;
+            A->T[at] = a;
+        }
+    for (int u = 0; u < nq; u++) {
+        const v4d x = Q[u].x, y = Q[u].y, z = Q[u].z;
+        A->zz += Q[u].w * z * z;
+        A->m += Q[u].w;
+        v4d r2 = x * x + y * y;
+        v4l gt = (v4l)(r2 > A->rmax2);
+        A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
+        if (rs)
+            for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+    }
+}
+
+/* Adds neighbours q[0..3] (NULL: none) to A (acc_quads). */
+static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
+                                                           const double p[3], const double fr[9],
+                                                           double iH, int top, int deg, int rs)
+{
+    quad4 Q;
+    quad_load(&Q, q, p, fr, iH);
+    acc_quads(A, &Q, 1, top, deg, rs);
+}
+
+/* Adds the eight neighbours nbr[i..i + 8) to A, as two acc_quad calls. */
+static inline __attribute__((always_inline)) void acc_eight(acc4 *A, const double *nbr, size_t i,
+                                                            const double p[3], const double fr[9],
+                                                            double iH, int top, int deg, int rs)
+{
+    quad4 Q[2];
+    const double *q0[4] = {nbr + 3 * i, nbr + 3 * i + 3, nbr + 3 * i + 6, nbr + 3 * i + 9};
+    const double *q1[4] = {nbr + 3 * i + 12, nbr + 3 * i + 15, nbr + 3 * i + 18, nbr + 3 * i + 21};
+    quad_load(&Q[0], q0, p, fr, iH);
+    quad_load(&Q[1], q1, p, fr, iH);
+    acc_quads(A, Q, 2, top, deg, rs);
 }
 
 /* The four neighbours from i (NULL past k). */
@@ -356,10 +407,14 @@ JF_CLONES static void moments(const double p[3], const double *nbr, size_t k, co
     acc4 A;
     memset(&A, 0, sizeof A);
     const double *q[4];
-    if (deg == 2)
-        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
-    else
-        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    size_t i = 0;
+    if (deg == 2) {
+        for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, 4, 2, 1);
+        for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
+    } else {
+        for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, top, deg, 1);
+        for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    }
     for (int j = 0; j < ntop; j++) mo->S[j] = sum4(A.S[j]);
     for (int j = 0; j < nt; j++) mo->T[j] = sum4(A.T[j]);
     mo->zz = sum4(A.zz);
@@ -379,10 +434,16 @@ JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nm
     memset(&A, 0, sizeof A);
     const double *q[4];
     int c = 0;
-    for (size_t i = 0; i < nmax && c < nc; i += 4) {
-        quad_of(nbr, i, nmax, q);
-        acc_quad(&A, q, p, fr, iH, 6, 3, 0);
-        if ((i + 4 < nmax ? i + 4 : nmax) < ks[c]) continue;
+    for (size_t i = 0; i < nmax && c < nc;) {
+        if (i + 8 <= nmax && ks[c] > i + 4) { /* no sums are read between the two quads */
+            acc_eight(&A, nbr, i, p, fr, iH, 6, 3, 0);
+            i += 8;
+        } else {
+            quad_of(nbr, i, nmax, q);
+            acc_quad(&A, q, p, fr, iH, 6, 3, 0);
+            i += 4;
+        }
+        if ((i < nmax ? i : nmax) < ks[c]) continue;
         mom *mc = &mo[c];
         mc->zz = sum4(A.zz);
         for (int j = 0; j < NPOW; j++) mc->S[j] = sum4(A.S[j]);
