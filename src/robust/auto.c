@@ -175,74 +175,107 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
     if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
 }
 
-/* solve_k for two candidates a and b at once, one in each SIMD lane
- * (the Cholesky's square roots and divisions are a chain of dependent
- * latencies: two chains side by side), the same operations per lane, so
- * the same bits; when the lanes would part (a different size, a singular
- * block) each runs solve_k on its own. */
-static void solve_k2(const mom *ma, const mom *mb, double H, double ha, double hb, const double fr[9],
-                     cand_fit oa[2], cand_fit ob[2])
+/* solve_k for every candidate at once: candidate l in lane l % 2 of pair
+ * l / 2, the pairs' chains of dependent square roots and divisions (the
+ * Cholesky's) side by side, each lane with solve_k's operations, so its
+ * bits.  A lane that would leave the common path (fewer than NMON + 4
+ * points, a singular block: solve_k lowers the degree) runs solve_k on
+ * its own; a candidate with no radius (hk <= 0) is left out (ok = 0). */
+#define NPAIR ((NCAND + 1) / 2)
+static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
+                      cand_fit cf[2][NCAND])
 {
-    const int nd = ma->m >= NMON + 4 ? NMON : 0;
-    if (!nd || !(mb->m >= NMON + 4)) {
-        solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
-        solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
-        return;
+    v2d L[NMON * NMON][NPAIR], y[NMON][NPAIR], u[2][NMON][NPAIR], idg[NMON][NPAIR], D[NMON][NPAIR];
+    v2d zz[NPAIR], floor[NPAIR], sv[NPAIR];
+    int use[2 * NPAIR], any = 0;
+    v2l bad[NPAIR];
+    const v2d one = {1.0, 1.0}, zero = {0.0, 0.0};
+    for (int l = 0; l < 2 * NPAIR; l++) {
+        use[l] = l < nc && hk[l] > 0.0 && mo[l].m >= NMON + 4;
+        any |= use[l];
     }
-    v2d D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
-    const v2d sv = {H / ha, H / hb}, one = {1.0, 1.0};
-    const v2d sp[4] = {one, sv, sv * sv, sv * sv * sv};
-    for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
-    for (int i = 0; i < nd; i++)
-        for (int j = 0; j <= i; j++)
-            L[i * NMON + j] = (v2d){ma->S[gpos[i][j]], mb->S[gpos[i][j]]} * D[i] * D[j];
-    const v2d floor = (v2d){ma->S[0], mb->S[0]} * 1e-12;
-    for (int j = 0; j < nd; j++) {
-        v2d sum = L[j * NMON + j];
-        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
-        v2l pos = (v2l)(sum > floor);
-        if (!pos[0] || !pos[1]) { /* a lane leaves the common path */
-            solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
-            solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
-            return;
+    if (any) {
+        /* a lane not used holds a used one's numbers (no NaN, no denormal) */
+        int src[2 * NPAIR], first = 0;
+        while (!use[first]) first++;
+        for (int l = 0; l < 2 * NPAIR; l++) src[l] = use[l] ? l : first;
+        const mom *ma[NPAIR], *mb[NPAIR];
+        for (int g = 0; g < NPAIR; g++) {
+            ma[g] = &mo[src[2 * g]];
+            mb[g] = &mo[src[2 * g + 1]];
+            sv[g] = (v2d){H / hk[src[2 * g]], H / hk[src[2 * g + 1]]};
+            zz[g] = (v2d){ma[g]->zz, mb[g]->zz};
+            floor[g] = (v2d){ma[g]->S[0], mb[g]->S[0]} * 1e-12;
+            bad[g] = (v2l){0, 0};
         }
-        L[j * NMON + j] = (v2d)_mm_sqrt_pd((__m128d)sum);
-        v2d inv = idg[j] = one / L[j * NMON + j];
-        for (int i = j + 1; i < nd; i++) {
-            v2d t = L[i * NMON + j];
-            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
-            L[i * NMON + j] = t * inv;
+        for (int j = 0; j < NMON; j++)
+            for (int g = 0; g < NPAIR; g++) {
+                const v2d s = sv[g];
+                D[j][g] = mdeg[j] == 0 ? one : mdeg[j] == 1 ? s : mdeg[j] == 2 ? s * s : s * s * s;
+            }
+        for (int i = 0; i < NMON; i++)
+            for (int j = 0; j <= i; j++)
+                for (int g = 0; g < NPAIR; g++)
+                    L[i * NMON + j][g] = (v2d){ma[g]->S[gpos[i][j]], mb[g]->S[gpos[i][j]]} * D[i][g] * D[j][g];
+        for (int j = 0; j < NMON; j++) {
+            for (int g = 0; g < NPAIR; g++) {
+                v2d sum = L[j * NMON + j][g];
+                for (int k = 0; k < j; k++) sum -= L[j * NMON + k][g] * L[j * NMON + k][g];
+                bad[g] |= ~(v2l)(sum > floor[g]); /* the lane's result is not used */
+                L[j * NMON + j][g] = (v2d)_mm_sqrt_pd((__m128d)sum);
+                idg[j][g] = one / L[j * NMON + j][g];
+            }
+            for (int i = j + 1; i < NMON; i++)
+                for (int g = 0; g < NPAIR; g++) {
+                    v2d t = L[i * NMON + j][g];
+                    for (int k = 0; k < j; k++) t -= L[i * NMON + k][g] * L[j * NMON + k][g];
+                    L[i * NMON + j][g] = t * idg[j][g];
+                }
+        }
+        for (int i = 0; i < NMON; i++) /* L y = D M^T z */
+            for (int g = 0; g < NPAIR; g++) {
+                v2d t = (v2d){ma[g]->T[PIDX(mex[i], mey[i])], mb[g]->T[PIDX(mex[i], mey[i])]} * D[i][g];
+                for (int k = 0; k < i; k++) t -= L[i * NMON + k][g] * y[k][g];
+                y[i][g] = t * idg[i][g];
+            }
+        for (int c = 1; c <= 2; c++) /* L u = e_c */
+            for (int g = 0; g < NPAIR; g++) {
+                u[c - 1][0][g] = zero;
+                if (c == 2) u[c - 1][1][g] = zero;
+                for (int i = c; i < NMON; i++) {
+                    v2d t = i == c ? one : zero;
+                    for (int k = c; k < i; k++) t -= L[i * NMON + k][g] * u[c - 1][k][g];
+                    u[c - 1][i][g] = t * idg[i][g];
+                }
+            }
+        for (int g = 0; g < NPAIR; g++) {
+            v2d a1 = zero, a2 = zero, var = zero, rss = zz[g];
+            for (int i = 0; i < NMON; i++) {
+                a1 += u[0][i][g] * y[i][g];
+                a2 += u[1][i][g] * y[i][g];
+                var += u[0][i][g] * u[0][i][g] + u[1][i][g] * u[1][i][g];
+                rss -= y[i][g] * y[i][g];
+                if (i == 5)
+                    for (int e = 0; e < 2; e++) {
+                        const int l = 2 * g + e;
+                        if (use[l] && !bad[g][e])
+                            put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, 6, hk[l], fr, &cf[0][l]);
+                    }
+            }
+            for (int e = 0; e < 2; e++) {
+                const int l = 2 * g + e;
+                if (use[l] && !bad[g][e])
+                    put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, NMON, hk[l], fr, &cf[1][l]);
+            }
         }
     }
-    for (int i = 0; i < nd; i++) { /* L y = D M^T z */
-        v2d t = (v2d){ma->T[PIDX(mex[i], mey[i])], mb->T[PIDX(mex[i], mey[i])]} * D[i];
-        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
-        y[i] = t * idg[i];
-    }
-    const v2d zero = {0.0, 0.0};
-    for (int c = 1; c <= 2; c++) { /* L u = e_c */
-        v2d *z = u[c - 1];
-        z[0] = zero;
-        if (c == 2) z[1] = zero;
-        for (int i = c; i < nd; i++) {
-            v2d t = i == c ? one : zero;
-            for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
-            z[i] = t * idg[i];
+    for (int l = 0; l < nc; l++)
+        if (hk[l] > 0.0 && (!use[l] || bad[l / 2][l % 2])) {
+            cand_fit two[2] = {{0}, {0}};
+            solve_k(mo[l].S, mo[l].T, mo[l].zz, mo[l].m, H, hk[l], fr, two);
+            cf[0][l] = two[0];
+            cf[1][l] = two[1];
         }
-    }
-    v2d a1 = zero, a2 = zero, var = zero, rss = {ma->zz, mb->zz};
-    for (int i = 0; i < nd; i++) {
-        a1 += u[0][i] * y[i];
-        a2 += u[1][i] * y[i];
-        var += u[0][i] * u[0][i] + u[1][i] * u[1][i];
-        rss -= y[i] * y[i];
-        if (i == 5) {
-            put_fit(a1[0], a2[0], var[0], rss[0], ma->m, 6, ha, fr, &oa[0]);
-            put_fit(a1[1], a2[1], var[1], rss[1], mb->m, 6, hb, fr, &ob[0]);
-        }
-    }
-    put_fit(a1[0], a2[0], var[0], rss[0], ma->m, NMON, ha, fr, &oa[1]);
-    put_fit(a1[1], a2[1], var[1], rss[1], mb->m, NMON, hb, fr, &ob[1]);
 }
 
 static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
@@ -636,18 +669,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     mom mo[NCAND];
     double hks[NCAND];
     first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
-    for (int c = 0; c < nc; c++) {
-        cand_fit two[2] = {{0}, {0}}, nxt[2] = {{0}, {0}};
-        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) { /* two at once */
-            solve_k2(&mo[c], &mo[c + 1], H, hks[c], hks[c + 1], fr, two, nxt);
-            cf[0][c + 1] = nxt[0];
-            cf[1][c + 1] = nxt[1];
-        } else if (hks[c] > 0.0)
-            solve_k(mo[c].S, mo[c].T, mo[c].zz, mo[c].m, H, hks[c], fr, two);
-        cf[0][c] = two[0];
-        cf[1][c] = two[1];
-        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) c++;
-    }
+    solve_all(mo, hks, nc, H, fr, cf);
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
     double s2 = NAN;
