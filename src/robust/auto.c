@@ -45,6 +45,13 @@
 #define NMON 10        /* monomials of a cubic                         */
 typedef double v2d __attribute__((vector_size(16)));
 typedef long long v2l __attribute__((vector_size(16)));
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
+#define JF_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define JF_CLONES
+#endif
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND JF_AUTO_NCAND
@@ -175,102 +182,117 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
     if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
 }
 
-/* solve_k for every candidate at once: candidate l in lane l % 2 of pair
- * l / 2, the pairs' chains of dependent square roots and divisions (the
+/* solve_k for every candidate at once: candidate l in lane l % 4 of quad
+ * l / 4 (AVX: one register a quad, no FMA; default: two SSE2 registers),
+ * the quads' chains of dependent square roots and divisions (the
  * Cholesky's) side by side, each lane with solve_k's operations, so its
  * bits.  A lane that would leave the common path (fewer than NMON + 4
  * points, a singular block: solve_k lowers the degree) runs solve_k on
  * its own; a candidate with no radius (hk <= 0) is left out (ok = 0). */
-#define NPAIR ((NCAND + 1) / 2)
-static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
-                      cand_fit cf[2][NCAND])
+#define NQUAD ((NCAND + 3) / 4)
+/* *r = sqrt(x) lane by lane, IEEE: correctly rounded (by pointer: a v4d
+ * return value's ABI differs with and without AVX) */
+static inline __attribute__((always_inline)) void sqrt4(v4d *r, const v4d *x)
 {
-    v2d L[NMON * NMON][NPAIR], y[NMON][NPAIR], u[2][NMON][NPAIR], idg[NMON][NPAIR], D[NMON][NPAIR];
-    v2d zz[NPAIR], floor[NPAIR], sv[NPAIR];
-    int use[2 * NPAIR], any = 0;
-    v2l bad[NPAIR];
-    const v2d one = {1.0, 1.0}, zero = {0.0, 0.0};
-    for (int l = 0; l < 2 * NPAIR; l++) {
+    const __m128d lo = _mm_sqrt_pd((__m128d){(*x)[0], (*x)[1]}), hi = _mm_sqrt_pd((__m128d){(*x)[2], (*x)[3]});
+    *r = (v4d){lo[0], lo[1], hi[0], hi[1]};
+}
+
+JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
+                                cand_fit cf[2][NCAND])
+{
+    v4d L[NMON * NMON][NQUAD], y[NMON][NQUAD], u[2][NMON][NQUAD], idg[NMON][NQUAD], D[NMON][NQUAD];
+    v4d zz[NQUAD], floor[NQUAD], sv[NQUAD];
+    int use[4 * NQUAD], any = 0;
+    v4l bad[NQUAD];
+    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    for (int l = 0; l < 4 * NQUAD; l++) {
         use[l] = l < nc && hk[l] > 0.0 && mo[l].m >= NMON + 4;
         any |= use[l];
     }
     if (any) {
         /* a lane not used holds a used one's numbers (no NaN, no denormal) */
-        int src[2 * NPAIR], first = 0;
+        int src[4 * NQUAD], first = 0;
         while (!use[first]) first++;
-        for (int l = 0; l < 2 * NPAIR; l++) src[l] = use[l] ? l : first;
-        const mom *ma[NPAIR], *mb[NPAIR];
-        for (int g = 0; g < NPAIR; g++) {
-            ma[g] = &mo[src[2 * g]];
-            mb[g] = &mo[src[2 * g + 1]];
-            sv[g] = (v2d){H / hk[src[2 * g]], H / hk[src[2 * g + 1]]};
-            zz[g] = (v2d){ma[g]->zz, mb[g]->zz};
-            floor[g] = (v2d){ma[g]->S[0], mb[g]->S[0]} * 1e-12;
-            bad[g] = (v2l){0, 0};
+        for (int l = 0; l < 4 * NQUAD; l++) src[l] = use[l] ? l : first;
+        const mom *ml[NQUAD][4];
+        for (int g = 0; g < NQUAD; g++) {
+            for (int e = 0; e < 4; e++) {
+                ml[g][e] = &mo[src[4 * g + e]];
+                sv[g][e] = H / hk[src[4 * g + e]];
+                zz[g][e] = ml[g][e]->zz;
+                floor[g][e] = ml[g][e]->S[0];
+            }
+            floor[g] *= 1e-12;
+            bad[g] = (v4l){0, 0, 0, 0};
         }
         for (int j = 0; j < NMON; j++)
-            for (int g = 0; g < NPAIR; g++) {
-                const v2d s = sv[g];
+            for (int g = 0; g < NQUAD; g++) {
+                const v4d s = sv[g];
                 D[j][g] = mdeg[j] == 0 ? one : mdeg[j] == 1 ? s : mdeg[j] == 2 ? s * s : s * s * s;
             }
         for (int i = 0; i < NMON; i++)
             for (int j = 0; j <= i; j++)
-                for (int g = 0; g < NPAIR; g++)
-                    L[i * NMON + j][g] = (v2d){ma[g]->S[gpos[i][j]], mb[g]->S[gpos[i][j]]} * D[i][g] * D[j][g];
+                for (int g = 0; g < NQUAD; g++) {
+                    const int at = gpos[i][j];
+                    const v4d S = {ml[g][0]->S[at], ml[g][1]->S[at], ml[g][2]->S[at], ml[g][3]->S[at]};
+                    L[i * NMON + j][g] = S * D[i][g] * D[j][g];
+                }
         for (int j = 0; j < NMON; j++) {
-            for (int g = 0; g < NPAIR; g++) {
-                v2d sum = L[j * NMON + j][g];
+            for (int g = 0; g < NQUAD; g++) {
+                v4d sum = L[j * NMON + j][g];
                 for (int k = 0; k < j; k++) sum -= L[j * NMON + k][g] * L[j * NMON + k][g];
-                bad[g] |= ~(v2l)(sum > floor[g]); /* the lane's result is not used */
-                L[j * NMON + j][g] = (v2d)_mm_sqrt_pd((__m128d)sum);
+                bad[g] |= ~(v4l)(sum > floor[g]); /* the lane's result is not used */
+                sqrt4(&L[j * NMON + j][g], &sum);
                 idg[j][g] = one / L[j * NMON + j][g];
             }
             for (int i = j + 1; i < NMON; i++)
-                for (int g = 0; g < NPAIR; g++) {
-                    v2d t = L[i * NMON + j][g];
+                for (int g = 0; g < NQUAD; g++) {
+                    v4d t = L[i * NMON + j][g];
                     for (int k = 0; k < j; k++) t -= L[i * NMON + k][g] * L[j * NMON + k][g];
                     L[i * NMON + j][g] = t * idg[j][g];
                 }
         }
         for (int i = 0; i < NMON; i++) /* L y = D M^T z */
-            for (int g = 0; g < NPAIR; g++) {
-                v2d t = (v2d){ma[g]->T[PIDX(mex[i], mey[i])], mb[g]->T[PIDX(mex[i], mey[i])]} * D[i][g];
+            for (int g = 0; g < NQUAD; g++) {
+                const int at = PIDX(mex[i], mey[i]);
+                v4d t = (v4d){ml[g][0]->T[at], ml[g][1]->T[at], ml[g][2]->T[at], ml[g][3]->T[at]} * D[i][g];
                 for (int k = 0; k < i; k++) t -= L[i * NMON + k][g] * y[k][g];
                 y[i][g] = t * idg[i][g];
             }
         for (int c = 1; c <= 2; c++) /* L u = e_c */
-            for (int g = 0; g < NPAIR; g++) {
+            for (int g = 0; g < NQUAD; g++) {
                 u[c - 1][0][g] = zero;
                 if (c == 2) u[c - 1][1][g] = zero;
                 for (int i = c; i < NMON; i++) {
-                    v2d t = i == c ? one : zero;
+                    v4d t = i == c ? one : zero;
                     for (int k = c; k < i; k++) t -= L[i * NMON + k][g] * u[c - 1][k][g];
                     u[c - 1][i][g] = t * idg[i][g];
                 }
             }
-        for (int g = 0; g < NPAIR; g++) {
-            v2d a1 = zero, a2 = zero, var = zero, rss = zz[g];
+        for (int g = 0; g < NQUAD; g++) {
+            v4d a1 = zero, a2 = zero, var = zero, rss = zz[g];
             for (int i = 0; i < NMON; i++) {
                 a1 += u[0][i][g] * y[i][g];
                 a2 += u[1][i][g] * y[i][g];
                 var += u[0][i][g] * u[0][i][g] + u[1][i][g] * u[1][i][g];
                 rss -= y[i][g] * y[i][g];
                 if (i == 5)
-                    for (int e = 0; e < 2; e++) {
-                        const int l = 2 * g + e;
+                    for (int e = 0; e < 4; e++) {
+                        const int l = 4 * g + e;
                         if (use[l] && !bad[g][e])
                             put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, 6, hk[l], fr, &cf[0][l]);
                     }
             }
-            for (int e = 0; e < 2; e++) {
-                const int l = 2 * g + e;
+            for (int e = 0; e < 4; e++) {
+                const int l = 4 * g + e;
                 if (use[l] && !bad[g][e])
                     put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, NMON, hk[l], fr, &cf[1][l]);
             }
         }
     }
     for (int l = 0; l < nc; l++)
-        if (hk[l] > 0.0 && (!use[l] || bad[l / 2][l % 2])) {
+        if (hk[l] > 0.0 && (!use[l] || bad[l / 4][l % 4])) {
             cand_fit two[2] = {{0}, {0}};
             solve_k(mo[l].S, mo[l].T, mo[l].zz, mo[l].m, H, hk[l], fr, two);
             cf[0][l] = two[0];
@@ -300,16 +322,9 @@ static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const doubl
  * loops are built twice (target_clones): AVX (four lanes a register, no
  * FMA, so no contraction) and the default (two SSE2 registers) -- the same
  * operations on every lane, so the same bits on every machine. */
-typedef double v4d __attribute__((vector_size(32)));
-typedef long long v4l __attribute__((vector_size(32)));
 typedef struct {
     v4d S[NPOW], T[NMON], zz, m, rmax2, rsum;
 } acc4;
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
-#define JF_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define JF_CLONES
-#endif
 
 static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
