@@ -82,6 +82,7 @@ static const int mey[NMON] = {0, 0, 1, 0, 1, 2, 0, 1, 2, 3};
 /* Position of the power sum x^i y^j (i + j <= 6) in the moment vector:
  * by degree t = i + j, then j. */
 #define NPOW 28
+_Static_assert(NPOW % 4 == 0 && NMON >= 8, "first_pass sums four power sums a step");
 #define PIDX(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j))
 
 /* The normal of a jet whose slope, in units of x / hK, is (a1, a2), and
@@ -328,6 +329,18 @@ typedef struct {
 
 static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
+/* out[i] = sum4(v[i]), i < 4: the same additions, four sums a step
+ * (pairs of lanes side by side, then the pairs' sums) */
+static inline __attribute__((always_inline)) void sum4x4(const v4d *v, double *out)
+{
+    typedef long long v4i __attribute__((vector_size(32)));
+    const v4i ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
+    const v4d ab = __builtin_shuffle(v[0], v[1], ev) + __builtin_shuffle(v[0], v[1], od); /* a01 b01 a23 b23 */
+    const v4d cd = __builtin_shuffle(v[2], v[3], ev) + __builtin_shuffle(v[2], v[3], od);
+    const v4d r = __builtin_shuffle(ab, cd, lo) + __builtin_shuffle(ab, cd, hi);
+    memcpy(out, &r, sizeof r);
+}
+
 /* One quad of neighbours q[0..3] (NULL: none) in the frame: x, y (units
  * of H: scaled by iH), z, and w = 1 (0: none or not finite). */
 typedef struct {
@@ -494,8 +507,10 @@ JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nm
         if ((i < nmax ? i : nmax) < ks[c]) continue;
         mom *mc = &mo[c];
         mc->zz = sum4(A.zz);
-        for (int j = 0; j < NPOW; j++) mc->S[j] = sum4(A.S[j]);
-        for (int j = 0; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
+        for (int j = 0; j < NPOW; j += 4) sum4x4(A.S + j, mc->S + j);
+        sum4x4(A.T, mc->T);
+        sum4x4(A.T + 4, mc->T + 4);
+        for (int j = 8; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
         mc->m = (size_t)sum4(A.m);
         mc->hmean = 0.0; /* unused: the reported jet has its own sums */
         v4d r = A.rmax2;
