@@ -23,7 +23,7 @@
  * + thr^4/24 (Taylor, every thr), with a margin of 1e-12 on d, far above
  * the rounding of d, of the bound and of acos (an angle moves at least as
  * much as its cosine); else jf__angle itself, so always its answer. */
-static int angle_le(const double a[3], const double b[3], double thr)
+int jf__angle_le(const double a[3], const double b[3], double thr)
 {
     if (thr > 0.0) {
         const double d = fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]), t2 = thr * thr / 2.0;
@@ -52,7 +52,7 @@ static int lepski(const jf__auto_cand *c, const size_t *ks, int nc, double s2, d
         for (int j = 0; j < na && okk; j++) {
             double sdj = sda[j];
             if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
-            okk = angle_le(c[i].nrm, c[acc[j]].nrm,
+            okk = jf__angle_le(c[i].nrm, c[acc[j]].nrm,
                            nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
         }
         if (!okk && lof > 0.0) {
@@ -126,7 +126,7 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *C, int *dout)
         double sd3 = sqrt(s2 * cu[c3].tr);
         for (int i = c2; i >= 0; i--) {
             if (!q[i].ok || !cu[i].ok) continue;
-            if (!angle_le(q[i].nrm, cu[i].nrm, tau * sqrt(s2 * cu[i].tr))) continue;
+            if (!jf__angle_le(q[i].nrm, cu[i].nrm, tau * sqrt(s2 * cu[i].tr))) continue;
             if (sqrt(s2 * q[i].tr) < sd3) {
                 d = 2;
                 ci = i;
