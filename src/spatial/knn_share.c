@@ -129,7 +129,7 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
          * (the density changes slowly along the walk; the tree's own
          * probe assumes a surface and, in 3-D noise, reads 6x the points).
          * 3e5 noisy torus: x 1.5 overflowed the 2k buffer in half of
-         * these searches, x 1.0 found too few in half, x 1.25 in 7% */
+         * these searches, x 1.0 found too few in half, x 1.25 in 4% */
         double b = m >= s->kc / 16 ? rin2 * pow((double)s->kc / (double)m, s->expo) * SH_MARGIN
                                    : s->R * s->R * SH_JUMP;
         if (b >= 0.0 && b < INFINITY) bound = b;
