@@ -45,6 +45,13 @@
 #define NMON 10        /* monomials of a cubic                         */
 typedef double v2d __attribute__((vector_size(16)));
 typedef long long v2l __attribute__((vector_size(16)));
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
+#define JF_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define JF_CLONES
+#endif
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND JF_AUTO_NCAND
@@ -75,6 +82,7 @@ static const int mey[NMON] = {0, 0, 1, 0, 1, 2, 0, 1, 2, 3};
 /* Position of the power sum x^i y^j (i + j <= 6) in the moment vector:
  * by degree t = i + j, then j. */
 #define NPOW 28
+_Static_assert(NPOW % 4 == 0 && NMON >= 8, "first_pass sums four power sums a step");
 #define PIDX(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j))
 
 /* The normal of a jet whose slope, in units of x / hK, is (a1, a2), and
@@ -175,74 +183,122 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
     if (nd == NMON) put_fit(a1, a2, var, rss, m, NMON, hK, fr, &out[1]);
 }
 
-/* solve_k for two candidates a and b at once, one in each SIMD lane
- * (the Cholesky's square roots and divisions are a chain of dependent
- * latencies: two chains side by side), the same operations per lane, so
- * the same bits; when the lanes would part (a different size, a singular
- * block) each runs solve_k on its own. */
-static void solve_k2(const mom *ma, const mom *mb, double H, double ha, double hb, const double fr[9],
-                     cand_fit oa[2], cand_fit ob[2])
+/* solve_k for every candidate at once: candidate l in lane l % 4 of quad
+ * l / 4 (AVX: one register a quad, no FMA; default: two SSE2 registers),
+ * the quads' chains of dependent square roots and divisions (the
+ * Cholesky's) side by side, each lane with solve_k's operations, so its
+ * bits.  A lane that would leave the common path (fewer than NMON + 4
+ * points, a singular block: solve_k lowers the degree) runs solve_k on
+ * its own; a candidate with no radius (hk <= 0) is left out (ok = 0). */
+#define NQUAD ((NCAND + 3) / 4)
+/* *r = sqrt(x) lane by lane, IEEE: correctly rounded (by pointer: a v4d
+ * return value's ABI differs with and without AVX) */
+static inline __attribute__((always_inline)) void sqrt4(v4d *r, const v4d *x)
 {
-    const int nd = ma->m >= NMON + 4 ? NMON : 0;
-    if (!nd || !(mb->m >= NMON + 4)) {
-        solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
-        solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
-        return;
+    const __m128d lo = _mm_sqrt_pd((__m128d){(*x)[0], (*x)[1]}), hi = _mm_sqrt_pd((__m128d){(*x)[2], (*x)[3]});
+    *r = (v4d){lo[0], lo[1], hi[0], hi[1]};
+}
+
+JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
+                                cand_fit cf[2][NCAND])
+{
+    v4d L[NMON * NMON][NQUAD], y[NMON][NQUAD], u[2][NMON][NQUAD], idg[NMON][NQUAD], D[NMON][NQUAD];
+    v4d zz[NQUAD], floor[NQUAD], sv[NQUAD];
+    int use[4 * NQUAD], any = 0;
+    v4l bad[NQUAD];
+    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    for (int l = 0; l < 4 * NQUAD; l++) {
+        use[l] = l < nc && hk[l] > 0.0 && mo[l].m >= NMON + 4;
+        any |= use[l];
     }
-    v2d D[NMON], L[NMON * NMON], y[NMON], u[2][NMON], idg[NMON];
-    const v2d sv = {H / ha, H / hb}, one = {1.0, 1.0};
-    const v2d sp[4] = {one, sv, sv * sv, sv * sv * sv};
-    for (int j = 0; j < nd; j++) D[j] = sp[mdeg[j]];
-    for (int i = 0; i < nd; i++)
-        for (int j = 0; j <= i; j++)
-            L[i * NMON + j] = (v2d){ma->S[gpos[i][j]], mb->S[gpos[i][j]]} * D[i] * D[j];
-    const v2d floor = (v2d){ma->S[0], mb->S[0]} * 1e-12;
-    for (int j = 0; j < nd; j++) {
-        v2d sum = L[j * NMON + j];
-        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
-        v2l pos = (v2l)(sum > floor);
-        if (!pos[0] || !pos[1]) { /* a lane leaves the common path */
-            solve_k(ma->S, ma->T, ma->zz, ma->m, H, ha, fr, oa);
-            solve_k(mb->S, mb->T, mb->zz, mb->m, H, hb, fr, ob);
-            return;
+    if (any) {
+        /* a lane not used holds a used one's numbers (no NaN, no denormal) */
+        int src[4 * NQUAD], first = 0;
+        while (!use[first]) first++;
+        for (int l = 0; l < 4 * NQUAD; l++) src[l] = use[l] ? l : first;
+        const mom *ml[NQUAD][4];
+        for (int g = 0; g < NQUAD; g++) {
+            for (int e = 0; e < 4; e++) {
+                ml[g][e] = &mo[src[4 * g + e]];
+                sv[g][e] = H / hk[src[4 * g + e]];
+                zz[g][e] = ml[g][e]->zz;
+                floor[g][e] = ml[g][e]->S[0];
+            }
+            floor[g] *= 1e-12;
+            bad[g] = (v4l){0, 0, 0, 0};
         }
-        L[j * NMON + j] = (v2d)_mm_sqrt_pd((__m128d)sum);
-        v2d inv = idg[j] = one / L[j * NMON + j];
-        for (int i = j + 1; i < nd; i++) {
-            v2d t = L[i * NMON + j];
-            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
-            L[i * NMON + j] = t * inv;
+        for (int j = 0; j < NMON; j++)
+            for (int g = 0; g < NQUAD; g++) {
+                const v4d s = sv[g];
+                D[j][g] = mdeg[j] == 0 ? one : mdeg[j] == 1 ? s : mdeg[j] == 2 ? s * s : s * s * s;
+            }
+        for (int i = 0; i < NMON; i++)
+            for (int j = 0; j <= i; j++)
+                for (int g = 0; g < NQUAD; g++) {
+                    const int at = gpos[i][j];
+                    const v4d S = {ml[g][0]->S[at], ml[g][1]->S[at], ml[g][2]->S[at], ml[g][3]->S[at]};
+                    L[i * NMON + j][g] = S * D[i][g] * D[j][g];
+                }
+        for (int j = 0; j < NMON; j++) {
+            for (int g = 0; g < NQUAD; g++) {
+                v4d sum = L[j * NMON + j][g];
+                for (int k = 0; k < j; k++) sum -= L[j * NMON + k][g] * L[j * NMON + k][g];
+                bad[g] |= ~(v4l)(sum > floor[g]); /* the lane's result is not used */
+                sqrt4(&L[j * NMON + j][g], &sum);
+                idg[j][g] = one / L[j * NMON + j][g];
+            }
+            for (int i = j + 1; i < NMON; i++)
+                for (int g = 0; g < NQUAD; g++) {
+                    v4d t = L[i * NMON + j][g];
+                    for (int k = 0; k < j; k++) t -= L[i * NMON + k][g] * L[j * NMON + k][g];
+                    L[i * NMON + j][g] = t * idg[j][g];
+                }
+        }
+        for (int i = 0; i < NMON; i++) /* L y = D M^T z */
+            for (int g = 0; g < NQUAD; g++) {
+                const int at = PIDX(mex[i], mey[i]);
+                v4d t = (v4d){ml[g][0]->T[at], ml[g][1]->T[at], ml[g][2]->T[at], ml[g][3]->T[at]} * D[i][g];
+                for (int k = 0; k < i; k++) t -= L[i * NMON + k][g] * y[k][g];
+                y[i][g] = t * idg[i][g];
+            }
+        for (int c = 1; c <= 2; c++) /* L u = e_c */
+            for (int g = 0; g < NQUAD; g++) {
+                u[c - 1][0][g] = zero;
+                if (c == 2) u[c - 1][1][g] = zero;
+                for (int i = c; i < NMON; i++) {
+                    v4d t = i == c ? one : zero;
+                    for (int k = c; k < i; k++) t -= L[i * NMON + k][g] * u[c - 1][k][g];
+                    u[c - 1][i][g] = t * idg[i][g];
+                }
+            }
+        for (int g = 0; g < NQUAD; g++) {
+            v4d a1 = zero, a2 = zero, var = zero, rss = zz[g];
+            for (int i = 0; i < NMON; i++) {
+                a1 += u[0][i][g] * y[i][g];
+                a2 += u[1][i][g] * y[i][g];
+                var += u[0][i][g] * u[0][i][g] + u[1][i][g] * u[1][i][g];
+                rss -= y[i][g] * y[i][g];
+                if (i == 5)
+                    for (int e = 0; e < 4; e++) {
+                        const int l = 4 * g + e;
+                        if (use[l] && !bad[g][e])
+                            put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, 6, hk[l], fr, &cf[0][l]);
+                    }
+            }
+            for (int e = 0; e < 4; e++) {
+                const int l = 4 * g + e;
+                if (use[l] && !bad[g][e])
+                    put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, NMON, hk[l], fr, &cf[1][l]);
+            }
         }
     }
-    for (int i = 0; i < nd; i++) { /* L y = D M^T z */
-        v2d t = (v2d){ma->T[PIDX(mex[i], mey[i])], mb->T[PIDX(mex[i], mey[i])]} * D[i];
-        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
-        y[i] = t * idg[i];
-    }
-    const v2d zero = {0.0, 0.0};
-    for (int c = 1; c <= 2; c++) { /* L u = e_c */
-        v2d *z = u[c - 1];
-        z[0] = zero;
-        if (c == 2) z[1] = zero;
-        for (int i = c; i < nd; i++) {
-            v2d t = i == c ? one : zero;
-            for (int k = c; k < i; k++) t -= L[i * NMON + k] * z[k];
-            z[i] = t * idg[i];
+    for (int l = 0; l < nc; l++)
+        if (hk[l] > 0.0 && (!use[l] || bad[l / 4][l % 4])) {
+            cand_fit two[2] = {{0}, {0}};
+            solve_k(mo[l].S, mo[l].T, mo[l].zz, mo[l].m, H, hk[l], fr, two);
+            cf[0][l] = two[0];
+            cf[1][l] = two[1];
         }
-    }
-    v2d a1 = zero, a2 = zero, var = zero, rss = {ma->zz, mb->zz};
-    for (int i = 0; i < nd; i++) {
-        a1 += u[0][i] * y[i];
-        a2 += u[1][i] * y[i];
-        var += u[0][i] * u[0][i] + u[1][i] * u[1][i];
-        rss -= y[i] * y[i];
-        if (i == 5) {
-            put_fit(a1[0], a2[0], var[0], rss[0], ma->m, 6, ha, fr, &oa[0]);
-            put_fit(a1[1], a2[1], var[1], rss[1], mb->m, 6, hb, fr, &ob[0]);
-        }
-    }
-    put_fit(a1[0], a2[0], var[0], rss[0], ma->m, NMON, ha, fr, &oa[1]);
-    put_fit(a1[1], a2[1], var[1], rss[1], mb->m, NMON, hb, fr, &ob[1]);
 }
 
 static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
@@ -267,26 +323,33 @@ static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const doubl
  * loops are built twice (target_clones): AVX (four lanes a register, no
  * FMA, so no contraction) and the default (two SSE2 registers) -- the same
  * operations on every lane, so the same bits on every machine. */
-typedef double v4d __attribute__((vector_size(32)));
-typedef long long v4l __attribute__((vector_size(32)));
 typedef struct {
     v4d S[NPOW], T[NMON], zz, m, rmax2, rsum;
 } acc4;
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
-#define JF_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define JF_CLONES
-#endif
 
 static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
-/* Adds neighbours q[0..3] (NULL: none) to A: their frame coordinates x,
- * y (units of H: scaled by iH), z; x^i y^j for i + j <= top, x^i y^j z for
- * i + j <= deg, z^2, the count, the largest x^2 + y^2 and (rs) the sum of
- * sqrt(x^2 + y^2).  A non-finite neighbour weighs 0. */
-static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
-                                                           const double p[3], const double fr[9],
-                                                           double iH, int top, int deg, int rs)
+/* out[i] = sum4(v[i]), i < 4: the same additions, four sums a step
+ * (pairs of lanes side by side, then the pairs' sums) */
+static inline __attribute__((always_inline)) void sum4x4(const v4d *v, double *out)
+{
+    typedef long long v4i __attribute__((vector_size(32)));
+    const v4i ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
+    const v4d ab = __builtin_shuffle(v[0], v[1], ev) + __builtin_shuffle(v[0], v[1], od); /* a01 b01 a23 b23 */
+    const v4d cd = __builtin_shuffle(v[2], v[3], ev) + __builtin_shuffle(v[2], v[3], od);
+    const v4d r = __builtin_shuffle(ab, cd, lo) + __builtin_shuffle(ab, cd, hi);
+    memcpy(out, &r, sizeof r);
+}
+
+/* One quad of neighbours q[0..3] (NULL: none) in the frame: x, y (units
+ * of H: scaled by iH), z, and w = 1 (0: none or not finite). */
+typedef struct {
+    v4d x, y, z, w;
+} quad4;
+
+static inline __attribute__((always_inline)) void quad_load(quad4 *Q, const double *const q[4],
+                                                            const double p[3], const double fr[9],
+                                                            double iH)
 {
     const v4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
     v4d v0, v1, v2;
@@ -314,29 +377,78 @@ static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double
     v4d z = v0 * fr[6] + v1 * fr[7] + v2 * fr[8];
     /* finite: t - t == 0 (NaN for an infinity or a NaN) */
     v4l ok = ((x - x) == zero) & ((y - y) == zero) & ((z - z) == zero) & live;
-    x = (v4d)((v4l)x & ok);
-    y = (v4d)((v4l)y & ok);
-    z = (v4d)((v4l)z & ok);
-    v4d w = (v4d)((v4l)one & ok), xp[7], yp[7];
-    xp[0] = w;
-    yp[0] = one;
-    for (int e = 1; e <= top; e++) {
-        xp[e] = xp[e - 1] * x;
-        yp[e] = yp[e - 1] * y;
+    Q->x = (v4d)((v4l)x & ok);
+    Q->y = (v4d)((v4l)y & ok);
+    Q->z = (v4d)((v4l)z & ok);
+    Q->w = (v4d)((v4l)one & ok);
+}
+
+/* Adds nq (1 or 2) quads Q[0..nq) to A, in that order: x^i y^j for
+ * i + j <= top, x^i y^j z for i + j <= deg, z^2, the count, the largest
+ * x^2 + y^2 and (rs) the sum of sqrt(x^2 + y^2).  Two quads add to each
+ * sum one after the other in a register, (A + a) + b, the bits of two
+ * calls with one quad, with half the loads and stores of the ~40 sums
+ * (which do not fit in registers: the stores bounded the loop). */
+static inline __attribute__((always_inline)) void acc_quads(acc4 *A, const quad4 *Q, int nq, int top,
+                                                            int deg, int rs)
+{
+    const v4d one = {1.0, 1.0, 1.0, 1.0};
+    v4d xp[2][7], yp[2][7];
+    for (int u = 0; u < nq; u++) {
+        xp[u][0] = Q[u].w;
+        yp[u][0] = one;
+        for (int e = 1; e <= top; e++) {
+            xp[u][e] = xp[u][e - 1] * Q[u].x;
+            yp[u][e] = yp[u][e - 1] * Q[u].y;
+        }
     }
     int at = 0; /* PIDX order: degree t, then j = 0..t */
     for (int t = 0; t <= top; t++)
-        for (int j = 0; j <= t; j++) A->S[at++] += xp[t - j] * yp[j];
+        for (int j = 0; j <= t; j++, at++) {
+            v4d a = A->S[at];
+            for (int u = 0; u < nq; u++) a += xp[u][t - j] * yp[u][j];
+            A->S[at] = a;
+        }
     at = 0;
     for (int t = 0; t <= deg; t++)
-        for (int j = 0; j <= t; j++) A->T[at++] += xp[t - j] * yp[j] * z;
-    A->zz += w * z * z;
-    A->m += w;
-    v4d r2 = x * x + y * y;
-    v4l gt = (v4l)(r2 > A->rmax2);
-    A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
-    if (rs)
-        for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+        for (int j = 0; j <= t; j++, at++) {
+            v4d a = A->T[at];
+            for (int u = 0; u < nq; u++) a += xp[u][t - j] * yp[u][j] * Q[u].z;
+            A->T[at] = a;
+        }
+    for (int u = 0; u < nq; u++) {
+        const v4d x = Q[u].x, y = Q[u].y, z = Q[u].z;
+        A->zz += Q[u].w * z * z;
+        A->m += Q[u].w;
+        v4d r2 = x * x + y * y;
+        v4l gt = (v4l)(r2 > A->rmax2);
+        A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
+        if (rs)
+            for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+    }
+}
+
+/* Adds neighbours q[0..3] (NULL: none) to A (acc_quads). */
+static inline __attribute__((always_inline)) void acc_quad(acc4 *A, const double *const q[4],
+                                                           const double p[3], const double fr[9],
+                                                           double iH, int top, int deg, int rs)
+{
+    quad4 Q;
+    quad_load(&Q, q, p, fr, iH);
+    acc_quads(A, &Q, 1, top, deg, rs);
+}
+
+/* Adds the eight neighbours nbr[i..i + 8) to A, as two acc_quad calls. */
+static inline __attribute__((always_inline)) void acc_eight(acc4 *A, const double *nbr, size_t i,
+                                                            const double p[3], const double fr[9],
+                                                            double iH, int top, int deg, int rs)
+{
+    quad4 Q[2];
+    const double *q0[4] = {nbr + 3 * i, nbr + 3 * i + 3, nbr + 3 * i + 6, nbr + 3 * i + 9};
+    const double *q1[4] = {nbr + 3 * i + 12, nbr + 3 * i + 15, nbr + 3 * i + 18, nbr + 3 * i + 21};
+    quad_load(&Q[0], q0, p, fr, iH);
+    quad_load(&Q[1], q1, p, fr, iH);
+    acc_quads(A, Q, 2, top, deg, rs);
 }
 
 /* The four neighbours from i (NULL past k). */
@@ -356,10 +468,14 @@ JF_CLONES static void moments(const double p[3], const double *nbr, size_t k, co
     acc4 A;
     memset(&A, 0, sizeof A);
     const double *q[4];
-    if (deg == 2)
-        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
-    else
-        for (size_t i = 0; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    size_t i = 0;
+    if (deg == 2) {
+        for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, 4, 2, 1);
+        for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
+    } else {
+        for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, top, deg, 1);
+        for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);
+    }
     for (int j = 0; j < ntop; j++) mo->S[j] = sum4(A.S[j]);
     for (int j = 0; j < nt; j++) mo->T[j] = sum4(A.T[j]);
     mo->zz = sum4(A.zz);
@@ -379,14 +495,22 @@ JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nm
     memset(&A, 0, sizeof A);
     const double *q[4];
     int c = 0;
-    for (size_t i = 0; i < nmax && c < nc; i += 4) {
-        quad_of(nbr, i, nmax, q);
-        acc_quad(&A, q, p, fr, iH, 6, 3, 0);
-        if ((i + 4 < nmax ? i + 4 : nmax) < ks[c]) continue;
+    for (size_t i = 0; i < nmax && c < nc;) {
+        if (i + 8 <= nmax && ks[c] > i + 4) { /* no sums are read between the two quads */
+            acc_eight(&A, nbr, i, p, fr, iH, 6, 3, 0);
+            i += 8;
+        } else {
+            quad_of(nbr, i, nmax, q);
+            acc_quad(&A, q, p, fr, iH, 6, 3, 0);
+            i += 4;
+        }
+        if ((i < nmax ? i : nmax) < ks[c]) continue;
         mom *mc = &mo[c];
         mc->zz = sum4(A.zz);
-        for (int j = 0; j < NPOW; j++) mc->S[j] = sum4(A.S[j]);
-        for (int j = 0; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
+        for (int j = 0; j < NPOW; j += 4) sum4x4(A.S + j, mc->S + j);
+        sum4x4(A.T, mc->T);
+        sum4x4(A.T + 4, mc->T + 4);
+        for (int j = 8; j < NMON; j++) mc->T[j] = sum4(A.T[j]);
         mc->m = (size_t)sum4(A.m);
         mc->hmean = 0.0; /* unused: the reported jet has its own sums */
         v4d r = A.rmax2;
@@ -575,18 +699,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     mom mo[NCAND];
     double hks[NCAND];
     first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
-    for (int c = 0; c < nc; c++) {
-        cand_fit two[2] = {{0}, {0}}, nxt[2] = {{0}, {0}};
-        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) { /* two at once */
-            solve_k2(&mo[c], &mo[c + 1], H, hks[c], hks[c + 1], fr, two, nxt);
-            cf[0][c + 1] = nxt[0];
-            cf[1][c + 1] = nxt[1];
-        } else if (hks[c] > 0.0)
-            solve_k(mo[c].S, mo[c].T, mo[c].zz, mo[c].m, H, hks[c], fr, two);
-        cf[0][c] = two[0];
-        cf[1][c] = two[1];
-        if (c + 1 < nc && hks[c] > 0.0 && hks[c + 1] > 0.0) c++;
-    }
+    solve_all(mo, hks, nc, H, fr, cf);
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
     double s2 = NAN;

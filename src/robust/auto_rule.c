@@ -18,6 +18,21 @@
 
 #include "robust_internal.h"
 
+/* jf__angle(a, b) <= thr, without its acos where the cosine d = |a.b|
+ * is clearly on one side of cos thr: 1 - thr^2/2 <= cos thr <= 1 - thr^2/2
+ * + thr^4/24 (Taylor, every thr), with a margin of 1e-12 on d, far above
+ * the rounding of d, of the bound and of acos (an angle moves at least as
+ * much as its cosine); else jf__angle itself, so always its answer. */
+int jf__angle_le(const double a[3], const double b[3], double thr)
+{
+    if (thr > 0.0) {
+        const double d = fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]), t2 = thr * thr / 2.0;
+        if (d >= 1.0 - t2 + t2 * t2 / 6.0 + 1e-12) return 1;
+        if (d <= 1.0 - t2 - 1e-12) return 0;
+    }
+    return jf__angle(a, b) <= thr;
+}
+
 /* Lepski / ICI over the candidates of one degree: the last K whose normal
  * agrees with every smaller accepted K's (within tau (sd_j + sd_K), or with
  * nest > 0 within nest sqrt(|sd_j^2 - sd_K^2|): the difference of nested
@@ -29,21 +44,23 @@ static int lepski(const jf__auto_cand *c, const size_t *ks, int nc, double s2, d
                   double nest, double lof)
 {
     int acc[JF_AUTO_NCAND], na = 0, best = -1;
+    double sda[JF_AUTO_NCAND]; /* the accepted ones' sd, computed once */
     for (int i = 0; i < nc; i++) {
         if (!c[i].ok) continue;
         double sdi = sqrt(s2 * c[i].tr);
         int okk = 1;
         for (int j = 0; j < na && okk; j++) {
-            double sdj = sqrt(s2 * c[acc[j]].tr);
+            double sdj = sda[j];
             if (!(sdj < sdmax)) continue; /* a normal of noise bounds nothing */
-            okk = jf__angle(c[i].nrm, c[acc[j]].nrm) <=
-                  (nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
+            okk = jf__angle_le(c[i].nrm, c[acc[j]].nrm,
+                           nest > 0.0 ? nest * sqrt(fabs(sdj * sdj - sdi * sdi)) : tau * (sdi + sdj));
         }
         if (!okk && lof > 0.0) {
             double dof = ks[i] > 7 ? (double)(ks[i] - 6) : 1.0;
             okk = c[i].s2 <= s2 * (1.0 + lof * sqrt(2.0 / dof));
         }
         if (!okk) break;
+        sda[na] = sdi;
         acc[na++] = i;
         best = i;
     }
@@ -109,7 +126,7 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *C, int *dout)
         double sd3 = sqrt(s2 * cu[c3].tr);
         for (int i = c2; i >= 0; i--) {
             if (!q[i].ok || !cu[i].ok) continue;
-            if (jf__angle(q[i].nrm, cu[i].nrm) > tau * sqrt(s2 * cu[i].tr)) continue;
+            if (!jf__angle_le(q[i].nrm, cu[i].nrm, tau * sqrt(s2 * cu[i].tr))) continue;
             if (sqrt(s2 * q[i].tr) < sd3) {
                 d = 2;
                 ci = i;

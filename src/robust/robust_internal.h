@@ -62,6 +62,8 @@ double jf__normal_sd(const jf__knobs *k, const jf_result *r, double s2, const do
 double jf__unbiased_var(const jf_result *r, double sigma, size_t n);
 /* Angle (radians) between two unoriented unit vectors. */
 double jf__angle(const double a[3], const double b[3]);
+/* jf__angle(a, b) <= thr, the same answer, mostly without acos (auto_rule.c). */
+int jf__angle_le(const double a[3], const double b[3], double thr);
 
 /* The fit with degree selection and distance weights as pr asks (the
  * plain or reweighted fit when neither is set). */

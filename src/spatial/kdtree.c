@@ -46,6 +46,7 @@
 #ifndef KD_PROBE_GROW
 #define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
 #endif
+#define KD_BKT_INS 16       /* buf_finish: one insertion sort if no bucket is larger */
 #define KD_IS_LEAF 3u       /* `dim` value marking a leaf                 */
 #define KD_APP_MAX (2 * KD_SORTED_MAX + KD_LEAF) /* append buffer (mode 3) */
 _Static_assert(KD_APP_MAX <= KD_BUF_STACK, "mode 3 uses the stack buffer of mode 2");
@@ -507,7 +508,37 @@ static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt,
         td[at] = hd[i];
         tp[at] = hp[i];
     }
-    /* start[b] is now the end of bucket b */
+    /* start[b] is now the end of bucket b.  Buckets of at most KD_BKT_INS
+     * up to the k-th's: one insertion sort of them all, which moves only
+     * the few bucket mates out of order (a sort per bucket mispredicts on
+     * every bucket size); else each bucket sorted on its own */
+    size_t bl = 0, bh = cnt - 1;
+    while (bl < bh) {
+        size_t mid = bl + (bh - bl) / 2;
+        if (start[mid] >= (k < cnt ? k : cnt)) bh = mid;
+        else bl = mid + 1;
+    }
+    uint32_t big = start[0] > KD_BKT_INS;
+    for (size_t b = 1; b <= bl; b++) big |= start[b] - start[b - 1] > KD_BKT_INS;
+    if (!big) {
+        const size_t end = start[bl], m = k < cnt ? k : cnt;
+        for (size_t i = 1; i < end; i++) {
+            const double d = td[i];
+            if (!KD_LESS(id, d, tp[i], td[i - 1], tp[i - 1])) continue;
+            const uint32_t p = tp[i];
+            size_t j = i;
+            do {
+                td[j] = td[j - 1];
+                tp[j] = tp[j - 1];
+                j--;
+            } while (j > 0 && KD_LESS(id, d, p, td[j - 1], tp[j - 1]));
+            td[j] = d;
+            tp[j] = p;
+        }
+        memcpy(hd, td, m * sizeof *hd);
+        memcpy(hp, tp, m * sizeof *hp);
+        return;
+    }
     size_t out = 0, lo = 0;
     for (size_t b = 0; b < cnt && out < k; b++) {
         size_t hi = start[b];
@@ -529,6 +560,34 @@ static void buf_push(kd_query *s, double d, uint32_t pos)
     s->cnt = s->cap;
     s->worst_d = s->hd[s->cap - 1];
     s->worst_p = s->hp[s->cap - 1];
+}
+
+/* Mode 2 without a scan record: as app_leaf, every point of a leaf within
+ * the bound appended without a branch (half the points of a k = 1024
+ * search's leaves fail the test, unpredictably), a superset of what the
+ * (d2, index) rule admits; from 2k on, a quickselect keeps the k least
+ * (as buf_push).  The buffer holds 2k + KD_LEAF. */
+static void buf_leaf(kd_query *s, const kd_node *nd)
+{
+    const uint32_t first = nd->first, cnt = nd->dim >> 2;
+    const double *p = s->ix->pts + 3 * (size_t)first;
+    const double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2], w = s->worst_d;
+    double *hd = s->hd;
+    uint32_t *hp = s->hp;
+    size_t c = s->cnt;
+    for (uint32_t j = 0; j < cnt; j++, p += 3) {
+        const double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
+        const double d = dx * dx + dy * dy + dz * dz;
+        hd[c] = d;
+        hp[c] = first + j;
+        c += d <= w;
+    }
+    s->cnt = c;
+    if (c < 2 * s->cap) return;
+    buf_select(s->ix->id, hd, hp, 0, c, s->cap - 1);
+    s->cnt = s->cap;
+    s->worst_d = hd[s->cap - 1];
+    s->worst_p = hp[s->cap - 1];
 }
 
 /* Mode 3's bound, lowered while at least k candidates stay within it: a
@@ -692,6 +751,7 @@ static void search(kd_query *s, const double g0[3])
             continue;
         }
         if (s->sorted == 3) app_leaf(s, nd);
+        else if (s->sorted == 2 && !s->scan) buf_leaf(s, nd);
         else scan_leaf(s, nd);
         /* next deferred cell whose bound can still beat the worst */
         for (;;) {
@@ -764,15 +824,16 @@ static jf_status query(const jf_index *ix, const double q[3], size_t k, double b
     uint32_t buf_pos[KD_BUF_STACK], buf_tp[KD_BUF_STACK], buf_start[KD_BUF_STACK + 1];
     double *bk = buf_keys, *btd = buf_td;
     uint32_t *bp = buf_pos, *btp = buf_tp, *bst = buf_start;
-    void *heap = NULL; /* 2k above KD_BUF_STACK: the scratch on the heap */
-    if (mode == 2 && 2 * k > KD_BUF_STACK) {
-        if (!(heap = malloc(2 * k * (2 * sizeof(double) + 3 * sizeof(uint32_t)) + sizeof(uint32_t))))
+    void *heap = NULL; /* 2k + KD_LEAF (buf_leaf) above KD_BUF_STACK: on the heap */
+    if (mode == 2 && 2 * k + KD_LEAF > KD_BUF_STACK) {
+        const size_t nb = 2 * k + KD_LEAF;
+        if (!(heap = malloc(nb * (2 * sizeof(double) + 3 * sizeof(uint32_t)) + sizeof(uint32_t))))
             return JF_ERR_NOMEM;
         bk = heap;
-        btd = bk + 2 * k;
-        bp = (uint32_t *)(btd + 2 * k);
-        btp = bp + 2 * k;
-        bst = btp + 2 * k;
+        btd = bk + nb;
+        bp = (uint32_t *)(btd + nb);
+        btp = bp + nb;
+        bst = btp + nb;
     }
     if (mode >= 2) keys = bk; /* mode 3: KD_APP_MAX <= KD_BUF_STACK */
     else if (!keys) {

@@ -106,6 +106,30 @@ END_TEST
 /* auto_lof z: a K whose residual variance is below s2 (1 + z sqrt(2 /
  * (K - 6))) passes; with z huge every K passes, so the cubic's Lepski
  * chain runs to the largest K and the mean chosen K must grow. */
+/* jf__angle_le answers as jf__angle(a, b) <= thr does: unit vectors at
+ * angles from 1e-7 to pi/2, thresholds at, one ulp around, and 1e-9 /
+ * 1e-3 relative around the angle jf__angle computes (where the shortcut's
+ * margin is thin), and far from it, zero, negative, NaN, huge. */
+START_TEST(test_angle_le_is_the_acos_test)
+{
+    uint64_t st = 27;
+    long n = 0;
+    for (int it = 0; it < 20000; it++) {
+        double u = (double)(jf_splitmix64(&st) >> 11) / 9007199254740992.0;
+        double th = 1e-7 * pow(1.5707963e7, u); /* log-uniform in [1e-7, pi/2] */
+        double ph = 6.283185307179586 * (double)(jf_splitmix64(&st) >> 11) / 9007199254740992.0;
+        double a[3] = {0, 0, 1}, b[3] = {sin(th) * cos(ph), sin(th) * sin(ph), cos(th)};
+        if (it & 1) b[2] = -b[2]; /* unoriented */
+        const double g = jf__angle(a, b);
+        const double thr[] = {g, nextafter(g, 0), nextafter(g, INFINITY), g * (1 + 1e-9), g * (1 - 1e-9),
+                              g * 1.001, g * 0.999, g * 2, g / 2, 0.0, -g, NAN, 1e300, INFINITY};
+        for (size_t t = 0; t < sizeof thr / sizeof thr[0]; t++, n++)
+            ck_assert_int_eq(jf__angle_le(a, b, thr[t]), jf__angle(a, b) <= thr[t]);
+    }
+    ck_assert_int_eq(n, 20000 * 14);
+}
+END_TEST
+
 START_TEST(test_lof_knob_is_live)
 {
     jf_sample s = cloud();
@@ -144,6 +168,7 @@ static Suite *suite(void)
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, test_diag_candidates_are_the_jets);
     tcase_add_test(tc, test_lof_knob_is_live);
+    tcase_add_test(tc, test_angle_le_is_the_acos_test);
     suite_add_tcase(s, tc);
     return s;
 }
