@@ -12,10 +12,7 @@
 #include <string.h>
 
 #include "fitter_internal.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "simd.h"
 
 /* Pins the sign of v: its largest-|component| (first on ties) positive. */
 static void pin_sign(double *v)
@@ -176,17 +173,7 @@ int jf__frame(const double *q, const double *w, size_t n, jf_frame_mode mode,
  * masks (a lane that would skip a rotation keeps its values), so each
  * lane gets the bits jf__eig3 gives.  The Jacobi rotations are a chain of
  * dependent divisions and square roots: two chains side by side cost
- * little more than one. */
-typedef double v2d __attribute__((vector_size(16)));
-typedef long long v2l __attribute__((vector_size(16)));
-
-static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
-static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
-#if defined(__SSE2__)
-static inline v2d sqrt2(v2d x) { return (v2d)_mm_sqrt_pd((__m128d)x); }
-#else /* IEEE sqrt is correctly rounded: the same bits lane by lane */
-static inline v2d sqrt2(v2d x) { return (v2d){sqrt(x[0]), sqrt(x[1])}; }
-#endif
+ * little more than one (lane helpers: simd.h). */
 
 /* The rotations of jf__eig3_x2: the diagonalised matrices and the
  * rotations' products, lane by lane, into al[lane], vl[lane]. */
@@ -277,27 +264,6 @@ void jf__eig3_x2(const double a0[9], const double a1[9], double eval0[3], double
  * vectors (one AVX register, two SSE2 ones in the default build): each
  * lane the same operations, the bits of jf__eig3.  The sqrt of four lanes
  * is a parameter (always inlined: vsqrtpd in the AVX build). */
-typedef double v4d __attribute__((vector_size(32)));
-typedef long long v4l __attribute__((vector_size(32)));
-typedef void (*sqrt4_fn)(v4d *);
-/* all inlined: no call passes a v4d (GCC's ABI note does not apply) */
-#if defined(__GNUC__) /* clang too */
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
-static inline v4d sel4(v4l m, v4d a, v4d b) { return (v4d)(((v4l)a & m) | ((v4l)b & ~m)); }
-static inline v4d abs4(v4d x) { return (v4d)((v4l)x & ~(v4l)(v4d){-0.0, -0.0, -0.0, -0.0}); }
-static inline int any4(v4l m) { return m[0] || m[1] || m[2] || m[3]; }
-static inline v4d vsqrt4(v4d x, sqrt4_fn sq)
-{
-    sq(&x);
-    return x;
-}
-static inline __attribute__((always_inline)) void sqrt4_sse(v4d *x)
-{
-    const v2d lo = sqrt2((v2d){(*x)[0], (*x)[1]}), hi = sqrt2((v2d){(*x)[2], (*x)[3]});
-    *x = (v4d){lo[0], lo[1], hi[0], hi[1]};
-}
 
 static inline __attribute__((always_inline)) void eig3_x4_sweeps(const double *const m[4],
                                                                  double al[4][3][3],
@@ -357,10 +323,6 @@ static inline __attribute__((always_inline)) void eig3_x4_sweeps(const double *c
 }
 
 #if JF_AVX_PATH
-__attribute__((target("avx"), always_inline)) static inline void sqrt4_avx(v4d *x)
-{
-    *x = __builtin_ia32_sqrtpd256(*x);
-}
 JF_AVX_FN static void eig3_x4_avx(const double *const m[4], double al[4][3][3], double vl[4][3][3])
 {
     eig3_x4_sweeps(m, al, vl, sqrt4_avx);

@@ -14,27 +14,12 @@
  * these extremes agrees with GSL's SVD to 1e-12 up to kappa 4e3, where
  * the QL's was off by up to 2.2e-9 (test_jet: test_gram_extremes). */
 #include <float.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <math.h>
 #include <stddef.h>
 
 #include "fitter_internal.h"
+#include "simd.h"
 
-typedef double v2d __attribute__((vector_size(16)));
-typedef long long v2l __attribute__((vector_size(16)));
-
-static inline v2d sel2(v2l m, v2d a, v2d b) { return (v2d)(((v2l)a & m) | ((v2l)b & ~m)); }
-static inline v2d abs2(v2d x) { return (v2d)((v2l)x & ~(v2l)(v2d){-0.0, -0.0}); }
-static inline v2d sqrt2(v2d x)
-{
-#if defined(__SSE2__)
-    return (v2d)_mm_sqrt_pd((__m128d)x);
-#else
-    return (v2d){sqrt(x[0]), sqrt(x[1])};
-#endif
-}
 
 #define GE_MAX 10    /* cols up to degree 3; larger: solve.c's QL       */
 #define GE_ITERS 100 /* Laguerre steps before a lane is declared failed */
@@ -218,30 +203,8 @@ void jf__eigvals_x2(jf_fitter *f0, jf_fitter *f1, size_t cols, int ok[2])
  * (one AVX register; two SSE2 registers in the default build): each lane
  * does exactly the operations of the two-lane code above, so each gets
  * the bits jf__eigvals gives.  The sqrt of four lanes is a parameter (an
- * always-inlined call: vsqrtpd in the AVX build, two sqrtpd else). */
-typedef double v4d __attribute__((vector_size(32)));
-typedef long long v4l __attribute__((vector_size(32)));
-typedef void (*sqrt4_fn)(v4d *);
-/* the helpers below are all inlined: no call passes a v4d, so GCC's
- * note that such a call's ABI differs without AVX does not apply */
-#if defined(__GNUC__) /* clang too */
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
-static inline v4d sel4(v4l m, v4d a, v4d b) { return (v4d)(((v4l)a & m) | ((v4l)b & ~m)); }
-static inline v4d abs4(v4d x) { return (v4d)((v4l)x & ~(v4l)(v4d){-0.0, -0.0, -0.0, -0.0}); }
-static inline int all4(v4l m) { return m[0] && m[1] && m[2] && m[3]; }
-static inline v4d vsqrt4(v4d x, sqrt4_fn sq)
-{
-    sq(&x);
-    return x;
-}
-static inline __attribute__((always_inline)) void sqrt4_sse(v4d *x)
-{
-    const v2d lo = sqrt2((v2d){(*x)[0], (*x)[1]}), hi = sqrt2((v2d){(*x)[2], (*x)[3]});
-    *x = (v4d){lo[0], lo[1], hi[0], hi[1]};
-}
-
+ * always-inlined call: vsqrtpd in the AVX build, two sqrtpd else;
+ * simd.h). */
 static inline __attribute__((always_inline)) void tridiag_x4(v4d *a, size_t n, v4d *d, v4d *e,
                                                              sqrt4_fn sq)
 {
@@ -380,10 +343,6 @@ static inline __attribute__((always_inline)) void gram_extremes_x4(const double 
 }
 
 #if JF_AVX_PATH
-__attribute__((target("avx"), always_inline)) static inline void sqrt4_avx(v4d *x)
-{
-    *x = __builtin_ia32_sqrtpd256(*x);
-}
 JF_AVX_FN static void gram_extremes_x4_avx(const double *const g[4], size_t cols, double hi[4],
                                            double lo[4], int rc[4])
 {

@@ -331,13 +331,16 @@ static inline double sum4(v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
 /* out[i] = sum4(v[i]), i < 4: the same additions, four sums a step
  * (pairs of lanes side by side, then the pairs' sums) */
+#if defined(__clang__) /* GCC's __builtin_shuffle is clang's shufflevector */
+#define SHUF4(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define SHUF4(a, b, i, j, k, l) __builtin_shuffle(a, b, (v4l){i, j, k, l})
+#endif
 static inline __attribute__((always_inline)) void sum4x4(const v4d *v, double *out)
 {
-    typedef long long v4i __attribute__((vector_size(32)));
-    const v4i ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
-    const v4d ab = __builtin_shuffle(v[0], v[1], ev) + __builtin_shuffle(v[0], v[1], od); /* a01 b01 a23 b23 */
-    const v4d cd = __builtin_shuffle(v[2], v[3], ev) + __builtin_shuffle(v[2], v[3], od);
-    const v4d r = __builtin_shuffle(ab, cd, lo) + __builtin_shuffle(ab, cd, hi);
+    const v4d ab = SHUF4(v[0], v[1], 0, 4, 2, 6) + SHUF4(v[0], v[1], 1, 5, 3, 7); /* a01 b01 a23 b23 */
+    const v4d cd = SHUF4(v[2], v[3], 0, 4, 2, 6) + SHUF4(v[2], v[3], 1, 5, 3, 7);
+    const v4d r = SHUF4(ab, cd, 0, 1, 4, 5) + SHUF4(ab, cd, 2, 3, 6, 7);
     memcpy(out, &r, sizeof r);
 }
 
