@@ -39,6 +39,7 @@
 #include "planes_internal.h"
 
 #define CHUNK JF_BLOCK_MAX /* points per scheduling unit (and progress tick) */
+#define LANES 4            /* fits side by side (jf__fit_point_x4) */
 
 void jf_estimate_opts_init(jf_estimate_opts *o)
 {
@@ -350,38 +351,31 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, 
 /* ---- per-thread workspace and the per-point step ----------------------- */
 
 typedef struct {
-    jf_fitter *fit, *fit2; /* fit2: the second of a pair (jf__fit_point_x2) */
-    jf_fitter *fit3, *fit4; /* and of a quad (jf__fit_point_x4)          */
-    double *coords3, *coords4, *raw3, *raw4;
+    /* lane k of a pair or quad of fits (jf__fit_point_x2, _x4): its
+     * fitter, neighbourhood and (natural fit_moved) raw ring */
+    jf_fitter *fit[LANES];
+    double *coords[LANES], *raw[LANES];
     jf_natural_ws *nws;
     uint32_t *idx;
-    double *d2, *coords, *coords2;
-    double *raw, *raw2;   /* natural fit_moved: the raw ring of each    */
+    double *d2;
     jf_result *blk;       /* block modes: the chunk's results (CHUNK)   */
     jf__knn_share *share; /* auto: the shared k-NN search               */
     uint32_t *bidx;       /* and their input indices                    */
     double *bxyz;         /* and coordinates (sinkx: the walk's, in order) */
     const double *hint;   /* knn: the last query's neighbours (coords or */
-    size_t hint_n;        /* coords2) and their count, for knn_hinted    */
+    size_t hint_n;        /* coords[k]) and their count, for knn_hinted  */
 } worker;
 
 static void worker_free(worker *w)
 {
-    jf_fitter_free(w->fit);
-    jf_fitter_free(w->fit2);
-    jf_fitter_free(w->fit3);
-    jf_fitter_free(w->fit4);
-    free(w->coords3);
-    free(w->coords4);
-    free(w->raw3);
-    free(w->raw4);
+    for (int k = 0; k < LANES; k++) {
+        jf_fitter_free(w->fit[k]);
+        free(w->coords[k]);
+        free(w->raw[k]);
+    }
     jf_natural_ws_free(w->nws);
     free(w->idx);
     free(w->d2);
-    free(w->coords);
-    free(w->coords2);
-    free(w->raw);
-    free(w->raw2);
     free(w->blk);
     free(w->bidx);
     free(w->bxyz);
@@ -392,27 +386,19 @@ static void worker_free(worker *w)
 static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int blocks)
 {
     memset(w, 0, sizeof *w);
-    jf_status st = jf_fitter_create(p, &w->fit);
-    if (st == JF_OK) st = jf_fitter_create(p, &w->fit2);
-    if (st == JF_OK) st = jf_fitter_create(p, &w->fit3);
-    if (st == JF_OK) st = jf_fitter_create(p, &w->fit4);
+    jf_status st = JF_OK;
+    for (int k = 0; k < LANES && st == JF_OK; k++) {
+        st = jf_fitter_create(p, &w->fit[k]);
+        if (st != JF_OK) break;
+        w->coords[k] = malloc(3 * x->cap * sizeof *w->coords[k]);
+        if (x->fit_moved) w->raw[k] = malloc(3 * x->cap * sizeof *w->raw[k]);
+        if (!w->coords[k] || (x->fit_moved && !w->raw[k])) st = JF_ERR_NOMEM;
+    }
     if (st == JF_OK && x->nt) st = jf_natural_ws_create(x->nt, &w->nws);
     if (st == JF_OK) {
         w->idx = malloc(x->cap * sizeof *w->idx);
         w->d2 = malloc(x->cap * sizeof *w->d2);
-        w->coords = malloc(3 * x->cap * sizeof *w->coords);
-        w->coords2 = malloc(3 * x->cap * sizeof *w->coords2);
-        w->coords3 = malloc(3 * x->cap * sizeof *w->coords3);
-        w->coords4 = malloc(3 * x->cap * sizeof *w->coords4);
-        if (!w->idx || !w->d2 || !w->coords || !w->coords2 || !w->coords3 || !w->coords4)
-            st = JF_ERR_NOMEM;
-    }
-    if (st == JF_OK && x->fit_moved) {
-        w->raw = malloc(3 * x->cap * sizeof *w->raw);
-        w->raw2 = malloc(3 * x->cap * sizeof *w->raw2);
-        w->raw3 = malloc(3 * x->cap * sizeof *w->raw3);
-        w->raw4 = malloc(3 * x->cap * sizeof *w->raw4);
-        if (!w->raw || !w->raw2 || !w->raw3 || !w->raw4) st = JF_ERR_NOMEM;
+        if (!w->idx || !w->d2) st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && blocks) {
         w->blk = malloc(CHUNK * sizeof *w->blk);
@@ -462,10 +448,9 @@ static void store_row(jf_result *out, const jf_result *r)
 
 static double *raw_of(const worker *w, const double *coords)
 {
-    return coords == w->coords    ? w->raw
-           : coords == w->coords2 ? w->raw2
-           : coords == w->coords3 ? w->raw3
-                                  : w->raw4;
+    int k = 0;
+    while (k + 1 < LANES && coords != w->coords[k]) k++;
+    return w->raw[k];
 }
 
 /* fit_moved: the residual of the raw ring about the jet fitted to the
@@ -513,86 +498,37 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
     return JF_OK;
 }
 
-static jf_status fit_one(worker *w, const nbctx *x, size_t i, const double *p, jf_result *out)
+/* Points i[0..L-1] (L = 1, 2 or 4 consecutive points of the walk): with
+ * L > 1, plain fits (x->plain) run side by side in one jf__fit_point_x2
+ * or _x4 (their 2- and 4-lane eigen-solvers), the same bits as one by
+ * one; a lane with no fit sends the others one by one. */
+static jf_status fit_lanes(worker *w, const nbctx *x, int L, const size_t i[], const double *const p[],
+                           jf_result *const out[])
 {
-    jf_result r;
-    size_t found = 0;
-    unsigned flags = 0;
-    int fit;
-    jf_status st = prepare(w, x, i, p, w->coords, &r, &found, &flags, &fit);
-    if (st != JF_OK) return st;
-    if (fit) {
-        st = jf_fit_point_full(w->fit, p, w->coords, found, &r);
-        raw_residual(w, x, w->fit, w->coords, found, &r);
-        r.status |= flags;
-    }
-    store_row(out, &r);
-    return st;
-}
-
-/* Points i0 and i1 (two consecutive points of the walk): plain fits
- * (x->plain) run side by side in one jf__fit_point_x2, the same bits as
- * one by one. */
-static jf_status fit_two(worker *w, const nbctx *x, size_t i0, const double *p0, size_t i1,
-                         const double *p1, jf_result *out0, jf_result *out1)
-{
-    jf_result r0, r1;
-    size_t n0 = 0, n1 = 0;
-    unsigned fl0 = 0, fl1 = 0;
-    int fit0, fit1;
-    jf_status st = prepare(w, x, i0, p0, w->coords, &r0, &n0, &fl0, &fit0);
-    if (st == JF_OK) st = prepare(w, x, i1, p1, w->coords2, &r1, &n1, &fl1, &fit1);
-    if (st != JF_OK) return st;
-    if (fit0 && fit1) {
-        st = jf__fit_point_x2(w->fit, p0, w->coords, n0, &r0, w->fit2, p1, w->coords2, n1, &r1);
-        raw_residual(w, x, w->fit, w->coords, n0, &r0);
-        raw_residual(w, x, w->fit2, w->coords2, n1, &r1);
-    } else {
-        if (fit0) {
-            st = jf_fit_point_full(w->fit, p0, w->coords, n0, &r0);
-            raw_residual(w, x, w->fit, w->coords, n0, &r0);
-        }
-        if (fit1 && st == JF_OK) {
-            st = jf_fit_point_full(w->fit, p1, w->coords2, n1, &r1);
-            raw_residual(w, x, w->fit, w->coords2, n1, &r1);
-        }
-    }
-    if (st != JF_OK) return st;
-    if (fit0) r0.status |= fl0;
-    if (fit1) r1.status |= fl1;
-    store_row(out0, &r0);
-    store_row(out1, &r1);
-    return JF_OK;
-}
-
-/* Points i[0..3] (consecutive in the walk): four plain fits side by side
- * in one jf__fit_point_x4 (its 4-lane eigen-solvers), the same bits. */
-static jf_status fit_four(worker *w, const nbctx *x, const size_t i[4], const double *const p[4],
-                          jf_result *const out[4])
-{
-    jf_result r[4];
-    size_t n[4] = {0, 0, 0, 0};
-    unsigned fl[4] = {0, 0, 0, 0};
-    int fit[4] = {0, 0, 0, 0};
-    double *const co[4] = {w->coords, w->coords2, w->coords3, w->coords4};
-    jf_fitter *const f[4] = {w->fit, w->fit2, w->fit3, w->fit4};
+    jf_result r[LANES];
+    size_t n[LANES] = {0};
+    unsigned fl[LANES] = {0};
+    int fit[LANES] = {0}, all = 1;
     jf_status st = JF_OK;
-    for (int k = 0; k < 4 && st == JF_OK; k++)
-        st = prepare(w, x, i[k], p[k], co[k], &r[k], &n[k], &fl[k], &fit[k]);
+    for (int k = 0; k < L && st == JF_OK; k++) {
+        st = prepare(w, x, i[k], p[k], w->coords[k], &r[k], &n[k], &fl[k], &fit[k]);
+        all &= fit[k];
+    }
     if (st != JF_OK) return st;
-    if (fit[0] && fit[1] && fit[2] && fit[3]) {
-        const double *const cc[4] = {co[0], co[1], co[2], co[3]};
+    if (all && L == 4) {
+        const double *const cc[4] = {w->coords[0], w->coords[1], w->coords[2], w->coords[3]};
         jf_result *const rr[4] = {&r[0], &r[1], &r[2], &r[3]};
-        st = jf__fit_point_x4(f, p, cc, n, rr);
-        for (int k = 0; k < 4; k++) raw_residual(w, x, f[k], co[k], n[k], &r[k]);
-    } else
-        for (int k = 0; k < 4 && st == JF_OK; k++)
-            if (fit[k]) {
-                st = jf_fit_point_full(w->fit, p[k], co[k], n[k], &r[k]);
-                raw_residual(w, x, w->fit, co[k], n[k], &r[k]);
-            }
+        st = jf__fit_point_x4(w->fit, p, cc, n, rr);
+    } else if (all && L == 2)
+        st = jf__fit_point_x2(w->fit[0], p[0], w->coords[0], n[0], &r[0], w->fit[1], p[1],
+                              w->coords[1], n[1], &r[1]);
+    for (int k = 0; k < L && st == JF_OK; k++) {
+        jf_fitter *f = all && L > 1 ? w->fit[k] : w->fit[0];
+        if (fit[k] && !(all && L > 1)) st = jf_fit_point_full(f, p[k], w->coords[k], n[k], &r[k]);
+        if (fit[k] && st == JF_OK) raw_residual(w, x, f, w->coords[k], n[k], &r[k]);
+    }
     if (st != JF_OK) return st;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < L; k++) {
         if (fit[k]) r[k].status |= fl[k];
         store_row(out[k], &r[k]);
     }
@@ -713,31 +649,26 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
                 }
                 if (blocks) w.bidx[m] = (uint32_t)i, memcpy(w.bxyz + 3 * m, pt, 3 * sizeof *pt);
                 jf_result *d0 = blocks ? &w.blk[m++] : &R->out[i];
+                /* plain fits go four (or two) at a time while the next points
+                 * are to be fitted in this chunk */
+                int L = 1;
                 if (x->plain && k + 3 < end &&
-                    (!fit || (fit[walk[k + 1]] && fit[walk[k + 2]] && fit[walk[k + 3]]))) {
-                    size_t iq[4] = {i};
-                    const double *pq[4] = {pt};
-                    jf_result *oq[4] = {d0};
-                    for (int q = 1; q < 4; q++) {
-                        iq[q] = walk[k + q];
-                        pq[q] = walk_xyz ? walk_xyz + 3 * (k + q) : R->c->xyz + 3 * iq[q];
-                        if (blocks) w.bidx[m] = (uint32_t)iq[q], memcpy(w.bxyz + 3 * m, pq[q], 3 * sizeof *pt);
-                        oq[q] = blocks ? &w.blk[m++] : &R->out[iq[q]];
-                    }
-                    wst = fit_four(&w, x, iq, pq, oq);
-                    k += 4;
-                } else if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]])) {
-                    const size_t i1 = walk[k + 1];
-                    const double *pt1 = walk_xyz ? walk_xyz + 3 * (k + 1) : R->c->xyz + 3 * i1;
-                    if (blocks) w.bidx[m] = (uint32_t)i1, memcpy(w.bxyz + 3 * m, pt1, 3 * sizeof *pt1);
-                    wst = fit_two(&w, x, i, pt, i1, pt1, d0,
-                                  blocks ? &w.blk[m++] : &R->out[i1]);
-                    k += 2;
-                } else {
-                    if (w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, end - k);
-                    wst = fit_one(&w, x, i, pt, d0);
-                    k++;
+                    (!fit || (fit[walk[k + 1]] && fit[walk[k + 2]] && fit[walk[k + 3]])))
+                    L = 4;
+                else if (x->plain && k + 1 < end && (!fit || fit[walk[k + 1]]))
+                    L = 2;
+                size_t iq[LANES] = {i};
+                const double *pq[LANES] = {pt};
+                jf_result *oq[LANES] = {d0};
+                for (int q = 1; q < L; q++) {
+                    iq[q] = walk[k + q];
+                    pq[q] = walk_xyz ? walk_xyz + 3 * (k + q) : R->c->xyz + 3 * iq[q];
+                    if (blocks) w.bidx[m] = (uint32_t)iq[q], memcpy(w.bxyz + 3 * m, pq[q], 3 * sizeof *pt);
+                    oq[q] = blocks ? &w.blk[m++] : &R->out[iq[q]];
                 }
+                if (L == 1 && w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, end - k);
+                wst = fit_lanes(&w, x, L, iq, pq, oq);
+                k += (size_t)L;
             }
             _mm_sfence(); /* the streamed rows (store_row), before anyone reads them */
             if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.bxyz, w.blk, m);
