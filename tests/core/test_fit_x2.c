@@ -144,15 +144,17 @@ START_TEST(test_eig3_x4_bits)
 }
 END_TEST
 
-/* jf__fit_point_x4 against four jf_fit_point calls on another fitter:
- * lanes of mixed kinds (some finished early, some lowered, some on the
- * SVD path), degrees 1..4, both fits and frames, AVX and default builds. */
-START_TEST(test_fit_x4_bits)
+/* jf__fit_point_x2 (L = 2) or _x4 (L = 4) against L jf_fit_point calls
+ * on another fitter, for degrees 1..4, both fits and frames: lanes of
+ * mixed kinds (some finished early, some lowered, some on the SVD path);
+ * the four-lane kernels in the AVX and the default build.  The fitters'
+ * state too: the residuals of the last fit.  At least 1/min_frac of the
+ * groups, and not all, keep every lane on the fast path. */
+static void lanes_vs_one(int L, int cases, size_t min_frac)
 {
-    rng_state = 4004;
     static const jf_fit_mode fits[2] = {JF_FIT_APPROX, JF_FIT_INTERP};
     static const jf_frame_mode frames[2] = {JF_FRAME_PCA, JF_FRAME_AXIS};
-    size_t quads = 0, all_fast = 0;
+    size_t groups = 0, all_fast = 0;
     for (int deg = 1; deg <= 4; deg++)
         for (int fm = 0; fm < 2; fm++)
             for (int fr = 0; fr < 2; fr++) {
@@ -164,45 +166,65 @@ START_TEST(test_fit_x4_bits)
                 p.frame = frames[fr];
                 p.max_neighbors = MAXN;
                 jf_fitter *f[4], *s0;
-                for (int k = 0; k < 4; k++) ck_assert_int_eq(jf_fitter_create(&p, &f[k]), JF_OK);
+                for (int k = 0; k < L; k++) ck_assert_int_eq(jf_fitter_create(&p, &f[k]), JF_OK);
                 ck_assert_int_eq(jf_fitter_create(&p, &s0), JF_OK);
-                for (int t = 0; t < 200; t++) {
-                    jf__no_avx = t % 2;
+                for (int t = 0; t < cases; t++) {
                     double nb[4][3 * MAXN], res[MAXN], ref_res[MAXN];
                     size_t n[4];
                     int kind[4];
-                    for (int k = 0; k < 4; k++) {
-                        kind[k] = (t / 4 + k * (t % 4 + 1)) % 9;
+                    for (int k = 0; k < L; k++) {
+                        kind[k] = L == 2 ? (k ? (t / 9 + t) % 9 : t % 9)
+                                         : (t / 4 + k * (t % 4 + 1)) % 9;
                         if (t % 3) kind[k] = t % 2 ? 0 : 1; /* mostly the usual case */
                         n[k] = make_nbhd(kind[k], nb[k]);
                     }
                     jf_result r[4], ref;
-                    const double *pp[4] = {nb[0], nb[1], nb[2], nb[3]};
-                    jf_result *const rr[4] = {&r[0], &r[1], &r[2], &r[3]};
-                    ck_assert_int_eq(jf__fit_point_x4(f, pp, pp, n, rr), JF_OK);
-                    jf__no_avx = 0;
+                    if (L == 2) {
+                        ck_assert_int_eq(jf__fit_point_x2(f[0], nb[0], nb[0], n[0], &r[0], f[1],
+                                                          nb[1], nb[1], n[1], &r[1]),
+                                         JF_OK);
+                    } else {
+                        const double *pp[4] = {nb[0], nb[1], nb[2], nb[3]};
+                        jf_result *const rr[4] = {&r[0], &r[1], &r[2], &r[3]};
+                        jf__no_avx = t % 2;
+                        ck_assert_int_eq(jf__fit_point_x4(f, pp, pp, n, rr), JF_OK);
+                        jf__no_avx = 0;
+                    }
                     int fast = 1;
-                    for (int k = 0; k < 4; k++) {
+                    for (int k = 0; k < L; k++) {
                         ck_assert_int_eq(jf_fit_point(s0, nb[k], nb[k], n[k], &ref), JF_OK);
                         ck_assert_msg(same_result(&r[k], &ref),
-                                      "deg %d fit %d frame %d case %d lane %d (kind %d): "
+                                      "x%d deg %d fit %d frame %d case %d lane %d (kind %d): "
                                       "k1 %.17g vs %.17g, cond %.17g vs %.17g",
-                                      deg, fm, fr, t, k, kind[k], r[k].k1, ref.k1, r[k].cond,
+                                      L, deg, fm, fr, t, k, kind[k], r[k].k1, ref.k1, r[k].cond,
                                       ref.cond);
                         ck_assert_int_eq(jf_fitter_residuals(f[k], res, n[k]), JF_OK);
                         ck_assert_int_eq(jf_fitter_residuals(s0, ref_res, n[k]), JF_OK);
                         ck_assert(same_bits(res, ref_res, n[k]));
                         fast &= r[k].degree == deg && r[k].cond <= 1e3;
                     }
-                    quads++;
+                    groups++;
                     all_fast += fast;
                 }
-                for (int k = 0; k < 4; k++) jf_fitter_free(f[k]);
+                for (int k = 0; k < L; k++) jf_fitter_free(f[k]);
                 jf_fitter_free(s0);
             }
-    jf__no_avx = 0;
-    ck_assert_uint_gt(all_fast, quads / 3);
-    ck_assert_uint_lt(all_fast, quads);
+    /* the lanes were exercised, and the other paths too */
+    ck_assert_uint_gt(all_fast, groups / min_frac);
+    ck_assert_uint_lt(all_fast, groups);
+}
+
+START_TEST(test_fit_x2_bits)
+{
+    rng_state = 2003;
+    lanes_vs_one(2, 300, 2);
+}
+END_TEST
+
+START_TEST(test_fit_x4_bits)
+{
+    rng_state = 4004;
+    lanes_vs_one(4, 200, 3);
 }
 END_TEST
 
@@ -226,64 +248,6 @@ START_TEST(test_ldexp_bits)
         ck_assert_msg(memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b)),
                       "ldexp(%a, %d): %a vs %a", x, e, a, b);
     }
-}
-END_TEST
-
-/* jf__fit_point_x2 against two jf_fit_point calls on other fitters, for
- * every pair of neighbourhood kinds, degrees 1..4, both fits and frames. */
-START_TEST(test_fit_x2_bits)
-{
-    rng_state = 2003;
-    static const jf_fit_mode fits[2] = {JF_FIT_APPROX, JF_FIT_INTERP};
-    static const jf_frame_mode frames[2] = {JF_FRAME_PCA, JF_FRAME_AXIS};
-    size_t pairs = 0, paired_fast = 0;
-    for (int deg = 1; deg <= 4; deg++)
-        for (int fm = 0; fm < 2; fm++)
-            for (int fr = 0; fr < 2; fr++) {
-                jf_params p;
-                jf_params_init(&p);
-                p.degree = deg;
-                p.monge_degree = deg < 2 ? 2 : (deg < 4 ? deg : 4);
-                p.fit = fits[fm];
-                p.frame = frames[fr];
-                p.max_neighbors = MAXN;
-                jf_fitter *a0, *a1, *s0;
-                ck_assert_int_eq(jf_fitter_create(&p, &a0), JF_OK);
-                ck_assert_int_eq(jf_fitter_create(&p, &a1), JF_OK);
-                ck_assert_int_eq(jf_fitter_create(&p, &s0), JF_OK);
-                for (int t = 0; t < 300; t++) {
-                    double nb[2][3 * MAXN], res[2][MAXN], ref_res[MAXN];
-                    size_t n[2];
-                    int kind[2] = {t % 9, (t / 9 + t) % 9};
-                    if (t % 3) kind[1] = kind[0] = t % 2 ? 0 : 1; /* mostly the usual case */
-                    for (int k = 0; k < 2; k++) n[k] = make_nbhd(kind[k], nb[k]);
-                    jf_result r[2], ref;
-                    ck_assert_int_eq(jf__fit_point_x2(a0, nb[0], nb[0], n[0], &r[0], a1, nb[1],
-                                                      nb[1], n[1], &r[1]),
-                                     JF_OK);
-                    for (int k = 0; k < 2; k++) {
-                        ck_assert_int_eq(jf_fit_point(s0, nb[k], nb[k], n[k], &ref), JF_OK);
-                        ck_assert_msg(same_result(&r[k], &ref),
-                                      "deg %d fit %d frame %d case %d lane %d (kinds %d %d): "
-                                      "k1 %.17g vs %.17g, cond %.17g vs %.17g",
-                                      deg, fm, fr, t, k, kind[0], kind[1], r[k].k1, ref.k1,
-                                      r[k].cond, ref.cond);
-                        /* the fitter's state too: residuals of the last fit */
-                        ck_assert_int_eq(jf_fitter_residuals(k ? a1 : a0, res[k], n[k]), JF_OK);
-                        ck_assert_int_eq(jf_fitter_residuals(s0, ref_res, n[k]), JF_OK);
-                        ck_assert(same_bits(res[k], ref_res, n[k]));
-                    }
-                    pairs++;
-                    paired_fast += r[0].degree == deg && r[1].degree == deg &&
-                                   r[0].cond <= 1e3 && r[1].cond <= 1e3;
-                }
-                jf_fitter_free(a0);
-                jf_fitter_free(a1);
-                jf_fitter_free(s0);
-            }
-    /* the lanes were exercised, and the other paths too */
-    ck_assert_uint_gt(paired_fast, pairs / 2);
-    ck_assert_uint_lt(paired_fast, pairs);
 }
 END_TEST
 
