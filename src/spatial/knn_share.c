@@ -17,7 +17,10 @@
  *     nearest -- the same list, bit for bit, as jf__index_query,
  *     whichever point built the candidates (threads, parts and ranks
  *     still agree).  A bucket sort by d2 (as the tree's buf_finish).
- *  3. Otherwise q becomes the new c.
+ *  3. Otherwise q becomes the new c.  The last SH_SETS searches'
+ *     candidates are kept (the walk comes back to a neighbourhood it
+ *     left), the set whose centre is nearest q tried first (the shortest
+ *     prefix); a search replaces the oldest.
  * Rounding: the test keeps a relative margin of 1e-9 (distances carry
  * errors near 1e-16), and a selection that finds fewer than k inside
  * the bound falls back to the search.
