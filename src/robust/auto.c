@@ -475,6 +475,9 @@ JF_CLONES static void moments(const double p[3], const double *nbr, size_t k, co
     if (deg == 2) {
         for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, 4, 2, 1);
         for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 4, 2, 1);
+    } else if (deg == 3) { /* constants: the sums' loops unrolled (the same operations) */
+        for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, 6, 3, 1);
+        for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, 6, 3, 1);
     } else {
         for (; i + 8 <= k; i += 8) acc_eight(&A, nbr, i, p, fr, iH, top, deg, 1);
         for (; i < k; i += 4) quad_of(nbr, i, k, q), acc_quad(&A, q, p, fr, iH, top, deg, 1);

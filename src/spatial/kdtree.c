@@ -10,8 +10,9 @@
  *    of its left half and the smallest of its right half along its axis
  *    (as nanoflann does), so the gap between the halves prunes too.
  *  - query: depth first, nearer child first; a bounded max-heap (or, for
- *    k up to 512, a 2k buffer cut back to k by quickselect; for k up to
- *    48, a buffer appended to without branches, ranked at the end) of
+ *    k up to KD_BUF_MAX / 2 = 1024, a 2k buffer cut back to k by
+ *    quickselect, on the heap above k = 500; for k up to 48, a buffer
+ *    appended to without branches, ranked at the end) of
  *    (d2, position in tree order) pairs lives in the caller's buffers,
  *    positions turned into original indices at the end (and, for the
  *    pipeline, the points' coordinates copied from the tree's storage:
@@ -41,7 +42,7 @@
 #define KD_STACK_KEYS 1024  /* d2 scratch on the stack when d2 == NULL    */
 #define KD_SORTED_MAX 48    /* k up to this: sorted array, else heap      */
 #define KD_BUF_MAX 2048     /* 2k up to this: buffer and quickselect      */
-#define KD_BUF_STACK 1024   /* its scratch on the stack up to this 2k     */
+#define KD_BUF_STACK 1024   /* its scratch on the stack up to this 2k + KD_LEAF */
 #define KD_PROBE_MIN 8      /* k >= 8 x this: a k/8 probe bounds the search */
 #ifndef KD_PROBE_GROW
 #define KD_PROBE_GROW 1.25  /* squared-radius margin of the probe's bound  */
@@ -551,23 +552,28 @@ static void buf_finish(const uint32_t *id, double *hd, uint32_t *hp, size_t cnt,
     }
 }
 
-static void buf_push(kd_query *s, double d, uint32_t pos)
+/* The k least of the cnt candidates kept (quickselect), the k-th of them
+ * the new worst. */
+static void keep_least(kd_query *s)
 {
-    s->hd[s->cnt] = d;
-    s->hp[s->cnt++] = pos;
-    if (s->cnt < 2 * s->cap) return;
     buf_select(s->ix->id, s->hd, s->hp, 0, s->cnt, s->cap - 1);
     s->cnt = s->cap;
     s->worst_d = s->hd[s->cap - 1];
     s->worst_p = s->hp[s->cap - 1];
 }
 
-/* Mode 2 without a scan record: as app_leaf, every point of a leaf within
- * the bound appended without a branch (half the points of a k = 1024
- * search's leaves fail the test, unpredictably), a superset of what the
- * (d2, index) rule admits; from 2k on, a quickselect keeps the k least
- * (as buf_push).  The buffer holds 2k + KD_LEAF. */
-static void buf_leaf(kd_query *s, const kd_node *nd)
+static void buf_push(kd_query *s, double d, uint32_t pos)
+{
+    s->hd[s->cnt] = d;
+    s->hp[s->cnt++] = pos;
+    if (s->cnt < 2 * s->cap) return;
+    keep_least(s);
+}
+
+/* Every point of a leaf within the bound appended without a branch (store
+ * always, advance on d <= worst): a superset of what the (d2, index) rule
+ * admits.  Returns the new count. */
+static inline __attribute__((always_inline)) size_t leaf_append(kd_query *s, const kd_node *nd)
 {
     const uint32_t first = nd->first, cnt = nd->dim >> 2;
     const double *p = s->ix->pts + 3 * (size_t)first;
@@ -582,12 +588,16 @@ static void buf_leaf(kd_query *s, const kd_node *nd)
         hp[c] = first + j;
         c += d <= w;
     }
-    s->cnt = c;
-    if (c < 2 * s->cap) return;
-    buf_select(s->ix->id, hd, hp, 0, c, s->cap - 1);
-    s->cnt = s->cap;
-    s->worst_d = hd[s->cap - 1];
-    s->worst_p = hp[s->cap - 1];
+    return s->cnt = c;
+}
+
+/* Mode 2 without a scan record: a leaf appended (leaf_append: half the
+ * points of a k = 1024 search's leaves fail the test, unpredictably);
+ * from 2k on, a quickselect keeps the k least (as buf_push).  The buffer
+ * holds 2k + KD_LEAF. */
+static void buf_leaf(kd_query *s, const kd_node *nd)
+{
+    if (leaf_append(s, nd) >= 2 * s->cap) keep_least(s);
 }
 
 /* Mode 3's bound, lowered while at least k candidates stay within it: a
@@ -624,35 +634,16 @@ static void app_shrink(kd_query *s)
     if (w < s->worst_d) s->worst_d = w, s->worst_p = UINT32_MAX;
 }
 
-/* Small k without a scan record: every point of a leaf within the bound
- * is appended without a branch (store always, advance on d <= worst), a
- * superset of what the (d2, index) rule admits; from 2k candidates on,
- * app_shrink lowers the bound.  The sorted insertion this replaces spent
+/* Small k without a scan record: a leaf appended (leaf_append); from 2k
+ * candidates on, app_shrink lowers the bound.  The sorted insertion this replaces spent
  * ~30% of a knn:16 query in mispredicted shifts.  Should the bound not
  * come down (many equal d2), a quickselect keeps the k least. */
 static void app_leaf(kd_query *s, const kd_node *nd)
 {
-    const uint32_t first = nd->first, cnt = nd->dim >> 2;
-    const double *p = s->ix->pts + 3 * (size_t)first;
-    const double q0 = s->q[0], q1 = s->q[1], q2 = s->q[2], w = s->worst_d;
-    double *hd = s->hd;
-    uint32_t *hp = s->hp;
-    size_t c = s->cnt;
-    for (uint32_t j = 0; j < cnt; j++, p += 3) {
-        const double dx = q0 - p[0], dy = q1 - p[1], dz = q2 - p[2];
-        const double d = dx * dx + dy * dy + dz * dz;
-        hd[c] = d;
-        hp[c] = first + j;
-        c += d <= w;
-    }
-    s->cnt = c;
-    if (c < 2 * s->cap) return;
+    if (leaf_append(s, nd) < 2 * s->cap) return;
     app_shrink(s);
     if (s->cnt + KD_LEAF <= KD_APP_MAX) return;
-    buf_select(s->ix->id, hd, hp, 0, s->cnt, s->cap - 1);
-    s->cnt = s->cap;
-    s->worst_d = hd[s->cap - 1];
-    s->worst_p = hp[s->cap - 1];
+    keep_least(s);
 }
 
 /* The k least of mode 3's cnt candidates, nearest first, into (od, op):

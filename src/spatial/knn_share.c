@@ -17,7 +17,10 @@
  *     nearest -- the same list, bit for bit, as jf__index_query,
  *     whichever point built the candidates (threads, parts and ranks
  *     still agree).  A bucket sort by d2 (as the tree's buf_finish).
- *  3. Otherwise q becomes the new c.
+ *  3. Otherwise q becomes the new c.  The last SH_SETS searches'
+ *     candidates are kept (the walk comes back to a neighbourhood it
+ *     left), the set whose centre is nearest q tried first (the shortest
+ *     prefix); a search replaces the oldest.
  * Rounding: the test keeps a relative margin of 1e-9 (distances carry
  * errors near 1e-16), and a selection that finds fewer than k inside
  * the bound falls back to the search.
@@ -32,9 +35,10 @@
 #define KSHARE 4 /* candidates: KSHARE x k (up to 1024: the tree's buffer mode) */
 #define SH_MARGIN 1.3 /* on the squared radius a search predicts (rebuild) */
 #define SH_JUMP 1.25 /* on the last search's squared radius, where it predicts nothing */
+#define SH_SETS 3 /* candidate sets kept: the walk comes back to the last but one */
 
-struct jf__knn_share {
-    size_t k, kc;  /* asked, candidates searched                       */
+/* One search's candidates. */
+typedef struct {
     size_t nc;     /* candidates held (0: none yet)                     */
     double c[3];   /* the point they were searched from                 */
     double rk, R;  /* |c - k-th|, |c - last| (INFINITY: the whole cloud) */
@@ -42,6 +46,12 @@ struct jf__knn_share {
     double *cxyz;
     double *cx, *cy, *cz; /* the same coordinates by axis (the d2 loop)    */
     double *cd2;   /* their squared distances to c, ascending           */
+} sh_set;
+
+struct jf__knn_share {
+    size_t k, kc;  /* asked, candidates searched                       */
+    sh_set set[SH_SETS];
+    int cur;       /* the set that served last (or was searched last)  */
     double *d2;    /* per query: candidates' d2                          */
     uint32_t *sel, *start, *bkt;
     double *td;
@@ -62,11 +72,13 @@ void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n)
 void jf__knn_share_free(jf__knn_share *s)
 {
     if (!s) return;
-    free(s->cid);
-    free(s->cxyz);
-    free(s->cx);
+    for (int i = 0; i < SH_SETS; i++) {
+        free(s->set[i].cid);
+        free(s->set[i].cxyz);
+        free(s->set[i].cx);
+        free(s->set[i].cd2);
+    }
     free(s->d2);
-    free(s->cd2);
     free(s->sel);
     free(s->bkt);
     free(s->start);
@@ -83,17 +95,23 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     if (!s) return JF_ERR_NOMEM;
     s->k = k;
     s->kc = KSHARE * k;
-    s->cid = malloc(s->kc * sizeof *s->cid);
-    s->cxyz = malloc(3 * s->kc * sizeof *s->cxyz);
-    s->cx = malloc(3 * s->kc * sizeof *s->cx);
+    int ok = 1;
+    for (int i = 0; i < SH_SETS; i++) {
+        sh_set *cs = &s->set[i];
+        cs->cid = malloc(s->kc * sizeof *cs->cid);
+        cs->cxyz = malloc(3 * s->kc * sizeof *cs->cxyz);
+        cs->cx = malloc(3 * s->kc * sizeof *cs->cx);
+        cs->cd2 = malloc(s->kc * sizeof *cs->cd2);
+        ok &= cs->cid && cs->cxyz && cs->cx && cs->cd2;
+        if (cs->cx) cs->cy = cs->cx + s->kc, cs->cz = cs->cy + s->kc;
+    }
     s->d2 = malloc(s->kc * sizeof *s->d2);
-    s->cd2 = malloc(s->kc * sizeof *s->cd2);
     s->sel = malloc(s->kc * sizeof *s->sel);
     s->bkt = malloc(s->kc * sizeof *s->bkt);
     s->start = malloc((2 * s->kc + 1) * sizeof *s->start);
     s->td = malloc(s->kc * sizeof *s->td);
     s->tp = malloc(s->kc * sizeof *s->tp);
-    if (!s->cid || !s->cxyz || !s->cx || !s->d2 || !s->cd2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
+    if (!ok || !s->d2 || !s->sel || !s->bkt || !s->start || !s->td || !s->tp) {
         jf__knn_share_free(s);
         return JF_ERR_NOMEM;
     }
@@ -105,10 +123,12 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
 #define SH_LESS(d, i, da, ia) ((d) < (da) || ((d) == (da) && (i) < (ia)))
 
 /* Step 1 at q: the candidates, and q's own k nearest as their prefix. */
-static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3], uint32_t *idx,
-                         double *d2, double *xyz, size_t *found)
+static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3], int slot,
+                         uint32_t *idx, double *d2, double *xyz, size_t *found)
 {
     size_t f = 0;
+    const sh_set *ls = &s->set[s->cur]; /* the last set served from or searched */
+    sh_set *cs = &s->set[slot];
     /* the tree's own bound for a large k assumes a surface (d2 ~ k); in
      * noise thicker than the spacing the cloud is locally 3-D and that
      * bound reads twice the points.  The candidates held count exactly the
@@ -117,12 +137,12 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
      * middle d2).  Exact either way: too few inside, the search runs
      * unbounded (SH_MARGIN 1.3: 2% of them on a 10^6 noisy torus) */
     double bound = INFINITY;
-    if (s->nc == s->kc && s->expo > 0.0) {
-        double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
-        double rin = s->R - sqrt(e0 * e0 + e1 * e1 + e2 * e2), rin2 = rin * rin;
+    if (ls->nc == s->kc && s->expo > 0.0) {
+        double e0 = q[0] - ls->c[0], e1 = q[1] - ls->c[1], e2 = q[2] - ls->c[2];
+        double rin = ls->R - sqrt(e0 * e0 + e1 * e1 + e2 * e2), rin2 = rin * rin;
         size_t m = 0;
-        for (size_t j = 0; rin > 0.0 && j < s->nc; j++) {
-            double dx = q[0] - s->cx[j], dy = q[1] - s->cy[j], dz = q[2] - s->cz[j];
+        for (size_t j = 0; rin > 0.0 && j < ls->nc; j++) {
+            double dx = q[0] - ls->cx[j], dy = q[1] - ls->cy[j], dz = q[2] - ls->cz[j];
             m += dx * dx + dy * dy + dz * dz <= rin2;
         }
         /* too few inside (the walk moved on): the last R^2 x SH_JUMP
@@ -131,61 +151,67 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
          * 3e5 noisy torus: x 1.5 overflowed the 2k buffer in half of
          * these searches, x 1.0 found too few in half, x 1.25 in 4% */
         double b = m >= s->kc / 16 ? rin2 * pow((double)s->kc / (double)m, s->expo) * SH_MARGIN
-                                   : s->R * s->R * SH_JUMP;
+                                   : ls->R * ls->R * SH_JUMP;
         if (b >= 0.0 && b < INFINITY) bound = b;
     }
-    s->nc = 0;
-    jf_status st = jf__index_query(ix, q, s->kc, bound, s->cid, s->cd2, s->cxyz, &f);
+    cs->nc = 0;
+    s->cur = slot;
+    jf_status st = jf__index_query(ix, q, s->kc, bound, cs->cid, cs->cd2, cs->cxyz, &f);
     if (st == JF_OK && f < s->kc && bound < INFINITY)
-        st = jf__index_query(ix, q, s->kc, INFINITY, s->cid, s->cd2, s->cxyz, &f);
+        st = jf__index_query(ix, q, s->kc, INFINITY, cs->cid, cs->cd2, cs->cxyz, &f);
     if (st != JF_OK) return st;
-    s->expo = f == s->kc && s->cd2[f / 2 - 1] > 0.0 ? log2(s->cd2[f - 1] / s->cd2[f / 2 - 1]) : 0.0;
+    s->expo = f == s->kc && cs->cd2[f / 2 - 1] > 0.0 ? log2(cs->cd2[f - 1] / cs->cd2[f / 2 - 1]) : 0.0;
     size_t m = f < s->k ? f : s->k;
-    memcpy(idx, s->cid, m * sizeof *idx);
-    if (d2) memcpy(d2, s->cd2, m * sizeof *d2);
-    if (xyz) memcpy(xyz, s->cxyz, 3 * m * sizeof *xyz);
+    memcpy(idx, cs->cid, m * sizeof *idx);
+    if (d2) memcpy(d2, cs->cd2, m * sizeof *d2);
+    if (xyz) memcpy(xyz, cs->cxyz, 3 * m * sizeof *xyz);
     *found = m;
     if (f <= s->k) return JF_OK; /* the whole cloud: nothing to share */
-    memcpy(s->c, q, sizeof s->c);
-    s->rk = s->rk_last = s->t_last = sqrt(s->cd2[s->k - 1]);
-    s->R = f < s->kc ? INFINITY : sqrt(s->cd2[f - 1]);
-    s->cy = s->cx + s->kc;
-    s->cz = s->cy + s->kc;
+    memcpy(cs->c, q, sizeof cs->c);
+    cs->rk = s->rk_last = s->t_last = sqrt(cs->cd2[s->k - 1]);
+    cs->R = f < s->kc ? INFINITY : sqrt(cs->cd2[f - 1]);
     for (size_t j = 0; j < f; j++) {
-        s->cx[j] = s->cxyz[3 * j];
-        s->cy[j] = s->cxyz[3 * j + 1];
-        s->cz[j] = s->cxyz[3 * j + 2];
+        cs->cx[j] = cs->cxyz[3 * j];
+        cs->cy[j] = cs->cxyz[3 * j + 1];
+        cs->cz[j] = cs->cxyz[3 * j + 2];
     }
-    s->nc = f;
+    cs->nc = f;
     return JF_OK;
 }
 
 /* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
-static int select_k(jf__knn_share *s, const double q[3], uint32_t *idx, double *d2, double *xyz,
-                    size_t *found)
+/* Built twice (target_clones): AVX (four distances a step, no FMA, so
+ * no contraction: the tree's bits) and the default (SSE2). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
+#define SH_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define SH_CLONES
+#endif
+SH_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q[3], uint32_t *idx, double *d2,
+                    double *xyz, size_t *found)
 {
-    if (!s->nc) return 0;
-    double e0 = q[0] - s->c[0], e1 = q[1] - s->c[1], e2 = q[2] - s->c[2];
+    if (!cs->nc) return 0;
+    double e0 = q[0] - cs->c[0], e1 = q[1] - cs->c[1], e2 = q[2] - cs->c[2];
     const double delta = sqrt(e0 * e0 + e1 * e1 + e2 * e2);
     /* q's k-th nearest is within rk + delta (c's k nearest are), so its k
      * nearest are the candidates within that of q, and among those no
      * farther than rk + 2 delta from c: a prefix of the candidates */
-    if (!((s->rk + delta) * (1.0 + 1e-9) < s->R)) return 0;
-    const double bmax = (s->rk + delta) * (1.0 + 1e-9);
+    if (!((cs->rk + delta) * (1.0 + 1e-9) < cs->R)) return 0;
+    const double bmax = (cs->rk + delta) * (1.0 + 1e-9);
     /* first a tighter b from the last query's k-th distance (+5%): if k
      * candidates lie within it, q's k nearest do too (fewer to sort) */
     double b = s->t_last * 1.05 < bmax ? s->t_last * 1.05 : bmax;
 again:;
     const double b2 = b * b, lc = (b + delta) * (1.0 + 1e-9), lc2 = lc * lc;
-    size_t lim = 0, hi = s->nc;
+    size_t lim = 0, hi = cs->nc;
     while (lim < hi) {
         size_t mid = lim + (hi - lim) / 2;
-        if (s->cd2[mid] <= lc2) lim = mid + 1;
+        if (cs->cd2[mid] <= lc2) lim = mid + 1;
         else hi = mid;
     }
     const double q0 = q[0], q1 = q[1], q2 = q[2];
     double *dd = s->td; /* scratch until the sort */
-    const double *cx = s->cx, *cy = s->cy, *cz = s->cz;
+    const double *cx = cs->cx, *cy = cs->cy, *cz = cs->cz;
     for (size_t j = 0; j < lim; j++) {
         double dx = q0 - cx[j], dy = q1 - cy[j], dz = q2 - cz[j];
         dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
@@ -208,7 +234,7 @@ again:;
     uint32_t *start = s->start, *tp = s->tp, *bkt = s->bkt;
     double *td = s->td;
     const double *sd = s->d2;
-    const uint32_t *sel = s->sel, *cid = s->cid;
+    const uint32_t *sel = s->sel, *cid = cs->cid;
     const size_t nb = 2 * n;
     const double scale = (double)nb / b2;
     if (!isfinite(scale)) return 0; /* b2 subnormal: the buckets would overflow */
@@ -250,17 +276,14 @@ again:;
     /* every point within t = |q - k-th| of q is within t + delta of c:
      * a candidate if that is below R (else a point beyond the candidates
      * may be nearer q) */
-    if (!((sqrt(td[k - 1]) + delta) * (1.0 + 1e-9) < s->R))
+    if (!((sqrt(td[k - 1]) + delta) * (1.0 + 1e-9) < cs->R))
         return 0;
-    const double *cxyz = s->cxyz;
+    const double *cxyz = cs->cxyz;
     for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
     if (d2) memcpy(d2, td, k * sizeof *d2);
     if (xyz)
-        for (size_t i = 0; i < k; i++) {
-            const double *a = cxyz + 3 * (size_t)tp[i];
-            double *o = xyz + 3 * i;
-            o[0] = a[0], o[1] = a[1], o[2] = a[2];
-        }
+        for (size_t i = 0; i < k; i++) /* one 16- and one 8-byte move */
+            memcpy(xyz + 3 * i, cxyz + 3 * (size_t)tp[i], 3 * sizeof *xyz);
     s->t_last = sqrt(s->td[k - 1]);
     *found = k;
     return 1;
@@ -270,7 +293,24 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
                               uint32_t *idx, double *d2, double *xyz, size_t *found)
 {
     *found = 0;
-    if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+    /* the sets whose centre is nearest q first (the shortest prefix) */
+    double dl[SH_SETS];
+    for (int j = 0; j < SH_SETS; j++) {
+        const sh_set *cs = &s->set[j];
+        double e0 = q[0] - cs->c[0], e1 = q[1] - cs->c[1], e2 = q[2] - cs->c[2];
+        dl[j] = cs->nc ? e0 * e0 + e1 * e1 + e2 * e2 : INFINITY;
+    }
+    for (int i = 0; i < SH_SETS; i++) {
+        int j = 0;
+        for (int t = 1; t < SH_SETS; t++)
+            if (dl[t] < dl[j]) j = t;
+        if (!(dl[j] < INFINITY)) break;
+        dl[j] = INFINITY;
+        if (select_k(s, &s->set[j], q, idx, d2, xyz, found)) {
+            s->cur = j;
+            return JF_OK;
+        }
+    }
     /* step 3, from the centroid of the walk's next points near q (within
      * half the last rk: the walk goes leaf by leaf, so a search there
      * serves the whole leaf); q itself when there are none */
@@ -288,11 +328,13 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
         }
         for (int d = 0; d < 3; d++) c[d] /= (double)nc;
     }
+    /* into the oldest set; a centre's that does not serve q, replaced */
+    int slot = (s->cur + 1) % SH_SETS;
     if (nc > 1) {
         size_t f = 0;
-        jf_status st = rebuild(s, ix, c, idx, d2, xyz, &f);
+        jf_status st = rebuild(s, ix, c, slot, idx, d2, xyz, &f);
         if (st != JF_OK) return st;
-        if (select_k(s, q, idx, d2, xyz, found)) return JF_OK;
+        if (select_k(s, &s->set[slot], q, idx, d2, xyz, found)) return JF_OK;
     }
-    return rebuild(s, ix, q, idx, d2, xyz, found);
+    return rebuild(s, ix, q, slot, idx, d2, xyz, found);
 }
