@@ -9,8 +9,8 @@
  *     cloud, 16 bytes per sampled point).
  *  2. For part a: index its own points; walking the index's leaf order
  *     (spatially coherent) on the threads, each own point whose own k-th
- *     distance may reach a cell holding another part's point (an
- *     occupancy grid over the cloud's box, rebuilt per part by one scan)
+ *     distance may reach a cell holding another part's point (a grid of
+ *     each cell's owner part over the cloud's box, built once in step 1)
  *     turns its neighbourhood into at most two requests "the k nearest
  *     within squared distance <= bound" (jf__halo_requests); in space
  *     order a knn point whose own k-th distance is bounded by the previous
@@ -30,7 +30,7 @@
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
  *  handed over first.  Every step runs on the threads; per part: two index
- *  builds (own, own + halo) and three scans of the coordinates.
+ *  builds (own, own + halo) and two scans of the coordinates.
  */
 #include <errno.h>
 #include <math.h>
@@ -266,19 +266,23 @@ static void heap_push(double *h, size_t *n, size_t k, double d)
  * underflow to 0. */
 static double ball_r(double b) { return sqrt(b) * (1 + 1e-9) + 1e-140; }
 
-/* Cells of a grid over the cloud's box that hold a point of another
- * part (the foreign points of part a): a ball over no such cell holds no
- * foreign point, so its point needs no halo (boxes of Z-curve runs
- * overlap too much to tell).  cell(v) = floor((v - lo) / s), clamped, is
- * monotone in v, so a point inside a box is in one of the box's cells. */
+/* Who owns each cell of a grid over the cloud's box (built once, in
+ * split's part pass): OCC_EMPTY, the one part (+1) whose points it holds,
+ * or OCC_MIXED.  A ball over no cell owned by another part (empty, or a's
+ * only) holds no foreign point, so its point needs no halo (boxes of
+ * Z-curve runs overlap too much to tell).  cell(v) = floor((v - lo) / s),
+ * clamped, is monotone in v, so a point inside a box is in one of the
+ * box's cells.  A byte a cell: the cells are jf__parts_grid_bits / 8, the
+ * bytes of the bit grid rebuilt per part by a scan before. */
 typedef struct {
     double lo[3], s;
     size_t dim[3];
-    uint64_t *bits;
-    double reach;      /* only parts within reach of a's box are marked  */
-    uint8_t *near;     /* near[b]: b's box within reach of a's (per part) */
+    uint8_t *own;
+    int P;
 } occgrid;
 
+#define OCC_EMPTY 0
+#define OCC_MIXED 255              /* also every cell when P > 254      */
 #define OCC_PROBE 4096             /* more cells in a ball: just ask   */
 /* (skipping a query: at most 64 cells probed, a query costs less) */
 
@@ -289,7 +293,7 @@ static size_t cell1(double v, double lo, double s, size_t dim)
     return t >= (double)dim ? dim - 1 : (size_t)t;
 }
 
-static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
+static void occ_setup(occgrid *g, const double box[6], size_t maxcells)
 {
     double ext = 0;
     for (int d = 0; d < 3; d++) ext = box[3 + d] - box[d] > ext ? box[3 + d] - box[d] : ext;
@@ -297,7 +301,7 @@ static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
     for (;;) {
         double cells = 1;
         for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1;
-        if (cells <= (double)maxbits) break;
+        if (cells <= (double)maxcells) break;
         g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
     }
     for (int d = 0; d < 3; d++) {
@@ -306,6 +310,8 @@ static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
     }
 }
 
+static size_t occ_cells(const occgrid *g) { return g->dim[0] * g->dim[1] * g->dim[2]; }
+
 static size_t occ_cell(const occgrid *g, const double *x)
 {
     return (cell1(x[2], g->lo[2], g->s, g->dim[2]) * g->dim[1] +
@@ -313,8 +319,23 @@ static size_t occ_cell(const occgrid *g, const double *x)
            cell1(x[0], g->lo[0], g->s, g->dim[0]);
 }
 
-/* 1 when no marked cell meets the box p +- r. */
-static int occ_free(const occgrid *g, const double p[3], double r, double probe)
+/* Part a (-1: none) holds x: its cell goes empty -> a + 1 -> mixed, on
+ * any thread (values only move forward, so a lost race retries once). */
+static void occ_set(occgrid *g, const double *x, int32_t a)
+{
+    uint8_t *c = g->own + occ_cell(g, x);
+    const uint8_t mine = g->P <= 254 ? (uint8_t)(a + 1) : OCC_MIXED;
+    uint8_t v = __atomic_load_n(c, __ATOMIC_RELAXED);
+    if (v == mine || v == OCC_MIXED) return;
+    if (v == OCC_EMPTY &&
+        __atomic_compare_exchange_n(c, &v, mine, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+        return;
+    if (v != mine) __atomic_store_n(c, (uint8_t)OCC_MIXED, __ATOMIC_RELAXED);
+}
+
+/* 1 when no cell meeting the box p +- r holds a point of a part other
+ * than a. */
+static int occ_free(const occgrid *g, const double p[3], double r, double probe, int32_t a)
 {
     size_t lo[3], hi[3];
     double cells = 1;
@@ -323,48 +344,15 @@ static int occ_free(const occgrid *g, const double p[3], double r, double probe)
         hi[d] = cell1(p[d] + r, g->lo[d], g->s, g->dim[d]);
         cells *= (double)(hi[d] - lo[d] + 1);
     }
-    if (!(r <= g->reach) || cells > probe) return 0; /* beyond: unmarked parts */
+    if (!(r < INFINITY) || cells > probe) return 0;
+    const uint8_t mine = g->P <= 254 ? (uint8_t)(a + 1) : OCC_EMPTY;
     for (size_t z = lo[2]; z <= hi[2]; z++)
-        for (size_t y = lo[1]; y <= hi[1]; y++)
-            for (size_t x = lo[0]; x <= hi[0]; x++) {
-                size_t c = (z * g->dim[1] + y) * g->dim[0] + x;
-                if ((g->bits[c / 64] >> (c % 64)) & 1) return 0;
-            }
-    return 1;
-}
-
-/* Marks the cells of the finite points of the parts near part a: those
- * whose box comes within reach of a's (reach: 16 cells); a ball wider
- * than that is never called free, so the parts left out cannot matter. */
-static void occ_mark(occgrid *g, reader *rd, const int32_t *part, int32_t a,
-                     const double *box, int P)
-{
-    g->reach = 16 * g->s;
-    const double *ba = box + 6 * a;
-    for (int b = 0; b < P; b++) {
-        const double *bb = box + 6 * b;
-        int near = b != a && bb[0] <= bb[3];
-        for (int d = 0; d < 3 && near; d++)
-            near = bb[d] <= ba[3 + d] + g->reach && bb[3 + d] >= ba[d] - g->reach;
-        g->near[b] = (uint8_t)near;
-    }
-    memset(g->bits, 0, (g->dim[0] * g->dim[1] * g->dim[2] + 63) / 64 * sizeof *g->bits);
-#pragma omp parallel for num_threads(rd->nt) schedule(dynamic, 4)
-    for (size_t ch = 0; ch < rd->nch; ch++) {
-        const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
-        size_t i = beg;
-        while (i < end && (part[i] < 0 || !g->near[part[i]])) i++;
-        if (i == end) continue; /* no near part's point: not read */
-        const double *x = chunk_xyz(rd, ch);
-        if (!x) continue;
-        for (; i < end; i++) {
-            if (part[i] < 0 || !g->near[part[i]]) continue;
-            size_t cix = occ_cell(g, x + 3 * (i - beg));
-            uint64_t bit = (uint64_t)1 << (cix % 64);
-            if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
-                __atomic_fetch_or(&g->bits[cix / 64], bit, __ATOMIC_RELAXED);
+        for (size_t y = lo[1]; y <= hi[1]; y++) {
+            const uint8_t *row = g->own + (z * g->dim[1] + y) * g->dim[0];
+            for (size_t x = lo[0]; x <= hi[0]; x++)
+                if (row[x] != OCC_EMPTY && row[x] != mine) return 0;
         }
-    }
+    return 1;
 }
 
 /* A halo point: input index and coordinates, as the scan read them. */
@@ -462,7 +450,8 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                          * it, no request, no query */
                         double dd = 0;
                         for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
-                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64)) continue;
+                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64, a))
+                            continue;
                     }
                     int nr = jf__halo_requests(own, q, p, idx, d2, r);
                     if (knn && nr == 1) {
@@ -470,7 +459,7 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                         last[3] = sqrt(r[0].bound);
                     }
                     for (int t = 0; t < nr && ok; t++)
-                        if (!occ_free(occ, p, ball_r(r[t].bound), OCC_PROBE))
+                        if (!occ_free(occ, p, ball_r(r[t].bound), OCC_PROBE, a))
                             ok = rvec_push(mine, (request){(uint32_t)j, r[t]});
                 }
             }
@@ -747,7 +736,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
  * the same parts as jf__parts_split_sampled (same sample, same keys), the
  * boxes the same min and max. */
 static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *count,
-                       double gbox[6], size_t *nfinite)
+                       double gbox[6], size_t *nfinite, occgrid *occ)
 {
     const size_t n = rd->n, nch = rd->nch;
     const int nt = rd->nt;
@@ -791,6 +780,12 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     const size_t nf = fc[nch];
     *nfinite = nf;
     const double scale = jf__morton_scale(gbox);
+    occ_setup(occ, gbox, jf__parts_grid_bits(n) / 8);
+    occ->P = P;
+    if (!(occ->own = calloc(occ_cells(occ), 1))) {
+        st = JF_ERR_NOMEM;
+        goto out;
+    }
     /* 2. every stride-th finite point in input order (parts.c's rule) */
     const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
     const size_t ns = nf ? (nf + stride - 1) / stride : 0;
@@ -840,6 +835,7 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
                 const int32_t a = jf__keyed_rank(cut, ncut, jf__morton_key(p, gbox, scale),
                                                 (uint32_t)(beg + j));
                 part[beg + j] = a;
+                occ_set(occ, p, a);
                 double *b = bx + 6 * a;
                 for (int d = 0; d < 3; d++) {
                     if (p[d] < b[d]) b[d] = p[d];
@@ -869,7 +865,6 @@ out:
     free(tc);
     free(smp);
     free(cut);
-    (void)n;
     return st;
 }
 
@@ -944,7 +939,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
     size_t *ccnt = NULL;
-    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, NULL};
+    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0};
     reader rd;
     double gb[6];
     if ((st = reader_open(&rd, src, n, nt)) != JF_OK) goto out;
@@ -952,19 +947,16 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         st = JF_ERR_NOMEM;
         goto out;
     }
-    if ((st = split(&rd, P, part, box, count, gb, &nf)) != JF_OK) goto out;
+    if ((st = split(&rd, P, part, box, count, gb, &nf, &occ)) != JF_OK) goto out;
     if ((st = reader_status(&rd, err)) != JF_OK) goto out;
     if (nf < n && (st = nonfinite_rows(&rd, part, sink, user)) != JF_OK) {
         if (rd.fail) st = reader_status(&rd, err);
         goto out;
     }
     for (int b = 0; b < P; b++) cmax = count[b] > cmax ? count[b] : cmax;
-    occ_setup(&occ, gb, jf__parts_grid_bits(n));
-    occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
-    occ.near = malloc((size_t)P);
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
-    if (!occ.bits || !occ.near || !ids || !sxyz) {
+    if (!ids || !sxyz) {
         st = JF_ERR_NOMEM;
         goto out;
     }
@@ -982,7 +974,6 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         if ((st = reader_status(&rd, err)) != JF_OK) goto out;
         jf_index *own = NULL;
         if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        occ_mark(&occ, &rd, part, a, box, P);
         st = rd.fail ? JF_ERR_IO
                      : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
         jf_index_free(own);
@@ -1060,7 +1051,6 @@ out:
     free(sscan);
     free(mask);
     free(ccnt);
-    free(occ.bits);
-    free(occ.near);
+    free(occ.own);
     return st;
 }
