@@ -66,26 +66,22 @@ static jf_status parts_query(const jf_estimate_opts *o, jf_part_query *q, jf_err
     return st;
 }
 
-/* The sink of one part: local indices back to input indices, with the
- * points' coordinates (the part's copy). */
+/* The sink of one part: local indices back to input indices (the
+ * coordinates come with the block, the walk's copy of the part's). */
 typedef struct {
     const uint32_t *ids; /* local -> input index                       */
-    const double *xyz;   /* the part's coordinates (local)             */
     jf__block_xyz_fn sink;
     void *user;
 } relay;
 
-static jf_status relay_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
+static jf_status relay_block(void *user, const uint32_t *idx, const double *xyz, jf_result *res,
+                             size_t m)
 {
     const relay *r = user;
     uint32_t g[256];
-    double x[3 * 256];
     if (m > 256) return JF_ERR_INVALID;
-    for (size_t j = 0; j < m; j++) {
-        g[j] = r->ids[idx[j]];
-        memcpy(x + 3 * j, r->xyz + 3 * (size_t)idx[j], sizeof(double[3]));
-    }
-    return r->sink(r->user, g, x, res, m);
+    for (size_t j = 0; j < m; j++) g[j] = r->ids[idx[j]];
+    return r->sink(r->user, g, xyz, res, m);
 }
 
 /* The coordinates' reader (jf_xyz_src): every scan walks the cloud in
@@ -98,6 +94,7 @@ typedef struct {
     double **xyz;          /* per thread: JF_SRC_CHUNK x 3              */
     unsigned char **raw;   /* per thread: JF_SRC_CHUNK rows             */
     int nt;
+    int plain;             /* rows are x y z doubles (no raw buffers)   */
     int fail;              /* a read failed: io_row, io_errno           */
     size_t io_row;
     int io_errno;
@@ -117,7 +114,8 @@ static const double *chunk_xyz(reader *rd, size_t ch)
     if (__atomic_load_n(&rd->fail, __ATOMIC_RELAXED)) return NULL;
     const int t = omp_get_thread_num();
     const jf_row_layout *l = rd->s->l;
-    unsigned char *p = rd->raw[t];
+    /* rows of three doubles: read straight into the coordinates */
+    unsigned char *p = rd->plain ? (unsigned char *)rd->xyz[t] : rd->raw[t];
     size_t left = m * l->row;
     uint64_t at = l->vertex_off + (uint64_t)first * l->row;
     while (left) {
@@ -134,7 +132,7 @@ static const double *chunk_xyz(reader *rd, size_t ch)
         }
         p += k, left -= (size_t)k, at += (uint64_t)k;
     }
-    jf__layout_rows(rd->raw[t], m, l, rd->xyz[t], NULL);
+    if (!rd->plain) jf__layout_rows(rd->raw[t], m, l, rd->xyz[t], NULL);
     return rd->xyz[t];
 }
 
@@ -146,11 +144,12 @@ static jf_status reader_open(reader *rd, const jf_xyz_src *s, size_t n, int nt)
     if (s->xyz) return JF_OK;
     rd->xyz = calloc((size_t)nt, sizeof *rd->xyz);
     rd->raw = calloc((size_t)nt, sizeof *rd->raw);
+    rd->plain = jf__layout_plain_xyz(s->l);
     if (!rd->xyz || !rd->raw) return JF_ERR_NOMEM;
     for (int t = 0; t < nt; t++) {
         rd->xyz[t] = malloc(JF_SRC_CHUNK * 3 * sizeof(double));
-        rd->raw[t] = malloc(JF_SRC_CHUNK * s->l->row);
-        if (!rd->xyz[t] || !rd->raw[t]) return JF_ERR_NOMEM;
+        rd->raw[t] = rd->plain ? NULL : malloc(JF_SRC_CHUNK * s->l->row);
+        if (!rd->xyz[t] || (!rd->plain && !rd->raw[t])) return JF_ERR_NOMEM;
     }
     return JF_OK;
 }
@@ -744,7 +743,12 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     double *tb = malloc((size_t)nt * 6 * (size_t)(P > 1 ? P : 1) * sizeof *tb);
     size_t *tc = calloc((size_t)nt * (size_t)P, sizeof *tc);
     jf__keyed *smp = NULL, *cut = NULL;
-    jf_status st = fc && tb && tc ? JF_OK : JF_ERR_NOMEM;
+    /* the sample if every point is finite (finite rank = input index):
+     * every stride1-th point's coordinates, taken by the first scan */
+    const size_t want1 = jf__parts_sample_size(n), stride1 = n > want1 ? n / want1 : 1;
+    const size_t ns1 = (n + stride1 - 1) / stride1;
+    double *sx1 = malloc(ns1 * 3 * sizeof *sx1);
+    jf_status st = fc && tb && tc && sx1 ? JF_OK : JF_ERR_NOMEM;
     if (st != JF_OK) goto out;
     for (size_t j = 0; j < (size_t)nt * (size_t)P; j++)
         for (int k = 0; k < 3; k++) tb[6 * j + k] = INFINITY, tb[6 * j + 3 + k] = -INFINITY;
@@ -755,7 +759,9 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
 #pragma omp for schedule(dynamic, 4)
         for (size_t ch = 0; ch < nch; ch++) {
             const double *x = chunk_xyz(rd, ch);
-            const size_t m = chunk_len(rd, ch);
+            const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+            for (size_t i = (beg + stride1 - 1) / stride1 * stride1; x && i < beg + m; i += stride1)
+                memcpy(sx1 + 3 * (i / stride1), x + 3 * (i - beg), sizeof(double[3]));
             size_t f = 0;
             for (size_t j = 0; x && j < m; j++) {
                 const double *p = x + 3 * j;
@@ -795,21 +801,26 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
         st = JF_ERR_NOMEM;
         goto out;
     }
+    if (nf == n) { /* the first scan's: the same points, stride and keys */
+        for (size_t r = 0; r < ns; r++)
+            smp[r] = (jf__keyed){jf__morton_key(sx1 + 3 * r, gbox, scale), (uint32_t)(r * stride)};
+    } else {
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 4)
-    for (size_t ch = 0; ch < nch; ch++) {
-        size_t seen = fc[ch];
-        if (fc[ch + 1] == seen) continue;
-        /* the chunk's first finite rank divisible by stride */
-        if ((seen + stride - 1) / stride * stride >= fc[ch + 1]) continue;
-        const double *x = chunk_xyz(rd, ch);
-        const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
-        for (size_t j = 0; x && j < m; j++) {
-            const double *p = x + 3 * j;
-            if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
-            if (seen % stride == 0)
-                smp[seen / stride] =
-                    (jf__keyed){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
-            seen++;
+        for (size_t ch = 0; ch < nch; ch++) {
+            size_t seen = fc[ch];
+            if (fc[ch + 1] == seen) continue;
+            /* the chunk's first finite rank divisible by stride */
+            if ((seen + stride - 1) / stride * stride >= fc[ch + 1]) continue;
+            const double *x = chunk_xyz(rd, ch);
+            const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+            for (size_t j = 0; x && j < m; j++) {
+                const double *p = x + 3 * j;
+                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+                if (seen % stride == 0)
+                    smp[seen / stride] =
+                        (jf__keyed){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
+                seen++;
+            }
         }
     }
     if (rd->fail) goto out;
@@ -865,6 +876,7 @@ out:
     free(tc);
     free(smp);
     free(cut);
+    free(sx1);
     return st;
 }
 
@@ -1025,8 +1037,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         sc.scan = sscan;
         sc.scanner = c->scanner;
         sc.nscans = c->nscans;
-        relay rl = {sid, sxyz, sink, user};
-        st = jf__estimate_blocks_masked(&sc, &po, mask, relay_block, &rl, err);
+        relay rl = {sid, sink, user};
+        st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
         free(sid);
         free(snrm);
         free(sscan);
