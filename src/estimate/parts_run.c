@@ -698,6 +698,150 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     return JF_OK;
 }
 
+/* Step 2 without the own index (knn:K, K < CNT_MAX): part a's halo as
+ * every point of another part in a cell near one of a's, on a grid over
+ * a's box (widened by GRID_PAD cells; as fine as the plan's second grid
+ * allows).  Why it holds the halo: an own point p in cell c that holds
+ * K + 1 own points has its own K-th distance t <= the cell's diagonal
+ * (sqrt 3 s), else, if the 3 x 3 x 3 cells around c hold K + 1, t <=
+ * 2 sqrt 3 s; every point of the whole cloud nearer p than t (the cloud's
+ * K-th distance is no larger) lies within R = 2 (or 4) cells of c (cell =
+ * floor((v - lo) / s) is monotone; the margins cover the roundings; 6
+ * cells for the 5 x 5 x 5 around c, t <= 3 sqrt 3 s), so
+ * the points of other parts in those cells are a superset of p's remote
+ * neighbours.  Cost: one scan of the cloud (the own points were gathered
+ * by another), no index, no query.  *served = 0 (nothing allocated) when
+ * a cell's 27 hold too few own points (sparse regions: the requests
+ * decide there), when the cells are too small for the coordinates'
+ * roundings, or when the halo would pass cap points (the memory plan's):
+ * the caller then takes halo_of. */
+#define CNT_MAX 63   /* counts in a byte's low 6 bits; bit 6: done, bit 7: near */
+#define GRID_PAD 7   /* cells around a's box: more than R = 6 */
+static jf_status halo_by_cells(reader *rd, const int32_t *part, const double *boxa, int32_t a,
+                               const double *xyz, size_t m, size_t K, size_t cap, size_t maxcells,
+                               int nt, hpoint **halo, size_t *nhalo, int *served)
+{
+    *served = 0;
+    if (K + 1 > CNT_MAX || !m) return JF_OK;
+    occgrid gg, *g = &gg;
+    double ext = 0, big = 0;
+    for (int d = 0; d < 3; d++) {
+        ext = boxa[3 + d] - boxa[d] > ext ? boxa[3 + d] - boxa[d] : ext;
+        big = fabs(boxa[d]) > big ? fabs(boxa[d]) : big;
+        big = fabs(boxa[3 + d]) > big ? fabs(boxa[3 + d]) : big;
+    }
+    /* the padding alone must fit (a small cloud's grid is small) */
+    const double pad = 2 * GRID_PAD + 2;
+    if (!(ext > 0) || !isfinite(ext) || pad * pad * pad > (double)maxcells) return JF_OK;
+    g->s = ext / 4096;
+    for (;;) {
+        double cells = 1;
+        for (int d = 0; d < 3; d++) cells *= floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
+        if (cells <= (double)maxcells) break;
+        g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
+    }
+    if (!(g->s > 1e-6 * (big + ext))) return JF_OK; /* cells of a few ulps: the margins fail */
+    for (int d = 0; d < 3; d++) {
+        g->lo[d] = boxa[d] - GRID_PAD * g->s;
+        g->dim[d] = (size_t)floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
+    }
+    double ghi[3];
+    for (int d = 0; d < 3; d++) ghi[d] = g->lo[d] + (double)g->dim[d] * g->s;
+    const size_t dx = g->dim[0], dy = g->dim[1], dz = g->dim[2];
+    /* the plan's second grid (its bytes: jf__parts_grid_bits / 8), freed
+     * before halo_of takes its own */
+    uint8_t *cnt = calloc(occ_cells(g), 1);
+    if (!cnt) return JF_ERR_NOMEM;
+    for (size_t j = 0; j < m; j++) {
+        uint8_t *c = cnt + occ_cell(g, xyz + 3 * j);
+        if (*c < CNT_MAX) (*c)++;
+    }
+    for (size_t j = 0; j < m; j++) {
+        const size_t c = occ_cell(g, xyz + 3 * j);
+        if (cnt[c] & 0x40) continue;
+        cnt[c] |= 0x40;
+        const size_t cx = c % dx, cy = c / dx % dy, cz = c / dx / dy;
+        /* the least block of (2L + 1)^3 cells around c holding K + 1 own
+         * points bounds t by sqrt 3 (L + 1) s: R = its ceiling */
+        static const size_t RL[3] = {2, 4, 6};
+        size_t R = 0;
+        for (size_t L = 0; L < 3 && !R; L++) {
+            size_t sum = 0;
+            for (size_t z = cz > L ? cz - L : 0; z <= cz + L && z < dz; z++)
+                for (size_t y = cy > L ? cy - L : 0; y <= cy + L && y < dy; y++)
+                    for (size_t x = cx > L ? cx - L : 0; x <= cx + L && x < dx; x++)
+                        sum += cnt[(z * dy + y) * dx + x] & 0x3f;
+            if (sum >= K + 1) R = RL[L];
+        }
+        if (!R) {
+            free(cnt);
+            return JF_OK;
+        }
+        for (size_t z = cz > R ? cz - R : 0; z <= cz + R && z < dz; z++)
+            for (size_t y = cy > R ? cy - R : 0; y <= cy + R && y < dy; y++) {
+                uint8_t *row = cnt + (z * dy + y) * dx;
+                for (size_t x = cx > R ? cx - R : 0; x <= cx + R && x < dx; x++) row[x] |= 0x80;
+            }
+    }
+    /* the scan: other parts' points in a marked cell, at most cap */
+    hvec *th = calloc((size_t)nt, sizeof *th);
+    size_t total = 0;
+    int fail = !th, over = 0;
+    if (th) {
+#pragma omp parallel num_threads(nt)
+        {
+            hvec *mine_v = &th[omp_get_thread_num()];
+            int ok = 1;
+#pragma omp for schedule(dynamic, 4)
+            for (size_t ch = 0; ch < rd->nch; ch++) {
+                if (!ok || __atomic_load_n(&over, __ATOMIC_RELAXED)) continue;
+                const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+                size_t i0 = beg;
+                while (i0 < end && (part[i0] < 0 || part[i0] == a)) i0++;
+                const double *xc = i0 < end ? chunk_xyz(rd, ch) : NULL;
+                const size_t had = mine_v->n;
+                for (size_t i = i0; xc && ok && i < end; i++) {
+                    if (part[i] < 0 || part[i] == a) continue;
+                    const double *x = xc + 3 * (i - beg);
+                    if (!(x[0] >= g->lo[0] && x[0] <= ghi[0] && x[1] >= g->lo[1] &&
+                          x[1] <= ghi[1] && x[2] >= g->lo[2] && x[2] <= ghi[2]))
+                        continue; /* farther than GRID_PAD cells from a's box */
+                    if (cnt[occ_cell(g, x)] & 0x80) ok = hvec_push(mine_v, (uint32_t)i, x);
+                }
+                if (__atomic_add_fetch(&total, mine_v->n - had, __ATOMIC_RELAXED) > cap)
+                    __atomic_store_n(&over, 1, __ATOMIC_RELAXED);
+            }
+            if (!ok) {
+#pragma omp atomic write
+                fail = 1;
+            }
+        }
+    }
+    hpoint *hv = NULL;
+    size_t nh = 0;
+    if (!fail && !over && !rd->fail) {
+        for (int t = 0; t < nt; t++) nh += th[t].n;
+        if (!(hv = malloc((nh ? nh : 1) * sizeof *hv))) fail = 1;
+    }
+    if (hv) {
+        size_t w = 0;
+        for (int t = 0; t < nt; t++) {
+            if (th[t].n) memcpy(hv + w, th[t].v, th[t].n * sizeof *hv);
+            w += th[t].n;
+        }
+        qsort(hv, nh, sizeof *hv, cmp_hpoint);
+    }
+    for (int t = 0; th && t < nt; t++) free(th[t].v);
+    free(th);
+    free(cnt);
+    if (fail) return JF_ERR_NOMEM;
+    if (!hv) return JF_OK; /* over the cap, or a failed read (the caller's) */
+    *halo = hv;
+    *nhalo = nh;
+    *served = 1;
+    return JF_OK;
+}
+
 /* jf_estimate_parts's sink without the coordinates. */
 typedef struct {
     jf_block_fn sink;
@@ -968,6 +1112,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     for (int b = 0; b < P; b++) cmax = count[b] > cmax ? count[b] : cmax;
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
+    /* the most own + halo points the plan holds for a part */
+    const size_t hcap = (size_t)(ceil((double)n / P) * JF_PLAN_HALO);
     if (!ids || !sxyz) {
         st = JF_ERR_NOMEM;
         goto out;
@@ -984,11 +1130,18 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         /* step 2: own index, requests, halo */
         size_t m = gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
         if ((st = reader_status(&rd, err)) != JF_OK) goto out;
-        jf_index *own = NULL;
-        if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        st = rd.fail ? JF_ERR_IO
-                     : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
-        jf_index_free(own);
+        int served = 0;
+        if (q.nb.kind == JF_NB_KNN &&
+            (st = halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, q.nb.k, hcap > m ? hcap - m : 0,
+                                jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
+            break;
+        if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
+            jf_index *own = NULL;
+            if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
+            st = rd.fail ? JF_ERR_IO
+                         : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
+            jf_index_free(own);
+        }
         if (rd.fail) st = reader_status(&rd, err);
         if (st != JF_OK) break;
         /* step 3: own + halo in input order, merged from the back into
