@@ -7,7 +7,13 @@
  *  1. Parts: the finite points cut along the (Morton key, index) order at
  *     the quantiles of a sample (jf__parts_split_sampled: no sort of the
  *     cloud, 16 bytes per sampled point).
- *  2. For part a: index its own points; walking the index's leaf order
+ *  2. For part a, knn with dense cells (halo_by_cells): the own points
+ *     counted on a grid over a's box; where a cell (or the 27 or 125
+ *     around it) holds K + 1 own points, the K-th distance is bounded by
+ *     the block's size, so the other parts' points in the cells that near
+ *     are a superset of the halo, taken by one scan: no index, no query.
+ *     Otherwise (sparse cells, radius kinds, a halo over the plan's):
+ *     index its own points; walking the index's leaf order
  *     (spatially coherent) on the threads, each own point whose own k-th
  *     distance may reach a cell holding another part's point (a grid of
  *     each cell's owner part over the cloud's box, built once in step 1)
@@ -29,8 +35,9 @@
  *     that contains all of it gives the same k nearest, the same order,
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
- *  handed over first.  Every step runs on the threads; per part: two index
- *  builds (own, own + halo) and two scans of the coordinates.
+ *  handed over first.  Every step runs on the threads; per part: one index
+ *  build (own + halo; two with the requests) and two scans of the
+ *  coordinates.
  */
 #include <errno.h>
 #include <math.h>
