@@ -277,14 +277,15 @@ static double ball_r(double b) { return sqrt(b) * (1 + 1e-9) + 1e-140; }
  * or OCC_MIXED.  A ball over no cell owned by another part (empty, or a's
  * only) holds no foreign point, so its point needs no halo (boxes of
  * Z-curve runs overlap too much to tell).  cell(v) = floor((v - lo) / s),
- * clamped, is monotone in v, so a point inside a box is in one of the
- * box's cells.  A byte a cell: the cells are jf__parts_grid_bits / 8, the
+ * clamped (a product by 1/s), is monotone in v, so a point inside a box
+ * is in one of the box's cells.  A byte a cell: the cells are jf__parts_grid_bits / 8, the
  * bytes of the bit grid rebuilt per part by a scan before. */
 typedef struct {
     double lo[3], s;
     size_t dim[3];
     uint8_t *own;
     int P;
+    double inv;        /* 1 / s: a product per axis, not a division     */
 } occgrid;
 
 #define OCC_EMPTY 0
@@ -292,9 +293,9 @@ typedef struct {
 #define OCC_PROBE 4096             /* more cells in a ball: just ask   */
 /* (skipping a query: at most 64 cells probed, a query costs less) */
 
-static size_t cell1(double v, double lo, double s, size_t dim)
+static inline size_t cell1(double v, double lo, double inv, size_t dim)
 {
-    double t = floor((v - lo) / s);
+    double t = floor((v - lo) * inv);
     if (!(t > 0)) return 0;
     return t >= (double)dim ? dim - 1 : (size_t)t;
 }
@@ -314,15 +315,16 @@ static void occ_setup(occgrid *g, const double box[6], size_t maxcells)
         g->lo[d] = box[d];
         g->dim[d] = (size_t)floor((box[3 + d] - box[d]) / g->s) + 1;
     }
+    g->inv = 1 / g->s;
 }
 
 static size_t occ_cells(const occgrid *g) { return g->dim[0] * g->dim[1] * g->dim[2]; }
 
-static size_t occ_cell(const occgrid *g, const double *x)
+static inline size_t occ_cell(const occgrid *g, const double *x)
 {
-    return (cell1(x[2], g->lo[2], g->s, g->dim[2]) * g->dim[1] +
-            cell1(x[1], g->lo[1], g->s, g->dim[1])) * g->dim[0] +
-           cell1(x[0], g->lo[0], g->s, g->dim[0]);
+    return (cell1(x[2], g->lo[2], g->inv, g->dim[2]) * g->dim[1] +
+            cell1(x[1], g->lo[1], g->inv, g->dim[1])) * g->dim[0] +
+           cell1(x[0], g->lo[0], g->inv, g->dim[0]);
 }
 
 /* Part a (-1: none) holds x: its cell goes empty -> a + 1 -> mixed, on
@@ -346,8 +348,8 @@ static int occ_free(const occgrid *g, const double p[3], double r, double probe,
     size_t lo[3], hi[3];
     double cells = 1;
     for (int d = 0; d < 3; d++) {
-        lo[d] = cell1(p[d] - r, g->lo[d], g->s, g->dim[d]);
-        hi[d] = cell1(p[d] + r, g->lo[d], g->s, g->dim[d]);
+        lo[d] = cell1(p[d] - r, g->lo[d], g->inv, g->dim[d]);
+        hi[d] = cell1(p[d] + r, g->lo[d], g->inv, g->dim[d]);
         cells *= (double)(hi[d] - lo[d] + 1);
     }
     if (!(r < INFINITY) || cells > probe) return 0;
@@ -713,7 +715,7 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
  * (sqrt 3 s), else, if the 3 x 3 x 3 cells around c hold K + 1, t <=
  * 2 sqrt 3 s; every point of the whole cloud nearer p than t (the cloud's
  * K-th distance is no larger) lies within R = 2 (or 4) cells of c (cell =
- * floor((v - lo) / s) is monotone; the margins cover the roundings; 6
+ * floor((v - lo) / s), as a product by 1 / s, is monotone; the margins cover the roundings; 6
  * cells for the 5 x 5 x 5 around c, t <= 3 sqrt 3 s), so
  * the points of other parts in those cells are a superset of p's remote
  * neighbours.  Cost: one scan of the cloud (the own points were gathered
@@ -752,6 +754,7 @@ static jf_status halo_by_cells(reader *rd, const int32_t *part, const double *bo
         g->lo[d] = boxa[d] - GRID_PAD * g->s;
         g->dim[d] = (size_t)floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
     }
+    g->inv = 1 / g->s;
     double ghi[3];
     for (int d = 0; d < 3; d++) ghi[d] = g->lo[d] + (double)g->dim[d] * g->s;
     const size_t dx = g->dim[0], dy = g->dim[1], dz = g->dim[2];
@@ -1102,7 +1105,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
     size_t *ccnt = NULL;
-    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0};
+    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, 1};
     reader rd;
     double gb[6];
     if ((st = reader_open(&rd, src, n, nt)) != JF_OK) goto out;
