@@ -249,4 +249,10 @@ jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *
 jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
                                   jf__block_xyz_fn sink, void *user, jf_error *err);
 
+/* Both: the masked fit handing the sink each block's coordinates (the
+ * bounded-memory estimate's parts need not gather them by index). */
+jf_status jf__estimate_blocks_masked_xyz(const jf_cloud *c, const jf_estimate_opts *o,
+                                         const uint8_t *fit, jf__block_xyz_fn sink, void *user,
+                                         jf_error *err);
+
 #endif /* JF_PARTS_H */

@@ -7,10 +7,16 @@
  *  1. Parts: the finite points cut along the (Morton key, index) order at
  *     the quantiles of a sample (jf__parts_split_sampled: no sort of the
  *     cloud, 16 bytes per sampled point).
- *  2. For part a: index its own points; walking the index's leaf order
+ *  2. For part a, knn with dense cells (halo_by_cells): the own points
+ *     counted on a grid over a's box; where a cell (or the 27 or 125
+ *     around it) holds K + 1 own points, the K-th distance is bounded by
+ *     the block's size, so the other parts' points in the cells that near
+ *     are a superset of the halo, taken by one scan: no index, no query.
+ *     Otherwise (sparse cells, radius kinds, a halo over the plan's):
+ *     index its own points; walking the index's leaf order
  *     (spatially coherent) on the threads, each own point whose own k-th
- *     distance may reach a cell holding another part's point (an
- *     occupancy grid over the cloud's box, rebuilt per part by one scan)
+ *     distance may reach a cell holding another part's point (a grid of
+ *     each cell's owner part over the cloud's box, built once in step 1)
  *     turns its neighbourhood into at most two requests "the k nearest
  *     within squared distance <= bound" (jf__halo_requests); in space
  *     order a knn point whose own k-th distance is bounded by the previous
@@ -29,8 +35,9 @@
  *     that contains all of it gives the same k nearest, the same order,
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
- *  handed over first.  Every step runs on the threads; per part: two index
- *  builds (own, own + halo) and three scans of the coordinates.
+ *  handed over first.  Every step runs on the threads; per part: one index
+ *  build (own + halo; two with the requests) and two scans of the
+ *  coordinates.
  */
 #include <errno.h>
 #include <math.h>
@@ -66,26 +73,22 @@ static jf_status parts_query(const jf_estimate_opts *o, jf_part_query *q, jf_err
     return st;
 }
 
-/* The sink of one part: local indices back to input indices, with the
- * points' coordinates (the part's copy). */
+/* The sink of one part: local indices back to input indices (the
+ * coordinates come with the block, the walk's copy of the part's). */
 typedef struct {
     const uint32_t *ids; /* local -> input index                       */
-    const double *xyz;   /* the part's coordinates (local)             */
     jf__block_xyz_fn sink;
     void *user;
 } relay;
 
-static jf_status relay_block(void *user, const uint32_t *idx, jf_result *res, size_t m)
+static jf_status relay_block(void *user, const uint32_t *idx, const double *xyz, jf_result *res,
+                             size_t m)
 {
     const relay *r = user;
     uint32_t g[256];
-    double x[3 * 256];
     if (m > 256) return JF_ERR_INVALID;
-    for (size_t j = 0; j < m; j++) {
-        g[j] = r->ids[idx[j]];
-        memcpy(x + 3 * j, r->xyz + 3 * (size_t)idx[j], sizeof(double[3]));
-    }
-    return r->sink(r->user, g, x, res, m);
+    for (size_t j = 0; j < m; j++) g[j] = r->ids[idx[j]];
+    return r->sink(r->user, g, xyz, res, m);
 }
 
 /* The coordinates' reader (jf_xyz_src): every scan walks the cloud in
@@ -98,6 +101,7 @@ typedef struct {
     double **xyz;          /* per thread: JF_SRC_CHUNK x 3              */
     unsigned char **raw;   /* per thread: JF_SRC_CHUNK rows             */
     int nt;
+    int plain;             /* rows are x y z doubles (no raw buffers)   */
     int fail;              /* a read failed: io_row, io_errno           */
     size_t io_row;
     int io_errno;
@@ -117,7 +121,8 @@ static const double *chunk_xyz(reader *rd, size_t ch)
     if (__atomic_load_n(&rd->fail, __ATOMIC_RELAXED)) return NULL;
     const int t = omp_get_thread_num();
     const jf_row_layout *l = rd->s->l;
-    unsigned char *p = rd->raw[t];
+    /* rows of three doubles: read straight into the coordinates */
+    unsigned char *p = rd->plain ? (unsigned char *)rd->xyz[t] : rd->raw[t];
     size_t left = m * l->row;
     uint64_t at = l->vertex_off + (uint64_t)first * l->row;
     while (left) {
@@ -134,7 +139,7 @@ static const double *chunk_xyz(reader *rd, size_t ch)
         }
         p += k, left -= (size_t)k, at += (uint64_t)k;
     }
-    jf__layout_rows(rd->raw[t], m, l, rd->xyz[t], NULL);
+    if (!rd->plain) jf__layout_rows(rd->raw[t], m, l, rd->xyz[t], NULL);
     return rd->xyz[t];
 }
 
@@ -146,11 +151,12 @@ static jf_status reader_open(reader *rd, const jf_xyz_src *s, size_t n, int nt)
     if (s->xyz) return JF_OK;
     rd->xyz = calloc((size_t)nt, sizeof *rd->xyz);
     rd->raw = calloc((size_t)nt, sizeof *rd->raw);
+    rd->plain = jf__layout_plain_xyz(s->l);
     if (!rd->xyz || !rd->raw) return JF_ERR_NOMEM;
     for (int t = 0; t < nt; t++) {
         rd->xyz[t] = malloc(JF_SRC_CHUNK * 3 * sizeof(double));
-        rd->raw[t] = malloc(JF_SRC_CHUNK * s->l->row);
-        if (!rd->xyz[t] || !rd->raw[t]) return JF_ERR_NOMEM;
+        rd->raw[t] = rd->plain ? NULL : malloc(JF_SRC_CHUNK * s->l->row);
+        if (!rd->xyz[t] || (!rd->plain && !rd->raw[t])) return JF_ERR_NOMEM;
     }
     return JF_OK;
 }
@@ -266,30 +272,35 @@ static void heap_push(double *h, size_t *n, size_t k, double d)
  * underflow to 0. */
 static double ball_r(double b) { return sqrt(b) * (1 + 1e-9) + 1e-140; }
 
-/* Cells of a grid over the cloud's box that hold a point of another
- * part (the foreign points of part a): a ball over no such cell holds no
- * foreign point, so its point needs no halo (boxes of Z-curve runs
- * overlap too much to tell).  cell(v) = floor((v - lo) / s), clamped, is
- * monotone in v, so a point inside a box is in one of the box's cells. */
+/* Who owns each cell of a grid over the cloud's box (built once, in
+ * split's part pass): OCC_EMPTY, the one part (+1) whose points it holds,
+ * or OCC_MIXED.  A ball over no cell owned by another part (empty, or a's
+ * only) holds no foreign point, so its point needs no halo (boxes of
+ * Z-curve runs overlap too much to tell).  cell(v) = floor((v - lo) / s),
+ * clamped (a product by 1/s), is monotone in v, so a point inside a box
+ * is in one of the box's cells.  A byte a cell: the cells are jf__parts_grid_bits / 8, the
+ * bytes of the bit grid rebuilt per part by a scan before. */
 typedef struct {
     double lo[3], s;
     size_t dim[3];
-    uint64_t *bits;
-    double reach;      /* only parts within reach of a's box are marked  */
-    uint8_t *near;     /* near[b]: b's box within reach of a's (per part) */
+    uint8_t *own;
+    int P;
+    double inv;        /* 1 / s: a product per axis, not a division     */
 } occgrid;
 
+#define OCC_EMPTY 0
+#define OCC_MIXED 255              /* also every cell when P > 254      */
 #define OCC_PROBE 4096             /* more cells in a ball: just ask   */
 /* (skipping a query: at most 64 cells probed, a query costs less) */
 
-static size_t cell1(double v, double lo, double s, size_t dim)
+static inline size_t cell1(double v, double lo, double inv, size_t dim)
 {
-    double t = floor((v - lo) / s);
+    double t = floor((v - lo) * inv);
     if (!(t > 0)) return 0;
     return t >= (double)dim ? dim - 1 : (size_t)t;
 }
 
-static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
+static void occ_setup(occgrid *g, const double box[6], size_t maxcells)
 {
     double ext = 0;
     for (int d = 0; d < 3; d++) ext = box[3 + d] - box[d] > ext ? box[3 + d] - box[d] : ext;
@@ -297,74 +308,59 @@ static void occ_setup(occgrid *g, const double box[6], size_t maxbits)
     for (;;) {
         double cells = 1;
         for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1;
-        if (cells <= (double)maxbits) break;
+        if (cells <= (double)maxcells) break;
         g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
     }
     for (int d = 0; d < 3; d++) {
         g->lo[d] = box[d];
         g->dim[d] = (size_t)floor((box[3 + d] - box[d]) / g->s) + 1;
     }
+    g->inv = 1 / g->s;
 }
 
-static size_t occ_cell(const occgrid *g, const double *x)
+static size_t occ_cells(const occgrid *g) { return g->dim[0] * g->dim[1] * g->dim[2]; }
+
+static inline size_t occ_cell(const occgrid *g, const double *x)
 {
-    return (cell1(x[2], g->lo[2], g->s, g->dim[2]) * g->dim[1] +
-            cell1(x[1], g->lo[1], g->s, g->dim[1])) * g->dim[0] +
-           cell1(x[0], g->lo[0], g->s, g->dim[0]);
+    return (cell1(x[2], g->lo[2], g->inv, g->dim[2]) * g->dim[1] +
+            cell1(x[1], g->lo[1], g->inv, g->dim[1])) * g->dim[0] +
+           cell1(x[0], g->lo[0], g->inv, g->dim[0]);
 }
 
-/* 1 when no marked cell meets the box p +- r. */
-static int occ_free(const occgrid *g, const double p[3], double r, double probe)
+/* Part a (-1: none) holds x: its cell goes empty -> a + 1 -> mixed, on
+ * any thread (values only move forward, so a lost race retries once). */
+static void occ_set(occgrid *g, const double *x, int32_t a)
+{
+    uint8_t *c = g->own + occ_cell(g, x);
+    const uint8_t mine = g->P <= 254 ? (uint8_t)(a + 1) : OCC_MIXED;
+    uint8_t v = __atomic_load_n(c, __ATOMIC_RELAXED);
+    if (v == mine || v == OCC_MIXED) return;
+    if (v == OCC_EMPTY &&
+        __atomic_compare_exchange_n(c, &v, mine, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+        return;
+    if (v != mine) __atomic_store_n(c, (uint8_t)OCC_MIXED, __ATOMIC_RELAXED);
+}
+
+/* 1 when no cell meeting the box p +- r holds a point of a part other
+ * than a. */
+static int occ_free(const occgrid *g, const double p[3], double r, double probe, int32_t a)
 {
     size_t lo[3], hi[3];
     double cells = 1;
     for (int d = 0; d < 3; d++) {
-        lo[d] = cell1(p[d] - r, g->lo[d], g->s, g->dim[d]);
-        hi[d] = cell1(p[d] + r, g->lo[d], g->s, g->dim[d]);
+        lo[d] = cell1(p[d] - r, g->lo[d], g->inv, g->dim[d]);
+        hi[d] = cell1(p[d] + r, g->lo[d], g->inv, g->dim[d]);
         cells *= (double)(hi[d] - lo[d] + 1);
     }
-    if (!(r <= g->reach) || cells > probe) return 0; /* beyond: unmarked parts */
+    if (!(r < INFINITY) || cells > probe) return 0;
+    const uint8_t mine = g->P <= 254 ? (uint8_t)(a + 1) : OCC_EMPTY;
     for (size_t z = lo[2]; z <= hi[2]; z++)
-        for (size_t y = lo[1]; y <= hi[1]; y++)
-            for (size_t x = lo[0]; x <= hi[0]; x++) {
-                size_t c = (z * g->dim[1] + y) * g->dim[0] + x;
-                if ((g->bits[c / 64] >> (c % 64)) & 1) return 0;
-            }
-    return 1;
-}
-
-/* Marks the cells of the finite points of the parts near part a: those
- * whose box comes within reach of a's (reach: 16 cells); a ball wider
- * than that is never called free, so the parts left out cannot matter. */
-static void occ_mark(occgrid *g, reader *rd, const int32_t *part, int32_t a,
-                     const double *box, int P)
-{
-    g->reach = 16 * g->s;
-    const double *ba = box + 6 * a;
-    for (int b = 0; b < P; b++) {
-        const double *bb = box + 6 * b;
-        int near = b != a && bb[0] <= bb[3];
-        for (int d = 0; d < 3 && near; d++)
-            near = bb[d] <= ba[3 + d] + g->reach && bb[3 + d] >= ba[d] - g->reach;
-        g->near[b] = (uint8_t)near;
-    }
-    memset(g->bits, 0, (g->dim[0] * g->dim[1] * g->dim[2] + 63) / 64 * sizeof *g->bits);
-#pragma omp parallel for num_threads(rd->nt) schedule(dynamic, 4)
-    for (size_t ch = 0; ch < rd->nch; ch++) {
-        const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
-        size_t i = beg;
-        while (i < end && (part[i] < 0 || !g->near[part[i]])) i++;
-        if (i == end) continue; /* no near part's point: not read */
-        const double *x = chunk_xyz(rd, ch);
-        if (!x) continue;
-        for (; i < end; i++) {
-            if (part[i] < 0 || !g->near[part[i]]) continue;
-            size_t cix = occ_cell(g, x + 3 * (i - beg));
-            uint64_t bit = (uint64_t)1 << (cix % 64);
-            if (!(__atomic_load_n(&g->bits[cix / 64], __ATOMIC_RELAXED) & bit))
-                __atomic_fetch_or(&g->bits[cix / 64], bit, __ATOMIC_RELAXED);
+        for (size_t y = lo[1]; y <= hi[1]; y++) {
+            const uint8_t *row = g->own + (z * g->dim[1] + y) * g->dim[0];
+            for (size_t x = lo[0]; x <= hi[0]; x++)
+                if (row[x] != OCC_EMPTY && row[x] != mine) return 0;
         }
-    }
+    return 1;
 }
 
 /* A halo point: input index and coordinates, as the scan read them. */
@@ -462,7 +458,8 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                          * it, no request, no query */
                         double dd = 0;
                         for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
-                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64)) continue;
+                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64, a))
+                            continue;
                     }
                     int nr = jf__halo_requests(own, q, p, idx, d2, r);
                     if (knn && nr == 1) {
@@ -470,7 +467,7 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                         last[3] = sqrt(r[0].bound);
                     }
                     for (int t = 0; t < nr && ok; t++)
-                        if (!occ_free(occ, p, ball_r(r[t].bound), OCC_PROBE))
+                        if (!occ_free(occ, p, ball_r(r[t].bound), OCC_PROBE, a))
                             ok = rvec_push(mine, (request){(uint32_t)j, r[t]});
                 }
             }
@@ -710,6 +707,151 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     return JF_OK;
 }
 
+/* Step 2 without the own index (knn:K, K < CNT_MAX): part a's halo as
+ * every point of another part in a cell near one of a's, on a grid over
+ * a's box (widened by GRID_PAD cells; as fine as the plan's second grid
+ * allows).  Why it holds the halo: an own point p in cell c that holds
+ * K + 1 own points has its own K-th distance t <= the cell's diagonal
+ * (sqrt 3 s), else, if the 3 x 3 x 3 cells around c hold K + 1, t <=
+ * 2 sqrt 3 s; every point of the whole cloud nearer p than t (the cloud's
+ * K-th distance is no larger) lies within R = 2 (or 4) cells of c (cell =
+ * floor((v - lo) / s), as a product by 1 / s, is monotone; the margins cover the roundings; 6
+ * cells for the 5 x 5 x 5 around c, t <= 3 sqrt 3 s), so
+ * the points of other parts in those cells are a superset of p's remote
+ * neighbours.  Cost: one scan of the cloud (the own points were gathered
+ * by another), no index, no query.  *served = 0 (nothing allocated) when
+ * a cell's 27 hold too few own points (sparse regions: the requests
+ * decide there), when the cells are too small for the coordinates'
+ * roundings, or when the halo would pass cap points (the memory plan's):
+ * the caller then takes halo_of. */
+#define CNT_MAX 63   /* counts in a byte's low 6 bits; bit 6: done, bit 7: near */
+#define GRID_PAD 7   /* cells around a's box: more than R = 6 */
+static jf_status halo_by_cells(reader *rd, const int32_t *part, const double *boxa, int32_t a,
+                               const double *xyz, size_t m, size_t K, size_t cap, size_t maxcells,
+                               int nt, hpoint **halo, size_t *nhalo, int *served)
+{
+    *served = 0;
+    if (K + 1 > CNT_MAX || !m) return JF_OK;
+    occgrid gg, *g = &gg;
+    double ext = 0, big = 0;
+    for (int d = 0; d < 3; d++) {
+        ext = boxa[3 + d] - boxa[d] > ext ? boxa[3 + d] - boxa[d] : ext;
+        big = fabs(boxa[d]) > big ? fabs(boxa[d]) : big;
+        big = fabs(boxa[3 + d]) > big ? fabs(boxa[3 + d]) : big;
+    }
+    /* the padding alone must fit (a small cloud's grid is small) */
+    const double pad = 2 * GRID_PAD + 2;
+    if (!(ext > 0) || !isfinite(ext) || pad * pad * pad > (double)maxcells) return JF_OK;
+    g->s = ext / 4096;
+    for (;;) {
+        double cells = 1;
+        for (int d = 0; d < 3; d++) cells *= floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
+        if (cells <= (double)maxcells) break;
+        g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
+    }
+    if (!(g->s > 1e-6 * (big + ext))) return JF_OK; /* cells of a few ulps: the margins fail */
+    for (int d = 0; d < 3; d++) {
+        g->lo[d] = boxa[d] - GRID_PAD * g->s;
+        g->dim[d] = (size_t)floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
+    }
+    g->inv = 1 / g->s;
+    double ghi[3];
+    for (int d = 0; d < 3; d++) ghi[d] = g->lo[d] + (double)g->dim[d] * g->s;
+    const size_t dx = g->dim[0], dy = g->dim[1], dz = g->dim[2];
+    /* the plan's second grid (its bytes: jf__parts_grid_bits / 8), freed
+     * before halo_of takes its own */
+    uint8_t *cnt = calloc(occ_cells(g), 1);
+    if (!cnt) return JF_ERR_NOMEM;
+    for (size_t j = 0; j < m; j++) {
+        uint8_t *c = cnt + occ_cell(g, xyz + 3 * j);
+        if (*c < CNT_MAX) (*c)++;
+    }
+    for (size_t j = 0; j < m; j++) {
+        const size_t c = occ_cell(g, xyz + 3 * j);
+        if (cnt[c] & 0x40) continue;
+        cnt[c] |= 0x40;
+        const size_t cx = c % dx, cy = c / dx % dy, cz = c / dx / dy;
+        /* the least block of (2L + 1)^3 cells around c holding K + 1 own
+         * points bounds t by sqrt 3 (L + 1) s: R = its ceiling */
+        static const size_t RL[3] = {2, 4, 6};
+        size_t R = 0;
+        for (size_t L = 0; L < 3 && !R; L++) {
+            size_t sum = 0;
+            for (size_t z = cz > L ? cz - L : 0; z <= cz + L && z < dz; z++)
+                for (size_t y = cy > L ? cy - L : 0; y <= cy + L && y < dy; y++)
+                    for (size_t x = cx > L ? cx - L : 0; x <= cx + L && x < dx; x++)
+                        sum += cnt[(z * dy + y) * dx + x] & 0x3f;
+            if (sum >= K + 1) R = RL[L];
+        }
+        if (!R) {
+            free(cnt);
+            return JF_OK;
+        }
+        for (size_t z = cz > R ? cz - R : 0; z <= cz + R && z < dz; z++)
+            for (size_t y = cy > R ? cy - R : 0; y <= cy + R && y < dy; y++) {
+                uint8_t *row = cnt + (z * dy + y) * dx;
+                for (size_t x = cx > R ? cx - R : 0; x <= cx + R && x < dx; x++) row[x] |= 0x80;
+            }
+    }
+    /* the scan: other parts' points in a marked cell, at most cap */
+    hvec *th = calloc((size_t)nt, sizeof *th);
+    size_t total = 0;
+    int fail = !th, over = 0;
+    if (th) {
+#pragma omp parallel num_threads(nt)
+        {
+            hvec *mine_v = &th[omp_get_thread_num()];
+            int ok = 1;
+#pragma omp for schedule(dynamic, 4)
+            for (size_t ch = 0; ch < rd->nch; ch++) {
+                if (!ok || __atomic_load_n(&over, __ATOMIC_RELAXED)) continue;
+                const size_t beg = ch * JF_SRC_CHUNK, end = beg + chunk_len(rd, ch);
+                size_t i0 = beg;
+                while (i0 < end && (part[i0] < 0 || part[i0] == a)) i0++;
+                const double *xc = i0 < end ? chunk_xyz(rd, ch) : NULL;
+                const size_t had = mine_v->n;
+                for (size_t i = i0; xc && ok && i < end; i++) {
+                    if (part[i] < 0 || part[i] == a) continue;
+                    const double *x = xc + 3 * (i - beg);
+                    if (!(x[0] >= g->lo[0] && x[0] <= ghi[0] && x[1] >= g->lo[1] &&
+                          x[1] <= ghi[1] && x[2] >= g->lo[2] && x[2] <= ghi[2]))
+                        continue; /* farther than GRID_PAD cells from a's box */
+                    if (cnt[occ_cell(g, x)] & 0x80) ok = hvec_push(mine_v, (uint32_t)i, x);
+                }
+                if (__atomic_add_fetch(&total, mine_v->n - had, __ATOMIC_RELAXED) > cap)
+                    __atomic_store_n(&over, 1, __ATOMIC_RELAXED);
+            }
+            if (!ok) {
+#pragma omp atomic write
+                fail = 1;
+            }
+        }
+    }
+    hpoint *hv = NULL;
+    size_t nh = 0;
+    if (!fail && !over && !rd->fail) {
+        for (int t = 0; t < nt; t++) nh += th[t].n;
+        if (!(hv = malloc((nh ? nh : 1) * sizeof *hv))) fail = 1;
+    }
+    if (hv) {
+        size_t w = 0;
+        for (int t = 0; t < nt; t++) {
+            if (th[t].n) memcpy(hv + w, th[t].v, th[t].n * sizeof *hv);
+            w += th[t].n;
+        }
+        qsort(hv, nh, sizeof *hv, cmp_hpoint);
+    }
+    for (int t = 0; th && t < nt; t++) free(th[t].v);
+    free(th);
+    free(cnt);
+    if (fail) return JF_ERR_NOMEM;
+    if (!hv) return JF_OK; /* over the cap, or a failed read (the caller's) */
+    *halo = hv;
+    *nhalo = nh;
+    *served = 1;
+    return JF_OK;
+}
+
 /* jf_estimate_parts's sink without the coordinates. */
 typedef struct {
     jf_block_fn sink;
@@ -747,7 +889,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
  * the same parts as jf__parts_split_sampled (same sample, same keys), the
  * boxes the same min and max. */
 static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *count,
-                       double gbox[6], size_t *nfinite)
+                       double gbox[6], size_t *nfinite, occgrid *occ)
 {
     const size_t n = rd->n, nch = rd->nch;
     const int nt = rd->nt;
@@ -755,7 +897,12 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     double *tb = malloc((size_t)nt * 6 * (size_t)(P > 1 ? P : 1) * sizeof *tb);
     size_t *tc = calloc((size_t)nt * (size_t)P, sizeof *tc);
     jf__keyed *smp = NULL, *cut = NULL;
-    jf_status st = fc && tb && tc ? JF_OK : JF_ERR_NOMEM;
+    /* the sample if every point is finite (finite rank = input index):
+     * every stride1-th point's coordinates, taken by the first scan */
+    const size_t want1 = jf__parts_sample_size(n), stride1 = n > want1 ? n / want1 : 1;
+    const size_t ns1 = (n + stride1 - 1) / stride1;
+    double *sx1 = malloc(ns1 * 3 * sizeof *sx1);
+    jf_status st = fc && tb && tc && sx1 ? JF_OK : JF_ERR_NOMEM;
     if (st != JF_OK) goto out;
     for (size_t j = 0; j < (size_t)nt * (size_t)P; j++)
         for (int k = 0; k < 3; k++) tb[6 * j + k] = INFINITY, tb[6 * j + 3 + k] = -INFINITY;
@@ -766,7 +913,9 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
 #pragma omp for schedule(dynamic, 4)
         for (size_t ch = 0; ch < nch; ch++) {
             const double *x = chunk_xyz(rd, ch);
-            const size_t m = chunk_len(rd, ch);
+            const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+            for (size_t i = (beg + stride1 - 1) / stride1 * stride1; x && i < beg + m; i += stride1)
+                memcpy(sx1 + 3 * (i / stride1), x + 3 * (i - beg), sizeof(double[3]));
             size_t f = 0;
             for (size_t j = 0; x && j < m; j++) {
                 const double *p = x + 3 * j;
@@ -791,6 +940,12 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     const size_t nf = fc[nch];
     *nfinite = nf;
     const double scale = jf__morton_scale(gbox);
+    occ_setup(occ, gbox, jf__parts_grid_bits(n) / 8);
+    occ->P = P;
+    if (!(occ->own = calloc(occ_cells(occ), 1))) {
+        st = JF_ERR_NOMEM;
+        goto out;
+    }
     /* 2. every stride-th finite point in input order (parts.c's rule) */
     const size_t want = jf__parts_sample_size(nf), stride = nf > want ? nf / want : 1;
     const size_t ns = nf ? (nf + stride - 1) / stride : 0;
@@ -800,21 +955,26 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
         st = JF_ERR_NOMEM;
         goto out;
     }
+    if (nf == n) { /* the first scan's: the same points, stride and keys */
+        for (size_t r = 0; r < ns; r++)
+            smp[r] = (jf__keyed){jf__morton_key(sx1 + 3 * r, gbox, scale), (uint32_t)(r * stride)};
+    } else {
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 4)
-    for (size_t ch = 0; ch < nch; ch++) {
-        size_t seen = fc[ch];
-        if (fc[ch + 1] == seen) continue;
-        /* the chunk's first finite rank divisible by stride */
-        if ((seen + stride - 1) / stride * stride >= fc[ch + 1]) continue;
-        const double *x = chunk_xyz(rd, ch);
-        const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
-        for (size_t j = 0; x && j < m; j++) {
-            const double *p = x + 3 * j;
-            if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
-            if (seen % stride == 0)
-                smp[seen / stride] =
-                    (jf__keyed){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
-            seen++;
+        for (size_t ch = 0; ch < nch; ch++) {
+            size_t seen = fc[ch];
+            if (fc[ch + 1] == seen) continue;
+            /* the chunk's first finite rank divisible by stride */
+            if ((seen + stride - 1) / stride * stride >= fc[ch + 1]) continue;
+            const double *x = chunk_xyz(rd, ch);
+            const size_t m = chunk_len(rd, ch), beg = ch * JF_SRC_CHUNK;
+            for (size_t j = 0; x && j < m; j++) {
+                const double *p = x + 3 * j;
+                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+                if (seen % stride == 0)
+                    smp[seen / stride] =
+                        (jf__keyed){jf__morton_key(p, gbox, scale), (uint32_t)(beg + j)};
+                seen++;
+            }
         }
     }
     if (rd->fail) goto out;
@@ -840,6 +1000,7 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
                 const int32_t a = jf__keyed_rank(cut, ncut, jf__morton_key(p, gbox, scale),
                                                 (uint32_t)(beg + j));
                 part[beg + j] = a;
+                occ_set(occ, p, a);
                 double *b = bx + 6 * a;
                 for (int d = 0; d < 3; d++) {
                     if (p[d] < b[d]) b[d] = p[d];
@@ -869,7 +1030,7 @@ out:
     free(tc);
     free(smp);
     free(cut);
-    (void)n;
+    free(sx1);
     return st;
 }
 
@@ -944,7 +1105,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
     size_t *ccnt = NULL;
-    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, NULL};
+    occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, 1};
     reader rd;
     double gb[6];
     if ((st = reader_open(&rd, src, n, nt)) != JF_OK) goto out;
@@ -952,19 +1113,18 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         st = JF_ERR_NOMEM;
         goto out;
     }
-    if ((st = split(&rd, P, part, box, count, gb, &nf)) != JF_OK) goto out;
+    if ((st = split(&rd, P, part, box, count, gb, &nf, &occ)) != JF_OK) goto out;
     if ((st = reader_status(&rd, err)) != JF_OK) goto out;
     if (nf < n && (st = nonfinite_rows(&rd, part, sink, user)) != JF_OK) {
         if (rd.fail) st = reader_status(&rd, err);
         goto out;
     }
     for (int b = 0; b < P; b++) cmax = count[b] > cmax ? count[b] : cmax;
-    occ_setup(&occ, gb, jf__parts_grid_bits(n));
-    occ.bits = malloc((occ.dim[0] * occ.dim[1] * occ.dim[2] + 63) / 64 * sizeof *occ.bits);
-    occ.near = malloc((size_t)P);
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
-    if (!occ.bits || !occ.near || !ids || !sxyz) {
+    /* the most own + halo points the plan holds for a part */
+    const size_t hcap = (size_t)(ceil((double)n / P) * JF_PLAN_HALO);
+    if (!ids || !sxyz) {
         st = JF_ERR_NOMEM;
         goto out;
     }
@@ -980,12 +1140,18 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         /* step 2: own index, requests, halo */
         size_t m = gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
         if ((st = reader_status(&rd, err)) != JF_OK) goto out;
-        jf_index *own = NULL;
-        if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-        occ_mark(&occ, &rd, part, a, box, P);
-        st = rd.fail ? JF_ERR_IO
-                     : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
-        jf_index_free(own);
+        int served = 0;
+        if (q.nb.kind == JF_NB_KNN &&
+            (st = halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, q.nb.k, hcap > m ? hcap - m : 0,
+                                jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
+            break;
+        if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
+            jf_index *own = NULL;
+            if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
+            st = rd.fail ? JF_ERR_IO
+                         : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
+            jf_index_free(own);
+        }
         if (rd.fail) st = reader_status(&rd, err);
         if (st != JF_OK) break;
         /* step 3: own + halo in input order, merged from the back into
@@ -1034,8 +1200,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         sc.scan = sscan;
         sc.scanner = c->scanner;
         sc.nscans = c->nscans;
-        relay rl = {sid, sxyz, sink, user};
-        st = jf__estimate_blocks_masked(&sc, &po, mask, relay_block, &rl, err);
+        relay rl = {sid, sink, user};
+        st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
         free(sid);
         free(snrm);
         free(sscan);
@@ -1060,7 +1226,6 @@ out:
     free(sscan);
     free(mask);
     free(ccnt);
-    free(occ.bits);
-    free(occ.near);
+    free(occ.own);
     return st;
 }

@@ -1010,3 +1010,10 @@ jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
 {
     return estimate(c, o, NULL, NULL, NULL, sink, user, err);
 }
+
+jf_status jf__estimate_blocks_masked_xyz(const jf_cloud *c, const jf_estimate_opts *o,
+                                         const uint8_t *fit, jf__block_xyz_fn sink, void *user,
+                                         jf_error *err)
+{
+    return estimate(c, o, fit, NULL, NULL, sink, user, err);
+}

@@ -166,6 +166,9 @@ jf_status jf__las_layout(const char *buf, size_t len, uint64_t size, const char 
  * nrm (3k), exactly as jf_read_ply / jf_read_las would. */
 void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz,
                      double *nrm);
+/* 1 when a row is x y z as the machine's doubles and nothing else: its
+ * bytes are jf__layout_rows's coordinates (no normals to decode). */
+int jf__layout_plain_xyz(const jf_row_layout *l);
 void jf__las_rows(const unsigned char *raw, size_t k, const jf_row_layout *l, double *xyz);
 /* LAS with l->has_normals: the Extra Bytes normals of k rows (type[3..5]:
  * 9 float, 10 double). */

@@ -719,6 +719,12 @@ void jf__layout_rows(const unsigned char *raw, size_t k, const jf_row_layout *l,
     }
 }
 
+int jf__layout_plain_xyz(const jf_row_layout *l)
+{
+    return !l->las && !l->laz && !l->swap && l->row == 24 && l->off[0] == 0 && l->off[1] == 8 &&
+           l->off[2] == 16 && l->type[0] == T_F64 && l->type[1] == T_F64 && l->type[2] == T_F64;
+}
+
 /* ---- binary PLY read in chunks (jf_cloud_read) ------------------------ */
 
 /* design (issue 12.1): a 10^8-point binary PLY must not be held twice (the

@@ -5,7 +5,8 @@
  * the plan is whole above the whole cloud's need, refuses below its least,
  * and takes fewer parts for a larger budget; and jf_estimate_parts on a
  * cloud with an isolated far point and a clump (balls too large for the
- * halo grid) equals the whole cloud's fit bit for bit. */
+ * halo grid) and on a dense surface (halos from the cells near each
+ * part's) equals the whole cloud's fit bit for bit. */
 #include <check.h>
 #include <math.h>
 #include <stdint.h>
@@ -140,6 +141,45 @@ START_TEST(far_balls_exact)
 }
 END_TEST
 
+/* A dense surface: every part's cells hold K + 1 own points, so its halo
+ * comes from the cells near its own (no index of its points, no request:
+ * parts_run.c's halo_by_cells); on the edges, the blocks of 27 or 125
+ * cells.  The same rows as the whole cloud, bit for bit. */
+START_TEST(cell_halos_exact)
+{
+    const size_t n = 200000;
+    double *xyz = make(n, 11);
+    jf_cloud c = {0};
+    c.n = n;
+    c.xyz = xyz;
+    static const size_t K[] = {8, 16, 40};
+    for (int kk = 0; kk < 3; kk++) {
+        jf_estimate_opts o;
+        jf_estimate_opts_init(&o);
+        o.threads = 2;
+        o.nb.kind = JF_NB_KNN;
+        o.nb.k = K[kk];
+        o.params.degree = 1;
+        rows w = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
+        jf_error err;
+        ck_assert_int_eq(jf_estimate_blocks(&c, &o, sink, &w, &err), JF_OK);
+        static const int P[] = {2, 5, 16};
+        for (int k = 0; k < 3; k++) {
+            rows p = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
+            ck_assert_int_eq(jf_estimate_parts(&c, &o, P[k], sink, &p, &err), JF_OK);
+            ck_assert_uint_eq(p.seen, n);
+            ck_assert_int_eq(memcmp(p.nrm, w.nrm, 3 * n * sizeof(double)), 0);
+            ck_assert_int_eq(memcmp(p.status, w.status, n * sizeof(uint32_t)), 0);
+            free(p.nrm);
+            free(p.status);
+        }
+        free(w.nrm);
+        free(w.status);
+    }
+    free(xyz);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("parts_plan");
@@ -148,6 +188,7 @@ int main(void)
     tcase_add_test(tc, sampled_parts_are_runs_of_the_morton_order);
     tcase_add_test(tc, plan_is_monotone);
     tcase_add_test(tc, far_balls_exact);
+    tcase_add_test(tc, cell_halos_exact);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
