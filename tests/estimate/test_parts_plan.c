@@ -106,6 +106,29 @@ static jf_status sink(void *user, const uint32_t *idx, jf_result *res, size_t m)
     return JF_OK;
 }
 
+/* jf_estimate_parts with each of P[0..np-1] parts gives the whole
+ * cloud's normals and statuses, bit for bit, every row once. */
+static void parts_match_whole(const jf_cloud *c, const jf_estimate_opts *o, const int *P, int np)
+{
+    const size_t n = c->n;
+    rows w = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
+    jf_error err;
+    ck_assert_int_eq(jf_estimate_blocks(c, o, sink, &w, &err), JF_OK);
+    for (int k = 0; k < np; k++) {
+        rows p = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
+        ck_assert_int_eq(jf_estimate_parts(c, o, P[k], sink, &p, &err), JF_OK);
+        ck_assert_uint_eq(p.seen, n);
+        ck_assert_int_eq(memcmp(p.nrm, w.nrm, 3 * n * sizeof(double)), 0);
+        ck_assert_int_eq(memcmp(p.status, w.status, n * sizeof(uint32_t)), 0);
+        free(p.nrm);
+        free(p.status);
+    }
+    free(w.nrm);
+    free(w.status);
+}
+
+/* Balls that reach over the whole cloud (an isolated point, a clump
+ * of fewer than K): the parts' halos still give the whole cloud's rows. */
 START_TEST(far_balls_exact)
 {
     const size_t n = 30000;
@@ -122,21 +145,8 @@ START_TEST(far_balls_exact)
     o.threads = 2;
     o.nb.kind = JF_NB_KNN;
     o.nb.k = 16;
-    rows w = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
-    jf_error err;
-    ck_assert_int_eq(jf_estimate_blocks(&c, &o, sink, &w, &err), JF_OK);
     static const int P[] = {2, 9, 32};
-    for (int k = 0; k < 3; k++) {
-        rows p = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
-        ck_assert_int_eq(jf_estimate_parts(&c, &o, P[k], sink, &p, &err), JF_OK);
-        ck_assert_uint_eq(p.seen, n);
-        ck_assert_int_eq(memcmp(p.nrm, w.nrm, 3 * n * sizeof(double)), 0);
-        ck_assert_int_eq(memcmp(p.status, w.status, n * sizeof(uint32_t)), 0);
-        free(p.nrm);
-        free(p.status);
-    }
-    free(w.nrm);
-    free(w.status);
+    parts_match_whole(&c, &o, P, 3);
     free(xyz);
 }
 END_TEST
@@ -160,21 +170,8 @@ START_TEST(cell_halos_exact)
         o.nb.kind = JF_NB_KNN;
         o.nb.k = K[kk];
         o.params.degree = 1;
-        rows w = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
-        jf_error err;
-        ck_assert_int_eq(jf_estimate_blocks(&c, &o, sink, &w, &err), JF_OK);
         static const int P[] = {2, 5, 16};
-        for (int k = 0; k < 3; k++) {
-            rows p = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
-            ck_assert_int_eq(jf_estimate_parts(&c, &o, P[k], sink, &p, &err), JF_OK);
-            ck_assert_uint_eq(p.seen, n);
-            ck_assert_int_eq(memcmp(p.nrm, w.nrm, 3 * n * sizeof(double)), 0);
-            ck_assert_int_eq(memcmp(p.status, w.status, n * sizeof(uint32_t)), 0);
-            free(p.nrm);
-            free(p.status);
-        }
-        free(w.nrm);
-        free(w.status);
+        parts_match_whole(&c, &o, P, 3);
     }
     free(xyz);
 }
