@@ -612,6 +612,7 @@ static int estimate(int argc, char **argv, int *fd)
     o.phase_user = &pg;
     jf_writer_progress(w, jf_cli_progress_phase, &pg);
     int nparts = plan > 1 ? plan : 1;
+    pg.parts = nparts > 1;
     const jf_xyz_src src = {NULL, *fd, &lay};
     st = ooc          ? jf__estimate_parts_src(&c, &src, &o, nparts, sink_block_xyz, &sk, &err)
          : nparts > 1 ? jf_estimate_parts(&c, &o, nparts, sink_block, &sk, &err)

@@ -60,7 +60,9 @@ void jf_cli_progress_phase(void *user, jf_phase ph, size_t done, size_t total)
         p->cur = (int)ph;
     }
     p->lastcall = t;
-    if (!p->draw || (ph == JF_PHASE_FIT && p->counted)) return;
+    if (!p->draw || (ph == JF_PHASE_FIT && p->counted) ||
+        (p->parts && (ph == JF_PHASE_INDEX || ph == JF_PHASE_ORDER)))
+        return;
     if (__atomic_exchange_n(&p->busy, 1, __ATOMIC_ACQUIRE)) return;
     draw(p, (int)ph, done, total, p->start);
     __atomic_store_n(&p->busy, 0, __ATOMIC_RELEASE);

@@ -14,6 +14,9 @@ typedef struct {
     const char *who;        /* "jetfit", "jetfit-mpi"                    */
     int draw;               /* draw the line (a terminal, not --quiet)   */
     int counted;            /* the fit's points come from _fitted         */
+    int parts;              /* in parts: their index and order phases are
+                             * timed, not drawn (each part's own counts
+                             * would interrupt the whole cloud's fit line) */
     int cur;                /* phase being timed, -1 none                 */
     double start, lastcall; /* its first and latest report                */
     double secs[JF_CLI_NPHASES];

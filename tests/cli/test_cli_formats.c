@@ -276,6 +276,29 @@ START_TEST(progress_on_terminal)
 }
 END_TEST
 
+/* --memory in parts: one fit line for the whole cloud; the parts' own
+ * index phases (each part's counts) are timed, not drawn. */
+START_TEST(progress_in_parts)
+{
+    const size_t side = 150, n = side * side;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    cli_surface61(side, xyz, 5);
+    cli_write_xyz(cli_path("big.xyz"), xyz, NULL, n);
+    free(xyz);
+    ck_assert_int_eq(cli_run("estimate", cli_path("big.xyz"), "-o", cli_path("p.csv"), "--memory",
+                             "4K", NULL), 1);
+    const char *lw = strstr(cli_err, "the least that works is --memory ");
+    char mem[32] = "", want[80];
+    ck_assert_msg(lw && sscanf(lw + 33, "%31s", mem) == 1, "%s", cli_err);
+    ck_assert_int_eq(cli_run_tty("estimate", cli_path("big.xyz"), "-o", cli_path("p.csv"),
+                                 "--memory", mem, NULL), 0);
+    snprintf(want, sizeof want, "\rjetfit: fitting  100.0%%  %zu/%zu points", n, n);
+    ck_assert_msg(strstr(cli_err, want) != NULL, "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, "indexing") == NULL, "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, "tree ") != NULL, "%s", cli_err); /* still timed */
+}
+END_TEST
+
 static int cmp_dbl(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -330,6 +353,7 @@ int main(void)
     tcase_add_test(tc, columns_option);
     tcase_add_test(tc, neighbourhood_kinds);
     tcase_add_test(tc, progress_on_terminal);
+    tcase_add_test(tc, progress_in_parts);
     tcase_add_test(tc, summary_percentiles);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
