@@ -300,20 +300,22 @@ static inline size_t cell1(double v, double lo, double inv, size_t dim)
     return t >= (double)dim ? dim - 1 : (size_t)t;
 }
 
-static void occ_setup(occgrid *g, const double box[6], size_t maxcells)
+/* A grid over box widened by pad cells on every side, of at most
+ * maxcells cells: the finest of ext / 4096 times powers of 2^(1/3). */
+static void occ_setup(occgrid *g, const double box[6], size_t maxcells, size_t pad)
 {
     double ext = 0;
     for (int d = 0; d < 3; d++) ext = box[3 + d] - box[d] > ext ? box[3 + d] - box[d] : ext;
     g->s = ext > 0 && isfinite(ext) ? ext / 4096 : 1;
     for (;;) {
         double cells = 1;
-        for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1;
+        for (int d = 0; d < 3; d++) cells *= floor((box[3 + d] - box[d]) / g->s) + 1 + 2 * (double)pad;
         if (cells <= (double)maxcells) break;
         g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
     }
     for (int d = 0; d < 3; d++) {
-        g->lo[d] = box[d];
-        g->dim[d] = (size_t)floor((box[3 + d] - box[d]) / g->s) + 1;
+        g->lo[d] = box[d] - (double)pad * g->s;
+        g->dim[d] = (size_t)floor((box[3 + d] - box[d]) / g->s) + 1 + 2 * pad;
     }
     g->inv = 1 / g->s;
 }
@@ -742,19 +744,8 @@ static jf_status halo_by_cells(reader *rd, const int32_t *part, const double *bo
     /* the padding alone must fit (a small cloud's grid is small) */
     const double pad = 2 * GRID_PAD + 2;
     if (!(ext > 0) || !isfinite(ext) || pad * pad * pad > (double)maxcells) return JF_OK;
-    g->s = ext / 4096;
-    for (;;) {
-        double cells = 1;
-        for (int d = 0; d < 3; d++) cells *= floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
-        if (cells <= (double)maxcells) break;
-        g->s *= 1.25992104989487316; /* cube root of 2: half the cells */
-    }
+    occ_setup(g, boxa, maxcells, GRID_PAD);
     if (!(g->s > 1e-6 * (big + ext))) return JF_OK; /* cells of a few ulps: the margins fail */
-    for (int d = 0; d < 3; d++) {
-        g->lo[d] = boxa[d] - GRID_PAD * g->s;
-        g->dim[d] = (size_t)floor((boxa[3 + d] - boxa[d]) / g->s) + 1 + 2 * GRID_PAD;
-    }
-    g->inv = 1 / g->s;
     double ghi[3];
     for (int d = 0; d < 3; d++) ghi[d] = g->lo[d] + (double)g->dim[d] * g->s;
     const size_t dx = g->dim[0], dy = g->dim[1], dz = g->dim[2];
@@ -940,7 +931,7 @@ static jf_status split(reader *rd, int P, int32_t *part, double *box, size_t *co
     const size_t nf = fc[nch];
     *nfinite = nf;
     const double scale = jf__morton_scale(gbox);
-    occ_setup(occ, gbox, jf__parts_grid_bits(n) / 8);
+    occ_setup(occ, gbox, jf__parts_grid_bits(n) / 8, 0);
     occ->P = P;
     if (!(occ->own = calloc(occ_cells(occ), 1))) {
         st = JF_ERR_NOMEM;
