@@ -19,8 +19,12 @@ extern int jf__no_avx;
 #define JF_AVX_FN __attribute__((target("avx"), noinline))
 #define JF_AVX_LEAVE() __builtin_ia32_vzeroupper()
 #define JF_HAVE_AVX() (__builtin_cpu_supports("avx") && !jf__no_avx)
+/* a function built twice, AVX and default, picked at load (no FMA: the
+ * same bits on every machine) */
+#define JF_CLONES __attribute__((target_clones("avx", "default")))
 #else
 #define JF_AVX_PATH 0
+#define JF_CLONES
 #endif
 
 #endif /* JF_AVX_PATH_H */

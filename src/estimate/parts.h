@@ -236,20 +236,15 @@ jf_status jf__parts_halos(const double *xyz, size_t n, const int32_t *part, int 
 jf_status jf__estimate_masked(const jf_cloud *c, const jf_estimate_opts *o,
                               const uint8_t *fit, jf_result *out, jf_error *err);
 
-/* jf_estimate_blocks with the same mask: only the points with fit[i] != 0
- * are fitted and handed to the sink (the halo points are neighbours
- * only).  Defined in estimate/pipeline.c; used by estimate/parts_run.c. */
-jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
-                                     const uint8_t *fit, jf_block_fn sink, void *user,
-                                     jf_error *err);
-
 /* jf_estimate_blocks handing the sink each block's coordinates too (the
  * walk's, bit for bit those of c->xyz), so that it need not read them
  * by input index.  Defined in estimate/pipeline.c. */
 jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
                                   jf__block_xyz_fn sink, void *user, jf_error *err);
 
-/* Both: the masked fit handing the sink each block's coordinates (the
+/* jf_estimate_blocks with the same mask (only the points with fit[i] !=
+ * 0 are fitted and handed to the sink; the halo points are neighbours
+ * only), handing the sink each block's coordinates (the
  * bounded-memory estimate's parts need not gather them by index). */
 jf_status jf__estimate_blocks_masked_xyz(const jf_cloud *c, const jf_estimate_opts *o,
                                          const uint8_t *fit, jf__block_xyz_fn sink, void *user,

@@ -998,13 +998,6 @@ jf_status jf_estimate_blocks(const jf_cloud *c, const jf_estimate_opts *o, jf_bl
     return estimate(c, o, NULL, NULL, sink, NULL, user, err);
 }
 
-jf_status jf__estimate_blocks_masked(const jf_cloud *c, const jf_estimate_opts *o,
-                                     const uint8_t *fit, jf_block_fn sink, void *user,
-                                     jf_error *err)
-{
-    return estimate(c, o, fit, NULL, sink, NULL, user, err);
-}
-
 jf_status jf__estimate_blocks_xyz(const jf_cloud *c, const jf_estimate_opts *o,
                                   jf__block_xyz_fn sink, void *user, jf_error *err)
 {

@@ -47,11 +47,6 @@ typedef double v2d __attribute__((vector_size(16)));
 typedef long long v2l __attribute__((vector_size(16)));
 typedef double v4d __attribute__((vector_size(32)));
 typedef long long v4l __attribute__((vector_size(32)));
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
-#define JF_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define JF_CLONES
-#endif
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND JF_AUTO_NCAND

@@ -29,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "avx_path.h" /* JF_CLONES */
 #include "index_internal.h"
 
 #define SH_AHEAD 16 /* walk points looked at for a search's centre */
@@ -182,12 +183,7 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
 /* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
 /* Built twice (target_clones): AVX (four distances a step, no FMA, so
  * no contraction: the tree's bits) and the default (SSE2). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JF_NO_CLONES)
-#define SH_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define SH_CLONES
-#endif
-SH_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q[3], uint32_t *idx, double *d2,
+JF_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q[3], uint32_t *idx, double *d2,
                     double *xyz, size_t *found)
 {
     if (!cs->nc) return 0;
