@@ -77,6 +77,19 @@ static inline double jf__ldexp(double x, int e)
  * Jacobi: eval ascending, evec[3*k..] the unit eigenvector of eval[k]
  * with its largest-|component| positive.  Deterministic. */
 void jf__eig3(const double a[9], double eval[3], double evec[9]);
+/* jf__eig3 to rounding (a sweep sooner; not jf__eig3's bits) of a matrix
+ * a given in the axes rot (rows: unit vectors in the world; NULL: the
+ * world's), its eigenvectors in the world's coordinates.  Fewer sweeps
+ * still when rot is near a's eigenvectors. */
+void jf__eig3_in(const double a[9], const double rot[9], double eval[3], double evec[9]);
+
+/* A tangent frame of a covariance a in the layout of jf__eig3's evec: the
+ * least eigenvalue's eigenvector (evec[0..2], in closed form: a fifth of
+ * the Jacobi solver's time, to about eps x l3 / (l2 - l1)) and two unit
+ * vectors perpendicular to it (evec[6..8], evec[3..5]), not a's.  Returns
+ * 0 (evec untouched) when l1 is not clearly apart from l2 or a is not
+ * finite: jf__eig3 decides there. */
+int jf__normal3(const double a[9], double evec[9]);
 
 /* Fitting frame (§5.2) of the local points q[3*i] (already translated to
  * p) with weights w[i] (> 0 used): two-pass weighted centred covariance,

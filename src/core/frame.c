@@ -45,18 +45,17 @@ static void eig3_sorted(double a[3][3], double v[3][3], double eval[3], double e
     }
 }
 
-void jf__eig3(const double a_in[9], double eval[3], double evec[9])
+/* Cyclic Jacobi on a (symmetric), rotations accumulated into v, until
+ * the off-diagonal sum is at most tol x the diagonal's. */
+static inline __attribute__((always_inline)) void jacobi3(double a[3][3], double v[3][3], double tol)
 {
-    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
 
     /* Cyclic Jacobi (Golub & Van Loan §8.5): each rotation zeroes a[p][q];
      * converges quadratically, 50 sweeps is far beyond what doubles need. */
     for (int sweep = 0; sweep < 50; sweep++) {
         double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
         double diag = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
-        if (off == 0.0 || off <= DBL_EPSILON * DBL_EPSILON * diag) break;
+        if (off == 0.0 || off <= tol * diag) break;
         for (int p = 0; p < 2; p++) {
             for (int q = p + 1; q < 3; q++) {
                 if (a[p][q] == 0.0) continue;
@@ -87,7 +86,34 @@ void jf__eig3(const double a_in[9], double eval[3], double evec[9])
             }
         }
     }
+}
+
+void jf__eig3(const double a_in[9], double eval[3], double evec[9])
+{
+    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
+    jacobi3(a, v, DBL_EPSILON * DBL_EPSILON);
     eig3_sorted(a, v, eval, evec);
+}
+
+void jf__eig3_in(const double a_in[9], const double rot[9], double eval[3], double evec[9])
+{
+    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, w[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
+    /* off-diagonal to rounding (eps, not eps^2 x the diagonal): the
+     * eigenvectors to rounding too, a sweep sooner */
+    jacobi3(a, v, DBL_EPSILON);
+    if (!rot) {
+        eig3_sorted(a, v, eval, evec);
+        return;
+    }
+    /* the eigenvectors in world coordinates: rot's rows are the axes */
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            w[i][k] = rot[i] * v[0][k] + rot[3 + i] * v[1][k] + rot[6 + i] * v[2][k];
+    eig3_sorted(a, w, eval, evec);
 }
 
 static void cross(const double a[3], const double b[3], double c[3])
@@ -95,6 +121,54 @@ static void cross(const double a[3], const double b[3], double c[3])
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+int jf__normal3(const double a[9], double evec[9])
+{
+    /* the eigenvalues in closed form (Smith, CACM 1961): A = q I + p B,
+     * det(B) / 2 = cos(3 phi) */
+    const double a00 = a[0], a11 = a[4], a22 = a[8];
+    const double a01 = 0.5 * (a[1] + a[3]), a02 = 0.5 * (a[2] + a[6]), a12 = 0.5 * (a[5] + a[7]);
+    const double q = (a00 + a11 + a22) / 3.0;
+    const double d0 = a00 - q, d1 = a11 - q, d2 = a22 - q;
+    const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12);
+    if (!(p2 > 0.0) || !isfinite(p2)) return 0; /* a multiple of I, or not finite */
+    const double p = sqrt(p2 / 6.0), ip = 1.0 / p;
+    const double b00 = d0 * ip, b11 = d1 * ip, b22 = d2 * ip, b01 = a01 * ip, b02 = a02 * ip,
+                 b12 = a12 * ip;
+    double r = 0.5 * (b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) +
+                      b02 * (b01 * b12 - b11 * b02));
+    r = r < -1.0 ? -1.0 : r > 1.0 ? 1.0 : r;
+    const double phi = acos(r) / 3.0;
+    const double l1 = q + 2.0 * p * cos(phi + 2.0943951023931957); /* + 2 pi / 3: the least */
+    /* its eigenvector: the longest cross product of two rows of A - l1 I
+     * (their length is about (l2 - l1)(l3 - l1)) */
+    const double r0[3] = {a00 - l1, a01, a02}, r1[3] = {a01, a11 - l1, a12},
+                 r2[3] = {a02, a12, a22 - l1};
+    double c[3][3], best = 0.0;
+    int kb = 0;
+    cross(r0, r1, c[0]);
+    cross(r0, r2, c[1]);
+    cross(r1, r2, c[2]);
+    for (int k = 0; k < 3; k++) {
+        double n2 = c[k][0] * c[k][0] + c[k][1] * c[k][1] + c[k][2] * c[k][2];
+        if (n2 > best) best = n2, kb = k;
+    }
+    /* l1 near l2 (no clear normal): the caller's Jacobi decides */
+    if (!(best > 1e-12 * (9.0 * p2) * (9.0 * p2)) || !isfinite(best)) return 0;
+    const double il = 1.0 / sqrt(best);
+    double *n = evec, *t = evec + 6;
+    for (int i = 0; i < 3; i++) n[i] = c[kb][i] * il;
+    pin_sign(n);
+    /* any unit t perpendicular to n (from the world axis least along n) */
+    int ax = 0;
+    for (int i = 1; i < 3; i++)
+        if (fabs(n[i]) < fabs(n[ax])) ax = i;
+    for (int i = 0; i < 3; i++) t[i] = (i == ax) - n[ax] * n[i];
+    const double it = 1.0 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int i = 0; i < 3; i++) t[i] *= it;
+    cross(n, t, evec + 3);
+    return 1;
 }
 
 int jf__frame_cov(const double *q, const double *w, size_t n, double cov[9])

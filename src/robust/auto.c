@@ -542,21 +542,14 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
     {
         const double *S = mo0->S, *T = mo0->T, n1 = (double)mo0->m;
         double mx = S[PIDX(1, 0)] * H / n1, my = S[PIDX(0, 1)] * H / n1, mz = T[0] / n1;
-        double c[9], cw[9], evec[9];
+        double c[9], evec[9];
         c[0] = S[PIDX(2, 0)] * H * H / n1 - mx * mx;
         c[1] = c[3] = S[PIDX(1, 1)] * H * H / n1 - mx * my;
         c[2] = c[6] = T[PIDX(1, 0)] * H / n1 - mx * mz;
         c[4] = S[PIDX(0, 2)] * H * H / n1 - my * my;
         c[5] = c[7] = T[PIDX(0, 1)] * H / n1 - my * mz;
         c[8] = mo0->zz / n1 - mz * mz;
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++) {
-                double t = 0.0;
-                for (int a = 0; a < 3; a++)
-                    for (int b = 0; b < 3; b++) t += fr0[3 * a + i] * c[3 * a + b] * fr0[3 * b + j];
-                cw[3 * i + j] = t;
-            }
-        jf__eig3(cw, pca_ev, evec);
+        jf__eig3_in(c, fr0, pca_ev, evec);
         jf__frame_axes(evec, pr->frame, fk);
     }
     const double *fr = fk;
@@ -666,7 +659,9 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         seen++;
     }
     double ev[3], evec[9], fr[9];
-    jf__eig3(cov, ev, evec);
+    /* the candidates' fits do not depend on the tangent axes (a rotation
+     * about the normal maps the polynomials of degree d onto themselves) */
+    if (!jf__normal3(cov, evec)) jf__eig3_in(cov, NULL, ev, evec);
     /* rows t1 (largest variance), t2 = nf x t1, nf (smallest), as the
      * jet's own frame (or the world axis nearest nf: params.frame) */
     jf__frame_axes(evec, pr->frame, fr);
