@@ -195,8 +195,11 @@ JF_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q
     if (!((cs->rk + delta) * (1.0 + 1e-9) < cs->R)) return 0;
     const double bmax = (cs->rk + delta) * (1.0 + 1e-9);
     /* first a tighter b from the last query's k-th distance (+5%): if k
-     * candidates lie within it, q's k nearest do too (fewer to sort) */
+     * candidates lie within it, q's k nearest do too (fewer to sort);
+     * too few, b x 1.3 up to bmax, the distances computed kept (straight
+     * to bmax: 2.6% more auto CPU on a 10^6 noisy torus, 14% retries) */
     double b = s->t_last * 1.05 < bmax ? s->t_last * 1.05 : bmax;
+    size_t done = 0; /* dd[] computed so far */
 again:;
     const double b2 = b * b, lc = (b + delta) * (1.0 + 1e-9), lc2 = lc * lc;
     size_t lim = 0, hi = cs->nc;
@@ -208,10 +211,11 @@ again:;
     const double q0 = q[0], q1 = q[1], q2 = q[2];
     double *dd = s->td; /* scratch until the sort */
     const double *cx = cs->cx, *cy = cs->cy, *cz = cs->cz;
-    for (size_t j = 0; j < lim; j++) {
+    for (size_t j = done; j < lim; j++) {
         double dx = q0 - cx[j], dy = q1 - cy[j], dz = q2 - cz[j];
         dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
     }
+    done = lim > done ? lim : done;
     size_t n = 0;
     for (size_t j = 0; j < lim; j++) {
         s->d2[n] = dd[j];
@@ -219,7 +223,7 @@ again:;
         n += dd[j] <= b2;
     }
     if (n < s->k && b < bmax) {
-        b = bmax;
+        b = b * 1.3 < bmax ? b * 1.3 : bmax;
         goto again;
     }
     if (n < s->k || !(b2 > 0.0)) return 0;
