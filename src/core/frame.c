@@ -127,8 +127,14 @@ int jf__normal3(const double a[9], double evec[9])
 {
     /* the eigenvalues in closed form (Smith, CACM 1961): A = q I + p B,
      * det(B) / 2 = cos(3 phi) */
-    const double a00 = a[0], a11 = a[4], a22 = a[8];
-    const double a01 = 0.5 * (a[1] + a[3]), a02 = 0.5 * (a[2] + a[6]), a12 = 0.5 * (a[5] + a[7]);
+    double m = 0.0; /* scaled to entries <= 1: no underflow in the products below */
+    for (int k = 0; k < 9; k++) m = fabs(a[k]) > m ? fabs(a[k]) : m;
+    if (!(m > 0.0) || !(m < INFINITY)) return 0;
+    const double im = 1.0 / m;
+    if (!(im < INFINITY)) return 0; /* subnormal entries only */
+    const double a00 = a[0] * im, a11 = a[4] * im, a22 = a[8] * im;
+    const double a01 = 0.5 * (a[1] + a[3]) * im, a02 = 0.5 * (a[2] + a[6]) * im,
+                 a12 = 0.5 * (a[5] + a[7]) * im;
     const double q = (a00 + a11 + a22) / 3.0;
     const double d0 = a00 - q, d1 = a11 - q, d2 = a22 - q;
     const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12);

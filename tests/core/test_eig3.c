@@ -51,10 +51,10 @@ static double axis_angle(const double *u, const double *v)
 }
 
 /* spectra: a plane's (l1 << l2), thick noise (l1 near l2), clean (l1 ~
- * 1e-12 l3), the scale of coordinates 1e-6 and 1e6 */
+ * 1e-12 l3), at the scales 1 and 1e+-150 (coordinates 1e+-75) */
 static void spectrum(int kind, double l[3])
 {
-    double s = kind % 4 == 3 ? 1e-12 : kind % 4 == 2 ? 1e12 : 1.0;
+    double s = kind % 4 == 3 ? 1e-150 : kind % 4 == 2 ? 1e150 : 1.0;
     double l3 = 1 + urand(), l2 = l3 * (0.05 + 0.95 * urand());
     double l1 = kind < 4 ? l2 * 0.3 * urand() : kind < 8 ? l2 * (0.5 + 0.45 * urand()) : l2 * 1e-12 * urand();
     l[0] = s * l1, l[1] = s * l2, l[2] = s * l3;
