@@ -6,7 +6,9 @@
  * weighted centroid (CGAL 5.5.1 sums in one pass in world coordinates and
  * loses all precision at large offsets, docs/design.md "CGAL 5.5.1"); a cyclic Jacobi
  * eigen-solver gives orthonormal eigenvectors whose signs are pinned so the
- * frame, hence every result, is reproducible. */
+ * frame, hence every result, is reproducible.  neighbors auto's frames
+ * take two faster forms: the least eigenvector in closed form
+ * (jf__normal3) and Jacobi to rounding in given axes (jf__eig3_in). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
