@@ -51,7 +51,6 @@ static void eig3_sorted(double a[3][3], double v[3][3], double eval[3], double e
  * the off-diagonal sum is at most tol x the diagonal's. */
 static inline __attribute__((always_inline)) void jacobi3(double a[3][3], double v[3][3], double tol)
 {
-
     /* Cyclic Jacobi (Golub & Van Loan §8.5): each rotation zeroes a[p][q];
      * converges quadratically, 50 sweeps is far beyond what doubles need. */
     for (int sweep = 0; sweep < 50; sweep++) {
@@ -90,32 +89,36 @@ static inline __attribute__((always_inline)) void jacobi3(double a[3][3], double
     }
 }
 
-void jf__eig3(const double a_in[9], double eval[3], double evec[9])
-{
-    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
-    jacobi3(a, v, DBL_EPSILON * DBL_EPSILON);
-    eig3_sorted(a, v, eval, evec);
-}
-
-void jf__eig3_in(const double a_in[9], const double rot[9], double eval[3], double evec[9])
+/* a_in symmetrised, Jacobi until off-diagonal <= tol x diagonal, the
+ * eigenvectors turned to the world from the axes rot (rows; NULL: the
+ * world's), sorted and pinned */
+static inline __attribute__((always_inline)) void
+eig3_tol(const double a_in[9], const double rot[9], double tol, double eval[3], double evec[9])
 {
     double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, w[3][3];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (a_in[3 * i + j] + a_in[3 * j + i]);
-    /* off-diagonal to rounding (eps, not eps^2 x the diagonal): the
-     * eigenvectors to rounding too, a sweep sooner */
-    jacobi3(a, v, DBL_EPSILON);
+    jacobi3(a, v, tol);
     if (!rot) {
         eig3_sorted(a, v, eval, evec);
         return;
     }
-    /* the eigenvectors in world coordinates: rot's rows are the axes */
     for (int i = 0; i < 3; i++)
         for (int k = 0; k < 3; k++)
             w[i][k] = rot[i] * v[0][k] + rot[3 + i] * v[1][k] + rot[6 + i] * v[2][k];
     eig3_sorted(a, w, eval, evec);
+}
+
+void jf__eig3(const double a_in[9], double eval[3], double evec[9])
+{
+    eig3_tol(a_in, NULL, DBL_EPSILON * DBL_EPSILON, eval, evec);
+}
+
+/* off-diagonal to rounding (eps, not eps^2 x the diagonal): the
+ * eigenvectors to rounding too, a sweep sooner */
+void jf__eig3_in(const double a_in[9], const double rot[9], double eval[3], double evec[9])
+{
+    eig3_tol(a_in, rot, DBL_EPSILON, eval, evec);
 }
 
 static void cross(const double a[3], const double b[3], double c[3])
@@ -140,7 +143,7 @@ int jf__normal3(const double a[9], double evec[9])
     const double q = (a00 + a11 + a22) / 3.0;
     const double d0 = a00 - q, d1 = a11 - q, d2 = a22 - q;
     const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12);
-    if (!(p2 > 0.0) || !isfinite(p2)) return 0; /* a multiple of I, or not finite */
+    if (!(p2 > 0.0)) return 0; /* a multiple of I, or NaN */
     const double p = sqrt(p2 / 6.0), ip = 1.0 / p;
     const double b00 = d0 * ip, b11 = d1 * ip, b22 = d2 * ip, b01 = a01 * ip, b02 = a02 * ip,
                  b12 = a12 * ip;
@@ -163,7 +166,7 @@ int jf__normal3(const double a[9], double evec[9])
         if (n2 > best) best = n2, kb = k;
     }
     /* l1 near l2 (no clear normal): the caller's Jacobi decides */
-    if (!(best > 1e-12 * (9.0 * p2) * (9.0 * p2)) || !isfinite(best)) return 0;
+    if (!(best > 1e-12 * (9.0 * p2) * (9.0 * p2))) return 0;
     const double il = 1.0 / sqrt(best);
     double *n = evec, *t = evec + 6;
     for (int i = 0; i < 3; i++) n[i] = c[kb][i] * il;

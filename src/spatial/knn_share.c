@@ -215,7 +215,7 @@ again:;
         double dx = q0 - cx[j], dy = q1 - cy[j], dz = q2 - cz[j];
         dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
     }
-    done = lim > done ? lim : done;
+    done = lim; /* lim grows with b */
     size_t n = 0;
     for (size_t j = 0; j < lim; j++) {
         s->d2[n] = dd[j];
