@@ -618,6 +618,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
     const nbctx *x = R->x;
     const int blocks = R->out == NULL;
     size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = R->done0;
+    size_t next = 1; /* atomic: the next chunk to claim */
     jf_status failed = JF_OK;
 #pragma omp parallel num_threads(nt)
     {
@@ -627,8 +628,10 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
 #pragma omp atomic write
             failed = wst;
         }
-#pragma omp for schedule(dynamic, 1)
-        for (size_t ch = 0; ch < nchunks; ch++) {
+        /* chunk 0 is the calling thread's, so the progress and cancel hooks
+         * (its own) run during the pass; the rest are claimed as they free */
+        size_t ch = omp_get_thread_num() == 0 ? 0 : __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED);
+        for (; ch < nchunks; ch = __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED)) {
             jf_status seen;
 #pragma omp atomic read
             seen = failed;
