@@ -15,7 +15,9 @@
  *     degrees of freedom), where truncation error (O(h^4), Theorem 3) is
  *     least and the noise is still well sampled; the next larger K where
  *     that exceeds auto_blob x the radius (a blob of noise, whose cubic
- *     follows it).  It is what `sigma` reports.
+ *     follows it); the cubic's at the largest K instead where its
+ *     residual variance stays flat from K = 48 on (no bias: the K = 32
+ *     estimate's chi-square tail).  It is what `sigma` reports.
  *  3. (Steps 3-4: auto_rule.c.) Per degree, Lepski's rule (Lepski, Mammen & Spokoiny 1997; the
  *     intersection of confidence intervals of Katkovnik 1999; the K that
  *     balances noise and curvature for normals: Mitra, Nguyen & Guibas
@@ -51,6 +53,7 @@ typedef long long v4l __attribute__((vector_size(32)));
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND JF_AUTO_NCAND
 #define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
+#define FLAT_K 48      /* the flat test's first K (step 2)             */
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
@@ -706,6 +709,16 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
     if (!isfinite(s2)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
+    /* On 22 dof the estimate at K = 32 falls, at a few points in a
+     * thousand, to a third of the noise's variance, and Lepski then stops
+     * on wild small-K normals.  Where the cubic's residual variance stays
+     * flat from K = 48 to the largest K there is no bias to fear (a
+     * cubic's grows like h^8, Theorem 3): the largest K's, on the most
+     * points, is the noise's. */
+    for (int i = 0, b = nc - 1; i < b && kn->auto_flat > 0.0; i++)
+        if (ks[i] == FLAT_K && cf[1][i].ok && cf[1][b].ok && cf[1][b].s2 > s2 &&
+            cf[1][b].s2 <= cf[1][i].s2 * (1.0 + kn->auto_flat * sqrt(2.0 / (FLAT_K - NMON))))
+            s2 = cf[1][b].s2;
     double sigma = sqrt(s2);
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small

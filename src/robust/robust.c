@@ -68,10 +68,12 @@
  * residual variance stays within 1 + z sqrt(2 / (K - 6)) of the noise's
  * passes Lepski's test; auto_s2floor c > 0: the noise variance at least
  * the cubic's at K = 48 where it exceeds (c x radius)^2 (auto_rule.c;
- * both off: docs/robustness.md). */
+ * both off: docs/robustness.md); auto_flat z: the noise variance is the
+ * cubic's at the largest K where that stays within 1 + z sqrt(2 / 38) of
+ * the cubic's at K = 48 (auto.c step 2; 0: off). */
 const jf__knobs jf__knob_defaults = {
     JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
-    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, 0.0, 0.0, NULL};
+    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, 0.0, 0.0, 2.0, NULL};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -135,6 +137,7 @@ int jf__robust_tune(jf_fitter *f, const char *name, double v)
     else if (!strcmp(name, "auto_nest")) k->auto_nest = v;
     else if (!strcmp(name, "auto_lof")) k->auto_lof = v;
     else if (!strcmp(name, "auto_s2floor")) k->auto_s2floor = v;
+    else if (!strcmp(name, "auto_flat")) k->auto_flat = v;
     else return -1;
     return 0;
 }

@@ -28,6 +28,7 @@ typedef struct {
     int auto_gl;
     double auto_nest; /* auto.c: > 0: Lepski on nested variances (dropped) */
     double auto_lof, auto_s2floor; /* auto_rule.c (off: 0; dropped) */
+    double auto_flat; /* auto.c step 2: the flat test's z (off: 0) */
     struct jf__auto_diag *auto_diag; /* bench-only: auto's candidates out */
 } jf__knobs;
 extern const jf__knobs jf__knob_defaults;

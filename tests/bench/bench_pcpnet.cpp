@@ -239,6 +239,8 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--auto-lof") && i + 1 < argc) tune("auto_lof", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-s2floor") && i + 1 < argc)
             tune("auto_s2floor", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-flat") && i + 1 < argc)
+            tune("auto_flat", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--cgal-ks") && i + 1 < argc) cgal_ks = argv[++i];
         else if (!std::strcmp(argv[i], "--cgal-k") && i + 1 < argc) cgal_k = std::strtoul(argv[++i], nullptr, 10);
         else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) only_levels = argv[++i];

@@ -2,7 +2,7 @@
  * generated surface its normals are below the default knn:32 and within
  * 5% of the best fixed K of 16..256 picked in hindsight (both computed
  * here, not quoted; issue 27 asks for below the best: not reached yet,
- * measured 1.03-1.04x here, docs/robustness.md), it flags every point, its
+ * measured 1.02x here, docs/robustness.md), it flags every point, its
  * reported jet is jf_fit_point's on the same K nearest and degree, its
  * noise estimate is near the noise drawn, and it is the same bits for 1
  * and 2 threads and in parts (jf_estimate_parts) as on the whole cloud. */

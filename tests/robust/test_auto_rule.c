@@ -4,8 +4,10 @@
  * (bench_auto_diag's per-point errors) is jf_fit_point's jet of that
  * degree on that many nearest; the row auto reports is the hook's chosen
  * candidate, bit for bit; jf__auto_rule on the hook's candidates makes the
- * same choice; and the auto_lof knob, set so that every K passes Lepski's
- * test, lets K grow (the knob is live). */
+ * same choice; the auto_lof knob, set so that every K passes Lepski's
+ * test, lets K grow (the knob is live); and step 2's flat test reads the
+ * noise at the largest K where the residual variance is flat, not where
+ * it grows. */
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
@@ -161,6 +163,61 @@ START_TEST(test_lof_knob_is_live)
 }
 END_TEST
 
+/* 256 neighbours of p = 0 (a sunflower, nearest first): on the plane
+ * z = 0 with noise of sd 0.01 along z, or on the sphere of radius 3
+ * through p with noise 1e-4 (the cubic's truncation dominates there). */
+static size_t patch(int curved, jf_rng *rng, double *nb)
+{
+    for (size_t i = 0; i < JF_NB_AUTO_KMAX; i++) {
+        double r = sqrt((double)i / JF_NB_AUTO_KMAX), t = 2.399963229728653 * (double)i;
+        double x = r * cos(t), y = r * sin(t), g = jf_rng_gauss(rng);
+        nb[3 * i] = x;
+        nb[3 * i + 1] = y;
+        nb[3 * i + 2] = curved ? 3.0 - sqrt(9.0 - x * x - y * y) + 1e-4 * g : 0.01 * g;
+    }
+    return JF_NB_AUTO_KMAX;
+}
+
+/* Step 2's flat test.  On 8000 noisy planes the K = 32 estimate alone
+ * (22 dof) puts sigma under 0.7 x the noise at about 2% of them (a
+ * chi-square's tail), and the test, reading the noise at K = 256 where
+ * the residual variance is flat, at half as many (asserted: at most
+ * 0.7x); where the variance grows with K (curvature) sigma stays the
+ * K = 32 estimate. */
+START_TEST(test_flat_noise)
+{
+    const double p[3] = {0, 0, 0};
+    static double nb[3 * JF_NB_AUTO_KMAX];
+    jf_fitter *on = fitter(2, 1), *off = fitter(2, 1);
+    ck_assert_int_eq(jf__robust_tune(off, "auto_flat", 0.0), 0);
+    jf_rng rng;
+    jf_rng_seed(&rng, 5);
+    int low_on = 0, low_off = 0;
+    for (int t = 0; t < 8000; t++) {
+        jf_result a, b;
+        size_t n = patch(0, &rng, nb);
+        ck_assert_int_eq(jf_fit_point_full(on, p, nb, n, &a), JF_OK);
+        ck_assert_int_eq(jf_fit_point_full(off, p, nb, n, &b), JF_OK);
+        ck_assert(a.sigma >= b.sigma); /* the test only raises it */
+        low_on += a.sigma < 0.7 * 0.01;
+        low_off += b.sigma < 0.7 * 0.01;
+    }
+    ck_assert_msg(low_off >= 80 && 10 * low_on <= 7 * low_off,
+                  "sigma < 0.7 noise: %d with the test, %d without", low_on, low_off);
+    for (int t = 0; t < 20; t++) {
+        jf_result a, b;
+        size_t n = patch(1, &rng, nb);
+        ck_assert_int_eq(jf_fit_point_full(on, p, nb, n, &a), JF_OK);
+        ck_assert_int_eq(jf_fit_point_full(off, p, nb, n, &b), JF_OK);
+        ck_assert(isfinite(a.sigma) && a.sigma > 0.0);
+        ck_assert_msg(a.sigma == b.sigma, "curved: sigma %g, without the test %g", a.sigma,
+                      b.sigma);
+    }
+    jf_fitter_free(on);
+    jf_fitter_free(off);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("auto_rule");
@@ -169,6 +226,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_diag_candidates_are_the_jets);
     tcase_add_test(tc, test_lof_knob_is_live);
     tcase_add_test(tc, test_angle_le_is_the_acos_test);
+    tcase_add_test(tc, test_flat_noise);
     suite_add_tcase(s, tc);
     return s;
 }
