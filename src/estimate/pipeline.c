@@ -31,6 +31,7 @@
 
 #include <stdint.h>
 
+#include "core/claim.h"
 #include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
@@ -618,7 +619,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
     const nbctx *x = R->x;
     const int blocks = R->out == NULL;
     size_t nchunks = (nwalk + CHUNK - 1) / CHUNK, done = R->done0;
-    size_t next = 1; /* atomic: the next chunk to claim */
+    size_t next = 1; /* the next chunk to claim (core/claim.h) */
     jf_status failed = JF_OK;
 #pragma omp parallel num_threads(nt)
     {
@@ -628,10 +629,9 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
 #pragma omp atomic write
             failed = wst;
         }
-        /* chunk 0 is the calling thread's, so the progress and cancel hooks
-         * (its own) run during the pass; the rest are claimed as they free */
-        size_t ch = omp_get_thread_num() == 0 ? 0 : __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED);
-        for (; ch < nchunks; ch = __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED)) {
+        /* chunk 0 the calling thread's: its progress and cancel hooks run
+         * during the pass (core/claim.h) */
+        for (size_t ch = jf__claim_first(&next); ch < nchunks; ch = jf__claim_next(&next)) {
             jf_status seen;
 #pragma omp atomic read
             seen = failed;

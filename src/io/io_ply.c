@@ -19,6 +19,8 @@
 
 #include <omp.h>
 
+#include "core/claim.h"
+
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
 static const char *const type_names[][2] = {
     {"", ""},          {"char", "int8"},   {"uchar", "uint8"},
@@ -864,7 +866,7 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
     const size_t nchunks = (nrows + per - 1) / per, cap = per * vrow;
     const int nt = ro && ro->threads > 0 ? ro->threads : jf_default_threads(NULL);
     size_t rows_done = 0;     /* atomic: progress, read by the calling thread */
-    size_t next = 1;          /* atomic: the next chunk to claim */
+    size_t next = 1;          /* the next chunk to claim (core/claim.h) */
     int failed = 0, fail_e = 0, nomem = 0;
     /* chunks read and decoded on the threads, each into its own rows (the
      * decode, not the copy from the page cache, is most of the time) */
@@ -873,10 +875,9 @@ static jf_status read_chunked(int fd, size_t len, const char *name, const jf_rea
         const int tid = omp_get_thread_num();
         unsigned char *tb = tid == 0 ? buf : malloc(cap);
         if (!tb) __atomic_store_n(&nomem, 1, __ATOMIC_RELAXED);
-        /* chunk 0 is the calling thread's, so a file of two chunks or more
-         * always reports progress between its ends; the rest are claimed */
-        for (size_t ch = tid == 0 ? 0 : __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED);
-             ch < nchunks; ch = __atomic_fetch_add(&next, 1, __ATOMIC_RELAXED)) {
+        /* chunk 0 the calling thread's: a file of two chunks or more
+         * always reports progress between its ends (core/claim.h) */
+        for (size_t ch = jf__claim_first(&next); ch < nchunks; ch = jf__claim_next(&next)) {
             if (__atomic_load_n(&failed, __ATOMIC_RELAXED) || !tb) continue;
             size_t r0 = ch * per, m = n - r0 < per ? n - r0 : per;
             int pe = 0;
