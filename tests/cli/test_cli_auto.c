@@ -45,6 +45,11 @@ START_TEST(auto_columns_and_summary)
                      0);
     ck_assert_msg(strstr(cli_err, "auto K: <="), "%s", cli_err);
     ck_assert_msg(strstr(cli_err, ", auto 1600"), "%s", cli_err);
+    /* "ok" counts the rows with no flag but auto's (which says how the
+     * row was made, not that anything went wrong) */
+    const char *okp = strstr(cli_err, "  status: ok ");
+    unsigned long ok = 0, nok = 0;
+    ck_assert_msg(okp && sscanf(okp + 13, "%lu", &ok) == 1, "%s", cli_err);
     jf_eval_table t;
     cli_read(cli_path("a.csv"), &t);
     ck_assert_uint_eq(t.nrows, SIDE * SIDE);
@@ -52,12 +57,15 @@ START_TEST(auto_columns_and_summary)
     for (size_t i = 0; i < t.nrows; i++) {
         unsigned st = (unsigned)cli_val(&t, i, "status");
         ck_assert_uint_ne(st & JF_PT_AUTO, 0);
+        nok += !(st & ~(unsigned)JF_PT_AUTO);
         double k = cli_val(&t, i, "neighbors"), d = cli_val(&t, i, "degree");
         ck_assert(k >= 16 && k <= JF_NB_AUTO_KMAX);
         ck_assert(d == 2 || d == 3);
         sg[i] = cli_val(&t, i, "sigma");
     }
     jf_eval_table_free(&t);
+    ck_assert_uint_eq(ok, nok);
+    ck_assert_uint_gt(ok, SIDE * SIDE / 2);
     /* the noise along the normal has sd NOISE (isotropic noise) */
     qsort(sg, SIDE * SIDE, sizeof sg[0], cmp_d);
     double med = sg[SIDE * SIDE / 2];
