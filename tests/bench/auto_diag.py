@@ -14,7 +14,13 @@ threshold tau and a largest K, over a grid, and the best grid cell per
 cloud -- an upper bound for any retuning of the rule's two knobs, even one
 that knew each cloud's noise.
 
-usage: python3 auto_diag.py [--sweep] FILE...
+With --cap (needs numpy): one largest K for the whole cloud, the K of
+least mean estimated squared error of the quadric's normal over the
+file's points (bias^2 from the drift against K = 16 or 24 less what the
+noise explains, plus sd^2), and the rule re-run under that cap -- what a
+cloud-wide pass before the fits would buy.
+
+usage: python3 auto_diag.py [--sweep | --cap] FILE...
 """
 import math
 import sys
@@ -210,7 +216,38 @@ def sweep(path, pts):
           (best[0], best[1], best[2], fixed, best[0] / fixed))
 
 
+def cloud_cap(path, pts):
+    import numpy as np
+    A = _sweep_arrays(pts)
+    N = len(A['s2'])
+    fixed = min(rms(list(A['err'][:, k, e])) for k in range(10) for e in range(2))
+
+    def rule_rms(kmax):
+        ci, d = np_rule(A, 2.0, kmax)
+        return rms(list(np.where(ci < 0, 90.0, A['err'][np.arange(N), np.maximum(ci, 0), d - 2])))
+
+    sd = np.sqrt(A['s2'][:, None] * A['tr'][:, :, 0])
+    n = A['n'][:, :, 0]
+    ok = (A['ok'][:, :, 0] > 0).all(1)
+    out = ['rule %.3f (x%.3f)' % (rule_rms(9), rule_rms(9) / fixed)]
+    for ref, trim in ((0, 0), (1, 0), (0, 1), (1, 1)):
+        cost = []
+        for k in range(10):
+            b2 = _np_ang(n[:, k], n[:, ref]) ** 2 - (sd[:, ref] ** 2 - sd[:, k] ** 2) if k > ref else 0.0 * sd[:, k]
+            c = np.sort((b2 + sd[:, k] ** 2)[ok])
+            cost.append(float(np.mean(c[: int(0.95 * len(c))]) if trim else np.median(c)))
+        kc = int(np.argmin(cost))
+        r = rule_rms(kc)
+        out.append('drift from K=%d, %s: cap K=%d %.3f (x%.3f)' %
+                   (A['K'][ref], 'mean of 95%' if trim else 'median', A['K'][kc], r, r / fixed))
+    print('## %s: best fixed candidate %.3f; %s' % (path, fixed, '; '.join(out)))
+
+
 if __name__ == '__main__':
-    do_sweep = '--sweep' in sys.argv[1:]
-    for path in (a for a in sys.argv[1:] if a != '--sweep'):
-        (sweep if do_sweep else summary)(path, load(path))
+    mode = summary
+    if '--sweep' in sys.argv[1:]:
+        mode = sweep
+    elif '--cap' in sys.argv[1:]:
+        mode = cloud_cap
+    for path in (a for a in sys.argv[1:] if a not in ('--sweep', '--cap')):
+        mode(path, load(path))

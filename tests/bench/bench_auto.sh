@@ -3,6 +3,7 @@
 # default knn:32 degree 2 on the same cloud, in the same run.
 #
 #   sh tests/bench/bench_auto.sh [BUILD] [N] [ROUNDS]
+#   EXTRA="knn:256 knn:512" sh tests/bench/bench_auto.sh ...
 #
 # BUILD (default: build) holds the jetfit command; N (default 100000) is
 # the point count of a `jetfit generate torus --density gradient --noise
@@ -11,7 +12,10 @@
 # setting's time is its least CPU time (user + system) over the rounds,
 # the two alternating so that both see the same load.  Prints per setting
 # that time, points/s and peak RSS, then the ratios auto / knn:32 (goal:
-# time <= 3, memory <= 1.5).  Needs GNU time (/usr/bin/time).
+# time <= 3, memory <= 1.5).  EXTRA: more --neighbors settings timed in
+# the same rounds, each with its ratio to knn:32 (the plain fits at the
+# K the accuracy target would need, docs/robustness.md).  Needs GNU time
+# (/usr/bin/time).
 set -eu
 B=${1:-build}
 N=${2:-100000}
@@ -34,15 +38,17 @@ one() { # one NB -> "cpu_seconds peak_kb"
 : >"$W/runs"
 i=0
 while [ "$i" -lt "$R" ]; do
-    for nb in knn:32 auto; do echo "$nb $(one $nb)" >>"$W/runs"; done
+    for nb in knn:32 auto ${EXTRA:-}; do echo "$nb $(one $nb)" >>"$W/runs"; done
     i=$((i + 1))
 done
-awk -v n="$N" '
+awk -v n="$N" -v list="knn:32 auto ${EXTRA:-}" '
 { if (!($1 in t) || $2 < t[$1]) t[$1] = $2; if ($3 > m[$1]) m[$1] = $3 }
 END {
     printf "| setting | CPU s (least of rounds) | points/s | peak RSS (MB) |\n|---|---|---|---|\n"
-    split("knn:32 auto", s, " ")
-    for (i = 1; i <= 2; i++)
+    ns = split(list, s, " ")
+    for (i = 1; i <= ns; i++)
         printf "| %s | %.3f | %.0f | %.1f |\n", s[i], t[s[i]], n / t[s[i]], m[s[i]] / 1024
     printf "auto / knn:32: time %.2fx, memory %.2fx\n", t["auto"] / t["knn:32"], m["auto"] / m["knn:32"]
+    for (i = 3; i <= ns; i++)
+        printf "%s / knn:32: time %.2fx, memory %.2fx\n", s[i], t[s[i]] / t["knn:32"], m[s[i]] / m["knn:32"]
 }' "$W/runs"

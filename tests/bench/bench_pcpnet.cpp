@@ -16,13 +16,15 @@
 // Usage: bench_pcpnet [DATA_DIR] [--quick] [--no-cgal] [--no-fixed]
 //   [--sweep "K,deg,robust[,dsel] ..."] [--varw X] [--floor X] [--target X]
 //   [--dtau X] [--dsdmin X] [--dfloorn X] [--distw X] [--same-points]
-//   [--levels L1,L2,..] [--cgal-k K]
+//   [--levels L1,L2,..] [--cgal-k K] [--seed S]
 // --same-points: jetfit fits K + 1 points like CGAL (default: K, the query
 // included); --distw X: dist_weight of the --sweep configurations;
 // --dtau, --dsdmin, --dfloorn: the degree-selection knobs of robust.c
 // (interval width, sd below which the top degree is kept, size above
 // which the blob floor shrinks); --levels: only these noise
-// levels; --cgal-k: CGAL at this K only (its K = 450 runs take minutes);
+// levels; --seed: the noise draws' seed (default 20031: another seed,
+// another draw of the same levels); --cgal-k: CGAL at this K only (its
+// K = 450 runs take minutes);
 // --quick: clean shape and the largest noise only, K = 18 and 112;
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
 // 0/1/2 = none/huber/tukey; with --no-fixed only those run); --varw,
@@ -215,6 +217,7 @@ int main(int argc, char **argv)
     const char *only_levels = nullptr; // "0,0.012": a subset of the noise levels
     bool same_points = false;    // jetfit fits K + 1 points, CGAL's neighbourhood
     size_t cgal_k = 0;           // run CGAL at this K only (0 = every K)
+    unsigned long seed = 20031;  // the noise draws' (--seed: another draw of the same levels)
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--no-cgal")) no_cgal = true;
@@ -227,6 +230,7 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--dfloorn") && i + 1 < argc) tune("degree_floor_n", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--distw") && i + 1 < argc) g_distw = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--same-points")) same_points = true;
+        else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoul(argv[++i], nullptr, 10);
         else if (!std::strcmp(argv[i], "--auto")) with_auto = true;
         else if (!std::strcmp(argv[i], "--cgal-jet2")) cgal_jet2 = true;
         else if (!std::strcmp(argv[i], "--auto-tau") && i + 1 < argc) tune("auto_tau", std::atof(argv[++i]));
@@ -295,7 +299,7 @@ int main(int argc, char **argv)
                 "time_s", "flagged");
     for (double lv : levels) {
         s.xyz = clean;
-        std::mt19937_64 rng(20031);
+        std::mt19937_64 rng(seed);
         std::normal_distribution<double> g(0.0, lv * diag);
         if (lv > 0)
             for (double &x : s.xyz) x += g(rng);
