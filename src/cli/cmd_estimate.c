@@ -165,13 +165,6 @@ static double now_s(void)
 #define NKBIN 10
 static const int kbin[NKBIN] = {16, 24, 32, 48, 64, 96, 128, 160, 200, JF_NB_AUTO_KMAX};
 
-/* flags that say how a row was made, not that anything went wrong: the
- * summary's "ok" counts rows with no other flag (under auto or natural
- * every row has one; "ok 0" there read as a failure) */
-#define HOW_FLAGS                                                                                  \
-    (JF_PT_AUTO | JF_PT_SCALE_SELECTED | JF_PT_NORMAL_POLES | JF_PT_NORMAL_MINCIRC |               \
-     JF_PT_NORMAL_INPUT | JF_PT_NORMAL_JET | JF_PT_NORMAL_PCA)
-
 typedef struct {
     size_t flags[32], ok, deg[JF_MAX_DEGREE + 1], k[NKBIN];
     size_t unfit; /* failed or nonfinite: no fit at all */
@@ -186,7 +179,7 @@ static void tally_add(tally *t, const jf_result *r)
         while (b < NKBIN - 1 && r->n_used > kbin[b]) b++;
         t->k[b]++;
     }
-    if (!(r->status & ~HOW_FLAGS)) t->ok++;
+    if (!(r->status & ~JF_CLI_HOW_FLAGS)) t->ok++; /* under auto every row has a flag */
     if (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) t->unfit++;
     for (int b = 0; b < 32; b++)
         if (r->status & (1u << b)) t->flags[b]++;

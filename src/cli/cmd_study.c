@@ -199,14 +199,8 @@ static int run_cell(jf_study_args *c, jf_study_cell *cl, const jf_sample *smp, c
     }
     snprintf(cl->status, sizeof cl->status, "ok");
     cl->ok = cl->lowered = cl->failed = cl->flagged = 0;
-    /* flags that say how a point was fitted, not that anything went
-     * wrong (the natural normal's source, a selected scale, an umbilic):
-     * such a point is ok */
-    const unsigned info = JF_PT_NORMAL_POLES | JF_PT_NORMAL_MINCIRC | JF_PT_NORMAL_INPUT |
-                          JF_PT_NORMAL_JET | JF_PT_NORMAL_PCA | JF_PT_SCALE_SELECTED |
-                          JF_PT_UMBILIC;
     for (size_t i = 0; i < smp->n; i++) {
-        unsigned u = res[i].status & ~info;
+        unsigned u = res[i].status & ~(unsigned)JF_CLI_HOW_FLAGS;
         cl->ok += u == 0;
         cl->lowered += (u & (JF_PT_LOWERED_COND | JF_PT_LOWERED_RANK | JF_PT_LOWERED_FEW)) != 0;
         cl->failed += (u & JF_PT_FAILED) != 0;

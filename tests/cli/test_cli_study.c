@@ -258,6 +258,9 @@ START_TEST(study_knows_auto)
     const csv_row *h = &r[0];
     int cs = col(h, "strategy"), cseed = col(h, "seed"), cn = col(h, "noise");
     ck_assert_str_eq(r[2].f[cs], "auto");
+    /* auto's flag says how the points were fitted: they are ok, not flagged */
+    ck_assert_msg(atoi(r[2].f[col(h, "ok")]) > 750 && atoi(r[2].f[col(h, "flagged")]) < 750,
+                  "auto cell: ok %s, flagged %s", r[2].f[col(h, "ok")], r[2].f[col(h, "flagged")]);
     const char *gen = cli_path("g.ply"), *truth = cli_path("t.ply");
     const char *g[] = {JETFIT_BIN, "generate", "exp", "--n", "1500", "--seed", r[2].f[cseed],
                        "--noise", r[2].f[cn], "-o", gen, "--truth", truth, NULL};
