@@ -54,6 +54,7 @@ typedef long long v4l __attribute__((vector_size(32)));
 #define NCAND JF_AUTO_NCAND
 #define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
 #define FLAT_K 48      /* the flat test's first K (step 2)             */
+#define FLAT_I 3       /* its index: cand[FLAT_I] == FLAT_K            */
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
 static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
@@ -715,10 +716,10 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
      * flat from K = 48 to the largest K there is no bias to fear (a
      * cubic's grows like h^8, Theorem 3): the largest K's, on the most
      * points, is the noise's. */
-    for (int i = 0, b = nc - 1; i < b && kn->auto_flat > 0.0; i++)
-        if (ks[i] == FLAT_K && cf[1][i].ok && cf[1][b].ok && cf[1][b].s2 > s2 &&
-            cf[1][b].s2 <= cf[1][i].s2 * (1.0 + kn->auto_flat * sqrt(2.0 / (FLAT_K - NMON))))
-            s2 = cf[1][b].s2;
+    const int b = nc - 1; /* ks[i] == cand[i] below the last */
+    if (kn->auto_flat > 0.0 && FLAT_I < b && cf[1][FLAT_I].ok && cf[1][b].ok && cf[1][b].s2 > s2 &&
+        cf[1][b].s2 <= cf[1][FLAT_I].s2 * (1.0 + kn->auto_flat * sqrt(2.0 / (FLAT_K - NMON))))
+        s2 = cf[1][b].s2;
     double sigma = sqrt(s2);
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small

@@ -197,8 +197,14 @@ def np_rule(A, tau=2.0, kmax=9):
     return ci, d
 
 
-def sweep(path, pts):
+def rule_rms(A, tau=2.0, kmax=9):
+    """RMS normal error of np_rule's choices (no choice: 90 degrees)"""
     import numpy as np
+    ci, d = np_rule(A, tau, kmax)
+    return rms(list(np.where(ci < 0, 90.0, A['err'][np.arange(len(ci)), np.maximum(ci, 0), d - 2])))
+
+
+def sweep(path, pts):
     A = _sweep_arrays(pts)
     N = len(A['s2'])
     ci, d = np_rule(A)
@@ -207,9 +213,7 @@ def sweep(path, pts):
     best = None
     for tau in (0.5, 1, 1.5, 2, 3, 4):
         for kmax in range(1, 10):
-            ci, d = np_rule(A, tau, kmax)
-            err = np.where(ci < 0, 90.0, A['err'][np.arange(N), np.maximum(ci, 0), d - 2])
-            r = rms(list(err))
+            r = rule_rms(A, tau, kmax)
             if best is None or r < best[0]:
                 best = (r, tau, A['K'][kmax])
     print('best (tau, largest K) %.3f at tau %g, K <= %d; best fixed candidate %.3f: x%.3f' %
@@ -219,17 +223,12 @@ def sweep(path, pts):
 def cloud_cap(path, pts):
     import numpy as np
     A = _sweep_arrays(pts)
-    N = len(A['s2'])
     fixed = min(rms(list(A['err'][:, k, e])) for k in range(10) for e in range(2))
-
-    def rule_rms(kmax):
-        ci, d = np_rule(A, 2.0, kmax)
-        return rms(list(np.where(ci < 0, 90.0, A['err'][np.arange(N), np.maximum(ci, 0), d - 2])))
-
     sd = np.sqrt(A['s2'][:, None] * A['tr'][:, :, 0])
     n = A['n'][:, :, 0]
     ok = (A['ok'][:, :, 0] > 0).all(1)
-    out = ['rule %.3f (x%.3f)' % (rule_rms(9), rule_rms(9) / fixed)]
+    r = rule_rms(A)
+    out = ['rule %.3f (x%.3f)' % (r, r / fixed)]
     for ref, trim in ((0, 0), (1, 0), (0, 1), (1, 1)):
         cost = []
         for k in range(10):
@@ -237,7 +236,7 @@ def cloud_cap(path, pts):
             c = np.sort((b2 + sd[:, k] ** 2)[ok])
             cost.append(float(np.mean(c[: int(0.95 * len(c))]) if trim else np.median(c)))
         kc = int(np.argmin(cost))
-        r = rule_rms(kc)
+        r = rule_rms(A, 2.0, kc)
         out.append('drift from K=%d, %s: cap K=%d %.3f (x%.3f)' %
                    (A['K'][ref], 'mean of 95%' if trim else 'median', A['K'][kc], r, r / fixed))
     print('## %s: best fixed candidate %.3f; %s' % (path, fixed, '; '.join(out)))
