@@ -1,0 +1,198 @@
+#!/usr/bin/env python3
+"""auto_agg.py -- issue 27, seventh round (docs/robustness.md): does
+aggregating the neighbours' jets beat the best fixed K where one fit
+cannot?  Offline, from jetfit's own rows; nothing here ships.
+
+usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
+       [--n N] [--seed S]
+
+At each point q, the jets of its m nearest points j (q itself first),
+m = f x the K auto chose at q, each j's fit the row jetfit wrote:
+  indiv  mean of n_j - W_j (q - j): each normal carried to q by its own
+         shape operator W_j = k1 d1 d1^T + k2 d2 d2^T (a first-order
+         Taylor step, §2's Monge form; signs aligned with n_q);
+  mid    mean of n_j - (W_j + W)/2 (q - j), W the mean of the W_j: the
+         step with the mean of its two ends' curvatures (trapezoid rule:
+         no second-order error, W standing for q's own); also only where auto's K is its
+         largest, 256 (elsewhere the row as auto wrote it);
+  curvatures: the eigenvalues of W in the plane normal to the normal.
+Printed against auto's own rows and the plain degree-2 jet on k + 1
+points (CGAL's jet on the same points, docs/robustness.md), k in 18, 32,
+64, 128, 256, the best k per column after seeing the truth: RMS normal
+angle (deg) and median |dk1|, |dk2| (jetfit eval's conventions).
+ 1. jetfit generate ellipsoid, torus --density gradient, exp at noise
+    0.1%, 0.3%, 1% (N points, seed S: study_auto.sh's clouds);
+ 2. with --pcpnet DIR: armadillo100k at Gaussian noise 0, 0.125%, 0.6%,
+    1.2% of the bounding-box diagonal (numpy's draw, seed 7), normals on
+    the 5000 .pidx points.
+Neighbours by brute force (numpy): minutes, not a benchmark of speed.
+"""
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+KS = (18, 32, 64, 128, 256)
+KMAX = 256  # auto's largest candidate
+
+
+def run(jetfit, cloud, nb, out):
+    subprocess.run([jetfit, "estimate", cloud, "-o", out, "--neighbors", nb, "--quiet"], check=True)
+    with open(out) as fh:
+        names = fh.readline().lstrip("#").split()
+    rows = np.loadtxt(out, comments="#")
+    return rows, {n: i for i, n in enumerate(names)}
+
+
+def neighbours(Y, Q, m):
+    """indices of the m nearest points of Y to each row of Q, nearest first"""
+    nb = np.empty((len(Q), m), dtype=np.int64)
+    for s in range(0, len(Q), 250):
+        d = ((Q[s:s + 250, None, :] - Y[None, :, :]) ** 2).sum(-1)
+        part = np.argpartition(d, m, axis=1)[:, :m]
+        dd = np.take_along_axis(d, part, 1)
+        nb[s:s + 250] = np.take_along_axis(part, np.argsort(dd, axis=1), 1)
+    return nb
+
+
+def aggregate(rows, col, I, nb, mq):
+    """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i]"""
+    P = rows[:, 0:3]
+    N = rows[:, col["nx"]:col["nx"] + 3]
+    k1, k2 = rows[:, col["k1"]], rows[:, col["k2"]]
+    D1 = rows[:, col["d1x"]:col["d1x"] + 3]
+    D2 = rows[:, col["d2x"]:col["d2x"] + 3]
+    good = np.isfinite(N).all(1) & np.isfinite(k1) & np.isfinite(k2)
+    NI, PI, n = N[I], P[I], len(I)
+    cnt = np.zeros(n)
+    mean_n, cen, ind = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    W = np.zeros((n, 3, 3))
+    for t in range(nb.shape[1]):
+        j = nb[:, t]
+        on = ((t < mq) & good[j]).astype(float)
+        if not on.any():
+            break
+        s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
+        nj = N[j] * s[:, None]
+        a1, a2 = k1[j] * s, k2[j] * s
+        Wj = a1[:, None, None] * D1[j][:, :, None] * D1[j][:, None, :] + \
+            a2[:, None, None] * D2[j][:, :, None] * D2[j][:, None, :]
+        d = PI - P[j]
+        cnt += on
+        mean_n += nj * on[:, None]
+        cen += P[j] * on[:, None]
+        W += Wj * on[:, None, None]
+        ind += (nj - np.einsum("nij,nj->ni", Wj, d)) * on[:, None]
+    cnt = np.maximum(cnt, 1.0)
+    W /= cnt[:, None, None]
+    mean_n /= cnt[:, None]
+    cen /= cnt[:, None]
+    ind /= cnt[:, None]
+    # sum of n_j - W (q - j) over the m, divided by m: mean_n - W (q - cen)
+    wbar = mean_n - np.einsum("nij,nj->ni", W, PI - cen)
+    out = {}
+    for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0)):
+        nn = v / np.linalg.norm(v, axis=1)[:, None]
+        Pm = np.eye(3)[None] - nn[:, :, None] * nn[:, None, :]
+        ev, evec = np.linalg.eigh(Pm @ W @ Pm)
+        along = np.argmax(np.abs((evec * nn[:, :, None]).sum(1)), axis=1)
+        keep = np.array([[i for i in range(3) if i != a] for a in along])
+        e = np.take_along_axis(ev, keep, 1)
+        out[name] = (nn, e[:, 1], e[:, 0])
+    return out
+
+
+def errors(nrm, c1, c2, T, t1=None, t2=None):
+    """RMS angle (deg, unoriented) and, with truth curvatures, median |dk1|, |dk2|"""
+    dot = (nrm * T).sum(1) / np.linalg.norm(nrm, axis=1)
+    ang = np.degrees(np.sqrt(np.nanmean(np.arccos(np.clip(np.abs(dot), 0, 1)) ** 2)))
+    if t1 is None:
+        return (ang,)
+    f = dot < 0  # orient along the truth: the curvatures negate and swap
+    e1, e2 = np.where(f, -c2, c1), np.where(f, -c1, c2)
+    return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
+
+
+def study(jetfit, cloud, I, T, t1, t2, fs, work):
+    """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
+    fixed = {}
+    for k in KS:
+        rows, col = run(jetfit, cloud, "knn:%d" % (k + 1), os.path.join(work, "f.xyz"))
+        fixed[k] = errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2)
+    best = [min((fixed[k][c], k) for k in KS) for c in range(len(fixed[KS[0]]))]
+    rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"))
+    K = rows[I, col["neighbors"]]
+    res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
+    nb = neighbours(rows[:, 0:3], rows[I, 0:3], int(max(fs) * K.max()) + 1)
+    for f in fs:
+        mq = np.maximum(1, np.round(f * K)).astype(int)
+        ag = aggregate(rows, col, I, nb, mq)
+        for name in ("indiv", "mid"):
+            res.append(("%s f=%g" % (name, f), errors(*ag[name], T, t1, t2)))
+        # only where auto's K reached its largest candidate (variance-bound)
+        ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
+        res.append(("mid f=%g, K=%d only" % (f, KMAX), errors(*ag["mid"], T, t1, t2)))
+    return best, res
+
+
+def table(title, cells, curv):
+    print("\n## " + title)
+    cols = ["normal", "dk1", "dk2"][:3 if curv else 1]
+    print("| cloud | estimate | " + " | ".join(cols) + " | / best fixed k |")
+    print("|---|---|" + "---|" * (len(cols) + 1))
+    for name, best, res in cells:
+        print("| %s | best fixed (k) | %s | |" % (name, " | ".join("%.4g (%d)" % b for b in best)))
+        for est, e in res:
+            ratio = ", ".join("%.3f" % (e[c] / best[c][0]) for c in range(len(cols)))
+            print("| | %s | %s | %s |" % (est, " | ".join("%.4g" % v for v in e), ratio))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("build")
+    ap.add_argument("--pcpnet")
+    ap.add_argument("--f", default="0.0625,0.125,0.25,0.5")
+    ap.add_argument("--n", type=int, default=20000)
+    ap.add_argument("--seed", type=int, default=27)
+    a = ap.parse_args()
+    jetfit = os.path.join(a.build, "jetfit")
+    if not os.access(jetfit, os.X_OK):
+        sys.exit("auto_agg: %s not built" % jetfit)
+    fs = [float(v) for v in a.f.split(",")]
+    with tempfile.TemporaryDirectory() as work:
+        cells = []
+        for surf in ("ellipsoid", "torus", "exp"):
+            for lev in ("0.001", "0.003", "0.01"):
+                cloud, truth = os.path.join(work, "c.ply"), os.path.join(work, "t.csv")
+                extra = ["--density", "gradient"] if surf == "torus" else []
+                subprocess.run([jetfit, "generate", surf, "-o", cloud, "--n", str(a.n), "--noise", lev,
+                                "--seed", str(a.seed), "--truth", truth] + extra, check=True,
+                               stdout=subprocess.DEVNULL)
+                tr = np.loadtxt(truth, delimiter=",", skiprows=1)
+                I = np.arange(len(tr))
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, work)
+                cells.append(("%s %s" % (surf, lev), best, res))
+                print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
+        table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
+        if a.pcpnet:
+            d = a.pcpnet
+            X = np.loadtxt(os.path.join(d, "armadillo100k.xyz"))
+            T = np.loadtxt(os.path.join(d, "armadillo100k.normals"))
+            I = np.loadtxt(os.path.join(d, "armadillo100k.pidx"), dtype=int)
+            diag = np.linalg.norm(X.max(0) - X.min(0))
+            cells = []
+            for lev in (0.0, 0.00125, 0.006, 0.012):
+                Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
+                cloud = os.path.join(work, "a_in.xyz")
+                np.savetxt(cloud, Y)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, work)
+                cells.append(("armadillo %g" % lev, best, res))
+                print("done armadillo %g" % lev, file=sys.stderr, flush=True)
+            table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
+
+
+if __name__ == "__main__":
+    main()
