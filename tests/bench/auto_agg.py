@@ -4,7 +4,7 @@ aggregating the neighbours' jets beat the best fixed K where one fit
 cannot?  Offline, from jetfit's own rows; nothing here ships.
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
-       [--n N] [--seed S]
+       [--lepski TAU,...] [--n N] [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -15,7 +15,8 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
          step with the mean of its two ends' curvatures (trapezoid rule:
          no second-order error, W standing for q's own); also only where auto's K is its
          largest, 256 (elsewhere the row as auto wrote it);
-  curvatures: the eigenvalues of W in the plane normal to the normal.
+  curvatures: the eigenvalues of W in the plane normal to the normal;
+  with --lepski, indiv's m chosen per point up to f x K (lepski below).
 Printed against auto's own rows and the plain degree-2 jet on k + 1
 points (CGAL's jet on the same points, docs/robustness.md), k in 18, 32,
 64, 128, 256, the best k per column after seeing the truth: RMS normal
@@ -59,14 +60,18 @@ def neighbours(Y, Q, m):
 
 
 def aggregate(rows, col, I, nb, mq):
-    """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i]"""
-    P = rows[:, 0:3]
-    N = rows[:, col["nx"]:col["nx"] + 3]
-    k1, k2 = rows[:, col["k1"]], rows[:, col["k2"]]
-    D1 = rows[:, col["d1x"]:col["d1x"] + 3]
-    D2 = rows[:, col["d2x"]:col["d2x"] + 3]
-    good = np.isfinite(N).all(1) & np.isfinite(k1) & np.isfinite(k2)
-    NI, PI, n = N[I], P[I], len(I)
+    """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i],
+    and (key "snaps") indiv's running sums and counts at m = 1, 2, 4, ..."""
+    NI, PI, n = rows[I, col["nx"]:col["nx"] + 3], rows[I, 0:3], len(I)
+    # a neighbour without a fit (NaN row) adds nothing: zeros, not NaN * 0
+    good = np.isfinite(rows[:, 0:col["d2x"] + 3]).all(1)
+    R = np.where(good[:, None], rows, 0.0)
+    P = R[:, 0:3]
+    N = R[:, col["nx"]:col["nx"] + 3]
+    k1, k2 = R[:, col["k1"]], R[:, col["k2"]]
+    D1 = R[:, col["d1x"]:col["d1x"] + 3]
+    D2 = R[:, col["d2x"]:col["d2x"] + 3]
+    snaps = {}
     cnt = np.zeros(n)
     mean_n, cen, ind = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     W = np.zeros((n, 3, 3))
@@ -86,6 +91,8 @@ def aggregate(rows, col, I, nb, mq):
         cen += P[j] * on[:, None]
         W += Wj * on[:, None, None]
         ind += (nj - np.einsum("nij,nj->ni", Wj, d)) * on[:, None]
+        if not t & (t + 1):  # t + 1 a power of two
+            snaps[t + 1] = (ind.copy(), cnt.copy())
     cnt = np.maximum(cnt, 1.0)
     W /= cnt[:, None, None]
     mean_n /= cnt[:, None]
@@ -93,7 +100,7 @@ def aggregate(rows, col, I, nb, mq):
     ind /= cnt[:, None]
     # sum of n_j - W (q - j) over the m, divided by m: mean_n - W (q - cen)
     wbar = mean_n - np.einsum("nij,nj->ni", W, PI - cen)
-    out = {}
+    out = {"snaps": snaps}
     for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0)):
         nn = v / np.linalg.norm(v, axis=1)[:, None]
         Pm = np.eye(3)[None] - nn[:, :, None] * nn[:, None, :]
@@ -116,7 +123,7 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, work):
+def study(jetfit, cloud, I, T, t1, t2, fs, taus, work):
     """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
     fixed = {}
     for k in KS:
@@ -126,7 +133,7 @@ def study(jetfit, cloud, I, T, t1, t2, fs, work):
     rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"))
     K = rows[I, col["neighbors"]]
     res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
-    nb = neighbours(rows[:, 0:3], rows[I, 0:3], int(max(fs) * K.max()) + 1)
+    nb = neighbours(rows[:, 0:3], rows[I, 0:3], max(int(max(fs) * K.max()) + 1, KMAX if taus else 0))
     for f in fs:
         mq = np.maximum(1, np.round(f * K)).astype(int)
         ag = aggregate(rows, col, I, nb, mq)
@@ -135,7 +142,30 @@ def study(jetfit, cloud, I, T, t1, t2, fs, work):
         # only where auto's K reached its largest candidate (variance-bound)
         ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
         res.append(("mid f=%g, K=%d only" % (f, KMAX), errors(*ag["mid"], T, t1, t2)))
+        for tau in taus:
+            res.append(("indiv, Lepski tau=%g, m <= %g K" % (tau, f),
+                        errors(lepski(rows, col, I, nb, K, mq, tau), None, None, T)))
     return best, res
+
+
+def lepski(rows, col, I, nb, K, cap, tau):
+    """indiv's normal at m chosen per point: m doubles from 1 up to cap
+    while the mean carried normal stays within tau sd of the row's own,
+    sd = 2 sqrt 2 sigma / (r_K sqrt K), the slope sd of a plane on K
+    points spread over a disk of radius r_K (the K-th distance)"""
+    snaps = aggregate(rows, col, I, nb, cap)["snaps"]
+    P, n0 = rows[:, 0:3], rows[I, col["nx"]:col["nx"] + 3]
+    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+    rk = np.linalg.norm(P[kth] - P[I], axis=1)
+    sd = 2.0 * np.sqrt(2.0) * rows[I, col["sigma"]] / (rk * np.sqrt(K))
+    best, alive, m = snaps[1][0].copy(), np.ones(len(I), bool), 2
+    while m in snaps:
+        v = snaps[m][0]
+        u = v / np.linalg.norm(v, axis=1)[:, None]
+        alive &= (m <= cap) & (np.abs((u * n0).sum(1)) >= np.cos(np.minimum(tau * sd, np.pi / 2)))
+        best[alive] = v[alive]
+        m *= 2
+    return best
 
 
 def table(title, cells, curv):
@@ -145,9 +175,11 @@ def table(title, cells, curv):
     print("|---|---|" + "---|" * (len(cols) + 1))
     for name, best, res in cells:
         print("| %s | best fixed (k) | %s | |" % (name, " | ".join("%.4g (%d)" % b for b in best)))
-        for est, e in res:
-            ratio = ", ".join("%.3f" % (e[c] / best[c][0]) for c in range(len(cols)))
-            print("| | %s | %s | %s |" % (est, " | ".join("%.4g" % v for v in e), ratio))
+        for est, e in res:  # a normals-only row leaves the curvature cells empty
+            e = e[:len(cols)]
+            ratio = ", ".join("%.3f" % (e[c] / best[c][0]) for c in range(len(e)))
+            cells_ = ["%.4g" % v for v in e] + [""] * (len(cols) - len(e))
+            print("| | %s | %s | %s |" % (est, " | ".join(cells_), ratio))
 
 
 def main():
@@ -155,6 +187,7 @@ def main():
     ap.add_argument("build")
     ap.add_argument("--pcpnet")
     ap.add_argument("--f", default="0.0625,0.125,0.25,0.5")
+    ap.add_argument("--lepski", default="", help="taus of a per-point m rule (e.g. 1,2,4)")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -162,6 +195,7 @@ def main():
     if not os.access(jetfit, os.X_OK):
         sys.exit("auto_agg: %s not built" % jetfit)
     fs = [float(v) for v in a.f.split(",")]
+    taus = [float(v) for v in a.lepski.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in ("ellipsoid", "torus", "exp"):
@@ -173,7 +207,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, work)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, work)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -188,7 +222,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, work)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, work)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
