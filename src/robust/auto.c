@@ -747,5 +747,14 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                     dg->res[e][i].status = JF_PT_FAILED;
     }
     if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
+    if (kn->auto_dw > 0.0) { /* bench-only knob, off: distance-weighted row */
+        jf_fitter *g = jf__ws_fitter(f, pr, d);
+        double *buf = jf__ws_buf(f, 4 * ks[ci]), sg, ne;
+        if (!g || !buf) return JF_ERR_NOMEM;
+        jf_status st = jf__fit_robust(g, pr, p, nbr, ks[ci], buf, kn->auto_dw, out, &sg, &ne);
+        out->status |= JF_PT_AUTO;
+        out->sigma = sigma;
+        return st;
+    }
     return direct_fit(f, pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
 }

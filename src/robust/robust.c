@@ -70,10 +70,13 @@
  * the cubic's at K = 48 where it exceeds (c x radius)^2 (auto_rule.c;
  * both off: docs/robustness.md); auto_flat z: the noise variance is the
  * cubic's at the largest K where that stays within 1 + z sqrt(2 / 38) of
- * the cubic's at K = 48 (auto.c step 2; 0: off). */
+ * the cubic's at K = 48 (auto.c step 2; 0: off); auto_dw C > 0: the
+ * reported fit with Gaussian weights of width C x the K-th distance
+ * (--dist-weight's; off: better at noise 0 and 0.125%, worse at 1.2%,
+ * and still above the best fixed K at 0.125%: docs/robustness.md). */
 const jf__knobs jf__knob_defaults = {
     JF_SCALE_VARW, JF_SCALE_TARGET, 0.3, JF_DEGREE_TAU, JF_DEGREE_SDMIN, JF_DEGREE_FLOOR_N,
-    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, 0.0, 0.0, 2.0, NULL};
+    2.0, 0.2, 0.3, 0.05, 1.0, 0, 0.0, 0.0, 0.0, 2.0, 0.0, NULL};
 
 /* ---- the fitter's robust state: fallback buffer for n > JF_STACK_N, and
  * the fitters of the lower degrees tried by degree selection (created on
@@ -138,6 +141,7 @@ int jf__robust_tune(jf_fitter *f, const char *name, double v)
     else if (!strcmp(name, "auto_lof")) k->auto_lof = v;
     else if (!strcmp(name, "auto_s2floor")) k->auto_s2floor = v;
     else if (!strcmp(name, "auto_flat")) k->auto_flat = v;
+    else if (!strcmp(name, "auto_dw")) k->auto_dw = v;
     else return -1;
     return 0;
 }

@@ -29,6 +29,7 @@ typedef struct {
     double auto_nest; /* auto.c: > 0: Lepski on nested variances (dropped) */
     double auto_lof, auto_s2floor; /* auto_rule.c (off: 0; dropped) */
     double auto_flat; /* auto.c step 2: the flat test's z (off: 0) */
+    double auto_dw;   /* auto.c step 5: distance weights (off: 0; dropped) */
     struct jf__auto_diag *auto_diag; /* bench-only: auto's candidates out */
 } jf__knobs;
 extern const jf__knobs jf__knob_defaults;

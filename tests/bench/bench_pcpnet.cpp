@@ -28,7 +28,9 @@
 // --quick: clean shape and the largest noise only, K = 18 and 112;
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
 // 0/1/2 = none/huber/tukey; with --no-fixed only those run); --varw,
-// --floor, --target override the scale-selection constants of robust.c.
+// --floor, --target override the scale-selection constants of robust.c;
+// --auto adds neighbors auto, --auto-tau/-blob/-sdmax/-varw/-clean/-gl/
+// -nest/-lof/-s2floor/-flat/-dw X set robust.c's auto_* knob of that name.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
 #include <CGAL/pca_estimate_normals.h>
@@ -243,6 +245,8 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "--auto-lof") && i + 1 < argc) tune("auto_lof", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-s2floor") && i + 1 < argc)
             tune("auto_s2floor", std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--auto-dw") && i + 1 < argc)
+            tune("auto_dw", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--auto-flat") && i + 1 < argc)
             tune("auto_flat", std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--cgal-ks") && i + 1 < argc) cgal_ks = argv[++i];
