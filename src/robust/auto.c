@@ -300,12 +300,21 @@ JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double 
         }
 }
 
-static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
-                           size_t k, double sigma, jf_result *out)
+/* The jet of degree d on the first k points by the fitter itself (dw > 0:
+ * with --dist-weight's Gaussian weights of width dw, the bench-only knob
+ * auto_dw), flagged JF_PT_AUTO with the noise auto assumed. */
+static jf_status fit_by_fitter(jf_fitter *f, const jf_params *pr, int d, const double p[3],
+                               const double *nbr, size_t k, double sigma, double dw, jf_result *out)
 {
     jf_fitter *g = jf__ws_fitter(f, pr, d);
     if (!g) return JF_ERR_NOMEM;
-    jf_status st = jf_fit_point(g, p, nbr, k, out);
+    jf_status st;
+    if (dw > 0.0) {
+        double *buf = jf__ws_buf(f, 4 * k), sg, ne;
+        if (!buf) return JF_ERR_NOMEM;
+        st = jf__fit_robust(g, pr, p, nbr, k, buf, dw, out, &sg, &ne);
+    } else
+        st = jf_fit_point(g, p, nbr, k, out);
     if (st != JF_OK) return st;
     /* b asked for but a quadric chosen: unknown, not 0 (jetfit.h) */
     if (pr->monge_degree >= 3 && out->degree < 3)
@@ -315,6 +324,12 @@ static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const doubl
     out->status |= JF_PT_AUTO;
     out->sigma = sigma;
     return JF_OK;
+}
+
+static jf_status final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
+                           size_t k, double sigma, jf_result *out)
+{
+    return fit_by_fitter(f, pr, d, p, nbr, k, sigma, 0.0, out);
 }
 
 /* Power sums in four SIMD lanes (four neighbours a step, lane l the
@@ -747,14 +762,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                     dg->res[e][i].status = JF_PT_FAILED;
     }
     if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
-    if (kn->auto_dw > 0.0) { /* bench-only knob, off: distance-weighted row */
-        jf_fitter *g = jf__ws_fitter(f, pr, d);
-        double *buf = jf__ws_buf(f, 4 * ks[ci]), sg, ne;
-        if (!g || !buf) return JF_ERR_NOMEM;
-        jf_status st = jf__fit_robust(g, pr, p, nbr, ks[ci], buf, kn->auto_dw, out, &sg, &ne);
-        out->status |= JF_PT_AUTO;
-        out->sigma = sigma;
-        return st;
-    }
+    if (kn->auto_dw > 0.0) /* bench-only knob, off: a distance-weighted row */
+        return fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
     return direct_fit(f, pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
 }

@@ -2,9 +2,9 @@
 # bench_scans.sh -- `jetfit estimate` on real scans: the ten raw Stanford
 # bunny range scans (ASCII PLY with range_grid elements, CRLF) and the
 # LAS-derived LiDAR .xyz clouds (georeferenced, coordinates ~1e5-1e6).
-# Checks: exit status 0, one row per input point, no NaN/Inf (outside the
-# b and c columns) in a row not flagged failed or non-finite; prints per
-# file: points, seconds, status counts.
+# Checks: exit status 0, one row per input point, no NaN/Inf in a row not
+# flagged failed or non-finite (but for what its degree leaves unknown: b,
+# c, and k1, k2 of a plane); prints per file: points, seconds, status counts.
 # Usage: sh tests/bench/bench_scans.sh BUILD_DIR DATA [-- extra estimate options]
 # DATA holds scans/stanford_bunny/data/*.ply and scans/lidar_laspy/*.xyz
 # (default: $JF_DATA).
