@@ -35,6 +35,7 @@
 #include "index_internal.h"
 #include "io_internal.h"
 #include "parts.h"
+#include "robust/neigh_jets.h"
 
 static int finite3(const double *p)
 {
@@ -66,6 +67,7 @@ jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q)
     if (q->cap > p->max_neighbors) return JF_ERR_INVALID;
     if (q->nb.kind != JF_NB_KNN && !(q->nb.r >= 0 && isfinite(q->nb.r))) return JF_ERR_INVALID;
     if (q->nb.kind != JF_NB_RADIUS && !q->nb.k) return JF_ERR_INVALID;
+    q->nj = p->auto_select && q->nb.kind == JF_NB_KNN ? JF_NJ_HEAD : 0;
     return JF_OK;
 }
 
@@ -126,6 +128,15 @@ int jf__halo_requests(const jf_index *own, const jf_part_query *q, const double 
         size_t k = q->nb.k < q->cap ? q->nb.k : q->cap;
         req[0].k = k;
         req[0].bound = tighten(own, p, k, INFINITY, idx, d2, &found);
+        if (q->nj && found == k && req[0].bound < INFINITY) {
+            /* auto's step 6: p's row reads the fits of its nj nearest j,
+             * each on its own k nearest x; |p - x| <= r_nj + r_k(j) <=
+             * r_k(p) + 2 r_nj (r_k(j) <= r_k(p) + |p - j|), the own part's
+             * distances bounding the cloud's: every point a row needs is
+             * in that ball (a superset: users keep all of it, not the k) */
+            const double r = sqrt(req[0].bound) + 2.0 * sqrt(d2[(q->nj < k ? q->nj : k) - 1]);
+            req[0].bound = r * r * (1 + 1e-9) + 1e-280;
+        }
         return 1;
     }
     case JF_NB_RADIUS:
@@ -154,8 +165,9 @@ int jf__halo_requests_near(const jf_index *own, const jf_part_query *q, const do
     if (knn && last[3] < INFINITY && finite3(p)) {
         double dd = 0, near2 = INFINITY;
         for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
-        /* own k-th distance <= last's + |p - last| (triangle inequality) */
-        const double u = sqrt(dd) + last[3];
+        /* own k-th distance <= last's + |p - last| (triangle inequality;
+         * step 6's ball, three such distances: 3 |p - last|) */
+        const double u = (q->nj ? 3.0 : 1.0) * sqrt(dd) + last[3];
         for (int b = 0; b < nboxes; b++) {
             const double bd = b == self ? INFINITY : jf__box_dist2(boxes + 6 * b, p);
             if (bd < near2) near2 = bd;

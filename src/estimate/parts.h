@@ -34,6 +34,9 @@ typedef struct {
     jf_nb_spec nb;    /* knn: K raised to the largest --scales entry    */
     size_t cap;       /* largest neighbourhood (radius: max_neighbors)  */
     size_t min_count; /* N_n of the degree: knn+radius's fallback floor */
+    size_t nj;        /* auto's step 6 (robust/neigh_jets.h): a row reads
+                         the fits of its nj nearest, so the halo holds
+                         their k nearest too (jf__halo_requests); 0: off */
 } jf_part_query;
 
 /* neighbors auto (src/robust/auto.c): turns o->nb = auto into knn:

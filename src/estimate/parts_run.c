@@ -460,7 +460,8 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                          * it, no request, no query */
                         double dd = 0;
                         for (int k = 0; k < 3; k++) dd += (p[k] - last[k]) * (p[k] - last[k]);
-                        if (occ_free(occ, p, (sqrt(dd) + last[3]) * (1 + 1e-9) + 1e-140, 64, a))
+                        const double step = (q->nj ? 3.0 : 1.0) * sqrt(dd); /* parts.c */
+                        if (occ_free(occ, p, (step + last[3]) * (1 + 1e-9) + 1e-140, 64, a))
                             continue;
                     }
                     int nr = jf__halo_requests(own, q, p, idx, d2, r);
@@ -579,9 +580,12 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     }
     free(rq);
     rq = NULL;
-    /* 4. the far balls' k-th distance over the other parts (first scan) */
+    /* 4. the far balls' k-th distance over the other parts (first scan;
+     * not for auto's step 6, whose balls are kept whole: parts.c) */
     for (size_t f = 0; f < nfar; f++) kmax = far[f].req.k > kmax ? far[f].req.k : kmax;
-    if (st == JF_OK && nfar) {
+    if (q->nj)
+        for (size_t f = 0; f < nfar; f++) far[f].req.bound = far[f].req.bound * (1 + 1e-9) + 1e-280;
+    if (st == JF_OK && nfar && !q->nj) {
         heaps = malloc((size_t)nt * nfar * kmax * sizeof *heaps);
         hn = calloc((size_t)nt * nfar, sizeof *hn);
         if (!heaps || !hn) st = JF_ERR_NOMEM;
@@ -1132,7 +1136,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         size_t m = gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
         if ((st = reader_status(&rd, err)) != JF_OK) goto out;
         int served = 0;
-        if (q.nb.kind == JF_NB_KNN &&
+        /* auto's step 6 needs a wider halo than the cells' rings: requests */
+        if (q.nb.kind == JF_NB_KNN && !q.nj &&
             (st = halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, q.nb.k, hcap > m ? hcap - m : 0,
                                 jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
             break;

@@ -38,9 +38,14 @@
 #include "orient_internal.h"
 #include "parts.h"
 #include "planes_internal.h"
+#include "neigh_jets.h"
 
 #define CHUNK JF_BLOCK_MAX /* points per scheduling unit (and progress tick) */
 #define LANES 4            /* fits side by side (jf__fit_point_x4) */
+/* auto's step 6: the points fitted before their rows are mixed from their
+ * neighbours' fits; a larger unit fits fewer neighbours twice (those in
+ * units not yet done: at its border) */
+#define NJ_UNIT (32 * CHUNK)
 
 void jf_estimate_opts_init(jf_estimate_opts *o)
 {
@@ -113,6 +118,10 @@ typedef struct {
     size_t gk;
     jf_fit_mode fit;
     int plain;            /* jf_fit_point_full is jf_fit_point: pairs   */
+    jf__njs *nj;          /* auto's step 6: each point's fit, compact,
+                             by tree position (the walk's order: a unit's
+                             records are neighbours in memory too)      */
+    const double *pts;    /* the tree's copy of the points, by position */
 } nbctx;
 
 static int cmp_double(const void *a, const void *b)
@@ -307,8 +316,8 @@ static jf_status knn_hinted(const nbctx *x, const double *p, const double *hint,
 }
 
 static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, size_t i,
-                          const double *p, uint32_t *idx, double *d2, double *xyz, size_t *found,
-                          unsigned *flags, const double *hint, size_t hint_n)
+                          const double *p, uint32_t *idx, uint32_t *pos, double *d2, double *xyz,
+                          size_t *found, unsigned *flags, const double *hint, size_t hint_n)
 {
     jf_status st;
     *found = 0;
@@ -338,7 +347,7 @@ static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, 
         break;
     default: /* sh: auto's 256 nearest, shared along the walk (knn_share.c) */
         if (sh)
-            st = jf__knn_share_query(sh, x->ix, p, idx, d2, xyz, found);
+            st = jf__knn_share_query(sh, x->ix, p, idx, pos, d2, xyz, found);
         else if (x->nb->kind == JF_NB_KNN && hint && x->nb->k && hint_n == x->nb->k &&
                  hint_n <= x->cap)
             st = knn_hinted(x, p, hint, hint_n, idx, d2, xyz, found);
@@ -365,6 +374,20 @@ typedef struct {
     double *bxyz;         /* and coordinates (sinkx: the walk's, in order) */
     const double *hint;   /* knn: the last query's neighbours (coords or */
     size_t hint_n;        /* coords[k]) and their count, for knn_hinted  */
+    uint32_t *pos;        /* auto's step 6: the query's tree positions   */
+    uint32_t *head;       /* and each unit point's nearest (positions)   */
+    uint8_t *headn;       /* (JF_NJ_HEAD a point) and their count        */
+    uint32_t *bpos;       /* the unit's rows' tree positions             */
+    jf_result *pblk;      /* rows held back to the thread's next unit    */
+    uint32_t *pidx, *phead; /* (a record they read not yet fitted), as    */
+    double *pxyz;         /* blk, bidx, head, headn, bxyz                */
+    uint8_t *pheadn;
+    size_t npend, pcap;
+    double *dec;          /* the unit's records decoded (jf__nj_cache)   */
+    uint8_t *decok;
+    jf__knn_share *oshare; /* a neighbour fitted on demand (its unit not */
+    uint32_t *oidx;       /* yet done): its search and neighbourhood     */
+    double *od2, *oxyz;
 } worker;
 
 static void worker_free(worker *w)
@@ -380,6 +403,21 @@ static void worker_free(worker *w)
     free(w->blk);
     free(w->bidx);
     free(w->bxyz);
+    free(w->pos);
+    free(w->head);
+    free(w->headn);
+    free(w->bpos);
+    free(w->pblk);
+    free(w->pidx);
+    free(w->phead);
+    free(w->pxyz);
+    free(w->pheadn);
+    free(w->dec);
+    free(w->decok);
+    jf__knn_share_free(w->oshare);
+    free(w->oidx);
+    free(w->od2);
+    free(w->oxyz);
     jf__knn_share_free(w->share);
     memset(w, 0, sizeof *w);
 }
@@ -401,11 +439,35 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->d2 = malloc(x->cap * sizeof *w->d2);
         if (!w->idx || !w->d2) st = JF_ERR_NOMEM;
     }
-    if (st == JF_OK && blocks) {
-        w->blk = malloc(CHUNK * sizeof *w->blk);
-        w->bidx = malloc(CHUNK * sizeof *w->bidx);
-        w->bxyz = malloc(3 * CHUNK * sizeof *w->bxyz);
+    const size_t unit = x->nj ? NJ_UNIT : CHUNK;
+    if (st == JF_OK && (blocks || x->nj)) {
+        w->blk = malloc(unit * sizeof *w->blk);
+        w->bidx = malloc(unit * sizeof *w->bidx);
+        w->bxyz = malloc(3 * unit * sizeof *w->bxyz);
         if (!w->blk || !w->bidx || !w->bxyz) st = JF_ERR_NOMEM;
+    }
+    if (st == JF_OK && x->nj) {
+        w->pos = malloc(x->cap * sizeof *w->pos);
+        w->head = malloc(unit * JF_NJ_HEAD * sizeof *w->head);
+        w->headn = malloc(unit);
+        w->bpos = malloc(unit * sizeof *w->bpos);
+        w->pcap = unit / 4;
+        w->pblk = malloc(w->pcap * sizeof *w->pblk);
+        w->pidx = malloc(w->pcap * sizeof *w->pidx);
+        w->phead = malloc(w->pcap * JF_NJ_HEAD * sizeof *w->phead);
+        w->pxyz = malloc(3 * w->pcap * sizeof *w->pxyz);
+        w->pheadn = malloc(w->pcap);
+        w->dec = malloc(unit * JF_NJ_DEC * sizeof *w->dec);
+        w->decok = malloc(unit);
+        w->oidx = malloc(x->cap * sizeof *w->oidx);
+        w->od2 = malloc(x->cap * sizeof *w->od2);
+        w->oxyz = malloc(3 * x->cap * sizeof *w->oxyz);
+        if (!w->pos || !w->head || !w->headn || !w->bpos || !w->pblk || !w->pidx || !w->phead ||
+            !w->pxyz || !w->pheadn || !w->dec || !w->decok || !w->oidx ||
+            !w->od2 || !w->oxyz)
+            st = JF_ERR_NOMEM;
+        if (st == JF_OK)
+            st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->oshare);
     }
     if (st == JF_OK && p->auto_select && x->nb->kind == JF_NB_KNN && x->nb->k >= 128)
         st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
@@ -477,7 +539,8 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
     }
     const double *hint = w->hint != coords ? w->hint : NULL; /* coords: overwritten */
     jf_status st =
-        nb_query(x, w->nws, w->share, i, p, w->idx, w->d2, coords, found, flags, hint, w->hint_n);
+        nb_query(x, w->nws, w->share, i, p, w->idx, w->pos, w->d2, coords, found, flags, hint,
+                 w->hint_n);
     if (st != JF_OK) return st;
     w->hint = coords;
     w->hint_n = *found;
@@ -698,6 +761,183 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
     return failed;
 }
 
+/* Auto's step 6: the record of the point at tree position j, fitted here
+ * because its own unit is not done: the same neighbourhood (knn_share.c
+ * gives one search's lists) and fit as its own walk step makes, so the
+ * same bytes. */
+static jf_status nj_fit_other(worker *w, const nbctx *x, uint32_t j)
+{
+    jf_result r;
+    size_t found = 0;
+    const double *p = x->pts + 3 * (size_t)j;
+    /* the points fitted on demand follow the unit's border: their searches
+     * share too */
+    jf_status st = jf__knn_share_query(w->oshare, x->ix, p, w->oidx, NULL, w->od2, w->oxyz, &found);
+    if (st == JF_OK) st = jf_fit_point_full(w->fit[0], p, w->oxyz, found, &r);
+    if (st != JF_OK) return st;
+    if (found < x->want) r.status |= JF_PT_FEW_NEIGHBORS;
+    jf__nj_put(x->nj, j, &r);
+    return JF_OK;
+}
+
+/* How many of row r's nearest (h of them kept) step 6 reads. */
+static size_t nj_count(const jf_result *r, size_t h)
+{
+    size_t m = jf__nj_head(r->n_used);
+    return m < h ? m : h;
+}
+
+/* Step 6 for rows blk[0..m-1] (inputs bidx, coordinates bxyz, nearest
+ * head, JF_NJ_HEAD a row, headn kept): the records they read not yet
+ * fitted are fitted here, each row mixed, the rows delivered by blocks. */
+static jf_status nj_finish(const runctx *R, worker *w, const jf__nj_cache *c, jf_result *blk,
+                           const uint32_t *bidx, const double *bxyz, const uint32_t *head,
+                           const uint8_t *headn, size_t m)
+{
+    const nbctx *x = R->x;
+    jf_status st = JF_OK;
+    for (size_t k = 0; k < m && st == JF_OK; k++) {
+        const uint32_t *hd = head + k * JF_NJ_HEAD;
+        const size_t h = nj_count(&blk[k], headn[k]);
+        for (size_t t = 0; t < h && st == JF_OK; t++)
+            if (jf__nj_state(x->nj, hd[t]) == JF_NJ_EMPTY) st = nj_fit_other(w, x, hd[t]);
+        if (st == JF_OK) jf__nj_mix(x->nj, c, x->pts, bxyz + 3 * k, hd, h, &blk[k]);
+    }
+    for (size_t k = 0; k < m && st == JF_OK; k += CHUNK) {
+        const size_t b = m - k < CHUNK ? m - k : CHUNK;
+        if (R->out)
+            for (size_t j = k; j < k + b; j++) store_row(&R->out[bidx[j]], &blk[j]);
+        else
+            st = deliver(R, bidx + k, bxyz + 3 * k, blk + k, b);
+    }
+    _mm_sfence();
+    return st;
+}
+
+/* Step 2 for auto with step 6: each unit of the walk is fitted (each
+ * point's record published, its nearest kept), then each row is mixed
+ * from its nearest's records; a row that reads a record not yet fitted
+ * waits for the thread's next unit (on one thread the next of the walk,
+ * which fits most of them), else fits it on demand.  The rows leave by
+ * blocks as in fit_pass. */
+static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double *walk_xyz,
+                             size_t nwalk, int nt)
+{
+    const jf_estimate_opts *o = R->o;
+    const nbctx *x = R->x;
+    /* the unit: large (few border points fitted twice), but a few per
+     * thread; the rows do not depend on it */
+    size_t unit = nwalk / (4 * (size_t)nt);
+    unit = unit < CHUNK ? CHUNK : unit > NJ_UNIT ? NJ_UNIT : unit;
+    size_t nunits = (nwalk + unit - 1) / unit, done = R->done0, next = 1;
+    jf_status failed = walk_xyz == x->pts ? JF_OK : JF_ERR_INVALID; /* the tree's walk */
+#pragma omp parallel num_threads(nt)
+    {
+        worker w = {0};
+        jf_status wst = failed == JF_OK ? worker_init(&w, &o->params, x, 1) : failed;
+        if (wst == JF_OK && !w.share) wst = JF_ERR_INVALID; /* positions come from it */
+        if (wst != JF_OK) {
+#pragma omp atomic write
+            failed = wst;
+        }
+        for (size_t u = jf__claim_first(&next); u < nunits; u = jf__claim_next(&next)) {
+            jf_status seen;
+#pragma omp atomic read
+            seen = failed;
+            if (seen != JF_OK || wst != JF_OK) continue;
+            const size_t beg = u * unit, nu = beg + unit < nwalk ? unit : nwalk - beg;
+            size_t m = 0; /* the unit's points to fit (a part's halo: not) */
+            for (size_t kk = 0; kk < nu && wst == JF_OK; kk++) {
+                const size_t i = walk[beg + kk], k = m;
+                const double *pt = walk_xyz ? walk_xyz + 3 * (beg + kk) : R->c->xyz + 3 * i;
+                if (R->fit && !R->fit[i]) {
+                    if (R->out) nan_result(&R->out[i], JF_PT_NONFINITE);
+                    continue;
+                }
+                m++;
+                w.bidx[k] = (uint32_t)i;
+                memcpy(w.bxyz + 3 * k, pt, 3 * sizeof *pt);
+                size_t iq[LANES] = {i};
+                const double *pq[LANES] = {pt};
+                jf_result *oq[LANES] = {&w.blk[k]};
+                if (w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, nu - kk);
+                w.hint_n = 0;
+                if ((wst = fit_lanes(&w, x, 1, iq, pq, oq)) != JF_OK) break;
+                /* prepare's query left the neighbourhood in w.idx */
+                const size_t h = w.hint_n < JF_NJ_HEAD ? w.hint_n : JF_NJ_HEAD;
+                memcpy(w.head + k * JF_NJ_HEAD, w.pos, h * sizeof *w.head);
+                w.headn[k] = (uint8_t)h;
+                w.bpos[k] = (uint32_t)(beg + kk);
+            }
+            /* the records after the fits: a locked store right after a fit
+             * waits for its stores to drain */
+            for (size_t k = 0; k < m && wst == JF_OK; k++) jf__nj_put(x->nj, w.bpos[k], &w.blk[k]);
+            for (size_t t = 0; t < nu && wst == JF_OK; t++)
+                w.decok[t] = jf__nj_state(x->nj, beg + t) == JF_NJ_EMPTY
+                                 ? 2 /* a halo point: maybe fitted on demand below */
+                                 : (uint8_t)jf__nj_decode(x->nj, beg + t, w.dec + JF_NJ_DEC * t);
+            const jf__nj_cache cache = {w.dec, w.decok, beg, nu};
+            /* the rows held back from the thread's last unit */
+            if (wst == JF_OK)
+                wst = nj_finish(R, &w, &cache, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend);
+            w.npend = 0;
+            size_t nr = 0; /* this unit's rows ready, moved to the front */
+            for (size_t k = 0; k < m && wst == JF_OK; k++) {
+                const uint32_t *hd = w.head + k * JF_NJ_HEAD;
+                const size_t h = nj_count(&w.blk[k], w.headn[k]);
+                size_t t = 0;
+                while (t < h && jf__nj_state(x->nj, hd[t]) != JF_NJ_EMPTY) t++;
+                size_t to = nr;
+                jf_result *db = w.blk;
+                uint32_t *di = w.bidx, *dh = w.head;
+                double *dx = w.bxyz;
+                uint8_t *dn = w.headn;
+                if (t < h && w.npend < w.pcap)
+                    to = w.npend++, db = w.pblk, di = w.pidx, dh = w.phead, dx = w.pxyz, dn = w.pheadn;
+                else
+                    nr++;
+                if (db == w.blk && to == k) continue;
+                db[to] = w.blk[k];
+                di[to] = w.bidx[k];
+                memcpy(dx + 3 * to, w.bxyz + 3 * k, 3 * sizeof *dx);
+                memcpy(dh + to * JF_NJ_HEAD, hd, w.headn[k] * sizeof *dh);
+                dn[to] = w.headn[k];
+            }
+            if (wst == JF_OK)
+                wst = nj_finish(R, &w, &cache, w.blk, w.bidx, w.bxyz, w.head, w.headn, nr);
+            if (wst != JF_OK) {
+#pragma omp atomic write
+                failed = wst;
+            }
+            size_t now;
+#pragma omp atomic capture
+            now = done += nu;
+            if (omp_get_thread_num() == 0) {
+                if (o->progress) o->progress(o->progress_user, now, R->total);
+                if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, now, R->total);
+                if (cancelled(o)) {
+#pragma omp atomic write
+                    failed = JF_ERR_CANCELLED;
+                }
+            }
+        }
+        /* the last rows held back: what they read, fitted on demand */
+        if (wst == JF_OK && w.npend) {
+            jf_status seen;
+#pragma omp atomic read
+            seen = failed;
+            if (seen == JF_OK &&
+                (wst = nj_finish(R, &w, NULL, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend)) !=
+                    JF_OK) {
+#pragma omp atomic write
+                failed = wst;
+            }
+        }
+        worker_free(&w);
+    }
+    return failed;
+}
+
 /* The rows of the non-finite points (not in the k-d tree, so not in its
  * walk), on the calling thread: to out, or in blocks to deliver. */
 static jf_status nonfinite_rows(const runctx *R, size_t n)
@@ -853,6 +1093,17 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     }
     if (need_index && o->phase) o->phase(o->phase_user, JF_PHASE_INDEX, n, n);
     x.ix = ix;
+    /* auto's step 6 (neigh_jets.h); a part's halo holds what it reads
+     * (parts.c, jf__halo_requests) */
+    jf__njs njs = {NULL, NULL};
+    if (p->auto_select && nb.kind == JF_NB_KNN && need_index) {
+        x.nj = &njs;
+        if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
+            st = JF_ERR_NOMEM;
+            set_err(err, "out of memory (auto's neighbour fits)");
+            goto out;
+        }
+    }
     if (cancelled(o)) {
         st = cancel_status(err);
         goto out;
@@ -892,6 +1143,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     size_t nwalk = n;
     if (need_index) {
         nwalk = jf__index_points(ix, &walk_xyz, &walk);
+        x.pts = walk_xyz;
     } else {
         order = malloc(n * sizeof *order);
         if (!order) {
@@ -919,7 +1171,10 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             set_err(err, "writing a block of results failed");
             goto out;
         }
-        if ((st = pass_status(fit_pass(&R, walk, walk_xyz, nwalk, nt), err)) != JF_OK) goto out;
+        if ((st = pass_status(x.nj ? fit_pass_nj(&R, walk, walk_xyz, nwalk, nt)
+                                   : fit_pass(&R, walk, walk_xyz, nwalk, nt),
+                              err)) != JF_OK)
+            goto out;
         if (pass == 0 && mst_blocks) {
             /* Prim on the normals alone; the second pass flips the rows */
             R.vf = calloc(n, 1);
@@ -976,6 +1231,7 @@ out:
     free(x.nrm_own);
     free(x.nflags);
     free(x.graph);
+    jf__njs_free(&njs);
     free(R.vn);
     free(R.vs);
     free(R.vf);

@@ -527,6 +527,25 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
                 const qrec *r = &qr[k0 + (size_t)j];
                 size_t found = 0;
                 size_t k = r->k < scratch ? (size_t)r->k : scratch;
+                if (q->nj) { /* auto's step 6: the whole ball (parts.c) */
+                    for (;;) {
+                        if (jf__index_query(ix, r->q, k, r->bound, idx, d2, NULL, &found) != JF_OK ||
+                            found < k)
+                            break;
+                        k *= 2;
+                        uint32_t *ni = realloc(idx, k * sizeof *idx);
+                        if (ni) idx = ni;
+                        double *nd = realloc(d2, k * sizeof *d2), *nx = NULL;
+                        if (nd) d2 = nd, nx = realloc(xs, 3 * k * sizeof *xs);
+                        if (nx) xs = nx;
+                        if (!ni || !nd || !nx) {
+                            jf_mpi_fail(m, "out of memory (halo answers)");
+                            break;
+                        }
+                    }
+                    if (m->failed) break;
+                    k = found > 0 ? found : 1;
+                }
                 if (nans + k > cap) {
                     size_t nc = cap ? 2 * cap : 4096;
                     while (nc < nans + k) nc *= 2;
@@ -568,6 +587,25 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
             const jf_halo_req *r = &rq[back[g].id];
             size_t found = 0;
             size_t k = r->k < scratch ? r->k : scratch;
+            if (q->nj) { /* auto's step 6: every answer is in the ball */
+                for (size_t t = g; t < e && !m->failed; t++) {
+                    if (*nhalo == hcap) {
+                        size_t nc = hcap ? 2 * hcap : 1024;
+                        hpt *nh = realloc(*halo, nc * sizeof *nh);
+                        if (!nh) {
+                            jf_mpi_fail(m, "out of memory");
+                            break;
+                        }
+                        *halo = nh;
+                        hcap = nc;
+                    }
+                    (*halo)[*nhalo].gid = back[t].gid;
+                    memcpy((*halo)[*nhalo].xyz, back[t].xyz, sizeof back[t].xyz);
+                    (*nhalo)++;
+                }
+                g = e;
+                continue;
+            }
             if (jf__index_query(ix, own[back[g].id / 2].xyz, k, r->bound, idx, d2, NULL, &found) !=
                 JF_OK) {
                 jf_mpi_fail(m, "halo query failed");

@@ -38,7 +38,8 @@ void jf__knn_share_free(jf__knn_share *s);
  * to search: any hint gives the same lists). */
 void jf__knn_share_ahead(jf__knn_share *s, const double *xyz, size_t n);
 jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
-                              uint32_t *idx, double *d2, double *xyz, size_t *found);
+                              uint32_t *idx, uint32_t *pos, double *d2, double *xyz,
+                              size_t *found);
 
 /* n given to the build (jf_index_size counts the finite ones only). */
 size_t jf__index_input_size(const jf_index *ix);

@@ -44,6 +44,7 @@ typedef struct {
     double c[3];   /* the point they were searched from                 */
     double rk, R;  /* |c - k-th|, |c - last| (INFINITY: the whole cloud) */
     uint32_t *cid; /* input indices, coordinates of the candidates      */
+    uint32_t *cpos; /* and their tree positions                        */
     double *cxyz;
     double *cx, *cy, *cz; /* the same coordinates by axis (the d2 loop)    */
     double *cd2;   /* their squared distances to c, ascending           */
@@ -75,6 +76,7 @@ void jf__knn_share_free(jf__knn_share *s)
     if (!s) return;
     for (int i = 0; i < SH_SETS; i++) {
         free(s->set[i].cid);
+        free(s->set[i].cpos);
         free(s->set[i].cxyz);
         free(s->set[i].cx);
         free(s->set[i].cd2);
@@ -100,10 +102,11 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
     for (int i = 0; i < SH_SETS; i++) {
         sh_set *cs = &s->set[i];
         cs->cid = malloc(s->kc * sizeof *cs->cid);
+        cs->cpos = malloc(s->kc * sizeof *cs->cpos);
         cs->cxyz = malloc(3 * s->kc * sizeof *cs->cxyz);
         cs->cx = malloc(3 * s->kc * sizeof *cs->cx);
         cs->cd2 = malloc(s->kc * sizeof *cs->cd2);
-        ok &= cs->cid && cs->cxyz && cs->cx && cs->cd2;
+        ok &= cs->cid && cs->cpos && cs->cxyz && cs->cx && cs->cd2;
         if (cs->cx) cs->cy = cs->cx + s->kc, cs->cz = cs->cy + s->kc;
     }
     s->d2 = malloc(s->kc * sizeof *s->d2);
@@ -125,7 +128,7 @@ jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
 
 /* Step 1 at q: the candidates, and q's own k nearest as their prefix. */
 static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3], int slot,
-                         uint32_t *idx, double *d2, double *xyz, size_t *found)
+                         uint32_t *idx, uint32_t *pos, double *d2, double *xyz, size_t *found)
 {
     size_t f = 0;
     const sh_set *ls = &s->set[s->cur]; /* the last set served from or searched */
@@ -157,13 +160,22 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     }
     cs->nc = 0;
     s->cur = slot;
-    jf_status st = jf__index_query(ix, q, s->kc, bound, cs->cid, cs->cd2, cs->cxyz, &f);
+    /* positions kept too (auto's step 6 keys its records by them) */
+    jf_status st = jf__index_knn_pos(ix, q, s->kc, bound, cs->cpos, cs->cd2, &f);
     if (st == JF_OK && f < s->kc && bound < INFINITY)
-        st = jf__index_query(ix, q, s->kc, INFINITY, cs->cid, cs->cd2, cs->cxyz, &f);
+        st = jf__index_knn_pos(ix, q, s->kc, INFINITY, cs->cpos, cs->cd2, &f);
     if (st != JF_OK) return st;
+    const double *pts;
+    const uint32_t *id;
+    jf__index_points(ix, &pts, &id);
+    for (size_t j = 0; j < f; j++) {
+        cs->cid[j] = id[cs->cpos[j]];
+        memcpy(cs->cxyz + 3 * j, pts + 3 * (size_t)cs->cpos[j], 3 * sizeof *pts);
+    }
     s->expo = f == s->kc && cs->cd2[f / 2 - 1] > 0.0 ? log2(cs->cd2[f - 1] / cs->cd2[f / 2 - 1]) : 0.0;
     size_t m = f < s->k ? f : s->k;
     memcpy(idx, cs->cid, m * sizeof *idx);
+    if (pos) memcpy(pos, cs->cpos, m * sizeof *pos);
     if (d2) memcpy(d2, cs->cd2, m * sizeof *d2);
     if (xyz) memcpy(xyz, cs->cxyz, 3 * m * sizeof *xyz);
     *found = m;
@@ -183,8 +195,8 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
 /* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
 /* Built twice (target_clones): AVX (four distances a step, no FMA, so
  * no contraction: the tree's bits) and the default (SSE2). */
-JF_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q[3], uint32_t *idx, double *d2,
-                    double *xyz, size_t *found)
+JF_CLONES static int select_k(jf__knn_share *s, const sh_set *cs, const double q[3], uint32_t *idx,
+                              uint32_t *pos, double *d2, double *xyz, size_t *found)
 {
     if (!cs->nc) return 0;
     double e0 = q[0] - cs->c[0], e1 = q[1] - cs->c[1], e2 = q[2] - cs->c[2];
@@ -280,6 +292,8 @@ again:;
         return 0;
     const double *cxyz = cs->cxyz;
     for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
+    if (pos)
+        for (size_t i = 0; i < k; i++) pos[i] = cs->cpos[tp[i]];
     if (d2) memcpy(d2, td, k * sizeof *d2);
     if (xyz)
         for (size_t i = 0; i < k; i++) /* one 16- and one 8-byte move */
@@ -290,7 +304,8 @@ again:;
 }
 
 jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double q[3],
-                              uint32_t *idx, double *d2, double *xyz, size_t *found)
+                              uint32_t *idx, uint32_t *pos, double *d2, double *xyz,
+                              size_t *found)
 {
     *found = 0;
     /* the sets whose centre is nearest q first (the shortest prefix) */
@@ -306,7 +321,7 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
             if (dl[t] < dl[j]) j = t;
         if (!(dl[j] < INFINITY)) break;
         dl[j] = INFINITY;
-        if (select_k(s, &s->set[j], q, idx, d2, xyz, found)) {
+        if (select_k(s, &s->set[j], q, idx, pos, d2, xyz, found)) {
             s->cur = j;
             return JF_OK;
         }
@@ -332,9 +347,9 @@ jf_status jf__knn_share_query(jf__knn_share *s, const jf_index *ix, const double
     int slot = (s->cur + 1) % SH_SETS;
     if (nc > 1) {
         size_t f = 0;
-        jf_status st = rebuild(s, ix, c, slot, idx, d2, xyz, &f);
+        jf_status st = rebuild(s, ix, c, slot, idx, pos, d2, xyz, &f);
         if (st != JF_OK) return st;
-        if (select_k(s, &s->set[slot], q, idx, d2, xyz, found)) return JF_OK;
+        if (select_k(s, &s->set[slot], q, idx, pos, d2, xyz, found)) return JF_OK;
     }
-    return rebuild(s, ix, q, slot, idx, d2, xyz, found);
+    return rebuild(s, ix, q, slot, idx, pos, d2, xyz, found);
 }

@@ -1,11 +1,13 @@
-/* test_auto.c -- neighbors auto (src/robust/auto.c, issue 27): on a noisy
- * generated surface its normals are below the default knn:32 and within
- * 5% of the best fixed K of 16..256 picked in hindsight (both computed
- * here, not quoted; issue 27 asks for below the best: not reached yet,
- * measured 1.02x here, docs/robustness.md), it flags every point, its
- * reported jet is jf_fit_point's on the same K nearest and degree, its
- * noise estimate is near the noise drawn, and it is the same bits for 1
- * and 2 threads and in parts (jf_estimate_parts) as on the whole cloud. */
+/* test_auto.c -- neighbors auto (src/robust/auto.c, neigh_jets.c, issue
+ * 27): on a noisy generated surface its normals are below the default
+ * knn:32 and within 5% of the best fixed K of 16..256 picked in hindsight
+ * (both computed here, not quoted; issue 27 asks for below the best: not
+ * reached on every cloud, docs/robustness.md), it flags every point, each
+ * point's own fit is jf_fit_point's on the same K nearest and degree, the
+ * row is step 6's mean of its nearest's fits (recomputed here in double
+ * precision from those fits), exact on a sphere, its noise estimate is
+ * near the noise drawn, and it is the same bits for 1 and 2 threads and
+ * in parts (jf_estimate_parts) as on the whole cloud. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -126,17 +128,102 @@ START_TEST(test_auto_threads)
 }
 END_TEST
 
-/* The reported jet is fitted from power sums (auto.c, direct_fit), not by
- * jf_fit_point: it must be the least-squares jet of its degree on its K
- * nearest, as jf_fit_point computes it on the same points (same frame,
- * the PCA of the K points; same preconditioning h, so the same cond) --
- * up to rounding, on every point. */
+/* Each point's own fit (steps 1-5): jf_fit_point_full with auto on its
+ * JF_NB_AUTO_KMAX nearest (idx[i * KMAX ...], the tree's order), as the
+ * estimate's walk makes it. */
+static jf_result *own_fits(const surf *c, const jf_index *ix, uint32_t *idx)
+{
+    jf_params p;
+    jf_params_init(&p);
+    p.auto_select = 1;
+    p.max_neighbors = JF_NB_AUTO_KMAX;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    jf_result *own = malloc(c->s.n * sizeof *own);
+    double nb[3 * JF_NB_AUTO_KMAX];
+    for (size_t i = 0; i < c->s.n; i++) {
+        size_t got;
+        uint32_t *id = idx + i * JF_NB_AUTO_KMAX;
+        ck_assert_int_eq(jf_index_knn(ix, c->s.xyz + 3 * i, JF_NB_AUTO_KMAX, id, NULL, &got), JF_OK);
+        ck_assert_uint_eq(got, JF_NB_AUTO_KMAX);
+        for (size_t j = 0; j < got; j++)
+            memcpy(nb + 3 * j, c->s.xyz + 3 * (size_t)id[j], 3 * sizeof(double));
+        ck_assert_int_eq(jf_fit_point_full(f, c->s.xyz + 3 * i, nb, got, &own[i]), JF_OK);
+    }
+    jf_fitter_free(f);
+    return own;
+}
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Step 6 as docs/robustness.md states it, in double precision from the
+ * own fits: the normal the mean over q's round(K/16) nearest j of n_j -
+ * W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side), the
+ * curvatures the eigenvalues of the mean W_j over round(K/8) <= 32 nearest
+ * in the plane normal to it; n[3], k[2] out; 0 where the row stays q's. */
+static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, double n[3],
+                 double k[2])
+{
+    const jf_result *a = &own[q];
+    if (a->degree < 2) return 0;
+    double fc = nearbyint(a->n_used / 8.0), fn = nearbyint(a->n_used / 16.0);
+    size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc, mn = fn < 1 ? 1 : (size_t)fn;
+    double W[9] = {0}, v[3] = {0};
+    for (size_t t = 0; t < mc; t++) {
+        const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
+        const double *pj = c->s.xyz + 3 * (size_t)idx[q * JF_NB_AUTO_KMAX + t];
+        if (b->degree < 2) continue;
+        double sg = dot3(b->normal, a->normal) < 0 ? -1 : 1, Wj[9];
+        for (int r = 0; r < 3; r++)
+            for (int s2 = 0; s2 < 3; s2++)
+                Wj[3 * r + s2] = sg * (b->k1 * b->d1[r] * b->d1[s2] + b->k2 * b->d2[r] * b->d2[s2]);
+        for (int e = 0; e < 9; e++) W[e] += Wj[e];
+        if (t < mn)
+            for (int r = 0; r < 3; r++) {
+                double wd = 0;
+                for (int s2 = 0; s2 < 3; s2++) wd += Wj[3 * r + s2] * (c->s.xyz[3 * q + s2] - pj[s2]);
+                v[r] += sg * b->normal[r] - wd;
+            }
+    }
+    double l = sqrt(dot3(v, v));
+    for (int r = 0; r < 3; r++) n[r] = v[r] / l;
+    /* a tangent pair of n, the 2 x 2 of the mean W in it */
+    double t1[3] = {1, 0, 0}, t2[3];
+    if (fabs(n[0]) > 0.6) t1[0] = 0, t1[1] = 1;
+    double dn = dot3(t1, n);
+    for (int r = 0; r < 3; r++) t1[r] -= dn * n[r];
+    double l1 = sqrt(dot3(t1, t1));
+    for (int r = 0; r < 3; r++) t1[r] /= l1;
+    t2[0] = n[1] * t1[2] - n[2] * t1[1], t2[1] = n[2] * t1[0] - n[0] * t1[2],
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    double m11 = 0, m12 = 0, m22 = 0;
+    for (int r = 0; r < 3; r++)
+        for (int s2 = 0; s2 < 3; s2++) {
+            m11 += t1[r] * W[3 * r + s2] * t1[s2];
+            m12 += t1[r] * W[3 * r + s2] * t2[s2];
+            m22 += t2[r] * W[3 * r + s2] * t2[s2];
+        }
+    double cnt = 0;
+    for (size_t t = 0; t < mc; t++) cnt += own[idx[q * JF_NB_AUTO_KMAX + t]].degree >= 2;
+    double mid = (m11 + m22) / 2, rad = hypot((m11 - m22) / 2, m12);
+    k[0] = (mid + rad) / cnt, k[1] = (mid - rad) / cnt;
+    return 1;
+}
+
+/* Steps 1-5: each point's own fit is the least-squares jet of its degree
+ * on its K nearest, as jf_fit_point computes it on the same points (same
+ * frame, the PCA of the K points; same preconditioning h, so the same
+ * cond) -- up to rounding, on every point (the fit comes from power sums,
+ * auto.c's direct_fit).  Step 6: the row is the mean of the nearest's
+ * fits (mixed() above, no quantization: to the records' 16 bits). */
 START_TEST(test_auto_is_the_jet)
 {
     surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
     jf_result *ra = run(&c, "auto", 2);
     jf_index *ix;
     ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
+    uint32_t *nbi = malloc(c.s.n * JF_NB_AUTO_KMAX * sizeof *nbi);
+    jf_result *own = own_fits(&c, ix, nbi);
     jf_fitter *fit[4] = {NULL, NULL, NULL, NULL};
     for (int d = 1; d <= 3; d++) {
         jf_params p;
@@ -145,22 +232,21 @@ START_TEST(test_auto_is_the_jet)
         p.max_neighbors = JF_NB_AUTO_KMAX;
         ck_assert_int_eq(jf_fitter_create(&p, &fit[d]), JF_OK);
     }
-    uint32_t idx[JF_NB_AUTO_KMAX];
     double nb[3 * JF_NB_AUTO_KMAX];
-    size_t nd[4] = {0};
+    size_t nd[4] = {0}, moved = 0;
     for (size_t i = 0; i < c.s.n; i++) {
-        const jf_result *a = &ra[i];
+        const jf_result *a = &own[i];
         ck_assert(a->degree >= 1 && a->degree <= 3);
-        size_t k = (size_t)a->n_used, got;
-        ck_assert_int_eq(jf_index_knn(ix, c.s.xyz + 3 * i, k, idx, NULL, &got), JF_OK);
-        ck_assert_uint_eq(got, k);
+        ck_assert_int_eq(ra[i].n_used, a->n_used);
+        ck_assert_int_eq(ra[i].degree, a->degree);
+        ck_assert(ra[i].cond == a->cond && ra[i].residual == a->residual && ra[i].sigma == a->sigma);
+        size_t k = (size_t)a->n_used;
         for (size_t j = 0; j < k; j++)
-            memcpy(nb + 3 * j, c.s.xyz + 3 * (size_t)idx[j], 3 * sizeof(double));
+            memcpy(nb + 3 * j, c.s.xyz + 3 * (size_t)nbi[i * JF_NB_AUTO_KMAX + j], 3 * sizeof(double));
         jf_result r;
         ck_assert_int_eq(jf_fit_point(fit[a->degree], c.s.xyz + 3 * i, nb, k, &r), JF_OK);
         ck_assert_int_eq(r.degree, a->degree);
-        double dot = r.normal[0] * a->normal[0] + r.normal[1] * a->normal[1] +
-                     r.normal[2] * a->normal[2];
+        double dot = dot3(r.normal, a->normal);
         ck_assert_msg(dot > 1.0 - 1e-12, "point %zu: normals differ (dot %.17g)", i, dot);
         double ks = fabs(r.k1) + fabs(r.k2) + 1e-300;
         ck_assert_msg(fabs(r.k1 - a->k1) <= 1e-7 * ks && fabs(r.k2 - a->k2) <= 1e-7 * ks,
@@ -173,11 +259,70 @@ START_TEST(test_auto_is_the_jet)
         for (int e = 0; e < 3; e++)
             ck_assert(fabs(r.pca_eval[e] - a->pca_eval[e]) <= 1e-9 * r.pca_eval[0]);
         nd[a->degree]++;
+        /* step 6 */
+        double n[3], kk[2];
+        if (!mixed(&c, own, nbi, i, n, kk)) {
+            ck_assert_int_eq(memcmp(&ra[i], a, sizeof *a), 0);
+            continue;
+        }
+        double dm = fabs(dot3(n, ra[i].normal)), ds = fabs(dot3(a->normal, ra[i].normal));
+        ck_assert_msg(dm > 1.0 - 2e-8, "point %zu: step 6's normal off by %.3g rad", i, acos(dm));
+        moved += ds < 1.0 - 1e-8;
+        double kscale = fabs(kk[0]) + fabs(kk[1]) + 1e-3;
+        double s = dot3(n, ra[i].normal) < 0 ? -1 : 1; /* the row's side */
+        double r1 = s > 0 ? kk[0] : -kk[1], r2 = s > 0 ? kk[1] : -kk[0];
+        ck_assert_msg(fabs(ra[i].k1 - r1) <= 2e-4 * kscale && fabs(ra[i].k2 - r2) <= 2e-4 * kscale,
+                      "point %zu: step 6's k1 %.9g / %.9g, k2 %.9g / %.9g", i, ra[i].k1, r1,
+                      ra[i].k2, r2);
+        ck_assert(fabs(dot3(ra[i].d1, ra[i].normal)) < 1e-12 && fabs(dot3(ra[i].d1, ra[i].d1) - 1) < 1e-12);
     }
     ck_assert_uint_gt(nd[2], 0); /* both degrees met */
     ck_assert_uint_gt(nd[3], 0);
+    ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
     for (int d = 1; d <= 3; d++) jf_fitter_free(fit[d]);
     jf_index_free(ix);
+    free(own);
+    free(nbi);
+    free(ra);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
+/* On a clean sphere of radius 1 (outward normal: k1 = k2 = -1) step 6
+ * carries each neighbour's normal to q with an error of third order in
+ * |q - j| (the second-order part is along the normal), and the mean
+ * shape operator is -I in the tangent plane: the rows are about as
+ * accurate as the fits they mix (which are not exact: a sphere is no
+ * polynomial), the curvatures more. */
+START_TEST(test_auto_sphere)
+{
+    surf c = make(JF_SURF_SPHERE, 4000, 0.0, JF_DENSITY_UNIFORM);
+    jf_result *ra = run(&c, "auto", 2);
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
+    uint32_t *nbi = malloc(c.s.n * JF_NB_AUTO_KMAX * sizeof *nbi);
+    jf_result *own = own_fits(&c, ix, nbi);
+    double worst[2] = {0, 0}, kw[2] = {0, 0}, rms[2] = {0, 0};
+    for (size_t i = 0; i < c.s.n; i++)
+        for (int w = 0; w < 2; w++) {
+            const jf_result *r = w ? &own[i] : &ra[i];
+            double d = dot3(r->normal, c.s.truth[i].normal), a = acos(fabs(d) > 1 ? 1 : fabs(d));
+            worst[w] = a > worst[w] ? a : worst[w];
+            rms[w] += a * a;
+            double s = d < 0 ? -1 : 1, e = fmax(fabs(s * r->k1 + 1), fabs(s * r->k2 + 1));
+            kw[w] = e > kw[w] ? e : kw[w];
+        }
+    for (int w = 0; w < 2; w++) rms[w] = sqrt(rms[w] / (double)c.s.n);
+    /* measured: normals 1.9e-4 rad RMS, 1.2e-3 worst (own fits 1.5e-4,
+     * 5.9e-4): the carry's third-order error, |q - j|^3 / 2; curvatures
+     * 0.023 worst (own fits 0.044) */
+    ck_assert_msg(rms[0] < 1.5 * rms[1] && rms[0] < 3e-4 && worst[0] < 2e-3,
+                  "normal rms %.3g rad (own fits %.3g), worst %.3g (%.3g)", rms[0], rms[1], worst[0],
+                  worst[1]);
+    ck_assert_msg(kw[0] <= kw[1] && kw[0] < 0.03, "worst |k + 1| %.3g, own fits %.3g", kw[0], kw[1]);
+    jf_index_free(ix);
+    free(own);
+    free(nbi);
     free(ra);
     jf_sample_free(&c.s);
 }
@@ -261,6 +406,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_torus_gradient);
     tcase_add_test(tc, test_auto_threads);
     tcase_add_test(tc, test_auto_is_the_jet);
+    tcase_add_test(tc, test_auto_sphere);
     tcase_add_test(tc, test_auto_parts);
     suite_add_tcase(s, tc);
     return s;

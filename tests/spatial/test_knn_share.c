@@ -45,7 +45,7 @@ static size_t mismatches(const double *xyz, size_t n, size_t k, int shuffled)
         if (!shuffled) jf__knn_share_ahead(sh, q, m - w); /* as the pipeline */
         size_t fa = 0, fb = 0;
         ck_assert_int_eq(jf__index_query(ix, q, k, INFINITY, ia, da, xa, &fa), JF_OK);
-        ck_assert_int_eq(jf__knn_share_query(sh, ix, q, ib, db, xb, &fb), JF_OK);
+        ck_assert_int_eq(jf__knn_share_query(sh, ix, q, ib, NULL, db, xb, &fb), JF_OK);
         if (fa != fb || memcmp(ia, ib, fa * sizeof *ia) || memcmp(da, db, fa * sizeof *da) ||
             memcmp(xa, xb, 3 * fa * sizeof *xa))
             bad++;

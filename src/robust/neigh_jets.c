@@ -1,0 +1,201 @@
+/* neigh_jets.c -- auto's step 6 (neigh_jets.h): the neighbours' jets.
+ *
+ * Why: where the best K is auto's largest (most noisy cells), one fit on
+ * K points can at best tie the fixed K (Gauss-Markov); the fits of the
+ * nearest points reach beyond those K.  Each neighbour's normal is
+ * carried to q by its own shape operator W_j = k1 d1 d1' + k2 d2 d2' (a
+ * first-order step of the Monge form, §2), so a curved patch adds no
+ * bias of first order; the curvatures are those of the mean W_j.  The
+ * counts (K/16 for the normal, K/8 for the curvatures) were measured
+ * offline (tests/bench/auto_agg.py; docs/robustness.md). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "neigh_jets.h"
+
+size_t jf__nj_head(int k)
+{
+    double m = nearbyint(k / 8.0); /* half to even, as the offline study */
+    return m < 1 ? 1 : m > JF_NJ_HEAD ? JF_NJ_HEAD : (size_t)m;
+}
+
+static size_t normal_count(int k)
+{
+    double m = nearbyint(k / 16.0);
+    return m < 1 ? 1 : (size_t)m;
+}
+
+/* A tangent basis of a unit n, a function of n alone (Duff et al., "Building
+ * an orthonormal basis, revisited", JCGT 2017). */
+static void basis(const double n[3], double e1[3], double e2[3])
+{
+    const double s = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (s + n[2]), b = n[0] * n[1] * a;
+    e1[0] = 1.0 + s * n[0] * n[0] * a, e1[1] = s * b, e1[2] = -s * n[0];
+    e2[0] = b, e2[1] = s + n[1] * n[1] * a, e2[2] = -n[1];
+}
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static int16_t q16(double u)
+{
+    return (int16_t)lrint(u < -1 ? -32767.0 : u > 1 ? 32767.0 : u * 32767.0);
+}
+
+static void oct_decode(const int16_t o[2], double n[3])
+{
+    double u = o[0] / 32767.0, v = o[1] / 32767.0, z = 1.0 - fabs(u) - fabs(v);
+    if (z < 0) {
+        const double u0 = u;
+        u = copysign(1.0 - fabs(v), u0);
+        v = copysign(1.0 - fabs(u0), v);
+    }
+    const double l = sqrt(u * u + v * v + z * z);
+    n[0] = u / l, n[1] = v / l, n[2] = z / l;
+}
+
+jf_status jf__njs_alloc(jf__njs *s, size_t n)
+{
+    s->v = malloc((n ? n : 1) * sizeof *s->v);
+    s->state = calloc(n ? n : 1, 1);
+    if (s->v && s->state) return JF_OK;
+    jf__njs_free(s);
+    return JF_ERR_NOMEM;
+}
+
+void jf__njs_free(jf__njs *s)
+{
+    free(s->v);
+    free(s->state);
+    s->v = NULL;
+    s->state = NULL;
+}
+
+int jf__nj_state(const jf__njs *s, size_t i)
+{
+    return __atomic_load_n(&s->state[i], __ATOMIC_ACQUIRE);
+}
+
+void jf__nj_put(const jf__njs *s, size_t i, const jf_result *r)
+{
+    uint8_t want = JF_NJ_EMPTY;
+    if (__atomic_load_n(&s->state[i], __ATOMIC_RELAXED) != JF_NJ_EMPTY ||
+        !__atomic_compare_exchange_n(&s->state[i], &want, JF_NJ_BUSY, 0, __ATOMIC_ACQUIRE,
+                                     __ATOMIC_RELAXED))
+        return; /* another thread writes (or wrote) the same bytes */
+    jf__njet *e = &s->v[i];
+    const double *n = r->normal;
+    int good = r->degree >= 2 && !(r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) &&
+               isfinite(r->k1) && isfinite(r->k2) && isfinite(n[0]) && isfinite(n[1]) &&
+               isfinite(n[2]) && isfinite(r->d1[0]) && isfinite(r->d1[1]) && isfinite(r->d1[2]);
+    if (good) {
+        const double l1 = fabs(n[0]) + fabs(n[1]) + fabs(n[2]);
+        double u = n[0] / l1, w = n[1] / l1;
+        if (n[2] < 0) {
+            const double u0 = u;
+            u = copysign(1.0 - fabs(w), u0);
+            w = copysign(1.0 - fabs(u0), w);
+        }
+        e->oct[0] = q16(u), e->oct[1] = q16(w);
+        /* W = k1 d1 d1' + k2 d2 d2' in the basis of the normal as decoded */
+        double m[3], e1[3], e2[3];
+        oct_decode(e->oct, m);
+        basis(m, e1, e2);
+        const double a1 = dot3(r->d1, e1), b1 = dot3(r->d1, e2), a2 = dot3(r->d2, e1),
+                     b2 = dot3(r->d2, e2);
+        e->w[0] = (float)(r->k1 * a1 * a1 + r->k2 * a2 * a2);
+        e->w[1] = (float)(r->k1 * a1 * b1 + r->k2 * a2 * b2);
+        e->w[2] = (float)(r->k1 * b1 * b1 + r->k2 * b2 * b2);
+    }
+    __atomic_store_n(&s->state[i], good ? JF_NJ_FIT : JF_NJ_NONE, __ATOMIC_RELEASE);
+}
+
+int jf__nj_decode(const jf__njs *s, size_t j, double out[JF_NJ_DEC])
+{
+    int st;
+    while ((st = __atomic_load_n(&s->state[j], __ATOMIC_ACQUIRE)) == JF_NJ_BUSY)
+        ; /* another thread is copying the same bytes in: a few stores */
+    if (st != JF_NJ_FIT) return 0;
+    const jf__njet *e = &s->v[j];
+    double *n = out, *W = out + 3, e1[3], e2[3], u1[3], u2[3];
+    oct_decode(e->oct, n);
+    basis(n, e1, e2);
+    /* W = u1 e1' + u2 e2', u1 = W e1, u2 = W e2 */
+    for (int k = 0; k < 3; k++)
+        u1[k] = e->w[0] * e1[k] + e->w[1] * e2[k], u2[k] = e->w[1] * e1[k] + e->w[2] * e2[k];
+    W[0] = u1[0] * e1[0] + u2[0] * e2[0];
+    W[1] = u1[0] * e1[1] + u2[0] * e2[1];
+    W[2] = u1[0] * e1[2] + u2[0] * e2[2];
+    W[3] = u1[1] * e1[1] + u2[1] * e2[1];
+    W[4] = u1[1] * e1[2] + u2[1] * e2[2];
+    W[5] = u1[2] * e1[2] + u2[2] * e2[2];
+    return 1;
+}
+
+void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, const double p[3],
+                const uint32_t *head, size_t m, jf_result *r)
+{
+    if (r->degree < 2 || (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) || !isfinite(r->k1) ||
+        !isfinite(r->k2))
+        return;
+    size_t mc = jf__nj_head(r->n_used), mn = normal_count(r->n_used);
+    if (mc > m) mc = m;
+    if (mn > mc) mn = mc;
+    double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
+    size_t cn = 0, cc = 0;
+    for (size_t t = 0; t < mc; t++) {
+        const size_t j = head[t];
+        double own[JF_NJ_DEC];
+        const double *D = own;
+        if (c && j - c->beg < c->n && c->ok[j - c->beg] != 2) { /* decoded once */
+            if (!c->ok[j - c->beg]) continue;
+            D = c->dec + JF_NJ_DEC * (j - c->beg);
+        } else if (!jf__nj_decode(s, j, own))
+            continue;
+        const double *n = D, *Wj = D + 3;
+        /* every neighbour on q's side: a flip negates the shape operator */
+        const double sg = dot3(n, r->normal) < 0 ? -1.0 : 1.0;
+        for (int k = 0; k < 6; k++) W[k] += sg * Wj[k];
+        cc++;
+        if (t < mn) { /* n_j - W_j (q - j): n_j carried to q (§2) */
+            const double *pj = xyz + 3 * j;
+            const double d[3] = {p[0] - pj[0], p[1] - pj[1], p[2] - pj[2]};
+            const double wd[3] = {Wj[0] * d[0] + Wj[1] * d[1] + Wj[2] * d[2],
+                                  Wj[1] * d[0] + Wj[3] * d[1] + Wj[4] * d[2],
+                                  Wj[2] * d[0] + Wj[4] * d[1] + Wj[5] * d[2]};
+            for (int k = 0; k < 3; k++) ind[k] += sg * (n[k] - wd[k]);
+            cn++;
+        }
+    }
+    const double l = sqrt(dot3(ind, ind));
+    if (!cn || !cc || !(l > 0) || !isfinite(l)) return;
+    double n[3] = {ind[0] / l, ind[1] / l, ind[2] / l}, e1[3], e2[3];
+    basis(n, e1, e2);
+    /* the mean W in the plane normal to n: 2 x 2, closed form */
+    double We1[3], We2[3];
+    for (int k = 0; k < 3; k++) W[k] /= (double)cc, W[3 + k] /= (double)cc;
+    We1[0] = W[0] * e1[0] + W[1] * e1[1] + W[2] * e1[2];
+    We1[1] = W[1] * e1[0] + W[3] * e1[1] + W[4] * e1[2];
+    We1[2] = W[2] * e1[0] + W[4] * e1[1] + W[5] * e1[2];
+    We2[0] = W[0] * e2[0] + W[1] * e2[1] + W[2] * e2[2];
+    We2[1] = W[1] * e2[0] + W[3] * e2[1] + W[4] * e2[2];
+    We2[2] = W[2] * e2[0] + W[4] * e2[1] + W[5] * e2[2];
+    const double a = dot3(e1, We1), b = dot3(e1, We2), cc2 = dot3(e2, We2);
+    const double mid = 0.5 * (a + cc2), rad = hypot(0.5 * (a - cc2), b),
+                 phi = 0.5 * atan2(2.0 * b, a - cc2);
+    const double cp = cos(phi), sp = sin(phi);
+    memcpy(r->normal, n, sizeof n);
+    r->k1 = mid + rad, r->k2 = mid - rad;
+    for (int k = 0; k < 3; k++) r->d1[k] = cp * e1[k] + sp * e2[k];
+    r->d2[0] = n[1] * r->d1[2] - n[2] * r->d1[1];
+    r->d2[1] = n[2] * r->d1[0] - n[0] * r->d1[2];
+    r->d2[2] = n[0] * r->d1[1] - n[1] * r->d1[0];
+    /* umbilic as the fit's rule (monge.c): k1 - k2 <= 1e-10 max(|k1|,
+     * |k2|, 1/h), h here the distance to the farthest record read */
+    const double *pf = xyz + 3 * (size_t)head[mc - 1];
+    const double h = sqrt((p[0] - pf[0]) * (p[0] - pf[0]) + (p[1] - pf[1]) * (p[1] - pf[1]) +
+                          (p[2] - pf[2]) * (p[2] - pf[2]));
+    const double big = fmax(fmax(fabs(r->k1), fabs(r->k2)), h > 0 ? 1.0 / h : 0.0);
+    r->status &= ~(unsigned)JF_PT_UMBILIC;
+    if (2.0 * rad <= 1e-10 * big) r->status |= JF_PT_UMBILIC;
+}

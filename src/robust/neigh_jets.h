@@ -1,0 +1,71 @@
+/* neigh_jets.h -- auto's last step: a point's normal and curvatures from
+ * the jets of its nearest points (docs/robustness.md, "Neighbourhood
+ * auto", step 6).  The estimate keeps one 16-byte record per point (its
+ * fit's normal and shape operator), written by whichever thread fits the
+ * point first: each fit depends only on its own neighbourhood, so every
+ * writer writes the same bytes. */
+#ifndef JF_NEIGH_JETS_H
+#define JF_NEIGH_JETS_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jetfit.h"
+
+/* One point's fit, compact: its normal (octahedral, 2 x 16 bits) and
+ * shape operator in the tangent basis of that normal as decoded (w11,
+ * w12, w22: no angle to decode).  The states are a byte array beside. */
+typedef struct {
+    int16_t oct[2];
+    float w[3];
+} jf__njet;
+
+typedef struct {
+    jf__njet *v;
+    uint8_t *state; /* JF_NJ_*: read and written atomically */
+} jf__njs;
+
+enum { JF_NJ_EMPTY = 0, JF_NJ_BUSY = 1, JF_NJ_FIT = 2, JF_NJ_NONE = 3 };
+
+/* n records, all JF_NJ_EMPTY; JF_OK or JF_ERR_NOMEM. */
+jf_status jf__njs_alloc(jf__njs *s, size_t n);
+void jf__njs_free(jf__njs *s);
+
+/* The most nearest points a row reads (f = 1/8 of K <= 256). */
+#define JF_NJ_HEAD 32
+
+/* How many of a point's nearest its row reads: curvatures from
+ * round(K / 8), the normal from the first round(K / 16) (at least 1). */
+size_t jf__nj_head(int k);
+
+/* The state of point i's record (JF_NJ_*). */
+int jf__nj_state(const jf__njs *s, size_t i);
+
+/* Point i's record from its row r (any thread; the first writer wins,
+ * later ones leave it: the same bytes). */
+void jf__nj_put(const jf__njs *s, size_t i, const jf_result *r);
+
+/* Record j decoded: its normal (3) and shape operator in 3-D (xx xy xz
+ * yy yz zz) to out; 0 if it holds no fit.  Waits out a JF_NJ_BUSY
+ * record (its writer is mid-copy); j must not be JF_NJ_EMPTY. */
+#define JF_NJ_DEC 9
+int jf__nj_decode(const jf__njs *s, size_t j, double out[JF_NJ_DEC]);
+
+/* Records beg .. beg + n - 1 decoded once (ok[t]: jf__nj_decode's
+ * return, or 2: not decoded, read the record), for the rows that read
+ * them most: the same bits. */
+typedef struct {
+    const double *dec;
+    const uint8_t *ok;
+    size_t beg, n;
+} jf__nj_cache;
+
+/* Row r of point q (at p) from the records of its nearest head[0..m-1]
+ * (q's own among them; none JF_NJ_EMPTY), through the cache c where it
+ * holds them (may be NULL), at coordinates xyz (3 per record): the
+ * normal the mean of each neighbour's normal carried to p by its shape
+ * operator, the curvatures and directions those of the mean shape
+ * operator in the plane normal to it.  Rows not fitted at degree >= 2
+ * are left as they are. */
+void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, const double p[3],
+                const uint32_t *head, size_t m, jf_result *r);
+#endif
