@@ -485,15 +485,15 @@ size_t jf__parts_grid_bits(size_t n)
 
 /* What a part of at most m own points holds at its peak: own + halo
  * points (the halo at most JF_PLAN_HALO of m) at JF_PLAN_PART_PT each. */
-static double part_bytes(size_t n, int P)
+static double part_bytes(size_t n, int P, size_t fit_pt)
 {
     double m = ceil((double)n / P) * JF_PLAN_HALO + 64;
-    return m * JF_PLAN_PART_PT;
+    return m * (double)(JF_PLAN_PART_PT + fit_pt);
 }
 
 /* The plan's figures: *whole, *least (the most parts) and, for a budget,
  * the fewest parts that fit (2..pmax) or 0. */
-static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t budget,
+static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
                         double *whole, double *least)
 {
     /* the writer: its file buffer (1 MiB), the sink's rows (a block per
@@ -502,44 +502,44 @@ static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t budg
     const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
                           (double)nt * 4096.0 * 32.0 * (double)ncols;
     const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
-    *whole = base + (double)JF_PLAN_WHOLE_PT * (double)n;
+    *whole = base + (double)(JF_PLAN_WHOLE_PT + fit_pt) * (double)n;
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
                          (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);
     /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
     size_t pmax = n / JF_PLAN_PART_MIN;
     pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;
-    *least = fixed + part_bytes(n, (int)pmax);
+    *least = fixed + part_bytes(n, (int)pmax, fit_pt);
     if ((double)budget < *least) return 0;
     /* the fewest parts that fit: each costs a scan of the cloud */
     int lo = 2, hi = (int)pmax;
     while (lo < hi) {
         int mid = lo + (hi - lo) / 2;
-        if (fixed + part_bytes(n, mid) <= (double)budget) hi = mid;
+        if (fixed + part_bytes(n, mid, fit_pt) <= (double)budget) hi = mid;
         else lo = mid + 1;
     }
     return lo;
 }
 
-int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
-                   size_t *need_min)
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
+                   size_t *need_whole, size_t *need_min)
 {
     double whole, least;
-    const int p = plan_figures(n, held, ncols, nt, budget, &whole, &least);
+    const int p = plan_figures(n, held, ncols, nt, fit_pt, budget, &whole, &least);
     if (need_whole) *need_whole = (size_t)whole;
     if (need_min) *need_min = (size_t)(least < whole ? least : whole);
     if ((double)budget >= whole || n < 2) return 1;
     return p;
 }
 
-int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, size_t budget,
-                       size_t *need_min)
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t row,
+                       size_t budget, size_t *need_min)
 {
     /* the read buffers: raw rows and their coordinates, per thread; never
      * the whole cloud (its tree would hold the coordinates) */
     held += (size_t)(nt > 0 ? nt : 1) * JF_SRC_CHUNK * (24 + row);
     double whole, least;
-    const int p = plan_figures(n, held, ncols, nt, budget, &whole, &least);
+    const int p = plan_figures(n, held, ncols, nt, fit_pt, budget, &whole, &least);
     if (need_min) *need_min = (size_t)least;
     return n < 2 ? 0 : p;
 }
@@ -551,7 +551,7 @@ static int ends_with(const char *s, const char *ext)
 }
 
 int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
-                        size_t ncols, int threads, int kd, int keep, const char *out,
+                        size_t ncols, int threads, int kd, size_t fit_pt, int keep, const char *out,
                         const char *out_fmt, jf_row_layout *l, jf_memchk *r)
 {
     memset(r, 0, sizeof *r);
@@ -581,18 +581,20 @@ int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int c
          * fits in memory with that, it is read whole; else their size is
          * known once read (then: in memory if it fits, else from the
          * file); --keep none: exact now */
-        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, budget, NULL, NULL))
+        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, fit_pt, budget, NULL,
+                           NULL))
             return JF_MEMCHK_OK;
         if (keep) return JF_MEMCHK_OOC;
-        if (jf__parts_plan(n, held, ncols, threads, budget, NULL, &need_min)) return JF_MEMCHK_OK;
-        if (jf__parts_plan_ooc(n, held - coords, ncols, threads, l->row, budget, &need_ooc))
+        if (jf__parts_plan(n, held, ncols, threads, fit_pt, budget, NULL, &need_min))
+            return JF_MEMCHK_OK;
+        if (jf__parts_plan_ooc(n, held - coords, ncols, threads, fit_pt, l->row, budget, &need_ooc))
             return JF_MEMCHK_OOC;
         r->ooc = need_ooc < need_min;
         r->need_min = r->ooc ? need_ooc : need_min;
         r->held = r->ooc ? held - coords : held;
         return JF_MEMCHK_REFUSED;
     }
-    if (jf__parts_plan(n, held, ncols, threads, budget, NULL, &need_min)) return JF_MEMCHK_OK;
+    if (jf__parts_plan(n, held, ncols, threads, fit_pt, budget, NULL, &need_min)) return JF_MEMCHK_OK;
     r->need_min = need_min, r->held = held;
     return JF_MEMCHK_REFUSED;
 }

@@ -97,18 +97,21 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
  * part[] per point, two grids (jf__parts_grid_bits each), the sample,
  * and one part at a time: own and halo points with their coordinates,
  * input index, mask and index (the own index during the halo, the fit's
- * after).  Returns 1 (whole), P >= 2 parts, or 0 when even
+ * after); fit_pt more bytes per fitted point (own and halo) while
+ * fitting (auto: JF_PLAN_NJ_PT).  Returns 1 (whole), P >= 2 parts, or 0 when even
  * min(JF_PLAN_PARTS_MAX, n / JF_PLAN_PART_MIN) parts (2 at least) do not fit; *need_whole, *need_min: the least
  * budget for the whole cloud and for any plan. */
 #define JF_PLAN_WHOLE_PT 36
 #define JF_PLAN_PART_PT 68
 #define JF_PLAN_SPLIT_PT 4
 #define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
+#define JF_PLAN_NJ_PT 17       /* auto: step 6's record and state per point
+                                  (robust/neigh_jets.h): the fit_pt below */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */
-int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t budget, size_t *need_whole,
-                   size_t *need_min);
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
+                   size_t *need_whole, size_t *need_min);
 
 /* Where the bounded-memory estimate reads the coordinates (issue 28): an
  * array in memory, or the rows of the input file itself (a binary PLY or
@@ -139,8 +142,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
 /* jf__parts_plan's parts for an estimate whose coordinates stay on disk
  * (held: without them; the read buffers added here): P >= 2, or 0 when
  * even the most parts do not fit; *need_min as jf__parts_plan's. */
-int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t row, size_t budget,
-                       size_t *need_min);
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t row,
+                       size_t budget, size_t *need_min);
 
 /* --memory's check before the input is read (jetfit estimate): for a
  * binary PLY or LAS input (in_fmt NULL, path ending .ply or .las), whose
@@ -160,7 +163,7 @@ typedef struct {
 } jf_memchk;
 enum { JF_MEMCHK_OK = 0, JF_MEMCHK_REFUSED = 1, JF_MEMCHK_OOC = 2 };
 int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
-                        size_t ncols, int threads, int kd, int keep, const char *out,
+                        size_t ncols, int threads, int kd, size_t fit_pt, int keep, const char *out,
                         const char *out_fmt, jf_row_layout *l, jf_memchk *r);
 
 /* Bits of the parts' occupancy and halo grids for n points (<= 2^26). */

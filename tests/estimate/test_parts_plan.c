@@ -70,20 +70,26 @@ START_TEST(plan_is_monotone)
 {
     const size_t n = 10000000, held = 24 * n;
     size_t whole = 0, least = 0;
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, SIZE_MAX / 2, &whole, &least), 1);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, SIZE_MAX / 2, &whole, &least), 1);
     ck_assert_uint_gt(whole, held + JF_PLAN_WHOLE_PT * n - 1);
     ck_assert_uint_lt(least, whole);
     ck_assert_uint_gt(least, held + JF_PLAN_SPLIT_PT * n);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, whole, NULL, NULL), 1);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, least - 1, NULL, NULL), 0);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, least, NULL, NULL), JF_PLAN_PARTS_MAX);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, whole, NULL, NULL), 1);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, least - 1, NULL, NULL), 0);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, least, NULL, NULL), JF_PLAN_PARTS_MAX);
     int prev = JF_PLAN_PARTS_MAX + 1;
     for (size_t b = least; b < whole; b += (whole - least) / 50) {
-        int p = jf__parts_plan(n, held, 24, 2, b, NULL, NULL);
+        int p = jf__parts_plan(n, held, 24, 2, 0, b, NULL, NULL);
         ck_assert_int_ge(p, 2);
         ck_assert_int_le(p, prev);
         prev = p;
     }
+    /* auto's step 6 records: JF_PLAN_NJ_PT more a point, whole and parts */
+    size_t whole6 = 0, least6 = 0;
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, JF_PLAN_NJ_PT, SIZE_MAX / 2, &whole6, &least6), 1);
+    ck_assert_uint_eq(whole6 - whole, JF_PLAN_NJ_PT * n);
+    ck_assert_uint_gt(least6, least);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, JF_PLAN_NJ_PT, least6 - 1, NULL, NULL), 0);
 }
 END_TEST
 
