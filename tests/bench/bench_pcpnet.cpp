@@ -29,8 +29,10 @@
 // --sweep adds configurations (K may be a scale set "12/18/36"; robust
 // 0/1/2 = none/huber/tukey; with --no-fixed only those run); --varw,
 // --floor, --target override the scale-selection constants of robust.c;
-// --auto adds neighbors auto, --auto-tau/-blob/-sdmax/-varw/-clean/-gl/
-// -nest/-lof/-s2floor/-flat/-dw X set robust.c's auto_* knob of that name.
+// --auto adds neighbors auto (jf_estimate on the whole cloud: the rows the
+// command writes), --auto-tau/-blob/-sdmax/-varw/-clean/-gl/-nest/-lof/
+// -s2floor/-flat/-dw X set robust.c's auto_* knob of that name (then each
+// .pidx point's own fit, without step 6: the knobs are a fitter's).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
 #include <CGAL/pca_estimate_normals.h>
@@ -157,7 +159,37 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
     std::map<std::pair<int, int>, size_t> chosen;
     double sig = 0;
     double t0 = now();
+    // auto without knobs: jf_estimate on the whole cloud, the product's
+    // rows (steps 1-6: step 6 reads the neighbours' fits); with a knob,
+    // each .pidx point's own fit (steps 1-5), the knobs being a fitter's
+    std::vector<jf_result> rows;
+    if (p.auto_select && tunes.empty()) {
+        jf_estimate_opts o;
+        jf_estimate_opts_init(&o);
+        o.nb.kind = JF_NB_AUTO;
+        o.orient = JF_ORIENT_NONE;
+        o.threads = 1;
+        jf_cloud cl = {};
+        cl.n = s.xyz.size() / 3;
+        cl.xyz = const_cast<double *>(s.xyz.data()); // read only
+        rows.resize(cl.n);
+        jf_error e;
+        if (jf_estimate(&cl, &o, rows.data(), &e) != JF_OK) {
+            std::fprintf(stderr, "bench_pcpnet: jf_estimate: %s\n", e.msg);
+            jf_fitter_free(f);
+            return NAN;
+        }
+    } else if (p.auto_select)
+        std::printf("# auto with knobs: each point's own fit (steps 1-5, no step 6)\n");
     for (size_t j = 0; j < s.pidx.size(); j++) {
+        if (!rows.empty()) {
+            const jf_result &r = rows[s.pidx[j]];
+            std::memcpy(&nrm[3 * j], r.normal, 3 * sizeof(double));
+            if (r.status & JF_PT_FAILED) (*flagged)++;
+            chosen[std::make_pair(r.n_used, r.degree)]++;
+            sig += r.sigma;
+            continue;
+        }
         const double *q = &s.xyz[3 * s.pidx[j]];
         size_t found = 0;
         jf_index_knn(ix, q, c.k, idx.data(), nullptr, &found);
@@ -177,7 +209,7 @@ static double run_jetfit(const Study &s, const jf_index *ix, const Config &c0, d
         for (auto &e : chosen) std::printf(" %d/%d:%zu", e.first.first, e.first.second, e.second);
         std::printf("; mean sigma %.4g\n", sig / (double)s.pidx.size());
     }
-    *secs = now() - t0;
+    *secs = now() - t0; // auto without knobs: the whole cloud's time
     jf_fitter_free(f);
     return rms_angle(s, nrm);
 }
