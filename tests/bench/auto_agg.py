@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""auto_agg.py -- issue 27, seventh round (docs/robustness.md): does
-aggregating the neighbours' jets beat the best fixed K where one fit
-cannot?  Offline, from jetfit's own rows; nothing here ships.
+"""auto_agg.py -- issue 27 (docs/robustness.md, "Where step 6 does not
+reach"): does aggregating the neighbours' jets beat the best fixed K where
+one fit cannot?  Offline, from jetfit's own rows (the variants below are
+applied to auto's rows as written: since step 6 shipped, on top of it;
+the build before it gave the figures of that section's table).
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
        [--lepski TAU,...] [--n N] [--seed S]
