@@ -673,6 +673,44 @@ static void prefetch_natural(const nbctx *x, size_t i)
     jf__natural_prefetch(x->nt, i);
 }
 
+/* After a thread's chunk (or unit) of cnt walk points with status wst:
+ * its failure kept, the count done, and on the calling thread only the
+ * progress and cancel hooks (a stop is seen by every thread before its
+ * next claim). */
+static void fail_keep(jf_status st, jf_status *failed)
+{
+    if (st != JF_OK) {
+#pragma omp atomic write
+        *failed = st;
+    }
+}
+
+/* Whether a thread takes no more work: its own failure or another's. */
+static int stop_seen(jf_status wst, jf_status *failed)
+{
+    jf_status seen;
+#pragma omp atomic read
+    seen = *failed;
+    return seen != JF_OK || wst != JF_OK;
+}
+
+static void block_done(const runctx *R, jf_status wst, size_t cnt, size_t *done, jf_status *failed)
+{
+    const jf_estimate_opts *o = R->o;
+    fail_keep(wst, failed);
+    size_t now;
+#pragma omp atomic capture
+    now = *done += cnt;
+    if (omp_get_thread_num() == 0) {
+        if (o->progress) o->progress(o->progress_user, now, R->total);
+        if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, now, R->total);
+        if (cancelled(o)) {
+#pragma omp atomic write
+            *failed = JF_ERR_CANCELLED;
+        }
+    }
+}
+
 /* Step 2 over walk[0..nwalk-1] (coordinates from walk_xyz, the tree's
  * copy, when not NULL): chunks of CHUNK points shared out dynamically. */
 static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *walk_xyz,
@@ -688,17 +726,11 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
     {
         worker w;
         jf_status wst = worker_init(&w, &o->params, x, blocks);
-        if (wst != JF_OK) {
-#pragma omp atomic write
-            failed = wst;
-        }
+        fail_keep(wst, &failed);
         /* chunk 0 the calling thread's: its progress and cancel hooks run
          * during the pass (core/claim.h) */
         for (size_t ch = jf__claim_first(&next); ch < nchunks; ch = jf__claim_next(&next)) {
-            jf_status seen;
-#pragma omp atomic read
-            seen = failed;
-            if (seen != JF_OK || wst != JF_OK) continue;
+            if (stop_seen(wst, &failed)) continue;
             size_t beg = ch * CHUNK, end = beg + CHUNK < nwalk ? beg + CHUNK : nwalk;
             const uint8_t *fit = R->fit;
             size_t m = 0; /* block modes: results in w.blk */
@@ -738,23 +770,7 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
             }
             _mm_sfence(); /* the streamed rows (store_row), before anyone reads them */
             if (wst == JF_OK && blocks && m) wst = deliver(R, w.bidx, w.bxyz, w.blk, m);
-            if (wst != JF_OK) {
-#pragma omp atomic write
-                failed = wst;
-            }
-            size_t now;
-#pragma omp atomic capture
-            now = done += end - beg;
-            /* the progress and cancel hooks run on the calling thread only;
-             * a stop is seen by every thread before its next block */
-            if (omp_get_thread_num() == 0) {
-                if (o->progress) o->progress(o->progress_user, now, R->total);
-                if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, now, R->total);
-                if (cancelled(o)) {
-#pragma omp atomic write
-                    failed = JF_ERR_CANCELLED;
-                }
-            }
+            block_done(R, wst, end - beg, &done, &failed);
         }
         worker_free(&w);
     }
@@ -836,15 +852,9 @@ static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double
         worker w = {0};
         jf_status wst = failed == JF_OK ? worker_init(&w, &o->params, x, 1) : failed;
         if (wst == JF_OK && !w.share) wst = JF_ERR_INVALID; /* positions come from it */
-        if (wst != JF_OK) {
-#pragma omp atomic write
-            failed = wst;
-        }
+        fail_keep(wst, &failed);
         for (size_t u = jf__claim_first(&next); u < nunits; u = jf__claim_next(&next)) {
-            jf_status seen;
-#pragma omp atomic read
-            seen = failed;
-            if (seen != JF_OK || wst != JF_OK) continue;
+            if (stop_seen(wst, &failed)) continue;
             const size_t beg = u * unit, nu = beg + unit < nwalk ? unit : nwalk - beg;
             size_t m = 0; /* the unit's points to fit (a part's halo: not) */
             for (size_t kk = 0; kk < nu && wst == JF_OK; kk++) {
@@ -905,34 +915,12 @@ static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double
             }
             if (wst == JF_OK)
                 wst = nj_finish(R, &w, &cache, w.blk, w.bidx, w.bxyz, w.head, w.headn, nr);
-            if (wst != JF_OK) {
-#pragma omp atomic write
-                failed = wst;
-            }
-            size_t now;
-#pragma omp atomic capture
-            now = done += nu;
-            if (omp_get_thread_num() == 0) {
-                if (o->progress) o->progress(o->progress_user, now, R->total);
-                if (o->phase) o->phase(o->phase_user, JF_PHASE_FIT, now, R->total);
-                if (cancelled(o)) {
-#pragma omp atomic write
-                    failed = JF_ERR_CANCELLED;
-                }
-            }
+            block_done(R, wst, nu, &done, &failed);
         }
         /* the last rows held back: what they read, fitted on demand */
-        if (wst == JF_OK && w.npend) {
-            jf_status seen;
-#pragma omp atomic read
-            seen = failed;
-            if (seen == JF_OK &&
-                (wst = nj_finish(R, &w, NULL, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend)) !=
-                    JF_OK) {
-#pragma omp atomic write
-                failed = wst;
-            }
-        }
+        if (w.npend && !stop_seen(wst, &failed))
+            fail_keep(nj_finish(R, &w, NULL, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend),
+                      &failed);
         worker_free(&w);
     }
     return failed;

@@ -430,6 +430,26 @@ static int cmp_hpt(const void *a, const void *b)
     return (x->gid > y->gid) - (x->gid < y->gid);
 }
 
+/* Appends (gid, xyz) to the halo list *v (*n of *cap); 0 when out of
+ * memory (the rank failed). */
+static int hpt_push(jf_mpi *m, hpt **v, size_t *n, size_t *cap, uint32_t gid, const double *xyz)
+{
+    if (*n == *cap) {
+        size_t nc = *cap ? 2 * *cap : 1024;
+        hpt *nh = realloc(*v, nc * sizeof *nh);
+        if (!nh) {
+            jf_mpi_fail(m, "out of memory");
+            return 0;
+        }
+        *v = nh;
+        *cap = nc;
+    }
+    (*v)[*n].gid = gid;
+    memcpy((*v)[*n].xyz, xyz, sizeof(double[3]));
+    (*n)++;
+    return 1;
+}
+
 /* The halo of this rank's part (own: its points, by input index). */
 static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_query *q,
                        int threads, hpt **halo, size_t *nhalo, size_t *fetched)
@@ -588,21 +608,8 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
             size_t found = 0;
             size_t k = r->k < scratch ? r->k : scratch;
             if (q->nj) { /* auto's step 6: every answer is in the ball */
-                for (size_t t = g; t < e && !m->failed; t++) {
-                    if (*nhalo == hcap) {
-                        size_t nc = hcap ? 2 * hcap : 1024;
-                        hpt *nh = realloc(*halo, nc * sizeof *nh);
-                        if (!nh) {
-                            jf_mpi_fail(m, "out of memory");
-                            break;
-                        }
-                        *halo = nh;
-                        hcap = nc;
-                    }
-                    (*halo)[*nhalo].gid = back[t].gid;
-                    memcpy((*halo)[*nhalo].xyz, back[t].xyz, sizeof back[t].xyz);
-                    (*nhalo)++;
-                }
+                for (size_t t = g; t < e && hpt_push(m, halo, nhalo, &hcap, back[t].gid, back[t].xyz);)
+                    t++;
                 g = e;
                 continue;
             }
@@ -629,20 +636,8 @@ static void fetch_halo(jf_mpi *m, const prec *own, size_t nown, const jf_part_qu
             qsort(mc, mn, sizeof *mc, jf__halo_cmp);
             for (size_t t = 0; t < mn && t < r->k; t++) {
                 if (!mc[t].remote) continue;
-                if (*nhalo == hcap) {
-                    size_t nc = hcap ? 2 * hcap : 1024;
-                    hpt *nh = realloc(*halo, nc * sizeof *nh);
-                    if (!nh) {
-                        jf_mpi_fail(m, "out of memory");
-                        break;
-                    }
-                    *halo = nh;
-                    hcap = nc;
-                }
                 const arec *a = &back[g + mc[t].remote - 1];
-                (*halo)[*nhalo].gid = a->gid;
-                memcpy((*halo)[*nhalo].xyz, a->xyz, sizeof a->xyz);
-                (*nhalo)++;
+                if (!hpt_push(m, halo, nhalo, &hcap, a->gid, a->xyz)) break;
             }
             g = e;
         }

@@ -129,10 +129,13 @@ START_TEST(test_auto_threads)
 END_TEST
 
 /* Each point's own fit (steps 1-5): jf_fit_point_full with auto on its
- * JF_NB_AUTO_KMAX nearest (idx[i * KMAX ...], the tree's order), as the
+ * JF_NB_AUTO_KMAX nearest (*nbi[i * KMAX ...], the tree's order), as the
  * estimate's walk makes it. */
-static jf_result *own_fits(const surf *c, const jf_index *ix, uint32_t *idx)
+static jf_result *own_fits(const surf *c, uint32_t **nbi)
 {
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(c->s.xyz, c->s.n, &ix), JF_OK);
+    uint32_t *idx = *nbi = malloc(c->s.n * JF_NB_AUTO_KMAX * sizeof *idx);
     jf_params p;
     jf_params_init(&p);
     p.auto_select = 1;
@@ -151,6 +154,7 @@ static jf_result *own_fits(const surf *c, const jf_index *ix, uint32_t *idx)
         ck_assert_int_eq(jf_fit_point_full(f, c->s.xyz + 3 * i, nb, got, &own[i]), JF_OK);
     }
     jf_fitter_free(f);
+    jf_index_free(ix);
     return own;
 }
 
@@ -220,10 +224,8 @@ START_TEST(test_auto_is_the_jet)
 {
     surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
     jf_result *ra = run(&c, "auto", 2);
-    jf_index *ix;
-    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
-    uint32_t *nbi = malloc(c.s.n * JF_NB_AUTO_KMAX * sizeof *nbi);
-    jf_result *own = own_fits(&c, ix, nbi);
+    uint32_t *nbi;
+    jf_result *own = own_fits(&c, &nbi);
     jf_fitter *fit[4] = {NULL, NULL, NULL, NULL};
     for (int d = 1; d <= 3; d++) {
         jf_params p;
@@ -280,7 +282,6 @@ START_TEST(test_auto_is_the_jet)
     ck_assert_uint_gt(nd[3], 0);
     ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
     for (int d = 1; d <= 3; d++) jf_fitter_free(fit[d]);
-    jf_index_free(ix);
     free(own);
     free(nbi);
     free(ra);
@@ -298,10 +299,8 @@ START_TEST(test_auto_sphere)
 {
     surf c = make(JF_SURF_SPHERE, 4000, 0.0, JF_DENSITY_UNIFORM);
     jf_result *ra = run(&c, "auto", 2);
-    jf_index *ix;
-    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
-    uint32_t *nbi = malloc(c.s.n * JF_NB_AUTO_KMAX * sizeof *nbi);
-    jf_result *own = own_fits(&c, ix, nbi);
+    uint32_t *nbi;
+    jf_result *own = own_fits(&c, &nbi);
     double worst[2] = {0, 0}, kw[2] = {0, 0}, rms[2] = {0, 0};
     for (size_t i = 0; i < c.s.n; i++)
         for (int w = 0; w < 2; w++) {
@@ -320,7 +319,6 @@ START_TEST(test_auto_sphere)
                   "normal rms %.3g rad (own fits %.3g), worst %.3g (%.3g)", rms[0], rms[1], worst[0],
                   worst[1]);
     ck_assert_msg(kw[0] <= kw[1] && kw[0] < 0.03, "worst |k + 1| %.3g, own fits %.3g", kw[0], kw[1]);
-    jf_index_free(ix);
     free(own);
     free(nbi);
     free(ra);
