@@ -165,7 +165,12 @@ typedef struct {
                                 (src/robust/auto.c; the neighbourhood
                                 JF_NB_AUTO sets it); overrides robust,
                                 scales, degree_select, dist_weight and
-                                degree.  0 = off (default)               */
+                                degree.  This is one point's own fit;
+                                jf_estimate with JF_NB_AUTO then takes
+                                each row's normal and curvatures from
+                                its nearest points' fits (docs/
+                                robustness.md, step 6).  0 = off
+                                (default)                                */
 } jf_params;
 
 /* Fills defaults.  Never fails. */
@@ -427,7 +432,9 @@ typedef enum {
     JF_NB_AUTO        /* auto: per point, K among the JF_NB_AUTO_KMAX
                          nearest and the degree chosen without being
                          told the noise (params.auto_select; the
-                         estimate runs it as knn:JF_NB_AUTO_KMAX)       */
+                         estimate runs it as knn:JF_NB_AUTO_KMAX), the
+                         row's normal and curvatures then the mean of
+                         its nearest points' fits (step 6)              */
 } jf_nb_kind;
 
 #define JF_NB_AUTO_KMAX 256 /* neighbors auto: the largest K it considers */

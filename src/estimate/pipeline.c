@@ -469,7 +469,7 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         if (st == JF_OK)
             st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->oshare);
     }
-    if (st == JF_OK && p->auto_select && x->nb->kind == JF_NB_KNN && x->nb->k >= 128)
+    if (st == JF_OK && jf__nj_on(p, x->nb)) /* auto's search, shared along the walk */
         st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
     if (st != JF_OK) worker_free(w);
     return st;
@@ -1084,7 +1084,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     /* auto's step 6 (neigh_jets.h); a part's halo holds what it reads
      * (parts.c, jf__halo_requests) */
     jf__njs njs = {NULL, NULL};
-    if (p->auto_select && nb.kind == JF_NB_KNN && need_index) {
+    if (jf__nj_on(p, &nb) && need_index) {
         x.nj = &njs;
         if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
             st = JF_ERR_NOMEM;

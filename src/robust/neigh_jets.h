@@ -33,6 +33,15 @@ void jf__njs_free(jf__njs *s);
 /* The most nearest points a row reads (f = 1/8 of K <= 256). */
 #define JF_NJ_HEAD 32
 
+/* Whether an estimate runs step 6: auto on a k-NN of at least
+ * JF_NJ_KMIN (JF_NB_AUTO's knn:JF_NB_AUTO_KMAX), whose shared search
+ * (knn_share.c) gives the tree positions the records are keyed by. */
+#define JF_NJ_KMIN 128
+static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
+{
+    return p->auto_select && nb->kind == JF_NB_KNN && nb->k >= JF_NJ_KMIN;
+}
+
 /* How many of a point's nearest its row reads: curvatures from
  * round(K / 8), the normal from the first round(K / 16) (at least 1). */
 size_t jf__nj_head(int k);

@@ -326,6 +326,47 @@ START_TEST(test_auto_sphere)
 }
 END_TEST
 
+/* params.auto_select on a knn below JF_NB_AUTO_KMAX's shared search
+ * (knn:64): each row is the point's own fit, no step 6. */
+START_TEST(test_auto_select_knn)
+{
+    surf c = make(JF_SURF_TORUS, 1500, 0.003, JF_DENSITY_GRADIENT);
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    ck_assert_int_eq(jf_nb_parse("knn:64", &o.nb, NULL), JF_OK);
+    o.orient = JF_ORIENT_NONE;
+    o.threads = 2;
+    o.params.auto_select = 1;
+    jf_cloud cl = {.n = c.s.n, .xyz = c.s.xyz};
+    jf_result *r = malloc(c.s.n * sizeof *r);
+    jf_error e;
+    ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
+    jf_index *ix;
+    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
+    jf_params p;
+    jf_params_init(&p);
+    p.auto_select = 1;
+    p.max_neighbors = JF_NB_AUTO_KMAX;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
+    uint32_t id[64];
+    double nb[3 * 64];
+    for (size_t i = 0; i < c.s.n; i += 7) {
+        size_t got;
+        ck_assert_int_eq(jf_index_knn(ix, c.s.xyz + 3 * i, 64, id, NULL, &got), JF_OK);
+        for (size_t j = 0; j < got; j++) memcpy(nb + 3 * j, c.s.xyz + 3 * (size_t)id[j], sizeof(double[3]));
+        jf_result a;
+        ck_assert_int_eq(jf_fit_point_full(f, c.s.xyz + 3 * i, nb, got, &a), JF_OK);
+        ck_assert_int_eq(memcmp(a.normal, r[i].normal, sizeof a.normal), 0);
+        ck_assert(a.k1 == r[i].k1 && a.n_used == r[i].n_used);
+    }
+    jf_fitter_free(f);
+    jf_index_free(ix);
+    free(r);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
 typedef struct {
     jf_result *r;
     size_t n, got;
@@ -405,6 +446,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_threads);
     tcase_add_test(tc, test_auto_is_the_jet);
     tcase_add_test(tc, test_auto_sphere);
+    tcase_add_test(tc, test_auto_select_knn);
     tcase_add_test(tc, test_auto_parts);
     suite_add_tcase(s, tc);
     return s;
