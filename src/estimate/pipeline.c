@@ -45,7 +45,7 @@
 /* auto's step 6: the points fitted before their rows are mixed from their
  * neighbours' fits; a larger unit fits fewer neighbours twice (those in
  * units not yet done: at its border) */
-#define NJ_UNIT (32 * CHUNK)
+#define NJ_UNIT (16 * CHUNK)
 
 void jf_estimate_opts_init(jf_estimate_opts *o)
 {
@@ -383,11 +383,11 @@ typedef struct {
     double *pxyz;         /* blk, bidx, head, headn, bxyz                */
     uint8_t *pheadn;
     size_t npend, pcap;
+    uint8_t *rdy;         /* the unit's rows: all their records fitted   */
     double *dec;          /* the unit's records decoded (jf__nj_cache)   */
     uint8_t *decok;
-    jf__knn_share *oshare; /* a neighbour fitted on demand (its unit not */
-    uint32_t *oidx;       /* yet done): its search and neighbourhood     */
-    double *od2, *oxyz;
+    uint32_t *oidx;       /* a neighbour fitted on demand (its unit not  */
+    double *od2, *oxyz;   /* yet done): its neighbourhood                */
 } worker;
 
 static void worker_free(worker *w)
@@ -412,9 +412,9 @@ static void worker_free(worker *w)
     free(w->phead);
     free(w->pxyz);
     free(w->pheadn);
+    free(w->rdy);
     free(w->dec);
     free(w->decok);
-    jf__knn_share_free(w->oshare);
     free(w->oidx);
     free(w->od2);
     free(w->oxyz);
@@ -451,23 +451,22 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->head = malloc(unit * JF_NJ_HEAD * sizeof *w->head);
         w->headn = malloc(unit);
         w->bpos = malloc(unit * sizeof *w->bpos);
-        w->pcap = unit / 4;
+        w->pcap = unit; /* rows wait for the units around theirs */
         w->pblk = malloc(w->pcap * sizeof *w->pblk);
         w->pidx = malloc(w->pcap * sizeof *w->pidx);
         w->phead = malloc(w->pcap * JF_NJ_HEAD * sizeof *w->phead);
         w->pxyz = malloc(3 * w->pcap * sizeof *w->pxyz);
         w->pheadn = malloc(w->pcap);
+        w->rdy = malloc(unit);
         w->dec = malloc(unit * JF_NJ_DEC * sizeof *w->dec);
         w->decok = malloc(unit);
         w->oidx = malloc(x->cap * sizeof *w->oidx);
         w->od2 = malloc(x->cap * sizeof *w->od2);
         w->oxyz = malloc(3 * x->cap * sizeof *w->oxyz);
         if (!w->pos || !w->head || !w->headn || !w->bpos || !w->pblk || !w->pidx || !w->phead ||
-            !w->pxyz || !w->pheadn || !w->dec || !w->decok || !w->oidx ||
+            !w->pxyz || !w->pheadn || !w->rdy || !w->dec || !w->decok || !w->oidx ||
             !w->od2 || !w->oxyz)
             st = JF_ERR_NOMEM;
-        if (st == JF_OK)
-            st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->oshare);
     }
     if (st == JF_OK && jf__nj_on(p, x->nb)) /* auto's search, shared along the walk */
         st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
@@ -786,14 +785,32 @@ static jf_status nj_fit_other(worker *w, const nbctx *x, uint32_t j)
     jf_result r;
     size_t found = 0;
     const double *p = x->pts + 3 * (size_t)j;
-    /* the points fitted on demand follow the unit's border: their searches
-     * share too */
-    jf_status st = jf__knn_share_query(w->oshare, x->ix, p, w->oidx, NULL, w->od2, w->oxyz, &found);
+    jf_status st =
+        jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, w->oidx, w->od2, w->oxyz, x->cap, &found);
     if (st == JF_OK) st = jf_fit_point_full(w->fit[0], p, w->oxyz, found, &r);
     if (st != JF_OK) return st;
     if (found < x->want) r.status |= JF_PT_FEW_NEIGHBORS;
     jf__nj_put(x->nj, j, &r);
     return JF_OK;
+}
+
+/* Rows of step 6 not yet mixed: a unit's (the worker's blk, bidx, head,
+ * headn, bxyz) or those held back (pblk, ...). */
+typedef struct {
+    jf_result *blk;
+    uint32_t *idx, *head; /* inputs; nearest positions, JF_NJ_HEAD a row */
+    double *xyz;
+    uint8_t *headn;       /* nearest kept */
+} njrows;
+
+static void nj_move(const njrows *a, size_t k, const njrows *b, size_t t)
+{
+    if (a == b && k == t) return;
+    b->blk[t] = a->blk[k];
+    b->idx[t] = a->idx[k];
+    memcpy(b->xyz + 3 * t, a->xyz + 3 * k, 3 * sizeof *b->xyz);
+    memcpy(b->head + t * JF_NJ_HEAD, a->head + k * JF_NJ_HEAD, a->headn[k] * sizeof *b->head);
+    b->headn[t] = a->headn[k];
 }
 
 /* How many of row r's nearest (h of them kept) step 6 reads. */
@@ -803,18 +820,29 @@ static size_t nj_count(const jf_result *r, size_t h)
     return m < h ? m : h;
 }
 
-/* Step 6 for rows blk[0..m-1] (inputs bidx, coordinates bxyz, nearest
- * head, JF_NJ_HEAD a row, headn kept): the records they read not yet
- * fitted are fitted here, each row mixed, the rows delivered by blocks. */
-static jf_status nj_finish(const runctx *R, worker *w, const jf__nj_cache *c, jf_result *blk,
-                           const uint32_t *bidx, const double *bxyz, const uint32_t *head,
-                           const uint8_t *headn, size_t m)
+/* Whether every record row k reads is fitted. */
+static int nj_ready(const nbctx *x, const njrows *r, size_t k)
+{
+    const uint32_t *hd = r->head + k * JF_NJ_HEAD;
+    const size_t h = nj_count(&r->blk[k], r->headn[k]);
+    for (size_t t = 0; t < h; t++)
+        if (jf__nj_state(x->nj, hd[t]) == JF_NJ_EMPTY) return 0;
+    return 1;
+}
+
+/* Step 6 for rows 0..m-1 of r: the records they read not yet fitted are
+ * fitted here, each row mixed, the rows delivered by blocks. */
+static jf_status nj_finish(const runctx *R, worker *w, const jf__nj_cache *c, const njrows *r,
+                           size_t m)
 {
     const nbctx *x = R->x;
+    jf_result *blk = r->blk;
+    const uint32_t *bidx = r->idx;
+    const double *bxyz = r->xyz;
     jf_status st = JF_OK;
     for (size_t k = 0; k < m && st == JF_OK; k++) {
-        const uint32_t *hd = head + k * JF_NJ_HEAD;
-        const size_t h = nj_count(&blk[k], headn[k]);
+        const uint32_t *hd = r->head + k * JF_NJ_HEAD;
+        const size_t h = nj_count(&blk[k], r->headn[k]);
         for (size_t t = 0; t < h && st == JF_OK; t++)
             if (jf__nj_state(x->nj, hd[t]) == JF_NJ_EMPTY) st = nj_fit_other(w, x, hd[t]);
         if (st == JF_OK) jf__nj_mix(x->nj, c, x->pts, bxyz + 3 * k, hd, h, &blk[k]);
@@ -887,40 +915,42 @@ static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double
                                  ? 2 /* a halo point: maybe fitted on demand below */
                                  : (uint8_t)jf__nj_decode(x->nj, beg + t, w.dec + JF_NJ_DEC * t);
             const jf__nj_cache cache = {w.dec, w.decok, beg, nu};
-            /* the rows held back from the thread's last unit */
-            if (wst == JF_OK)
-                wst = nj_finish(R, &w, &cache, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend);
-            w.npend = 0;
-            size_t nr = 0; /* this unit's rows ready, moved to the front */
-            for (size_t k = 0; k < m && wst == JF_OK; k++) {
-                const uint32_t *hd = w.head + k * JF_NJ_HEAD;
-                const size_t h = nj_count(&w.blk[k], w.headn[k]);
-                size_t t = 0;
-                while (t < h && jf__nj_state(x->nj, hd[t]) != JF_NJ_EMPTY) t++;
-                size_t to = nr;
-                jf_result *db = w.blk;
-                uint32_t *di = w.bidx, *dh = w.head;
-                double *dx = w.bxyz;
-                uint8_t *dn = w.headn;
-                if (t < h && w.npend < w.pcap)
-                    to = w.npend++, db = w.pblk, di = w.pidx, dh = w.phead, dx = w.pxyz, dn = w.pheadn;
-                else
-                    nr++;
-                if (db == w.blk && to == k) continue;
-                db[to] = w.blk[k];
-                di[to] = w.bidx[k];
-                memcpy(dx + 3 * to, w.bxyz + 3 * k, 3 * sizeof *dx);
-                memcpy(dh + to * JF_NJ_HEAD, hd, w.headn[k] * sizeof *dh);
-                dn[to] = w.headn[k];
+            /* the unit's rows whose records are all fitted go now (the
+             * front of cur), the others wait in pend while it has room
+             * (else fitted on demand); then the waiting rows now ready */
+            const njrows cur = {w.blk, w.bidx, w.head, w.bxyz, w.headn};
+            const njrows pend = {w.pblk, w.pidx, w.phead, w.pxyz, w.pheadn};
+            size_t nr = 0, wait = 0, keep = 0;
+            for (size_t k = 0; k < m; k++) wait += !(w.rdy[k] = (uint8_t)nj_ready(x, &cur, k));
+            /* no room: the rows waiting longest go first (on demand) */
+            size_t out = w.npend + wait > w.pcap ? w.npend + wait - w.pcap : 0;
+            out = out < w.npend ? out : w.npend;
+            if (out && wst == JF_OK) wst = nj_finish(R, &w, &cache, &pend, out);
+            for (size_t k = out; k < w.npend; k++) nj_move(&pend, k, &pend, k - out);
+            w.npend -= out;
+            const size_t np0 = w.npend;
+            for (size_t k = 0; k < m; k++) {
+                if (!w.rdy[k] && w.npend < w.pcap) nj_move(&cur, k, &pend, w.npend++);
+                else nj_move(&cur, k, &cur, nr++);
             }
-            if (wst == JF_OK)
-                wst = nj_finish(R, &w, &cache, w.blk, w.bidx, w.bxyz, w.head, w.headn, nr);
+            for (size_t k = 0; k < w.npend && wst == JF_OK; k++) {
+                if (k >= np0 || !nj_ready(x, &pend, k)) {
+                    nj_move(&pend, k, &pend, keep++);
+                    continue;
+                }
+                if (nr == unit) { /* cur full */
+                    wst = nj_finish(R, &w, &cache, &cur, nr);
+                    nr = 0;
+                }
+                nj_move(&pend, k, &cur, nr++);
+            }
+            w.npend = keep;
+            if (wst == JF_OK) wst = nj_finish(R, &w, &cache, &cur, nr);
             block_done(R, wst, nu, &done, &failed);
         }
         /* the last rows held back: what they read, fitted on demand */
-        if (w.npend && !stop_seen(wst, &failed))
-            fail_keep(nj_finish(R, &w, NULL, w.pblk, w.pidx, w.pxyz, w.phead, w.pheadn, w.npend),
-                      &failed);
+        const njrows pend = {w.pblk, w.pidx, w.phead, w.pxyz, w.pheadn};
+        if (w.npend && !stop_seen(wst, &failed)) fail_keep(nj_finish(R, &w, NULL, &pend, w.npend), &failed);
         worker_free(&w);
     }
     return failed;
