@@ -880,6 +880,7 @@ static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double
         worker w = {0};
         jf_status wst = failed == JF_OK ? worker_init(&w, &o->params, x, 1) : failed;
         if (wst == JF_OK && !w.share) wst = JF_ERR_INVALID; /* positions come from it */
+        if (w.pcap > unit) w.pcap = unit; /* a small cloud's units: a shorter list */
         fail_keep(wst, &failed);
         for (size_t u = jf__claim_first(&next); u < nunits; u = jf__claim_next(&next)) {
             if (stop_seen(wst, &failed)) continue;
