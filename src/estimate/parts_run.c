@@ -583,14 +583,13 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     /* 4. the far balls' k-th distance over the other parts (first scan;
      * not for auto's step 6, whose balls are kept whole: parts.c) */
     for (size_t f = 0; f < nfar; f++) kmax = far[f].req.k > kmax ? far[f].req.k : kmax;
-    if (q->nj)
-        for (size_t f = 0; f < nfar; f++) far[f].req.bound = far[f].req.bound * (1 + 1e-9) + 1e-280;
-    if (st == JF_OK && nfar && !q->nj) {
+    const int tighten = nfar && !q->nj;
+    if (st == JF_OK && tighten) {
         heaps = malloc((size_t)nt * nfar * kmax * sizeof *heaps);
         hn = calloc((size_t)nt * nfar, sizeof *hn);
         if (!heaps || !hn) st = JF_ERR_NOMEM;
     }
-    if (st == JF_OK && nfar) {
+    if (st == JF_OK && tighten) {
 #pragma omp parallel num_threads(nt)
         {
             const size_t t = (size_t)omp_get_thread_num();
@@ -612,7 +611,7 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                 }
             }
         }
-        /* threshold: the k-th smallest over the threads, inflated */
+        /* threshold: the k-th smallest over the threads */
         double *all = malloc((size_t)nt * kmax * sizeof *all);
         if (!all) st = JF_ERR_NOMEM;
         for (size_t f = 0; st == JF_OK && f < nfar; f++) {
@@ -626,10 +625,11 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                 const double th2 = all[far[f].req.k - 1] * (1 + 1e-9) + 1e-280;
                 if (th2 < far[f].req.bound) far[f].req.bound = th2;
             }
-            far[f].req.bound = far[f].req.bound * (1 + 1e-9) + 1e-280;
         }
         free(all);
     }
+    for (size_t f = 0; f < nfar; f++) /* room for the roundings */
+        far[f].req.bound = far[f].req.bound * (1 + 1e-9) + 1e-280;
     free(heaps);
     free(hn);
     heaps = NULL;

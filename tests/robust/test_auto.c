@@ -35,13 +35,15 @@ static surf make(jf_surface kind, size_t n, double noise, jf_density den)
     return c;
 }
 
-static jf_result *run(const surf *c, const char *nb, int threads)
+/* jf_estimate's rows with nb (params.auto_select set to sel) */
+static jf_result *run_sel(const surf *c, const char *nb, int threads, int sel)
 {
     jf_estimate_opts o;
     jf_estimate_opts_init(&o);
     ck_assert_int_eq(jf_nb_parse(nb, &o.nb, NULL), JF_OK);
     o.orient = JF_ORIENT_NONE;
     o.threads = threads;
+    o.params.auto_select = sel;
     if (o.nb.kind == JF_NB_KNN && o.nb.k > o.params.max_neighbors) o.params.max_neighbors = o.nb.k;
     jf_cloud cl = {.n = c->s.n, .xyz = c->s.xyz};
     jf_result *r = malloc(c->s.n * sizeof *r);
@@ -50,6 +52,8 @@ static jf_result *run(const surf *c, const char *nb, int threads)
     ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
     return r;
 }
+
+static jf_result *run(const surf *c, const char *nb, int threads) { return run_sel(c, nb, threads, 0); }
 
 /* RMS unoriented normal angle (degrees) against the exact normals */
 static double rms_normal(const surf *c, const jf_result *r)
@@ -129,9 +133,9 @@ START_TEST(test_auto_threads)
 END_TEST
 
 /* Each point's own fit (steps 1-5): jf_fit_point_full with auto on its
- * JF_NB_AUTO_KMAX nearest (*nbi[i * KMAX ...], the tree's order), as the
- * estimate's walk makes it. */
-static jf_result *own_fits(const surf *c, uint32_t **nbi)
+ * k <= JF_NB_AUTO_KMAX nearest (*nbi[i * KMAX ...], the tree's order), as
+ * the estimate's walk makes it. */
+static jf_result *own_fits(const surf *c, size_t k, uint32_t **nbi)
 {
     jf_index *ix;
     ck_assert_int_eq(jf_index_build(c->s.xyz, c->s.n, &ix), JF_OK);
@@ -147,8 +151,8 @@ static jf_result *own_fits(const surf *c, uint32_t **nbi)
     for (size_t i = 0; i < c->s.n; i++) {
         size_t got;
         uint32_t *id = idx + i * JF_NB_AUTO_KMAX;
-        ck_assert_int_eq(jf_index_knn(ix, c->s.xyz + 3 * i, JF_NB_AUTO_KMAX, id, NULL, &got), JF_OK);
-        ck_assert_uint_eq(got, JF_NB_AUTO_KMAX);
+        ck_assert_int_eq(jf_index_knn(ix, c->s.xyz + 3 * i, k, id, NULL, &got), JF_OK);
+        ck_assert_uint_eq(got, k);
         for (size_t j = 0; j < got; j++)
             memcpy(nb + 3 * j, c->s.xyz + 3 * (size_t)id[j], 3 * sizeof(double));
         ck_assert_int_eq(jf_fit_point_full(f, c->s.xyz + 3 * i, nb, got, &own[i]), JF_OK);
@@ -225,7 +229,7 @@ START_TEST(test_auto_is_the_jet)
     surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
     jf_result *ra = run(&c, "auto", 2);
     uint32_t *nbi;
-    jf_result *own = own_fits(&c, &nbi);
+    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi);
     jf_fitter *fit[4] = {NULL, NULL, NULL, NULL};
     for (int d = 1; d <= 3; d++) {
         jf_params p;
@@ -300,7 +304,7 @@ START_TEST(test_auto_sphere)
     surf c = make(JF_SURF_SPHERE, 4000, 0.0, JF_DENSITY_UNIFORM);
     jf_result *ra = run(&c, "auto", 2);
     uint32_t *nbi;
-    jf_result *own = own_fits(&c, &nbi);
+    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi);
     double worst[2] = {0, 0}, kw[2] = {0, 0}, rms[2] = {0, 0};
     for (size_t i = 0; i < c.s.n; i++)
         for (int w = 0; w < 2; w++) {
@@ -331,37 +335,15 @@ END_TEST
 START_TEST(test_auto_select_knn)
 {
     surf c = make(JF_SURF_TORUS, 1500, 0.003, JF_DENSITY_GRADIENT);
-    jf_estimate_opts o;
-    jf_estimate_opts_init(&o);
-    ck_assert_int_eq(jf_nb_parse("knn:64", &o.nb, NULL), JF_OK);
-    o.orient = JF_ORIENT_NONE;
-    o.threads = 2;
-    o.params.auto_select = 1;
-    jf_cloud cl = {.n = c.s.n, .xyz = c.s.xyz};
-    jf_result *r = malloc(c.s.n * sizeof *r);
-    jf_error e;
-    ck_assert_int_eq(jf_estimate(&cl, &o, r, &e), JF_OK);
-    jf_index *ix;
-    ck_assert_int_eq(jf_index_build(c.s.xyz, c.s.n, &ix), JF_OK);
-    jf_params p;
-    jf_params_init(&p);
-    p.auto_select = 1;
-    p.max_neighbors = JF_NB_AUTO_KMAX;
-    jf_fitter *f;
-    ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
-    uint32_t id[64];
-    double nb[3 * 64];
+    jf_result *r = run_sel(&c, "knn:64", 2, 1);
+    uint32_t *nbi;
+    jf_result *own = own_fits(&c, 64, &nbi);
     for (size_t i = 0; i < c.s.n; i += 7) {
-        size_t got;
-        ck_assert_int_eq(jf_index_knn(ix, c.s.xyz + 3 * i, 64, id, NULL, &got), JF_OK);
-        for (size_t j = 0; j < got; j++) memcpy(nb + 3 * j, c.s.xyz + 3 * (size_t)id[j], sizeof(double[3]));
-        jf_result a;
-        ck_assert_int_eq(jf_fit_point_full(f, c.s.xyz + 3 * i, nb, got, &a), JF_OK);
-        ck_assert_int_eq(memcmp(a.normal, r[i].normal, sizeof a.normal), 0);
-        ck_assert(a.k1 == r[i].k1 && a.n_used == r[i].n_used);
+        ck_assert_int_eq(memcmp(own[i].normal, r[i].normal, sizeof r[i].normal), 0);
+        ck_assert(own[i].k1 == r[i].k1 && own[i].n_used == r[i].n_used);
     }
-    jf_fitter_free(f);
-    jf_index_free(ix);
+    free(own);
+    free(nbi);
     free(r);
     jf_sample_free(&c.s);
 }
@@ -384,26 +366,44 @@ static jf_status sink(void *user, const uint32_t *idx, jf_result *res, size_t m)
     return JF_OK;
 }
 
-START_TEST(test_auto_parts)
+/* jf_estimate_parts (5 parts) gives the whole cloud's bytes */
+static void same_in_parts(surf *c)
 {
-    surf c = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
-    c.s.xyz[3 * 17] = NAN; /* a non-finite row too */
-    jf_result *whole = run(&c, "auto", 2);
+    jf_result *whole = run(c, "auto", 2);
     jf_estimate_opts o;
     jf_estimate_opts_init(&o);
     ck_assert_int_eq(jf_nb_parse("auto", &o.nb, NULL), JF_OK);
     o.orient = JF_ORIENT_NONE;
     o.threads = 2;
-    jf_cloud cl = {.n = c.s.n, .xyz = c.s.xyz};
-    collect k = {calloc(c.s.n, sizeof(jf_result)), c.s.n, 0};
+    jf_cloud cl = {.n = c->s.n, .xyz = c->s.xyz};
+    collect k = {calloc(c->s.n, sizeof(jf_result)), c->s.n, 0};
     jf_error e;
     ck_assert_int_eq(jf_estimate_parts(&cl, &o, 5, sink, &k, &e), JF_OK);
-    ck_assert_uint_eq(k.got, c.s.n);
-    ck_assert_int_eq(memcmp(whole, k.r, c.s.n * sizeof *whole), 0);
+    ck_assert_uint_eq(k.got, c->s.n);
+    ck_assert_int_eq(memcmp(whole, k.r, c->s.n * sizeof *whole), 0);
     ck_assert_uint_ne(whole[17].status & JF_PT_NONFINITE, 0);
     free(k.r);
     free(whole);
-    jf_sample_free(&c.s);
+    jf_sample_free(&c->s);
+}
+
+START_TEST(test_auto_parts)
+{
+    surf c = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
+    c.s.xyz[3 * 17] = NAN; /* a non-finite row too */
+    same_in_parts(&c);
+}
+END_TEST
+
+/* Isolated points far from the rest: their halo balls are too large for
+ * the parts' grid and are scanned whole (parts_run.c, step 4) */
+START_TEST(test_auto_parts_far)
+{
+    surf c = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
+    c.s.xyz[3 * 17] = NAN;
+    for (int j = 0; j < 3; j++)
+        for (int d = 0; d < 3; d++) c.s.xyz[3 * (100 + 700 * j) + d] = (d == j ? 50.0 : 0.0) - 20.0 * j;
+    same_in_parts(&c);
 }
 END_TEST
 
@@ -448,6 +448,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_sphere);
     tcase_add_test(tc, test_auto_select_knn);
     tcase_add_test(tc, test_auto_parts);
+    tcase_add_test(tc, test_auto_parts_far);
     suite_add_tcase(s, tc);
     return s;
 }
