@@ -417,7 +417,7 @@ static int cmp_hpoint(const void *a, const void *b)
  * over the cloud's coordinates, no other part indexed. */
 static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int P,
                          const occgrid *occ, int32_t a,
-                         const jf_index *own,
+                         const jf_index *own, const jf_index *qix,
                          const double *xyz, size_t m, const jf_part_query *q, int nt,
                          hpoint **halo, size_t *nhalo)
 {
@@ -464,7 +464,7 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
                         if (occ_free(occ, p, (step + last[3]) * (1 + 1e-9) + 1e-140, 64, a))
                             continue;
                     }
-                    int nr = jf__halo_requests(own, q, p, idx, d2, r);
+                    int nr = jf__halo_requests(qix, q, p, idx, d2, r);
                     if (knn && nr == 1) {
                         memcpy(last, p, sizeof(double[3]));
                         last[3] = sqrt(r[0].bound);
@@ -711,6 +711,38 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     *halo = hv;
     *nhalo = nh;
     return JF_OK;
+}
+
+/* Auto's step-6 ball (r_K + 2 r_nj about an own point, parts.c) from
+ * the cloud's distances, not the part's: the part's K-th distance is
+ * one-sided at its border and unbounded on an island of it (a Morton
+ * range is not connected), and such balls took up to 94% of a 10^6
+ * cloud as one part's halo.  So first the knn:K halo (exact: it holds
+ * every own point's K nearest), then an index over own + that halo,
+ * whose K-th and nj-th distances at an own point are the cloud's. */
+static jf_status wide_index(reader *rd, const int32_t *part, const double *box, int P,
+                            const occgrid *occ, int32_t a, const jf_index *own,
+                            const double *xyz, size_t m, const jf_part_query *q, int nt,
+                            jf_index **wide)
+{
+    jf_part_query qk = *q;
+    qk.nj = 0;
+    hpoint *h = NULL;
+    size_t nh = 0;
+    *wide = NULL;
+    jf_status st = halo_of(rd, part, box, P, occ, a, own, own, xyz, m, &qk, nt, &h, &nh);
+    double *w = st == JF_OK ? malloc(3 * (m + nh) * sizeof *w) : NULL;
+    if (st == JF_OK && !w) st = JF_ERR_NOMEM;
+    if (st == JF_OK) {
+        memcpy(w, xyz, 3 * m * sizeof *w);
+        for (size_t i = 0; i < nh; i++) memcpy(w + 3 * (m + i), h[i].x, sizeof(double[3]));
+        free(h);
+        h = NULL;
+        st = jf__index_build_threads(w, m + nh, nt, wide);
+    }
+    free(h);
+    free(w); /* the index holds its own copy */
+    return st;
 }
 
 /* Step 2 without the own index (knn:K, K < CNT_MAX): part a's halo as
@@ -1142,10 +1174,14 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
                                 jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
             break;
         if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
-            jf_index *own = NULL;
+            jf_index *own = NULL, *wide = NULL;
             if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-            st = rd.fail ? JF_ERR_IO
-                         : halo_of(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh);
+            if (q.nj) st = wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &wide);
+            if (st == JF_OK)
+                st = rd.fail ? JF_ERR_IO
+                             : halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, sxyz, m,
+                                       &q, nt, &halo, &nh);
+            jf_index_free(wide);
             jf_index_free(own);
         }
         if (rd.fail) st = reader_status(&rd, err);

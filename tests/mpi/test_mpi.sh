@@ -97,6 +97,12 @@ equal-more)
   same "2" lattice.ply xyz --neighbors knn:16 --monge-degree 3 --degree 3
   same "3" clusters.ply ply --ascii --neighbors knn:16
   same "2 3" clusters.ply csv --neighbors auto  # issue 27: per-point K and degree, sigma column
+  # auto's halo balls overlap: each point is sent to a rank once (kept == fetched)
+  mpi 3 estimate "$d/clusters.ply" -o "$d/got.csv" --neighbors auto 2>"$d/stderr" >/dev/null
+  h=$(sed -n 's/^ *halo: \([0-9]*\) points kept, \([0-9]*\) fetched.*/\1 \2/p' "$d/stderr")
+  set -- $h
+  if [ -n "$h" ] && [ "$1" -gt 0 ] && [ "$1" = "$2" ]; then echo "ok   np 3 auto halo: $1 kept, $2 fetched"
+  else bad "np 3 auto halo: '$h' (want N kept, N fetched)"; cat "$d/stderr"; fi
   ;;
 errors)
   refused "not supported in distributed runs" 2 "$d/lattice.ply" -o "$d/err.ply" --neighbors natural

@@ -407,6 +407,49 @@ START_TEST(test_auto_parts_far)
 }
 END_TEST
 
+/* The largest part's own and halo points, from the index phase each part
+ * reports (jf_estimate_opts.phase: per part, with the part's counts). */
+static void most_points(void *user, jf_phase ph, size_t done, size_t total)
+{
+    (void)done;
+    size_t *most = user;
+    if (ph == JF_PHASE_INDEX && total > *most) *most = total;
+}
+
+/* A part of a Morton cut is not connected (a torus cut in 6 holds
+ * islands of a few points); its own K-th distance there reaches across the
+ * part, and step 6's ball, taken from it, made the whole cloud one part's
+ * halo (24,000 of 24,000).  From the cloud's distances (parts_run.c,
+ * wide_index) the largest part holds its 4,000 points and a ring: 16,260
+ * here (r_K + 2 r_32 is wide against so small a part); at most 5x its own,
+ * and still the whole cloud's bytes. */
+START_TEST(test_auto_parts_halo)
+{
+    surf c = make(JF_SURF_TORUS, 24000, 0.003, JF_DENSITY_GRADIENT);
+    const size_t n = c.s.n;
+    const int P = 6;
+    jf_result *whole = run(&c, "auto", 2);
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    ck_assert_int_eq(jf_nb_parse("auto", &o.nb, NULL), JF_OK);
+    o.orient = JF_ORIENT_NONE;
+    o.threads = 2;
+    size_t most = 0;
+    o.phase = most_points;
+    o.phase_user = &most;
+    jf_cloud cl = {.n = n, .xyz = c.s.xyz};
+    collect k = {calloc(n, sizeof(jf_result)), n, 0};
+    jf_error e;
+    ck_assert_int_eq(jf_estimate_parts(&cl, &o, P, sink, &k, &e), JF_OK);
+    ck_assert_uint_eq(k.got, n);
+    ck_assert_int_eq(memcmp(whole, k.r, n * sizeof *whole), 0);
+    ck_assert_msg(most > n / P && most <= 5 * (n / P), "largest part with its halo: %zu of %zu", most, n);
+    free(k.r);
+    free(whole);
+    jf_sample_free(&c.s);
+}
+END_TEST
+
 START_TEST(test_auto_spec)
 {
     jf_nb_spec s;
@@ -449,6 +492,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_select_knn);
     tcase_add_test(tc, test_auto_parts);
     tcase_add_test(tc, test_auto_parts_far);
+    tcase_add_test(tc, test_auto_parts_halo);
     suite_add_tcase(s, tc);
     return s;
 }
