@@ -405,10 +405,11 @@ static int estimate(int argc, char **argv, int *fd)
         const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
                        o.orient != JF_ORIENT_MST;
         jf_memchk mc;
+        jf_plan_nb pnb; /* the halo's ring and auto's records */
+        jf__plan_nb(&o, &pnb);
         ooc = jf__memory_precheck(in, cmd.in_fmt, memory, !quiet,
                                   jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc),
-                                  o.threads > 0 ? o.threads : jf_default_threads(NULL), kd,
-                                  o.nb.kind == JF_NB_AUTO ? JF_PLAN_NJ_PT : 0, keep,
+                                  o.threads > 0 ? o.threads : jf_default_threads(NULL), kd, &pnb, keep,
                                   out, cmd.out_fmt, &lay, &mc);
         if (ooc == JF_MEMCHK_REFUSED) {
             memory_refused(in, memory, &mc);
@@ -446,8 +447,9 @@ static int estimate(int argc, char **argv, int *fd)
         const size_t nc = jf_result_columns(monge, o.nb.kind == JF_NB_AUTO, pc);
         size_t held = c.n * ((c.nrm ? 24 : 0) + (quiet ? 0 : 8)) +
                       (c.attrs.rec ? c.n * c.attrs.stride : 0);
-        if (jf__parts_plan(c.n, held + 24 * c.n, nc, pt, o.nb.kind == JF_NB_AUTO ? JF_PLAN_NJ_PT : 0,
-                           memory, NULL, NULL)) {
+        jf_plan_nb pnb;
+        jf__plan_nb(&o, &pnb);
+        if (jf__parts_plan(c.n, held + 24 * c.n, nc, pt, &pnb, memory, NULL, NULL)) {
             jf_cloud_free(&c);
             close(*fd);
             *fd = -1;
@@ -493,14 +495,15 @@ static int estimate(int argc, char **argv, int *fd)
         size_t need_whole = 0, need_min = 0;
         const int kd = o.nb.kind != JF_NB_RINGS && o.nb.kind != JF_NB_NATURAL &&
                        o.orient != JF_ORIENT_MST;
-        const size_t fit_pt = o.nb.kind == JF_NB_AUTO ? JF_PLAN_NJ_PT : 0; /* step 6 */
-        plan = jf__parts_plan(c.n, held, ncols, pt, fit_pt, memory ? memory : mem_available(), &need_whole,
+        jf_plan_nb pnb;
+        jf__plan_nb(&o, &pnb);
+        plan = jf__parts_plan(c.n, held, ncols, pt, &pnb, memory ? memory : mem_available(), &need_whole,
                               &need_min);
         if (ooc) { /* no coordinates held: parts only */
             size_t need_ooc = 0;
-            plan = jf__parts_plan_ooc(c.n, held, ncols, pt, fit_pt, lay.row, memory, &need_ooc);
+            plan = jf__parts_plan_ooc(c.n, held, ncols, pt, &pnb, lay.row, memory, &need_ooc);
             if (!plan) { /* the smaller of the two leasts */
-                need_min = jf__parts_plan(c.n, held + 24 * c.n, ncols, pt, fit_pt, memory, NULL, &need_min)
+                need_min = jf__parts_plan(c.n, held + 24 * c.n, ncols, pt, &pnb, memory, NULL, &need_min)
                                ? 0 : need_min;
                 const int o1 = need_ooc < need_min;
                 memory_refused(in, memory, &(jf_memchk){c.n, o1 ? need_ooc : need_min,

@@ -483,17 +483,39 @@ size_t jf__parts_grid_bits(size_t n)
     return b < 4096 ? 4096 : b;
 }
 
-/* What a part of at most m own points holds at its peak: own + halo
- * points (the halo at most JF_PLAN_HALO of m) at JF_PLAN_PART_PT each. */
-static double part_bytes(size_t n, int P, size_t fit_pt)
+void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb)
 {
-    double m = ceil((double)n / P) * JF_PLAN_HALO + 64;
-    return m * (double)(JF_PLAN_PART_PT + fit_pt);
+    jf_part_query q;
+    memset(nb, 0, sizeof *nb);
+    if (jf__part_query_init(o, &q) != JF_OK || q.nb.kind != JF_NB_KNN) return;
+    const double r = sqrt((double)q.nb.k) + 2.0 * sqrt((double)q.nj); /* step 6's ball */
+    nb->ball = q.nj ? r * r : (double)q.nb.k;
+    nb->fit_pt = q.nj ? JF_PLAN_NJ_PT : 0;
+}
+
+double jf__plan_part_points(size_t n, int P, const jf_plan_nb *nb)
+{
+    const double m = ceil((double)n / P) * JF_PLAN_IMBALANCE;
+    /* knn:32's ring when not told (the default) */
+    const double ball = nb && nb->ball > 0.0 ? nb->ball : 32.0;
+    double h = JF_PLAN_RING * sqrt(ball / m);
+    h = h > JF_PLAN_HALO ? h : JF_PLAN_HALO;
+    const double pts = m * (1.0 + h);
+    return (pts < (double)n ? pts : (double)n) + 64;
+}
+
+/* What one of P parts holds at its peak: own + halo points at
+ * JF_PLAN_PART_PT (+ fit_pt) each, the halo's lists while it is taken. */
+static double part_bytes(size_t n, int P, const jf_plan_nb *nb)
+{
+    const double pts = jf__plan_part_points(n, P, nb), own = ceil((double)n / P);
+    const double halo = pts > own ? pts - own : 0.0;
+    return pts * (double)(JF_PLAN_PART_PT + (nb ? nb->fit_pt : 0)) + halo * JF_PLAN_HALO_PT;
 }
 
 /* The plan's figures: *whole, *least (the most parts) and, for a budget,
  * the fewest parts that fit (2..pmax) or 0. */
-static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
+static int plan_figures(size_t n, size_t held, size_t ncols, int nt, const jf_plan_nb *nb, size_t budget,
                         double *whole, double *least)
 {
     /* the writer: its file buffer (1 MiB), the sink's rows (a block per
@@ -502,45 +524,45 @@ static int plan_figures(size_t n, size_t held, size_t ncols, int nt, size_t fit_
     const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
                           (double)nt * 4096.0 * 32.0 * (double)ncols;
     const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
-    *whole = base + (double)(JF_PLAN_WHOLE_PT + fit_pt) * (double)n;
+    *whole = base + (double)(JF_PLAN_WHOLE_PT + (nb ? nb->fit_pt : 0)) * (double)n;
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
                          (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);
     /* parts of JF_PLAN_PART_MIN points at least: each has fixed costs */
     size_t pmax = n / JF_PLAN_PART_MIN;
     pmax = pmax < 2 ? 2 : pmax > JF_PLAN_PARTS_MAX ? JF_PLAN_PARTS_MAX : pmax;
-    *least = fixed + part_bytes(n, (int)pmax, fit_pt);
+    *least = fixed + part_bytes(n, (int)pmax, nb);
     if ((double)budget < *least) return 0;
     /* the fewest parts that fit: each costs a scan of the cloud */
     int lo = 2, hi = (int)pmax;
     while (lo < hi) {
         int mid = lo + (hi - lo) / 2;
-        if (fixed + part_bytes(n, mid, fit_pt) <= (double)budget) hi = mid;
+        if (fixed + part_bytes(n, mid, nb) <= (double)budget) hi = mid;
         else lo = mid + 1;
     }
     return lo;
 }
 
-int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
-                   size_t *need_whole, size_t *need_min)
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, const jf_plan_nb *nb,
+                   size_t budget, size_t *need_whole, size_t *need_min)
 {
     double whole, least;
-    const int p = plan_figures(n, held, ncols, nt, fit_pt, budget, &whole, &least);
-    if (need_whole) *need_whole = (size_t)whole;
-    if (need_min) *need_min = (size_t)(least < whole ? least : whole);
+    const int p = plan_figures(n, held, ncols, nt, nb, budget, &whole, &least);
+    if (need_whole) *need_whole = (size_t)ceil(whole);
+    if (need_min) *need_min = (size_t)ceil(least < whole ? least : whole);
     if ((double)budget >= whole || n < 2) return 1;
     return p;
 }
 
-int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t row,
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, const jf_plan_nb *nb, size_t row,
                        size_t budget, size_t *need_min)
 {
     /* the read buffers: raw rows and their coordinates, per thread; never
      * the whole cloud (its tree would hold the coordinates) */
     held += (size_t)(nt > 0 ? nt : 1) * JF_SRC_CHUNK * (24 + row);
     double whole, least;
-    const int p = plan_figures(n, held, ncols, nt, fit_pt, budget, &whole, &least);
-    if (need_min) *need_min = (size_t)least;
+    const int p = plan_figures(n, held, ncols, nt, nb, budget, &whole, &least);
+    if (need_min) *need_min = (size_t)ceil(least);
     return n < 2 ? 0 : p;
 }
 
@@ -551,7 +573,7 @@ static int ends_with(const char *s, const char *ext)
 }
 
 int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
-                        size_t ncols, int threads, int kd, size_t fit_pt, int keep, const char *out,
+                        size_t ncols, int threads, int kd, const jf_plan_nb *nb, int keep, const char *out,
                         const char *out_fmt, jf_row_layout *l, jf_memchk *r)
 {
     memset(r, 0, sizeof *r);
@@ -581,20 +603,20 @@ int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int c
          * fits in memory with that, it is read whole; else their size is
          * known once read (then: in memory if it fits, else from the
          * file); --keep none: exact now */
-        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, fit_pt, budget, NULL,
+        if (jf__parts_plan(n, held + (keep ? n * l->row : 0), ncols, threads, nb, budget, NULL,
                            NULL))
             return JF_MEMCHK_OK;
         if (keep) return JF_MEMCHK_OOC;
-        if (jf__parts_plan(n, held, ncols, threads, fit_pt, budget, NULL, &need_min))
+        if (jf__parts_plan(n, held, ncols, threads, nb, budget, NULL, &need_min))
             return JF_MEMCHK_OK;
-        if (jf__parts_plan_ooc(n, held - coords, ncols, threads, fit_pt, l->row, budget, &need_ooc))
+        if (jf__parts_plan_ooc(n, held - coords, ncols, threads, nb, l->row, budget, &need_ooc))
             return JF_MEMCHK_OOC;
         r->ooc = need_ooc < need_min;
         r->need_min = r->ooc ? need_ooc : need_min;
         r->held = r->ooc ? held - coords : held;
         return JF_MEMCHK_REFUSED;
     }
-    if (jf__parts_plan(n, held, ncols, threads, fit_pt, budget, NULL, &need_min)) return JF_MEMCHK_OK;
+    if (jf__parts_plan(n, held, ncols, threads, nb, budget, NULL, &need_min)) return JF_MEMCHK_OK;
     r->need_min = need_min, r->held = held;
     return JF_MEMCHK_REFUSED;
 }

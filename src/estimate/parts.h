@@ -87,6 +87,19 @@ size_t jf__parts_sample_size(size_t nf);
 jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int threads,
                                   int32_t *part);
 
+/* What the memory plan needs of an estimate's neighbourhood: fit_pt,
+ * bytes more per fitted point (own and halo) while fitting (auto's step
+ * 6 records: JF_PLAN_NJ_PT), and ball, the points a halo request's ball
+ * holds on a surface (knn: K, raised to the largest --scales entry;
+ * auto: (sqrt K + 2 sqrt 32)^2, step 6's r_K + 2 r_32; 0: not known,
+ * radius kinds).  jf__plan_nb fills both from the options (zeros when
+ * the parts cannot take them). */
+typedef struct {
+    size_t fit_pt;
+    double ball;
+} jf_plan_nb;
+void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
+
 /* The memory plan of `jetfit estimate --memory SIZE` (docs/scale.md):
  * bytes per point measured with massif (tests/bench/bench_memory.sh).
  * held: what the caller holds whatever the plan (the cloud, the
@@ -95,23 +108,37 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
  * threads.  The whole-cloud estimate
  * adds its k-d tree (copy of the points, indices, nodes); the parts add
  * part[] per point, two grids (jf__parts_grid_bits each), the sample,
- * and one part at a time: own and halo points with their coordinates,
- * input index, mask and index (the own index during the halo, the fit's
- * after); fit_pt more bytes per fitted point (own and halo) while
- * fitting (auto: JF_PLAN_NJ_PT).  Returns 1 (whole), P >= 2 parts, or 0 when even
+ * and one part at a time: own and halo points (jf__plan_part_points)
+ * with their coordinates, input index, mask and index (the own index
+ * during the halo, the fit's after), nb->fit_pt more each while fitting,
+ * and JF_PLAN_HALO_PT more a halo point while the halo is gathered (the
+ * threads' lists, their merge and its sort).  nb may be NULL (knn:32's
+ * ring).  Returns 1 (whole), P >= 2 parts, or 0 when even
  * min(JF_PLAN_PARTS_MAX, n / JF_PLAN_PART_MIN) parts (2 at least) do not fit; *need_whole, *need_min: the least
  * budget for the whole cloud and for any plan. */
 #define JF_PLAN_WHOLE_PT 36
 #define JF_PLAN_PART_PT 68
 #define JF_PLAN_SPLIT_PT 4
-#define JF_PLAN_HALO 1.3       /* own points x this: halo and imbalance */
+#define JF_PLAN_HALO_PT 64
+#define JF_PLAN_IMBALANCE 1.1  /* own points: the sample's quantiles, within 10% */
+#define JF_PLAN_HALO 0.2       /* halo points / own points, at least      */
+#define JF_PLAN_RING 20.0      /* ... and RING sqrt(ball / own points): the
+                                  ring about a part of a surface, as the
+                                  halo grid's cells take it; the largest
+                                  part's, on tori and sheets of 2*10^4 to
+                                  10^6 points cut in 4 to 32, at most 10 to
+                                  20 (docs/scale.md)                      */
 #define JF_PLAN_NJ_PT 17       /* auto: step 6's record and state per point
-                                  (robust/neigh_jets.h): the fit_pt below */
+                                  (robust/neigh_jets.h): fit_pt          */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */
-int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t budget,
-                   size_t *need_whole, size_t *need_min);
+int jf__parts_plan(size_t n, size_t held, size_t ncols, int nt, const jf_plan_nb *nb,
+                   size_t budget, size_t *need_whole, size_t *need_min);
+
+/* The most own and halo points the plan holds for one of P parts of n
+ * points (at most n; nb as jf__parts_plan's). */
+double jf__plan_part_points(size_t n, int P, const jf_plan_nb *nb);
 
 /* Where the bounded-memory estimate reads the coordinates (issue 28): an
  * array in memory, or the rows of the input file itself (a binary PLY or
@@ -142,7 +169,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
 /* jf__parts_plan's parts for an estimate whose coordinates stay on disk
  * (held: without them; the read buffers added here): P >= 2, or 0 when
  * even the most parts do not fit; *need_min as jf__parts_plan's. */
-int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, size_t fit_pt, size_t row,
+int jf__parts_plan_ooc(size_t n, size_t held, size_t ncols, int nt, const jf_plan_nb *nb, size_t row,
                        size_t budget, size_t *need_min);
 
 /* --memory's check before the input is read (jetfit estimate): for a
@@ -163,7 +190,7 @@ typedef struct {
 } jf_memchk;
 enum { JF_MEMCHK_OK = 0, JF_MEMCHK_REFUSED = 1, JF_MEMCHK_OOC = 2 };
 int jf__memory_precheck(const char *in, const char *in_fmt, size_t budget, int cond_held,
-                        size_t ncols, int threads, int kd, size_t fit_pt, int keep, const char *out,
+                        size_t ncols, int threads, int kd, const jf_plan_nb *nb, int keep, const char *out,
                         const char *out_fmt, jf_row_layout *l, jf_memchk *r);
 
 /* Bits of the parts' occupancy and halo grids for n points (<= 2^26). */

@@ -1150,7 +1150,9 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     ids = malloc((cmax ? cmax : 1) * sizeof *ids);
     sxyz = malloc(3 * (cmax ? cmax : 1) * sizeof *sxyz);
     /* the most own + halo points the plan holds for a part */
-    const size_t hcap = (size_t)(ceil((double)n / P) * JF_PLAN_HALO);
+    /* the cells' halo, a superset, while it stays as small as the
+     * plan's least ring (else the exact requests: a smaller halo) */
+    const size_t hcap = (size_t)(ceil((double)n / P) * JF_PLAN_IMBALANCE * (1 + JF_PLAN_HALO));
     if (!ids || !sxyz) {
         st = JF_ERR_NOMEM;
         goto out;

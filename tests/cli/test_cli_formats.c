@@ -280,7 +280,7 @@ END_TEST
  * index phases (each part's counts) are timed, not drawn. */
 START_TEST(progress_in_parts)
 {
-    const size_t side = 150, n = side * side;
+    const size_t side = 250, n = side * side; /* parts pay (their halo rings) */
     double *xyz = malloc(3 * n * sizeof *xyz);
     cli_surface61(side, xyz, 5);
     cli_write_xyz(cli_path("big.xyz"), xyz, NULL, n);

@@ -71,7 +71,9 @@ END_TEST
  * every k-d tree neighbourhood, binary PLY and CSV (through the spool). */
 START_TEST(small_budgets_same_bytes)
 {
-    ck_assert_int_eq(cli_run("generate", "exp", "--n", "20000", "--seed", "4", "-o",
+    /* 60,000 points: the parts' least (their halo rings, the plan's) is
+     * more than 256K below the whole cloud's need */
+    ck_assert_int_eq(cli_run("generate", "exp", "--n", "60000", "--seed", "4", "-o",
                              cli_path("in.ply"), NULL),
                      0);
     static const struct {
@@ -127,18 +129,26 @@ static void write_sheet(const char *path, size_t n, uint64_t seed)
 START_TEST(coordinates_on_disk_same_bytes)
 {
     write_sheet(cli_path("in.ply"), 30000, 5);
+    /* auto's halo ring (r_256 + 2 r_32, jf__plan_part_points) is wider
+     * than a part of 30,000 / 32 points: parts pay below ~3e5 points, and
+     * the least plan for the small sheet is the whole cloud in memory */
+    write_sheet(cli_path("big.ply"), 300000, 5);
     static const struct {
-        const char *nb, *ext, *keep;
-    } runs[] = {{"knn:16", "ply", "all"},        {"radius:0.02", "csv", "all"},
-                {"knn:12,radius:0.015", "ply", "none"}, {"auto", "ply", "all"}};
+        const char *nb, *ext, *keep, *in;
+    } runs[] = {{"knn:16", "ply", "all", "in.ply"},        {"radius:0.02", "csv", "all", "in.ply"},
+                {"knn:12,radius:0.015", "ply", "none", "in.ply"}, {"auto", "ply", "all", "big.ply"}};
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path("a.ply"), "--neighbors",
+                             "auto", "--memory", "1K", NULL),
+                     1);
+    ck_assert_msg(strstr(cli_err, "(the cloud and the summary's values"), "%s", cli_err);
     for (size_t k = 0; k < sizeof runs / sizeof *runs; k++) {
         char w[32], p[32];
         snprintf(w, sizeof w, "w%zu.%s", k, runs[k].ext);
         snprintf(p, sizeof p, "p%zu.%s", k, runs[k].ext);
-        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(w), "--neighbors",
+        ck_assert_int_eq(cli_run("estimate", cli_path(runs[k].in), "-o", cli_path(w), "--neighbors",
                                  runs[k].nb, "--threads", "2", "--keep", runs[k].keep, NULL),
                          0);
-        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+        ck_assert_int_eq(cli_run("estimate", cli_path(runs[k].in), "-o", cli_path(p), "--neighbors",
                                  runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
                                  "1K", NULL),
                          1);
@@ -149,13 +159,13 @@ START_TEST(coordinates_on_disk_same_bytes)
         ck_assert_msg(least > 0, "%s", cli_err);
         char mem[32];
         snprintf(mem, sizeof mem, "%lluK", (least >> 10) - 1);
-        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+        ck_assert_int_eq(cli_run("estimate", cli_path(runs[k].in), "-o", cli_path(p), "--neighbors",
                                  runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
                                  mem, NULL),
                          1);
         ck_assert_uint_eq(least_named(), least);
         snprintf(mem, sizeof mem, "%lluK", least >> 10);
-        ck_assert_int_eq(cli_run("estimate", cli_path("in.ply"), "-o", cli_path(p), "--neighbors",
+        ck_assert_int_eq(cli_run("estimate", cli_path(runs[k].in), "-o", cli_path(p), "--neighbors",
                                  runs[k].nb, "--threads", "2", "--keep", runs[k].keep, "--memory",
                                  mem, NULL),
                          0);

@@ -9,6 +9,7 @@
  * part's) equals the whole cloud's fit bit for bit. */
 #include <check.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,26 +71,47 @@ START_TEST(plan_is_monotone)
 {
     const size_t n = 10000000, held = 24 * n;
     size_t whole = 0, least = 0;
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, SIZE_MAX / 2, &whole, &least), 1);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, NULL, SIZE_MAX / 2, &whole, &least), 1);
     ck_assert_uint_gt(whole, held + JF_PLAN_WHOLE_PT * n - 1);
     ck_assert_uint_lt(least, whole);
     ck_assert_uint_gt(least, held + JF_PLAN_SPLIT_PT * n);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, whole, NULL, NULL), 1);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, least - 1, NULL, NULL), 0);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, 0, least, NULL, NULL), JF_PLAN_PARTS_MAX);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, NULL, whole, NULL, NULL), 1);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, NULL, least - 1, NULL, NULL), 0);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, NULL, least, NULL, NULL), JF_PLAN_PARTS_MAX);
     int prev = JF_PLAN_PARTS_MAX + 1;
     for (size_t b = least; b < whole; b += (whole - least) / 50) {
-        int p = jf__parts_plan(n, held, 24, 2, 0, b, NULL, NULL);
+        int p = jf__parts_plan(n, held, 24, 2, NULL, b, NULL, NULL);
         ck_assert_int_ge(p, 2);
         ck_assert_int_le(p, prev);
         prev = p;
     }
-    /* auto's step 6 records: JF_PLAN_NJ_PT more a point, whole and parts */
-    size_t whole6 = 0, least6 = 0;
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, JF_PLAN_NJ_PT, SIZE_MAX / 2, &whole6, &least6), 1);
+    /* auto: step 6's records, JF_PLAN_NJ_PT more a point, whole and
+     * parts; and its wider halo ring, parts only */
+    jf_estimate_opts o;
+    jf_estimate_opts_init(&o);
+    ck_assert_int_eq(jf_nb_parse("auto", &o.nb, NULL), JF_OK);
+    jf_plan_nb au, rec;
+    jf__plan_nb(&o, &au);
+    ck_assert_uint_eq(au.fit_pt, JF_PLAN_NJ_PT);
+    ck_assert(fabs(au.ball - pow(16 + 2 * sqrt(32), 2)) < 1e-9); /* r_256 + 2 r_32 */
+    rec = au;
+    rec.ball = 0; /* the records alone */
+    size_t whole6 = 0, least6 = 0, leastr = 0;
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, &rec, SIZE_MAX / 2, &whole6, &leastr), 1);
     ck_assert_uint_eq(whole6 - whole, JF_PLAN_NJ_PT * n);
-    ck_assert_uint_gt(least6, least);
-    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, JF_PLAN_NJ_PT, least6 - 1, NULL, NULL), 0);
+    ck_assert_uint_gt(leastr, least);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, &au, SIZE_MAX / 2, NULL, &least6), 1);
+    ck_assert_uint_gt(least6, leastr);
+    ck_assert_int_eq(jf__parts_plan(n, held, 24, 2, &au, least6 - 1, NULL, NULL), 0);
+    /* knn:32 is the default ring; a radius kind's ball is not known */
+    jf_plan_nb k32, rad;
+    o.nb = (jf_nb_spec){.kind = JF_NB_KNN, .k = 32};
+    jf__plan_nb(&o, &k32);
+    ck_assert(k32.ball == 32 && k32.fit_pt == 0);
+    ck_assert(jf__plan_part_points(n, 32, &k32) == jf__plan_part_points(n, 32, NULL));
+    o.nb = (jf_nb_spec){.kind = JF_NB_RADIUS, .r = 0.1};
+    jf__plan_nb(&o, &rad);
+    ck_assert(rad.ball == 0 && rad.fit_pt == 0);
 }
 END_TEST
 
@@ -183,6 +205,59 @@ START_TEST(cell_halos_exact)
 }
 END_TEST
 
+/* The largest part's own and halo points, from the index phase each part
+ * reports (jf_estimate_opts.phase: per part, with the part's counts). */
+static void most_points(void *user, jf_phase ph, size_t done, size_t total)
+{
+    (void)done;
+    size_t *most = user;
+    if (ph == JF_PHASE_INDEX && total > *most) *most = total;
+}
+
+/* The plan's part (jf__plan_part_points: own points and the ring its
+ * neighbourhood's ball makes) holds the largest part's real halo: a
+ * surface of 60,000 points cut in 8 and 24 (parts with islands), at
+ * knn:32 and auto, and knn:256 in 8.  Not knn:256 in 24 parts: 25,660
+ * points against the plan's 19,595 -- a knn halo's balls come from the
+ * part's own K-th distances, one-sided on an island (auto's from the
+ * cloud's, parts_run.c's wide_index; docs/scale.md). */
+START_TEST(plan_holds_the_halo)
+{
+    const size_t n = 60000;
+    double *xyz = make(n, 13);
+    jf_cloud c = {0};
+    c.n = n;
+    c.xyz = xyz;
+    static const struct {
+        const char *nb;
+        int P;
+    } runs[] = {{"knn:32", 8}, {"knn:32", 24}, {"auto", 8}, {"auto", 24}, {"knn:256", 8}};
+    for (size_t k = 0; k < sizeof runs / sizeof *runs; k++) {
+        jf_estimate_opts o;
+        jf_estimate_opts_init(&o);
+        ck_assert_int_eq(jf_nb_parse(runs[k].nb, &o.nb, NULL), JF_OK);
+        if (o.nb.kind == JF_NB_KNN) o.params.max_neighbors = o.nb.k;
+        o.threads = 2;
+        o.orient = JF_ORIENT_NONE;
+        size_t most = 0;
+        o.phase = most_points;
+        o.phase_user = &most;
+        rows r = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
+        jf_error err;
+        ck_assert_int_eq(jf_estimate_parts(&c, &o, runs[k].P, sink, &r, &err), JF_OK);
+        ck_assert_uint_eq(r.seen, n);
+        jf_plan_nb nb;
+        jf__plan_nb(&o, &nb);
+        const double plan = jf__plan_part_points(n, runs[k].P, &nb);
+        ck_assert_msg((double)most <= plan, "%s in %d parts: %zu points, the plan %.0f", runs[k].nb,
+                      runs[k].P, most, plan);
+        free(r.nrm);
+        free(r.status);
+    }
+    free(xyz);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("parts_plan");
@@ -192,6 +267,7 @@ int main(void)
     tcase_add_test(tc, plan_is_monotone);
     tcase_add_test(tc, far_balls_exact);
     tcase_add_test(tc, cell_halos_exact);
+    tcase_add_test(tc, plan_holds_the_halo);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }
