@@ -28,6 +28,15 @@ static double *make(size_t n, uint64_t seed)
     return xyz;
 }
 
+/* The cloud of n points xyz (nothing else). */
+static jf_cloud cloud_of(double *xyz, size_t n)
+{
+    jf_cloud c = {0};
+    c.n = n;
+    c.xyz = xyz;
+    return c;
+}
+
 START_TEST(sampled_parts_are_runs_of_the_morton_order)
 {
     const size_t n = 200000;
@@ -165,9 +174,7 @@ START_TEST(far_balls_exact)
      * than K) away from the rest: their balls reach over the whole cloud */
     xyz[0] = 40, xyz[1] = 40, xyz[2] = 3;
     for (int k = 1; k <= 5; k++) xyz[3 * k] = -20 + 1e-3 * k, xyz[3 * k + 1] = -20, xyz[3 * k + 2] = 0;
-    jf_cloud c = {0};
-    c.n = n;
-    c.xyz = xyz;
+    const jf_cloud c = cloud_of(xyz, n);
     jf_estimate_opts o;
     jf_estimate_opts_init(&o);
     o.threads = 2;
@@ -187,9 +194,7 @@ START_TEST(cell_halos_exact)
 {
     const size_t n = 200000;
     double *xyz = make(n, 11);
-    jf_cloud c = {0};
-    c.n = n;
-    c.xyz = xyz;
+    const jf_cloud c = cloud_of(xyz, n);
     static const size_t K[] = {8, 16, 40};
     for (int kk = 0; kk < 3; kk++) {
         jf_estimate_opts o;
@@ -225,9 +230,7 @@ START_TEST(plan_holds_the_halo)
 {
     const size_t n = 60000;
     double *xyz = make(n, 13);
-    jf_cloud c = {0};
-    c.n = n;
-    c.xyz = xyz;
+    const jf_cloud c = cloud_of(xyz, n);
     static const struct {
         const char *nb;
         int P;
