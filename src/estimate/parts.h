@@ -122,12 +122,12 @@ void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
 #define JF_PLAN_HALO_PT 64
 #define JF_PLAN_IMBALANCE 1.1  /* own points: the sample's quantiles, within 10% */
 #define JF_PLAN_HALO 0.2       /* halo points / own points, at least      */
-#define JF_PLAN_RING 20.0      /* ... and RING sqrt(ball / own points): the
+#define JF_PLAN_RING 24.0      /* ... and RING sqrt(ball / own points): the
                                   ring about a part of a surface, as the
                                   halo grid's cells take it; the largest
                                   part's, on tori and sheets of 2*10^4 to
-                                  10^6 points cut in 4 to 32, at most 10 to
-                                  20 (docs/scale.md)                      */
+                                  10^6 points cut in 4 to 32, at most 6 to
+                                  23 (docs/scale.md)                      */
 #define JF_PLAN_NJ_PT 17       /* auto: step 6's record and state per point
                                   (robust/neigh_jets.h): fit_pt          */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */

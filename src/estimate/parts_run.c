@@ -27,7 +27,11 @@
  *     by a request's ball, and for the few balls too large for the grid
  *     (an isolated point, a part of fewer than k points) those within its
  *     k-th distance over the other parts (halo_of).  A superset of the
- *     exact halo; no other part is indexed.
+ *     exact halo; no other part is indexed.  A knn's bounds come from
+ *     the cloud, not the part (wide_index): a first such pass with every
+ *     ball capped at twice the median radius, then the requests again
+ *     over own + that halo (a part's own K-th distance is unbounded on an
+ *     island of it).
  *  3. The part's own points and its halo, in input-index order (so the
  *     k-d tree's tie rule, smaller position first, is the input index's),
  *     form a small cloud; jf_estimate_blocks on it fits the own points only
@@ -36,8 +40,8 @@
  *     the same fit.  The blocks go to the caller's sink with input indices.
  *  Non-finite points belong to no part: their rows (NaN, NONFINITE) are
  *  handed over first.  Every step runs on the threads; per part: one index
- *  build (own + halo; two with the requests) and two scans of the
- *  coordinates.
+ *  build (own + halo; three with a knn's requests) and two scans of the
+ *  coordinates (four with a knn's requests).
  */
 #include <errno.h>
 #include <math.h>
@@ -417,7 +421,7 @@ static int cmp_hpoint(const void *a, const void *b)
  * over the cloud's coordinates, no other part indexed. */
 static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int P,
                          const occgrid *occ, int32_t a,
-                         const jf_index *own, const jf_index *qix,
+                         const jf_index *own, const jf_index *qix, double cap, int *capped,
                          const double *xyz, size_t m, const jf_part_query *q, int nt,
                          hpoint **halo, size_t *nhalo)
 {
@@ -509,6 +513,16 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
         for (size_t r = 0; r < nrq; r++)
             if (rq[r].req.bound < INFINITY) bs[nfin++] = rq[r].req.bound;
         qsort(bs, nfin, sizeof *bs, cmp_f64);
+        if (nfin && cap > 0) { /* a first stage (wide_index): no ball past cap x the median */
+            const double cb = bs[nfin / 2] * cap;
+            for (size_t r = 0; r < nrq; r++)
+                if (!(rq[r].req.bound <= cb)) {
+                    rq[r].req.bound = cb;
+                    *capped = 1;
+                }
+            for (size_t r = 0; r < nfin; r++)
+                if (bs[r] > cb) bs[r] = cb;
+        }
         if (nfin) {
             const double med = bs[nfin / 2];
             cutb = med * FAR_RATIO;
@@ -713,24 +727,34 @@ static jf_status halo_of(reader *rd, const int32_t *part, const double *box, int
     return JF_OK;
 }
 
-/* Auto's step-6 ball (r_K + 2 r_nj about an own point, parts.c) from
- * the cloud's distances, not the part's: the part's K-th distance is
- * one-sided at its border and unbounded on an island of it (a Morton
- * range is not connected), and such balls took up to 94% of a 10^6
- * cloud as one part's halo.  So first the knn:K halo (exact: it holds
- * every own point's K nearest), then an index over own + that halo,
- * whose K-th and nj-th distances at an own point are the cloud's. */
+/* A knn halo's balls from the cloud's distances, not the part's: the
+ * part's K-th distance is one-sided at its border and unbounded on an
+ * island of it (a Morton range is not connected); such balls made up to
+ * 94% of a 10^6 cloud one part's halo under auto (r_K + 2 r_nj, parts.c),
+ * and 20 times a part's points under knn:256.  So first the halo of balls
+ * capped at WIDE_CAP x the median: if none was capped (and no step 6)
+ * that is the halo; else the index over own + it, a subset of the cloud
+ * over which a point's K-th distance bounds the cloud's (and equals it
+ * wherever the capped ball held the K nearest), for the requests again. */
+#define WIDE_CAP 16.0 /* squared: 4 x the median radius (a border point's own reach 2 x) */
 static jf_status wide_index(reader *rd, const int32_t *part, const double *box, int P,
                             const occgrid *occ, int32_t a, const jf_index *own,
                             const double *xyz, size_t m, const jf_part_query *q, int nt,
-                            jf_index **wide)
+                            hpoint **halo, size_t *nhalo, jf_index **wide)
 {
     jf_part_query qk = *q;
     qk.nj = 0;
     hpoint *h = NULL;
     size_t nh = 0;
+    int capped = 0;
     *wide = NULL;
-    jf_status st = halo_of(rd, part, box, P, occ, a, own, own, xyz, m, &qk, nt, &h, &nh);
+    jf_status st =
+        halo_of(rd, part, box, P, occ, a, own, own, WIDE_CAP, &capped, xyz, m, &qk, nt, &h, &nh);
+    if (st == JF_OK && !capped && !q->nj) { /* the exact requests' halo already */
+        *halo = h;
+        *nhalo = nh;
+        return JF_OK;
+    }
     double *w = st == JF_OK ? malloc(3 * (m + nh) * sizeof *w) : NULL;
     if (st == JF_OK && !w) st = JF_ERR_NOMEM;
     if (st == JF_OK) {
@@ -1178,11 +1202,13 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
             jf_index *own = NULL, *wide = NULL;
             if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-            if (q.nj) st = wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &wide);
-            if (st == JF_OK)
+            if (q.nb.kind == JF_NB_KNN) /* the balls from the cloud's distances */
+                st = wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh,
+                                &wide);
+            if (st == JF_OK && !halo)
                 st = rd.fail ? JF_ERR_IO
-                             : halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, sxyz, m,
-                                       &q, nt, &halo, &nh);
+                             : halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, 0.0,
+                                       NULL, sxyz, m, &q, nt, &halo, &nh);
             jf_index_free(wide);
             jf_index_free(own);
         }
