@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "jetfit.h"
+
 /* Runs every case of s (Check's normal output, its summary line); the
  * process's exit status: 0 if all passed, else 1. */
 static inline int jf_test_run(Suite *s)
@@ -92,6 +94,16 @@ static inline void jf_test_assert_same_files(const char *what, const char *a, co
 }
 
 /* splitmix64 (Steele, Lea & Flood 2014): the next 64 bits of *state. */
+/* A jf_estimate_opts.phase hook: the largest total of JF_PHASE_INDEX
+ * into *(size_t *)user -- jf_estimate_parts reports each part's index
+ * with the part's own and halo points, so this is the largest part. */
+static inline void jf_test_most_indexed(void *user, jf_phase ph, size_t done, size_t total)
+{
+    (void)done;
+    size_t *most = (size_t *)user; /* C++ tests include this too */
+    if (ph == JF_PHASE_INDEX && total > *most) *most = total;
+}
+
 static inline uint64_t jf_splitmix64(uint64_t *state)
 {
     uint64_t z = (*state += 0x9e3779b97f4a7c15ULL);

@@ -210,15 +210,6 @@ START_TEST(cell_halos_exact)
 }
 END_TEST
 
-/* The largest part's own and halo points, from the index phase each part
- * reports (jf_estimate_opts.phase: per part, with the part's counts). */
-static void most_points(void *user, jf_phase ph, size_t done, size_t total)
-{
-    (void)done;
-    size_t *most = user;
-    if (ph == JF_PHASE_INDEX && total > *most) *most = total;
-}
-
 /* The plan's part (jf__plan_part_points: own points and the ring its
  * neighbourhood's ball makes) holds the largest part's real halo: a
  * surface of 60,000 points cut in 8 and 24 (parts with islands), at
@@ -242,7 +233,7 @@ START_TEST(plan_holds_the_halo)
         o.threads = 2;
         o.orient = JF_ORIENT_NONE;
         size_t most = 0;
-        o.phase = most_points;
+        o.phase = jf_test_most_indexed;
         o.phase_user = &most;
         rows r = {calloc(3 * n, sizeof(double)), calloc(n, sizeof(uint32_t)), 0};
         jf_error err;

@@ -407,15 +407,6 @@ START_TEST(test_auto_parts_far)
 }
 END_TEST
 
-/* The largest part's own and halo points, from the index phase each part
- * reports (jf_estimate_opts.phase: per part, with the part's counts). */
-static void most_points(void *user, jf_phase ph, size_t done, size_t total)
-{
-    (void)done;
-    size_t *most = user;
-    if (ph == JF_PHASE_INDEX && total > *most) *most = total;
-}
-
 /* A part of a Morton cut is not connected (a torus cut in 6 holds
  * islands of a few points); its own K-th distance there reaches across the
  * part, and step 6's ball, taken from it, made the whole cloud one part's
@@ -435,7 +426,7 @@ START_TEST(test_auto_parts_halo)
     o.orient = JF_ORIENT_NONE;
     o.threads = 2;
     size_t most = 0;
-    o.phase = most_points;
+    o.phase = jf_test_most_indexed;
     o.phase_user = &most;
     jf_cloud cl = {.n = n, .xyz = c.s.xyz};
     collect k = {calloc(n, sizeof(jf_result)), n, 0};
