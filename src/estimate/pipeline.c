@@ -38,6 +38,7 @@
 #include "orient_internal.h"
 #include "parts.h"
 #include "planes_internal.h"
+#include "nbctx.h"
 #include "neigh_jets.h"
 
 #define CHUNK JF_BLOCK_MAX /* points per scheduling unit (and progress tick) */
@@ -66,11 +67,6 @@ jf_orient_mode jf_orient_resolve(jf_orient_mode m, int has_normals, int has_scan
     return has_scanners ? JF_ORIENT_SCANNER : has_normals ? JF_ORIENT_INPUT : JF_ORIENT_NONE;
 }
 
-static void set_err(jf_error *err, const char *msg)
-{
-    if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
-}
-
 /* A row for a point that cannot be fitted: NaN quantities and flags. */
 static void nan_result(jf_result *r, unsigned status)
 {
@@ -89,273 +85,8 @@ static int cancelled(const jf_estimate_opts *o)
 
 static jf_status cancel_status(jf_error *err)
 {
-    set_err(err, "cancelled");
+    jf__set_err(err, "cancelled");
     return JF_ERR_CANCELLED;
-}
-
-static int finite3(const double *p)
-{
-    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
-}
-
-/* ---- the neighbourhood of a point, whatever its kind ------------------- */
-
-typedef struct {
-    const jf_nb_spec *nb;
-    const double *xyz;
-    const jf_index *ix;
-    jf_mesh *mesh;        /* rings                                     */
-    jf_natural *nt;       /* natural                                   */
-    double *nrm_own;      /* natural: normals we computed (3n)         */
-    const double *nrm;    /* natural: the tangent-plane normals        */
-    unsigned *nflags;     /* natural: JF_PT_NORMAL_* per point         */
-    int fit_moved;        /* natural, noisy: fit the ring's points moved
-                             onto their jets (nt's own coordinates)     */
-    size_t min_count;     /* N_n of the asked degree                   */
-    size_t want;          /* fewer found than this: FEW_NEIGHBORS      */
-    size_t cap;           /* buffer size (largest neighbourhood)       */
-    uint32_t *graph;      /* mst: the first gk neighbours of each point */
-    size_t gk;
-    jf_fit_mode fit;
-    int plain;            /* jf_fit_point_full is jf_fit_point: pairs   */
-    jf__njs *nj;          /* auto's step 6: each point's fit, compact,
-                             by tree position (the walk's order: a unit's
-                             records are neighbours in memory too)      */
-    const double *pts;    /* the tree's copy of the points, by position */
-} nbctx;
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* JF_NORMAL_AUTO's test (jetfit.h): at up to NOISE_SAMPLES points spread
- * over the input order, the RMS residual of a plain degree-2 jet fitted to
- * the NOISE_N natural neighbours (rings of the PCA planes' own-plane
- * rows), relative to their RMS distance to the point.  A clean surface leaves a residual of higher
- * order (~ r^3 / R^2); noise leaves ~ sigma.  Noisy: the median ratio is
- * above JF_NATURAL_NOISY_RESIDUAL. */
-#define NOISE_SAMPLES 2000
-#define NOISE_N 20
-static jf_status noisy_cloud(const jf_natural *nt, const double *xyz, const double *nrm,
-                             size_t n, int threads, int *noisy)
-{
-    *noisy = 0;
-    jf_params p;
-    jf_params_init(&p);
-    p.degree = 2;
-    /* every n / NOISE_SAMPLES-th point (fewer than 4000 points: each),
-     * side by side, one slot each; the first NOISE_SAMPLES that give a
-     * ratio are the test's, whatever the thread count */
-    const size_t step = n > NOISE_SAMPLES ? n / NOISE_SAMPLES : 1;
-    const long ns = (long)((n + step - 1) / step);
-    double *ratio = malloc((size_t)ns * sizeof *ratio);
-    if (!ratio) return JF_ERR_NOMEM;
-    jf_status failed = JF_OK;
-#pragma omp parallel num_threads(threads)
-    {
-        jf_fitter *f = NULL;
-        jf_natural_ws *ws = NULL;
-        jf_status st = jf_fitter_create(&p, &f);
-        if (st == JF_OK) st = jf_natural_ws_create(nt, &ws);
-#pragma omp for schedule(static)
-        for (long k = 0; k < ns; k++) {
-            const size_t i = (size_t)k * step;
-            uint32_t idx[NOISE_N];
-            double pts[3 * NOISE_N], d2 = 0;
-            size_t found = 0;
-            jf_result r;
-            ratio[k] = NAN;
-            if (st != JF_OK || jf_natural_kept(nt, i) != i || !finite3(nrm + 3 * i)) continue;
-            if ((st = jf__natural_neighbors_own(nt, ws, i, nrm + 3 * i, NOISE_N, idx, NOISE_N, &found)) != JF_OK)
-                continue;
-            for (size_t j = 0; j < found; j++)
-                for (int c = 0; c < 3; c++) {
-                    pts[3 * j + c] = xyz[3 * (size_t)idx[j] + c];
-                    d2 += (pts[3 * j + c] - xyz[3 * i + c]) * (pts[3 * j + c] - xyz[3 * i + c]);
-                }
-            if (found < NOISE_N || (st = jf_fit_point(f, xyz + 3 * i, pts, found, &r)) != JF_OK) continue;
-            if (r.degree == 2 && d2 > 0) ratio[k] = r.residual / sqrt(d2 / (double)found);
-        }
-        if (st != JF_OK) {
-#pragma omp atomic write
-            failed = st;
-        }
-        jf_natural_ws_free(ws);
-        jf_fitter_free(f);
-    }
-    size_t m = 0;
-    for (long k = 0; k < ns && m < NOISE_SAMPLES; k++)
-        if (!isnan(ratio[k])) ratio[m++] = ratio[k];
-    if (failed == JF_OK && m > 0) {
-        qsort(ratio, m, sizeof *ratio, cmp_double);
-        *noisy = ratio[m / 2] > JF_NATURAL_NOISY_RESIDUAL;
-    }
-    free(ratio);
-    return failed;
-}
-
-/* The k-NN form's own-plane rows from the normals nrm (by input index). */
-static jf_status own_rows(nbctx *x, const double *nrm, int nt, jf_error *err)
-{
-    jf_status st = jf__natural_own_rows(x->nt, nt, nrm);
-    if (st != JF_OK) set_err(err, "natural neighbours: the own-plane cells failed");
-    return st;
-}
-
-/* JF_NORMAL_JET (planes.c): the plane of point i is the jet normal of its
- * N nearest points, and the cells are made on the points moved to their
- * jets (the k-NN form, over a tree of its own); the fit later uses the
- * original points (x->xyz).  A point whose jet failed (too few points)
- * gets its PCA plane. */
-static jf_status jet_setup(nbctx *x, const jf_cloud *c, int nt, const jf_params *prm,
-                           jf_error *err)
-{
-    size_t n = c->n;
-    double *proj = malloc(3 * n * sizeof *proj);
-    jf_status st = proj ? JF_OK : JF_ERR_NOMEM;
-    /* x->nflags holds "jet ok" until turned into flags below */
-    if (st == JF_OK)
-        st = jf__planes_knn_jet(x->ix, c->xyz, n, x->want, prm, nt, x->nrm_own, proj, x->nflags);
-    x->fit_moved = 1;
-    if (st == JF_OK && (st = jf_natural_create_knn(proj, n, nt, &x->nt)) != JF_OK)
-        set_err(err, "natural neighbours: the k-d tree of the moved points failed");
-    free(proj);
-    for (size_t i = 0; st == JF_OK && i < n; i++) {
-        if (x->nflags[i]) {
-            x->nflags[i] = JF_PT_NORMAL_JET;
-        } else if (finite3(c->xyz + 3 * i)) {
-            double *m = x->nrm_own + 3 * i;
-            x->nflags[i] = jf__planes_pca_one(x->ix, c->xyz, i, m) ? JF_PT_NORMAL_PCA : JF_PT_FAILED;
-            if (x->nflags[i] == JF_PT_FAILED) m[0] = m[1] = m[2] = NAN;
-        }
-    }
-    return st == JF_OK ? own_rows(x, x->nrm_own, nt, err) : st;
-}
-
-/* Step 1 for natural[:N]: the cells' structure and the tangent-plane
- * normals.  POLES and MINCIRC need the 3D Delaunay triangulation; every
- * other source uses the k-NN form over x->ix (docs/natural.md, "Speed").
- * AUTO is PCA on a clean cloud and JET on a noisy one. */
-static jf_status natural_setup(nbctx *x, const jf_cloud *c, jf_normal_source src, int nt,
-                               const jf_params *prm, jf_error *err)
-{
-    size_t n = c->n;
-    x->nflags = calloc(n, sizeof *x->nflags);
-    if (!x->nflags) return JF_ERR_NOMEM;
-    if (src == JF_NORMAL_INPUT && !c->nrm) {
-        set_err(err, "normal input: the cloud has no normals");
-        return JF_ERR_INVALID;
-    }
-    if (src != JF_NORMAL_INPUT) {
-        x->nrm_own = malloc(3 * n * sizeof *x->nrm_own);
-        if (!x->nrm_own) return JF_ERR_NOMEM;
-        x->nrm = x->nrm_own;
-    }
-    if (src == JF_NORMAL_JET) return jet_setup(x, c, nt, prm, err);
-    int delaunay = src == JF_NORMAL_POLES || src == JF_NORMAL_MINCIRC;
-    jf_status st = delaunay ? jf_natural_create_threads(c->xyz, n, nt, &x->nt)
-                            : jf__natural_from_index(x->ix, nt, &x->nt);
-    if (st != JF_OK) {
-        set_err(err, st == JF_ERR_UNSUPPORTED
-                         ? "natural neighbours: the poles and mincirc normals need a 3D Delaunay "
-                           "triangulation (CGAL), which this build leaves out (JF_CGAL=OFF)"
-                     : delaunay ? "natural neighbours: building the Delaunay triangulation failed"
-                                : "natural neighbours: the k-NN form failed");
-        return st;
-    }
-    if (src == JF_NORMAL_INPUT) {
-        x->nrm = c->nrm;
-        for (size_t i = 0; i < n; i++) x->nflags[i] = JF_PT_NORMAL_INPUT;
-        return own_rows(x, c->nrm, nt, err);
-    }
-    if (delaunay) {
-        st = jf_natural_normals(x->nt, src, nt, x->nrm_own, x->nflags, NULL);
-        if (st != JF_OK) set_err(err, "natural neighbours: tangent-plane normals failed");
-        return st;
-    }
-    if ((st = jf__planes_pca_knn(x->nt, n, nt, x->nrm_own, x->nflags)) != JF_OK) {
-        set_err(err, "natural neighbours: the PCA planes and own-plane cells failed");
-        return st;
-    }
-    int noisy = 0;
-    if (src == JF_NORMAL_AUTO && (st = noisy_cloud(x->nt, c->xyz, x->nrm_own, n, nt, &noisy)) != JF_OK) {
-        set_err(err, "natural neighbours: the noise test failed");
-        return st;
-    }
-    if (!noisy) return JF_OK;
-    jf_natural_free(x->nt); /* made anew on the projected points */
-    x->nt = NULL;
-    memset(x->nflags, 0, n * sizeof *x->nflags);
-    return jet_setup(x, c, nt, prm, err);
-}
-
-/* Neighbourhood of point i (at p) into idx[0..cap-1] and, for the k-d
- * tree's kinds (knn, radius), their coordinates from its own storage into
- * xyz (other kinds leave that to the caller); *flags gets per-point flags
- * (few neighbours, the natural normal's source, failure). */
-/* knn: the previous point of the walk's neighbours (hint, hint_n of them)
- * bound this one's k-th distance (their farthest from p): the search
- * starts with that radius instead of none, so it inserts fewer
- * candidates.  Exact: with k points inside, the k nearest are inside; too
- * few found (the bound rounded low), the search runs unbounded. */
-static jf_status knn_hinted(const nbctx *x, const double *p, const double *hint, size_t hint_n,
-                            uint32_t *idx, double *d2, double *xyz, size_t *found)
-{
-    const size_t k = x->nb->k < x->cap ? x->nb->k : x->cap;
-    double b = 0;
-    for (size_t j = 0; j < hint_n; j++) {
-        const double dx = p[0] - hint[3 * j], dy = p[1] - hint[3 * j + 1], dz = p[2] - hint[3 * j + 2];
-        const double d = dx * dx + dy * dy + dz * dz;
-        b = d > b ? d : b;
-    }
-    jf_status st = jf__index_query(x->ix, p, k, b, idx, d2, xyz, found);
-    if (st == JF_OK && *found < k) st = jf__index_query(x->ix, p, k, INFINITY, idx, d2, xyz, found);
-    return st;
-}
-
-static jf_status nb_query(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, size_t i,
-                          const double *p, uint32_t *idx, uint32_t *pos, double *d2, double *xyz,
-                          size_t *found, unsigned *flags, const double *hint, size_t hint_n)
-{
-    jf_status st;
-    *found = 0;
-    *flags = 0;
-    switch (x->nb->kind) {
-    case JF_NB_RINGS:
-        st = jf_nb_query_mesh(x->mesh, x->xyz, x->nb, x->min_count, x->fit, (uint32_t)i, idx,
-                              x->cap, found);
-        /* rings through a non-manifold edge mix sheets: say so */
-        if (jf_mesh_vertex_flags(x->mesh)[i] & JF_MESH_NONMANIFOLD)
-            *flags |= JF_PT_MESH_NONMANIFOLD;
-        break;
-    case JF_NB_NATURAL:
-        *flags = x->nflags[i];
-        const double *m = x->nrm + 3 * i;
-        /* a PCA or jet plane is a unit normal: not read here (input order,
-         * a cache miss per point); the others are checked */
-        if (!(*flags & (JF_PT_NORMAL_PCA | JF_PT_NORMAL_JET)) &&
-            (!finite3(m) || (m[0] == 0 && m[1] == 0 && m[2] == 0))) {
-            *flags |= JF_PT_FAILED; /* no tangent plane (e.g. a zero input normal) */
-            return JF_OK;
-        }
-        /* the k-NN form's own-plane rows, or the triangulation's cells;
-         * input indices only for the graph and the raw points */
-        st = jf__natural_neighbors_own(x->nt, ws, i, m, x->want,
-                                       x->graph || x->fit_moved ? idx : NULL, x->cap, found);
-        break;
-    default: /* sh: auto's 256 nearest, shared along the walk (knn_share.c) */
-        if (sh)
-            st = jf__knn_share_query(sh, x->ix, p, idx, pos, d2, xyz, found);
-        else if (x->nb->kind == JF_NB_KNN && hint && x->nb->k && hint_n == x->nb->k &&
-                 hint_n <= x->cap)
-            st = knn_hinted(x, p, hint, hint_n, idx, d2, xyz, found);
-        else
-            st = jf__nb_query_xyz(x->ix, x->nb, x->min_count, p, idx, d2, xyz, x->cap, found);
-    }
-    if (st == JF_OK && *found < x->want) *flags |= JF_PT_FEW_NEIGHBORS;
-    return st;
 }
 
 /* ---- per-thread workspace and the per-point step ----------------------- */
@@ -532,13 +263,13 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
                          jf_result *row, size_t *found, unsigned *flags, int *fit)
 {
     *fit = 0;
-    if (!finite3(p)) {
+    if (!jf__finite3(p)) {
         nonfinite_row(x, i, row);
         return JF_OK;
     }
     const double *hint = w->hint != coords ? w->hint : NULL; /* coords: overwritten */
     jf_status st =
-        nb_query(x, w->nws, w->share, i, p, w->idx, w->pos, w->d2, coords, found, flags, hint,
+        jf__nb_point(x, w->nws, w->share, i, p, w->idx, w->pos, w->d2, coords, found, flags, hint,
                  w->hint_n);
     if (st != JF_OK) return st;
     w->hint = coords;
@@ -548,7 +279,7 @@ static jf_status prepare(worker *w, const nbctx *x, size_t i, const double *p, d
         nan_result(row, *flags);
         return JF_OK;
     }
-    const int gathered = x->nb->kind <= JF_NB_KNN_RADIUS; /* by nb_query */
+    const int gathered = x->nb->kind <= JF_NB_KNN_RADIUS; /* by jf__nb_point */
     /* fit_moved: the moved points are fitted, the raw ones kept for the
      * residual (raw_of: the buffer beside coords) */
     double *raw = x->fit_moved ? raw_of(w, coords) : coords;
@@ -662,7 +393,7 @@ static jf_status deliver(const runctx *R, const uint32_t *idx, const double *xyz
     return R->sinkx ? R->sinkx(R->user, idx, xyz, res, m) : R->sink(R->user, idx, res, m);
 }
 
-/* natural: what nb_query reads of point i by input index (its flags and
+/* natural: what jf__nb_point reads of point i by input index (its flags and
  * vertex), asked PREFETCH points of the walk ahead: in the tree's walk
  * these are cache misses (the input is in any order). */
 #define PREFETCH 8
@@ -967,7 +698,7 @@ static jf_status nonfinite_rows(const runctx *R, size_t n)
     size_t m = 0;
     jf_status st = JF_OK;
     for (size_t i = 0; i < n && st == JF_OK; i++) {
-        if (finite3(R->c->xyz + 3 * i)) continue;
+        if (jf__finite3(R->c->xyz + 3 * i)) continue;
         if (R->out) {
             nonfinite_row(R->x, i, &R->out[i]);
             continue;
@@ -988,7 +719,7 @@ static jf_status pass_status(jf_status failed, jf_error *err)
 {
     if (failed == JF_ERR_CANCELLED) return cancel_status(err);
     if (failed != JF_OK)
-        set_err(err, failed == JF_ERR_NOMEM ? "out of memory (per-thread workspace)"
+        jf__set_err(err, failed == JF_ERR_NOMEM ? "out of memory (per-thread workspace)"
                                             : "a neighbourhood query or fit failed");
     return failed;
 }
@@ -1003,29 +734,29 @@ jf_status jf__estimate_check(const jf_cloud *c, const jf_estimate_opts *o, jf_es
     use->orient = jf_orient_resolve(o->orient, c->nrm != NULL,
                                     c->scan && c->scanner && c->nscans);
     if (use->orient == JF_ORIENT_INPUT && !c->nrm) {
-        set_err(err, "orient input: the cloud has no normals");
+        jf__set_err(err, "orient input: the cloud has no normals");
         return JF_ERR_INVALID;
     }
     if (use->orient == JF_ORIENT_SCANNER && (!c->scan || !c->scanner || !c->nscans)) {
-        set_err(err, "orient scanner: the cloud has no scanner positions (PTX input has)");
+        jf__set_err(err, "orient scanner: the cloud has no scanner positions (PTX input has)");
         return JF_ERR_INVALID;
     }
     if (o->nb.kind == JF_NB_RINGS && !c->nfaces) {
-        set_err(err, "neighbors rings needs a mesh (faces in the input)");
+        jf__set_err(err, "neighbors rings needs a mesh (faces in the input)");
         return JF_ERR_INVALID;
     }
     if ((unsigned)o->orient > JF_ORIENT_AUTO) {
-        set_err(err, "invalid parameter 'orient'");
+        jf__set_err(err, "invalid parameter 'orient'");
         return JF_ERR_INVALID;
     }
     if (jf_params_validate(&use->params, &bad) != JF_OK) {
         char m[128];
         snprintf(m, sizeof m, "invalid parameter '%s'", bad ? bad : "?");
-        set_err(err, m);
+        jf__set_err(err, m);
         return JF_ERR_INVALID;
     }
     if (c->n >= UINT32_MAX - 2) {
-        set_err(err, "too many points (2^32 - 2 at most)");
+        jf__set_err(err, "too many points (2^32 - 2 at most)");
         return JF_ERR_TOO_LARGE;
     }
     return JF_OK;
@@ -1048,7 +779,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
 {
     if (err) err->msg[0] = '\0';
     if (!c || !o_in || (c->n && (!c->xyz || (!out && !sink && !sinkx)))) {
-        set_err(err, out || !(sink || sinkx) ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
+        jf__set_err(err, out || !(sink || sinkx) ? "jf_estimate: NULL argument" : "jf_estimate_blocks: NULL argument");
         return JF_ERR_INVALID;
     }
     jf_estimate_opts use;
@@ -1060,7 +791,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     if (!out && o->orient == JF_ORIENT_SCANNER)
         for (size_t i = 0; i < n; i++) /* blocks go out oriented: check first */
             if (c->scan[i] >= c->nscans) {
-                set_err(err, "orientation failed");
+                jf__set_err(err, "orientation failed");
                 return JF_ERR_INVALID;
             }
 
@@ -1092,7 +823,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     }
     x.cap = max_sz(x.cap, 1);
     if (x.cap > p->max_neighbors) {
-        set_err(err, "neighbourhood larger than params.max_neighbors");
+        jf__set_err(err, "neighbourhood larger than params.max_neighbors");
         return JF_ERR_INVALID;
     }
 
@@ -1107,7 +838,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     int need_index = nb.kind <= JF_NB_KNN_RADIUS || knn_cells;
     if (need_index && o->phase) o->phase(o->phase_user, JF_PHASE_INDEX, 0, n);
     if (need_index && (st = jf__index_build_threads(c->xyz, n, nt, &ix)) != JF_OK) {
-        set_err(err, "building the k-d tree failed");
+        jf__set_err(err, "building the k-d tree failed");
         goto out;
     }
     if (need_index && o->phase) o->phase(o->phase_user, JF_PHASE_INDEX, n, n);
@@ -1119,7 +850,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         x.nj = &njs;
         if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
             st = JF_ERR_NOMEM;
-            set_err(err, "out of memory (auto's neighbour fits)");
+            jf__set_err(err, "out of memory (auto's neighbour fits)");
             goto out;
         }
     }
@@ -1130,15 +861,15 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     if (o->nb.kind == JF_NB_RINGS &&
         (st = jf_mesh_build(n, c->nfaces, c->face_off, c->face_idx, &x.mesh, err)) != JF_OK)
         goto out;
-    if (o->nb.kind == JF_NB_NATURAL && (st = natural_setup(&x, c, o->normal, nt, p, err)) != JF_OK) {
-        if (err && !err->msg[0]) set_err(err, jf_strerror(st));
+    if (o->nb.kind == JF_NB_NATURAL && (st = jf__nb_natural_setup(&x, c, o->normal, nt, p, err)) != JF_OK) {
+        if (err && !err->msg[0]) jf__set_err(err, jf_strerror(st));
         goto out;
     }
     if (o->orient == JF_ORIENT_MST) {
         /* mst on the fit's own neighbourhoods: no queries again later */
         if (o->orient_k < 1 || o->orient_k > 1024) {
             st = JF_ERR_INVALID;
-            set_err(err, "orient_k must be 1..1024");
+            jf__set_err(err, "orient_k must be 1..1024");
             goto out;
         }
         x.gk = o->orient_k;
@@ -1149,7 +880,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         }
         if (!x.graph || (mst_blocks && (!R.vn || !R.vs))) {
             st = JF_ERR_NOMEM;
-            set_err(err, "out of memory (orientation graph)");
+            jf__set_err(err, "out of memory (orientation graph)");
             goto out;
         }
     }
@@ -1167,12 +898,12 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         order = malloc(n * sizeof *order);
         if (!order) {
             st = JF_ERR_NOMEM;
-            set_err(err, "out of memory (point order)");
+            jf__set_err(err, "out of memory (point order)");
             goto out;
         }
         if (o->phase) o->phase(o->phase_user, JF_PHASE_ORDER, 0, n);
         if ((st = jf_spatial_order(c->xyz, n, order)) != JF_OK) {
-            set_err(err, "spatial order failed");
+            jf__set_err(err, "spatial order failed");
             goto out;
         }
         if (o->phase) o->phase(o->phase_user, JF_PHASE_ORDER, n, n);
@@ -1187,7 +918,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         }
         R.done0 = (size_t)pass * n + (n - nwalk);
         if (nwalk < n && (st = nonfinite_rows(&R, n)) != JF_OK) {
-            set_err(err, "writing a block of results failed");
+            jf__set_err(err, "writing a block of results failed");
             goto out;
         }
         if ((st = pass_status(x.nj ? fit_pass_nj(&R, walk, walk_xyz, nwalk, nt)
@@ -1199,12 +930,12 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             R.vf = calloc(n, 1);
             if (!R.vf) {
                 st = JF_ERR_NOMEM;
-                set_err(err, "out of memory (orientation)");
+                jf__set_err(err, "out of memory (orientation)");
                 goto out;
             }
             st = jf__orient_mst_view(R.vn, R.vs, R.vf, c->xyz, n, x.graph, x.gk);
             if (st != JF_OK) {
-                set_err(err, "orientation failed");
+                jf__set_err(err, "orientation failed");
                 goto out;
             }
             free(R.vn);
@@ -1241,7 +972,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     case JF_ORIENT_MST: st = jf_orient_mst_graph(out, c->xyz, n, x.graph, x.gk); break;
     default: st = JF_ERR_INVALID;
     }
-    if (st != JF_OK) set_err(err, "orientation failed");
+    if (st != JF_OK) jf__set_err(err, "orientation failed");
 out:
     free(order);
     jf_index_free(ix);
