@@ -39,7 +39,12 @@ void jf__njs_free(jf__njs *s);
 #define JF_NJ_KMIN 128
 static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
 {
+#ifdef JF_STEP6_OFF /* a study build: steps 1-5's rows (tests/bench/auto_agg.py) */
+    (void)p, (void)nb;
+    return 0;
+#else
     return p->auto_select && nb->kind == JF_NB_KNN && nb->k >= JF_NJ_KMIN;
+#endif
 }
 
 /* How many of a point's nearest its row reads: curvatures from

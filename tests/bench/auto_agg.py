@@ -6,7 +6,7 @@ applied to auto's rows as written: since step 6 shipped, on top of it;
 the build before it gave the figures of that section's table).
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
-       [--lepski TAU,...] [--n N] [--seed S]
+       [--lepski TAU,...] [--gate LO:HI,...] [--n N] [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -18,7 +18,14 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
          no second-order error, W standing for q's own); also only where auto's K is its
          largest, 256 (elsewhere the row as auto wrote it);
   curvatures: the eigenvalues of W in the plane normal to the normal;
-  with --lepski, indiv's m chosen per point up to f x K (lepski below).
+  with --lepski, indiv's m chosen per point up to f x K (lepski below);
+  with --gate LO:HI, a per-point f by the noise over the fit's radius,
+  s = sigma / r_K (r_K: the K-th distance): indiv, f = 1/16 where
+  s <= LO, indiv, f = 1/2 where LO < s <= HI, mid, f = 1/2 above (normals);
+  LO:HI:KMIN only where auto's K >= KMIN, LO:HI:KMIN:1 only quadric rows
+  (each cloud's 10/50/90% of s on stderr).
+The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
+steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
 points (CGAL's jet on the same points, docs/robustness.md), k in 18, 32,
 64, 128, 256, the best k per column after seeing the truth: RMS normal
@@ -125,7 +132,7 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, taus, work):
+def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work):
     """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
     fixed = {}
     for k in KS:
@@ -135,7 +142,8 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, work):
     rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"))
     K = rows[I, col["neighbors"]]
     res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
-    nb = neighbours(rows[:, 0:3], rows[I, 0:3], max(int(max(fs) * K.max()) + 1, KMAX if taus else 0))
+    nb = neighbours(rows[:, 0:3], rows[I, 0:3],
+                    max(int(max(fs + ([0.5] if gates else [])) * K.max()) + 1, KMAX if taus else 0))
     for f in fs:
         mq = np.maximum(1, np.round(f * K)).astype(int)
         ag = aggregate(rows, col, I, nb, mq)
@@ -147,6 +155,21 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, work):
         for tau in taus:
             res.append(("indiv, Lepski tau=%g, m <= %g K" % (tau, f),
                         errors(lepski(rows, col, I, nb, K, mq, tau), None, None, T)))
+    if gates:
+        kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+        s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+        print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
+              file=sys.stderr, flush=True)
+        small = aggregate(rows, col, I, nb, np.maximum(1, np.round(K / 16.0)).astype(int))["indiv"][0]
+        wide = aggregate(rows, col, I, nb, np.maximum(1, np.round(K / 2.0)).astype(int))
+        for g in gates:
+            lo, hi = g[0], g[1]
+            ok = K >= (g[2] if len(g) > 2 else 0)
+            if len(g) > 3 and g[3]:
+                ok &= rows[I, col["degree"]] == 2
+            pick = np.where((ok & (s > hi))[:, None], wide["mid"][0],
+                            np.where((ok & (s > lo))[:, None], wide["indiv"][0], small))
+            res.append(("gate sigma/r_K %s" % ":".join("%g" % v for v in g), errors(pick, None, None, T)))
     return best, res
 
 
@@ -190,6 +213,7 @@ def main():
     ap.add_argument("--pcpnet")
     ap.add_argument("--f", default="0.0625,0.125,0.25,0.5")
     ap.add_argument("--lepski", default="", help="taus of a per-point m rule (e.g. 1,2,4)")
+    ap.add_argument("--gate", default="", help="LO:HI[:KMIN[:1]] bounds of sigma / r_K (e.g. 0.01:0.02)")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -198,6 +222,7 @@ def main():
         sys.exit("auto_agg: %s not built" % jetfit)
     fs = [float(v) for v in a.f.split(",")]
     taus = [float(v) for v in a.lepski.split(",") if v]
+    gates = [tuple(float(x) for x in v.split(":")) for v in a.gate.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in ("ellipsoid", "torus", "exp"):
@@ -209,7 +234,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, work)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -224,7 +249,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, work)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
