@@ -188,7 +188,7 @@ END_TEST
 
 /* A dense surface: every part's cells hold K + 1 own points, so its halo
  * comes from the cells near its own (no index of its points, no request:
- * parts_run.c's halo_by_cells); on the edges, the blocks of 27 or 125
+ * parts_halo.c's jf__halo_by_cells); on the edges, the blocks of 27 or 125
  * cells.  The same rows as the whole cloud, bit for bit. */
 START_TEST(cell_halos_exact)
 {
@@ -214,7 +214,7 @@ END_TEST
  * neighbourhood's ball makes) holds the largest part's real halo: a
  * surface of 60,000 points cut in 8 and 24 (parts with islands), at
  * knn:32, knn:256 and auto.  Before the balls came from the cloud's
- * distances (parts_run.c's wide_index), knn:256 in 24 parts took 25,660
+ * distances (parts_halo.c's jf__wide_index), knn:256 in 24 parts took 25,660
  * points (now 13,545; the plan's part: 22,951). */
 START_TEST(plan_holds_the_halo)
 {

@@ -410,8 +410,8 @@ END_TEST
 /* A part of a Morton cut is not connected (a torus cut in 6 holds
  * islands of a few points); its own K-th distance there reaches across the
  * part, and step 6's ball, taken from it, made the whole cloud one part's
- * halo (24,000 of 24,000).  From the cloud's distances (parts_run.c,
- * wide_index) the largest part holds its 4,000 points and a ring: 16,260
+ * halo (24,000 of 24,000).  From the cloud's distances (parts_halo.c,
+ * jf__wide_index) the largest part holds its 4,000 points and a ring: 16,260
  * here (r_K + 2 r_32 is wide against so small a part); at most 5x its own,
  * and still the whole cloud's bytes. */
 START_TEST(test_auto_parts_halo)
