@@ -183,6 +183,15 @@ int jf__halo_requests_near(const jf_index *own, const jf_part_query *q, const do
     return nr;
 }
 
+void *jf__grow(void *v, size_t *cap, size_t n, size_t elem)
+{
+    if (n < *cap) return v;
+    size_t nc = *cap ? 2 * *cap : 1024;
+    void *nv = realloc(v, nc * elem);
+    if (nv) *cap = nc;
+    return nv;
+}
+
 /* Growable list of input indices (one per thread). */
 typedef struct {
     uint32_t *v;
@@ -191,13 +200,9 @@ typedef struct {
 
 static int ivec_push(ivec *a, uint32_t x)
 {
-    if (a->n == a->cap) {
-        size_t nc = a->cap ? 2 * a->cap : 1024;
-        uint32_t *nv = realloc(a->v, nc * sizeof *nv);
-        if (!nv) return 0;
-        a->v = nv;
-        a->cap = nc;
-    }
+    void *nv = jf__grow(a->v, &a->cap, a->n, sizeof *a->v);
+    if (!nv) return 0;
+    a->v = nv;
     a->v[a->n++] = x;
     return 1;
 }
@@ -237,13 +242,9 @@ typedef struct {
 
 static int cand_push(hworker *w, double d2, uint32_t id, int remote)
 {
-    if (w->mn == w->mcap) {
-        size_t nc = w->mcap ? 2 * w->mcap : 1024;
-        jf_halo_cand *nv = realloc(w->m, nc * sizeof *nv);
-        if (!nv) return 0;
-        w->m = nv;
-        w->mcap = nc;
-    }
+    void *nv = jf__grow(w->m, &w->mcap, w->mn, sizeof *w->m);
+    if (!nv) return 0;
+    w->m = nv;
     w->m[w->mn++] = (jf_halo_cand){d2, id, (uint32_t)remote};
     return 1;
 }

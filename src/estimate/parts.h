@@ -283,4 +283,9 @@ jf_status jf__estimate_blocks_masked_xyz(const jf_cloud *c, const jf_estimate_op
                                          const uint8_t *fit, jf__block_xyz_fn sink, void *user,
                                          jf_error *err);
 
+/* Room for one more element in a growable array v of *cap elements of
+ * size elem holding n: v, or v moved with *cap doubled (first 1024) when
+ * full; NULL out of memory (v still valid, *cap unchanged). */
+void *jf__grow(void *v, size_t *cap, size_t n, size_t elem);
+
 #endif /* JF_PARTS_H */

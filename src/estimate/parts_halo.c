@@ -23,13 +23,9 @@ typedef struct {
 
 static int rvec_push(rvec *v, request x)
 {
-    if (v->n == v->cap) {
-        size_t nc = v->cap ? 2 * v->cap : 1024;
-        request *nr = realloc(v->r, nc * sizeof *nr);
-        if (!nr) return 0;
-        v->r = nr;
-        v->cap = nc;
-    }
+    void *nv = jf__grow(v->r, &v->cap, v->n, sizeof *v->r);
+    if (!nv) return 0;
+    v->r = nv;
     v->r[v->n++] = x;
     return 1;
 }
@@ -74,13 +70,9 @@ static double ball_r(double b) { return sqrt(b) * (1 + 1e-9) + 1e-140; }
 
 static int hvec_push(hvec *a, uint32_t id, const double *x)
 {
-    if (a->n == a->cap) {
-        size_t nc = a->cap ? 2 * a->cap : 1024;
-        hpoint *nv = realloc(a->v, nc * sizeof *nv);
-        if (!nv) return 0;
-        a->v = nv;
-        a->cap = nc;
-    }
+    void *nv = jf__grow(a->v, &a->cap, a->n, sizeof *a->v);
+    if (!nv) return 0;
+    a->v = nv;
     a->v[a->n].id = id;
     memcpy(a->v[a->n].x, x, sizeof(double[3]));
     a->n++;
