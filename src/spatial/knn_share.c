@@ -192,6 +192,56 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     return JF_OK;
 }
 
+/* The d[j] <= b2 of d[0..n) and their j, in order, into out and sel
+ * (both of room n; a compare and moves only: the same bits everywhere).
+ * AVX-512's compress does eight a step where the machine has it. */
+static size_t compact_le_scalar(const double *d, size_t n, double b2, double *out, uint32_t *sel)
+{
+    size_t m = 0;
+    for (size_t j = 0; j < n; j++) {
+        out[m] = d[j];
+        sel[m] = (uint32_t)j;
+        m += d[j] <= b2;
+    }
+    return m;
+}
+
+#if JF_AVX_PATH
+#include <immintrin.h>
+__attribute__((target("avx512f"), noinline)) static size_t compact_le_512(const double *d, size_t n,
+                                                                         double b2, double *out,
+                                                                         uint32_t *sel)
+{
+    size_t m = 0, j = 0;
+    const __m512d vb = _mm512_set1_pd(b2);
+    __m512i id = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0);
+    const __m512i eight = _mm512_set1_epi32(8);
+    for (; j + 8 <= n; j += 8) { /* m <= j: the full stores stay below n */
+        __m512d v = _mm512_loadu_pd(d + j);
+        __mmask8 k = _mm512_cmp_pd_mask(v, vb, _CMP_LE_OQ);
+        _mm512_storeu_pd(out + m, _mm512_maskz_compress_pd(k, v));
+        _mm256_storeu_si256((__m256i *)(sel + m),
+                            _mm512_castsi512_si256(_mm512_maskz_compress_epi32((__mmask16)k, id)));
+        m += (size_t)__builtin_popcount(k);
+        id = _mm512_add_epi32(id, eight);
+    }
+    for (; j < n; j++) {
+        out[m] = d[j];
+        sel[m] = (uint32_t)j;
+        m += d[j] <= b2;
+    }
+    return m;
+}
+#endif
+
+static size_t compact_le(const double *d, size_t n, double b2, double *out, uint32_t *sel)
+{
+#if JF_AVX_PATH
+    if (__builtin_cpu_supports("avx512f") && !jf__no_avx) return compact_le_512(d, n, b2, out, sel);
+#endif
+    return compact_le_scalar(d, n, b2, out, sel);
+}
+
 /* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
 /* Built twice (target_clones): AVX (four distances a step, no FMA, so
  * no contraction: the tree's bits) and the default (SSE2). */
@@ -228,12 +278,7 @@ again:;
         dd[j] = dx * dx + dy * dy + dz * dz; /* as the tree's scan_leaf */
     }
     done = lim; /* lim grows with b */
-    size_t n = 0;
-    for (size_t j = 0; j < lim; j++) {
-        s->d2[n] = dd[j];
-        s->sel[n] = (uint32_t)j;
-        n += dd[j] <= b2;
-    }
+    size_t n = compact_le(dd, lim, b2, s->d2, s->sel);
     if (n < s->k && b < bmax) {
         b = b * 1.3 < bmax ? b * 1.3 : bmax;
         goto again;
