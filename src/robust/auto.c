@@ -440,8 +440,11 @@ static inline __attribute__((always_inline)) void acc_quads(acc4 *A, const quad4
         v4d r2 = x * x + y * y;
         v4l gt = (v4l)(r2 > A->rmax2);
         A->rmax2 = (v4d)(((v4l)r2 & gt) | ((v4l)A->rmax2 & ~gt));
-        if (rs)
-            for (int l = 0; l < 4; l++) A->rsum[l] += __builtin_sqrt(r2[l]); /* IEEE: exact */
+        if (rs) { /* four lanes a step (sqrt is correctly rounded: the bits of one at a time) */
+            v4d r;
+            sqrt4(&r, &r2);
+            A->rsum += r;
+        }
     }
 }
 
