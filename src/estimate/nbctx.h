@@ -11,6 +11,7 @@
 #include "index_internal.h"
 #include "jetfit.h"
 #include "neigh_jets.h"
+#include "set_err.h" /* jf__set_err */
 
 typedef struct {
     const jf_nb_spec *nb;
@@ -39,11 +40,6 @@ typedef struct {
 static inline int jf__finite3(const double *p)
 {
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
-}
-
-static inline void jf__set_err(jf_error *err, const char *msg)
-{
-    if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
 }
 
 /* Step 1 for natural[:N]: the cells' structure and the tangent-plane

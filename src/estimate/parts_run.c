@@ -55,11 +55,7 @@
 #include "jetfit.h"
 #include "parts.h"
 #include "parts_run.h"
-
-static void set_err(jf_error *err, const char *msg)
-{
-    if (err) snprintf(err->msg, sizeof err->msg, "%s", msg);
-}
+#include "set_err.h"
 
 /* The query of the parts from o (jf__part_query_init), the one check both
  * entry points make: JF_ERR_UNSUPPORTED with its message where parts
@@ -69,7 +65,7 @@ static jf_status parts_query(const jf_estimate_opts *o, jf_part_query *q, jf_err
 {
     jf_status st = jf__part_query_init(o, q);
     if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
-        set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
+        jf__set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
                      "orientation (not mst)");
         return JF_ERR_UNSUPPORTED;
     }
@@ -113,7 +109,7 @@ jf_status jf_estimate_parts(const jf_cloud *c, const jf_estimate_opts *o, int np
 {
     if (err) err->msg[0] = '\0';
     if (!c || !o || !sink || (c->n && !c->xyz) || nparts < 1 || nparts > JF_PARTS_MAX) {
-        set_err(err, "jf_estimate_parts: NULL argument or nparts out of 1..65536");
+        jf__set_err(err, "jf_estimate_parts: NULL argument or nparts out of 1..65536");
         return JF_ERR_INVALID;
     }
     jf_part_query q;
@@ -320,14 +316,14 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     if (err) err->msg[0] = '\0';
     if (!c || !src || !o || !sink || (c->n && !src->xyz && (src->fd < 0 || !src->l)) ||
         nparts < 2 || nparts > JF_PARTS_MAX) {
-        set_err(err, "jf__estimate_parts_src: NULL argument or nparts out of 2..65536");
+        jf__set_err(err, "jf__estimate_parts_src: NULL argument or nparts out of 2..65536");
         return JF_ERR_INVALID;
     }
     jf_part_query q;
     jf_status st = parts_query(o, &q, err);
     if (st == JF_ERR_UNSUPPORTED) return st;
     if (st != JF_OK) {
-        set_err(err, "invalid parameters");
+        jf__set_err(err, "invalid parameters");
         return st;
     }
     /* the whole cloud's checks first (a bad option fails before any work);
@@ -378,7 +374,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         if (!count[a]) continue;
         if (o->cancel && o->cancel(o->cancel_user)) {
             st = JF_ERR_CANCELLED;
-            set_err(err, "cancelled");
+            jf__set_err(err, "cancelled");
             goto out;
         }
         /* step 2: own index, requests, halo */
@@ -465,7 +461,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     if (st == JF_OK && o->progress) o->progress(o->progress_user, n, n);
 out:
     if (st != JF_OK && err && !err->msg[0])
-        set_err(err, st == JF_ERR_NOMEM ? "out of memory (parts)" : jf_strerror(st));
+        jf__set_err(err, st == JF_ERR_NOMEM ? "out of memory (parts)" : jf_strerror(st));
     jf__reader_close(&rd);
     free(part);
     free(count);
