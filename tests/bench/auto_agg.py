@@ -6,7 +6,8 @@ applied to auto's rows as written: since step 6 shipped, on top of it;
 the build before it gave the figures of that section's table).
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
-       [--lepski TAU,...] [--gate LO:HI,...] [--n N] [--seed S]
+       [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...] [--n N]
+       [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -23,7 +24,9 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   s = sigma / r_K (r_K: the K-th distance): indiv, f = 1/16 where
   s <= LO, indiv, f = 1/2 where LO < s <= HI, mid, f = 1/2 above (normals);
   LO:HI:KMIN only where auto's K >= KMIN, LO:HI:KMIN:1 only quadric rows
-  (each cloud's 10/50/90% of s on stderr).
+  (each cloud's 10/50/90% of s on stderr);
+  with --sheet TAU, indiv and mid again over only the j whose height off
+  q's own osculating quadric is at most TAU x q's sigma (q's sheet).
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
@@ -68,9 +71,13 @@ def neighbours(Y, Q, m):
     return nb
 
 
-def aggregate(rows, col, I, nb, mq):
+def aggregate(rows, col, I, nb, mq, sheet=None):
     """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i],
-    and (key "snaps") indiv's running sums and counts at m = 1, 2, 4, ..."""
+    and (key "snaps") indiv's running sums and counts at m = 1, 2, 4, ...;
+    with sheet = TAU only the j whose height off q's own osculating
+    quadric, |n_q . (j - q) - (j - q)^T W_q (j - q) / 2|, is at most TAU
+    sigma_q (q's `sigma`): the same sheet, not the other side of a thin
+    part"""
     NI, PI, n = rows[I, col["nx"]:col["nx"] + 3], rows[I, 0:3], len(I)
     # a neighbour without a fit (NaN row) adds nothing: zeros, not NaN * 0
     good = np.isfinite(rows[:, 0:col["d2x"] + 3]).all(1)
@@ -84,9 +91,18 @@ def aggregate(rows, col, I, nb, mq):
     cnt = np.zeros(n)
     mean_n, cen, ind = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     W = np.zeros((n, 3, 3))
+    if sheet is not None:
+        Wq = k1[I][:, None, None] * D1[I][:, :, None] * D1[I][:, None, :] + \
+            k2[I][:, None, None] * D2[I][:, :, None] * D2[I][:, None, :]
+        lim = sheet * R[I, col["sigma"]]
     for t in range(nb.shape[1]):
         j = nb[:, t]
-        on = ((t < mq) & good[j]).astype(float)
+        on = (t < mq) & good[j]
+        if sheet is not None and t > 0:
+            e = P[j] - PI
+            h = (e * NI).sum(1) - 0.5 * np.einsum("ni,nij,nj->n", e, Wq, e)
+            on &= np.abs(h) <= lim
+        on = on.astype(float)
         if not on.any():
             break
         s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
@@ -132,7 +148,7 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work):
+def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=()):
     """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
     fixed = {}
     for k in KS:
@@ -152,6 +168,10 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work):
         # only where auto's K reached its largest candidate (variance-bound)
         ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
         res.append(("mid f=%g, K=%d only" % (f, KMAX), errors(*ag["mid"], T, t1, t2)))
+        for tau in sheets:
+            ag = aggregate(rows, col, I, nb, mq, sheet=tau)
+            for name in ("indiv", "mid"):
+                res.append(("%s f=%g, sheet %g sigma" % (name, f, tau), errors(*ag[name], T, t1, t2)))
         for tau in taus:
             res.append(("indiv, Lepski tau=%g, m <= %g K" % (tau, f),
                         errors(lepski(rows, col, I, nb, K, mq, tau), None, None, T)))
@@ -214,6 +234,7 @@ def main():
     ap.add_argument("--f", default="0.0625,0.125,0.25,0.5")
     ap.add_argument("--lepski", default="", help="taus of a per-point m rule (e.g. 1,2,4)")
     ap.add_argument("--gate", default="", help="LO:HI[:KMIN[:1]] bounds of sigma / r_K (e.g. 0.01:0.02)")
+    ap.add_argument("--sheet", default="", help="TAUs of the same-sheet test (e.g. 2,3,4)")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -223,6 +244,7 @@ def main():
     fs = [float(v) for v in a.f.split(",")]
     taus = [float(v) for v in a.lepski.split(",") if v]
     gates = [tuple(float(x) for x in v.split(":")) for v in a.gate.split(",") if v]
+    sheets = [float(v) for v in a.sheet.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in ("ellipsoid", "torus", "exp"):
@@ -234,7 +256,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -249,7 +271,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
