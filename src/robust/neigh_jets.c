@@ -5,9 +5,10 @@
  * nearest points reach beyond those K.  Each neighbour's normal is
  * carried to q by its own shape operator W_j = k1 d1 d1' + k2 d2 d2' (a
  * first-order step of the Monge form, §2), so a curved patch adds no
- * bias of first order; the curvatures are those of the mean W_j.  The
- * counts (K/16 for the normal, K/8 for the curvatures) were measured
- * offline (tests/bench/auto_agg.py; docs/robustness.md). */
+ * bias of first order; the curvatures are those of the mean W_j.  Both
+ * over the round(K/8) nearest, measured offline (tests/bench/auto_agg.py;
+ * docs/robustness.md: K/16 for the normal lost the ellipsoid at 0.1%,
+ * K/4 the clean armadillo). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,11 +21,6 @@ size_t jf__nj_head(int k)
     return m < 1 ? 1 : m > JF_NJ_HEAD ? JF_NJ_HEAD : (size_t)m;
 }
 
-static size_t normal_count(int k)
-{
-    double m = nearbyint(k / 16.0);
-    return m < 1 ? 1 : (size_t)m;
-}
 
 /* A tangent basis of a unit n, a function of n alone (Duff et al., "Building
  * an orthonormal basis, revisited", JCGT 2017). */
@@ -138,11 +134,10 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     if (r->degree < 2 || (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) || !isfinite(r->k1) ||
         !isfinite(r->k2))
         return;
-    size_t mc = jf__nj_head(r->n_used), mn = normal_count(r->n_used);
+    size_t mc = jf__nj_head(r->n_used);
     if (mc > m) mc = m;
-    if (mn > mc) mn = mc;
     double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
-    size_t cn = 0, cc = 0;
+    size_t cc = 0;
     for (size_t t = 0; t < mc; t++) {
         const size_t j = head[t];
         double own[JF_NJ_DEC];
@@ -157,18 +152,16 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
         const double sg = dot3(n, r->normal) < 0 ? -1.0 : 1.0;
         for (int k = 0; k < 6; k++) W[k] += sg * Wj[k];
         cc++;
-        if (t < mn) { /* n_j - W_j (q - j): n_j carried to q (§2) */
-            const double *pj = xyz + 3 * j;
-            const double d[3] = {p[0] - pj[0], p[1] - pj[1], p[2] - pj[2]};
-            const double wd[3] = {Wj[0] * d[0] + Wj[1] * d[1] + Wj[2] * d[2],
-                                  Wj[1] * d[0] + Wj[3] * d[1] + Wj[4] * d[2],
-                                  Wj[2] * d[0] + Wj[4] * d[1] + Wj[5] * d[2]};
-            for (int k = 0; k < 3; k++) ind[k] += sg * (n[k] - wd[k]);
-            cn++;
-        }
+        /* n_j - W_j (q - j): n_j carried to q (§2) */
+        const double *pj = xyz + 3 * j;
+        const double d[3] = {p[0] - pj[0], p[1] - pj[1], p[2] - pj[2]};
+        const double wd[3] = {Wj[0] * d[0] + Wj[1] * d[1] + Wj[2] * d[2],
+                              Wj[1] * d[0] + Wj[3] * d[1] + Wj[4] * d[2],
+                              Wj[2] * d[0] + Wj[4] * d[1] + Wj[5] * d[2]};
+        for (int k = 0; k < 3; k++) ind[k] += sg * (n[k] - wd[k]);
     }
     const double l = sqrt(dot3(ind, ind));
-    if (!cn || !cc || !(l > 0) || !isfinite(l)) return;
+    if (!cc || !(l > 0) || !isfinite(l)) return;
     double n[3] = {ind[0] / l, ind[1] / l, ind[2] / l}, e1[3], e2[3];
     basis(n, e1, e2);
     /* the mean W in the plane normal to n: 2 x 2, closed form */

@@ -47,8 +47,8 @@ static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
 #endif
 }
 
-/* How many of a point's nearest its row reads: curvatures from
- * round(K / 8), the normal from the first round(K / 16) (at least 1). */
+/* How many of a point's nearest its row reads: the normal and the
+ * curvatures from round(K / 8) (at least 1, at most JF_NJ_HEAD). */
 size_t jf__nj_head(int k);
 
 /* The state of point i's record (JF_NJ_*). */

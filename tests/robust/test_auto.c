@@ -165,17 +165,17 @@ static jf_result *own_fits(const surf *c, size_t k, uint32_t **nbi)
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Step 6 as docs/robustness.md states it, in double precision from the
- * own fits: the normal the mean over q's round(K/16) nearest j of n_j -
- * W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side), the
- * curvatures the eigenvalues of the mean W_j over round(K/8) <= 32 nearest
- * in the plane normal to it; n[3], k[2] out; 0 where the row stays q's. */
+ * own fits, over q's round(K/8) <= 32 nearest j: the normal the mean of
+ * n_j - W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side), the
+ * curvatures the eigenvalues of the mean W_j in the plane normal to it;
+ * n[3], k[2] out; 0 where the row stays q's. */
 static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, double n[3],
                  double k[2])
 {
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
-    double fc = nearbyint(a->n_used / 8.0), fn = nearbyint(a->n_used / 16.0);
-    size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc, mn = fn < 1 ? 1 : (size_t)fn;
+    double fc = nearbyint(a->n_used / 8.0);
+    size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
     double W[9] = {0}, v[3] = {0};
     for (size_t t = 0; t < mc; t++) {
         const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
@@ -186,12 +186,11 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
             for (int s2 = 0; s2 < 3; s2++)
                 Wj[3 * r + s2] = sg * (b->k1 * b->d1[r] * b->d1[s2] + b->k2 * b->d2[r] * b->d2[s2]);
         for (int e = 0; e < 9; e++) W[e] += Wj[e];
-        if (t < mn)
-            for (int r = 0; r < 3; r++) {
-                double wd = 0;
-                for (int s2 = 0; s2 < 3; s2++) wd += Wj[3 * r + s2] * (c->s.xyz[3 * q + s2] - pj[s2]);
-                v[r] += sg * b->normal[r] - wd;
-            }
+        for (int r = 0; r < 3; r++) {
+            double wd = 0;
+            for (int s2 = 0; s2 < 3; s2++) wd += Wj[3 * r + s2] * (c->s.xyz[3 * q + s2] - pj[s2]);
+            v[r] += sg * b->normal[r] - wd;
+        }
     }
     double l = sqrt(dot3(v, v));
     for (int r = 0; r < 3; r++) n[r] = v[r] / l;
