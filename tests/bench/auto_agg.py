@@ -167,6 +167,7 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=()):
             res.append(("%s f=%g" % (name, f), errors(*ag[name], T, t1, t2)))
         # only where auto's K reached its largest candidate (variance-bound)
         ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
+        res.append(("indiv f=%g, K=%d only" % (f, KMAX), errors(*ag["indiv"], T, t1, t2)))
         res.append(("mid f=%g, K=%d only" % (f, KMAX), errors(*ag["mid"], T, t1, t2)))
         for tau in sheets:
             ag = aggregate(rows, col, I, nb, mq, sheet=tau)
