@@ -66,7 +66,7 @@ static jf_status parts_query(const jf_estimate_opts *o, jf_part_query *q, jf_err
     jf_status st = jf__part_query_init(o, q);
     if (st == JF_ERR_UNSUPPORTED || o->orient == JF_ORIENT_MST) {
         jf__set_err(err, "parts need a k-d tree neighbourhood (knn, radius) and a per-point "
-                     "orientation (not mst)");
+                         "orientation (not mst)");
         return JF_ERR_UNSUPPORTED;
     }
     return st;
