@@ -15,7 +15,7 @@ typedef struct {
     jf_halo_req req;
 } request;
 
-/* A growable array of requests or of input indices (one per thread). */
+/* A growable array of requests (one per thread). */
 typedef struct {
     request *r;
     size_t n, cap;

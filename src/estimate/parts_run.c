@@ -44,7 +44,6 @@
  *  coordinates (four with a knn's requests).
  */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 

@@ -192,13 +192,15 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     return JF_OK;
 }
 
-/* The d[j] <= b2 of d[0..n) and their j, in order, into out and sel
- * (both of room n; a compare and moves only: the same bits everywhere).
- * AVX-512's compress does eight a step where the machine has it. */
-static size_t compact_le_scalar(const double *d, size_t n, double b2, double *out, uint32_t *sel)
+/* The d[j] <= b2 of d[j0..n) and their j, in order, into out and sel
+ * after the m0 already there (both of room n; a compare and moves only:
+ * the same bits everywhere); returns the count.  AVX-512's compress does
+ * eight a step where the machine has it (compact_le). */
+static size_t compact_le_from(const double *d, size_t j0, size_t n, double b2, double *out,
+                              uint32_t *sel, size_t m0)
 {
-    size_t m = 0;
-    for (size_t j = 0; j < n; j++) {
+    size_t m = m0;
+    for (size_t j = j0; j < n; j++) {
         out[m] = d[j];
         sel[m] = (uint32_t)j;
         m += d[j] <= b2;
@@ -225,12 +227,7 @@ __attribute__((target("avx512f"), noinline)) static size_t compact_le_512(const 
         m += (size_t)__builtin_popcount(k);
         id = _mm512_add_epi32(id, eight);
     }
-    for (; j < n; j++) {
-        out[m] = d[j];
-        sel[m] = (uint32_t)j;
-        m += d[j] <= b2;
-    }
-    return m;
+    return compact_le_from(d, j, n, b2, out, sel, m);
 }
 #endif
 
@@ -239,7 +236,7 @@ static size_t compact_le(const double *d, size_t n, double b2, double *out, uint
 #if JF_AVX_PATH
     if (__builtin_cpu_supports("avx512f") && !jf__no_avx) return compact_le_512(d, n, b2, out, sel);
 #endif
-    return compact_le_scalar(d, n, b2, out, sel);
+    return compact_le_from(d, 0, n, b2, out, sel, 0);
 }
 
 /* Step 2 for q from the candidates held: 1 with q's k nearest, or 0. */
