@@ -8,7 +8,12 @@
  * bias of first order; the curvatures are those of the mean W_j.  Both
  * over the round(K/8) nearest, measured offline (tests/bench/auto_agg.py;
  * docs/robustness.md: K/16 for the normal lost the ellipsoid at 0.1%,
- * K/4 the clean armadillo). */
+ * K/4 the clean armadillo).  Where the noise is large against the fit's
+ * spread (JF_NJ_MID) each W_j is noisy: the normal is then the mean of
+ * that and the normals carried by the mean shape operator (a trapezoid
+ * step), each neighbour weighted by its slope's inverse variance (a
+ * one-sided fit at a border, on fewer points, counts less). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -102,6 +107,10 @@ void jf__nj_put(const jf__njs *s, size_t i, const jf_result *r)
         e->w[0] = (float)(r->k1 * a1 * a1 + r->k2 * a2 * a2);
         e->w[1] = (float)(r->k1 * a1 * b1 + r->k2 * a2 * b2);
         e->w[2] = (float)(r->k1 * b1 * b1 + r->k2 * b2 * b2);
+        /* 1 / var of the slope, up to sigma's constant: K points spread
+         * over l1 + l2 each (0 where sigma is unknown, FLT_MAX exact) */
+        const double iv = r->n_used * (r->pca_eval[1] + r->pca_eval[2]) / (r->sigma * r->sigma);
+        e->iv = !(iv >= 0.0) ? 0.0f : iv < FLT_MAX ? (float)iv : FLT_MAX;
     }
     __atomic_store_n(&s->state[i], good ? JF_NJ_FIT : JF_NJ_NONE, __ATOMIC_RELEASE);
 }
@@ -125,6 +134,7 @@ int jf__nj_decode(const jf__njs *s, size_t j, double out[JF_NJ_DEC])
     W[3] = u1[1] * e1[1] + u2[1] * e2[1];
     W[4] = u1[1] * e1[2] + u2[1] * e2[2];
     W[5] = u1[2] * e1[2] + u2[2] * e2[2];
+    out[9] = e->iv;
     return 1;
 }
 
@@ -138,6 +148,10 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     if (mc > m) mc = m;
     double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
     size_t cc = 0;
+    /* the weighted sums (JF_NJ_MID): carried normals, normals, q - j, W */
+    const double sq = r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2]));
+    const int wide = sq > JF_NJ_MID;
+    double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0}, Ww[6] = {0, 0, 0, 0, 0, 0};
     for (size_t t = 0; t < mc; t++) {
         const size_t j = head[t];
         double own[JF_NJ_DEC];
@@ -159,6 +173,21 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
                               Wj[1] * d[0] + Wj[3] * d[1] + Wj[4] * d[2],
                               Wj[2] * d[0] + Wj[4] * d[1] + Wj[5] * d[2]};
         for (int k = 0; k < 3; k++) ind[k] += sg * (n[k] - wd[k]);
+        if (!wide) continue;
+        const double w = D[9], ws = sg * w;
+        sw += w;
+        for (int k = 0; k < 3; k++)
+            iw[k] += ws * (n[k] - wd[k]), nw[k] += ws * n[k], dw[k] += w * d[k];
+        for (int k = 0; k < 6; k++) Ww[k] += ws * Wj[k];
+    }
+    if (wide && sw > 0 && isfinite(sw)) {
+        /* (mean of n_j - W_j (q - j) + mean of n_j - W (q - j)) / 2, W
+         * the mean W_j; the second is mean n_j - W (mean q - j) */
+        for (int k = 0; k < 3; k++) dw[k] /= sw; /* mean q - j; the sums stay x sw */
+        const double wb[3] = {nw[0] - (Ww[0] * dw[0] + Ww[1] * dw[1] + Ww[2] * dw[2]),
+                              nw[1] - (Ww[1] * dw[0] + Ww[3] * dw[1] + Ww[4] * dw[2]),
+                              nw[2] - (Ww[2] * dw[0] + Ww[4] * dw[1] + Ww[5] * dw[2])};
+        for (int k = 0; k < 3; k++) ind[k] = iw[k] + wb[k]; /* x 2 sw: normalised below */
     }
     const double l = sqrt(dot3(ind, ind));
     if (!cc || !(l > 0) || !isfinite(l)) return;

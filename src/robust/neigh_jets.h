@@ -1,7 +1,7 @@
 /* neigh_jets.h -- auto's last step: a point's normal and curvatures from
  * the jets of its nearest points (docs/robustness.md, "Neighbourhood
- * auto", step 6).  The estimate keeps one 16-byte record per point (its
- * fit's normal and shape operator), written by whichever thread fits the
+ * auto", step 6).  The estimate keeps one 20-byte record per point (its
+ * fit's normal, shape operator and slope's weight), written by whichever thread fits the
  * point first: each fit depends only on its own neighbourhood, so every
  * writer writes the same bytes. */
 #ifndef JF_NEIGH_JETS_H
@@ -11,12 +11,15 @@
 
 #include "jetfit.h"
 
-/* One point's fit, compact: its normal (octahedral, 2 x 16 bits) and
+/* One point's fit, compact: its normal (octahedral, 2 x 16 bits),
  * shape operator in the tangent basis of that normal as decoded (w11,
- * w12, w22: no angle to decode).  The states are a byte array beside. */
+ * w12, w22: no angle to decode) and the inverse variance of its slope
+ * up to a constant, K (l1 + l2) / sigma^2 (l: the K points' tangent
+ * covariance eigenvalues).  The states are a byte array beside. */
 typedef struct {
     int16_t oct[2];
     float w[3];
+    float iv;
 } jf__njet;
 
 typedef struct {
@@ -29,6 +32,11 @@ enum { JF_NJ_EMPTY = 0, JF_NJ_BUSY = 1, JF_NJ_FIT = 2, JF_NJ_NONE = 3 };
 /* n records, all JF_NJ_EMPTY; JF_OK or JF_ERR_NOMEM. */
 jf_status jf__njs_alloc(jf__njs *s, size_t n);
 void jf__njs_free(jf__njs *s);
+
+/* sigma / sqrt(2 (l1 + l2)) of the point's own fit (about sigma / r_K
+ * on a disk of radius r_K) above which the normal mixes with weights
+ * (jf__nj_mix; docs/robustness.md, step 6) */
+#define JF_NJ_MID 0.03
 
 /* The most nearest points a row reads (f = 1/8 of K <= 256). */
 #define JF_NJ_HEAD 32
@@ -58,10 +66,10 @@ int jf__nj_state(const jf__njs *s, size_t i);
  * later ones leave it: the same bytes). */
 void jf__nj_put(const jf__njs *s, size_t i, const jf_result *r);
 
-/* Record j decoded: its normal (3) and shape operator in 3-D (xx xy xz
- * yy yz zz) to out; 0 if it holds no fit.  Waits out a JF_NJ_BUSY
+/* Record j decoded: its normal (3), shape operator in 3-D (xx xy xz
+ * yy yz zz) and weight iv to out; 0 if it holds no fit.  Waits out a JF_NJ_BUSY
  * record (its writer is mid-copy); j must not be JF_NJ_EMPTY. */
-#define JF_NJ_DEC 9
+#define JF_NJ_DEC 10
 int jf__nj_decode(const jf__njs *s, size_t j, double out[JF_NJ_DEC]);
 
 /* Records beg .. beg + n - 1 decoded once (ok[t]: jf__nj_decode's
@@ -77,8 +85,11 @@ typedef struct {
  * (q's own among them; none JF_NJ_EMPTY), through the cache c where it
  * holds them (may be NULL), at coordinates xyz (3 per record): the
  * normal the mean of each neighbour's normal carried to p by its shape
- * operator, the curvatures and directions those of the mean shape
- * operator in the plane normal to it.  Rows not fitted at degree >= 2
+ * operator (where the noise is small against the fit's spread; above
+ * JF_NJ_MID, the mean of that and the normals carried by the mean
+ * shape operator, weighted by the slopes' inverse variances), the
+ * curvatures and directions those of the mean shape operator in the
+ * plane normal to it.  Rows not fitted at degree >= 2
  * are left as they are. */
 void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, const double p[3],
                 const uint32_t *head, size_t m, jf_result *r);

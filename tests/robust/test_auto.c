@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "jetfit.h"
+#include "robust/neigh_jets.h" /* JF_NJ_MID */
 #include "synth/surfaces.h"
 #include "jf_test.h"
 
@@ -166,9 +167,12 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
 
 /* Step 6 as docs/robustness.md states it, in double precision from the
  * own fits, over q's round(K/8) <= 32 nearest j: the normal the mean of
- * n_j - W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side), the
- * curvatures the eigenvalues of the mean W_j in the plane normal to it;
- * n[3], k[2] out; 0 where the row stays q's. */
+ * n_j - W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side) --
+ * where q's sigma / sqrt(2 (l1 + l2)) exceeds JF_NJ_MID, the mean of that
+ * and n_j - W (q - j), W the mean W_j, all means weighted by K_j (l1 +
+ * l2)_j / sigma_j^2 -- the curvatures the eigenvalues of the plain mean
+ * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
+ * q's, 2 where the weighted mean was taken. */
 static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, double n[3],
                  double k[2])
 {
@@ -176,7 +180,8 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
     if (a->degree < 2) return 0;
     double fc = nearbyint(a->n_used / 8.0);
     size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
-    double W[9] = {0}, v[3] = {0};
+    const int wide = a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID;
+    double W[9] = {0}, v[3] = {0}, sw = 0, Ww[9] = {0}, vw[3] = {0}, nw[3] = {0}, dw[3] = {0};
     for (size_t t = 0; t < mc; t++) {
         const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
         const double *pj = c->s.xyz + 3 * (size_t)idx[q * JF_NB_AUTO_KMAX + t];
@@ -185,13 +190,24 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
         for (int r = 0; r < 3; r++)
             for (int s2 = 0; s2 < 3; s2++)
                 Wj[3 * r + s2] = sg * (b->k1 * b->d1[r] * b->d1[s2] + b->k2 * b->d2[r] * b->d2[s2]);
-        for (int e = 0; e < 9; e++) W[e] += Wj[e];
+        double w = b->n_used * (b->pca_eval[1] + b->pca_eval[2]) / (b->sigma * b->sigma);
+        sw += w;
+        for (int e = 0; e < 9; e++) W[e] += Wj[e], Ww[e] += w * Wj[e];
         for (int r = 0; r < 3; r++) {
             double wd = 0;
             for (int s2 = 0; s2 < 3; s2++) wd += Wj[3 * r + s2] * (c->s.xyz[3 * q + s2] - pj[s2]);
             v[r] += sg * b->normal[r] - wd;
+            vw[r] += w * (sg * b->normal[r] - wd);
+            nw[r] += w * sg * b->normal[r];
+            dw[r] += w * (c->s.xyz[3 * q + r] - pj[r]);
         }
     }
+    if (wide)
+        for (int r = 0; r < 3; r++) {
+            double wbar = nw[r] / sw;
+            for (int s2 = 0; s2 < 3; s2++) wbar -= Ww[3 * r + s2] / sw * dw[s2] / sw;
+            v[r] = (vw[r] / sw + wbar) / 2;
+        }
     double l = sqrt(dot3(v, v));
     for (int r = 0; r < 3; r++) n[r] = v[r] / l;
     /* a tangent pair of n, the 2 x 2 of the mean W in it */
@@ -214,7 +230,7 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
     for (size_t t = 0; t < mc; t++) cnt += own[idx[q * JF_NB_AUTO_KMAX + t]].degree >= 2;
     double mid = (m11 + m22) / 2, rad = hypot((m11 - m22) / 2, m12);
     k[0] = (mid + rad) / cnt, k[1] = (mid - rad) / cnt;
-    return 1;
+    return wide ? 2 : 1;
 }
 
 /* Steps 1-5: each point's own fit is the least-squares jet of its degree
@@ -238,7 +254,7 @@ START_TEST(test_auto_is_the_jet)
         ck_assert_int_eq(jf_fitter_create(&p, &fit[d]), JF_OK);
     }
     double nb[3 * JF_NB_AUTO_KMAX];
-    size_t nd[4] = {0}, moved = 0;
+    size_t nd[4] = {0}, moved = 0, nwide = 0;
     for (size_t i = 0; i < c.s.n; i++) {
         const jf_result *a = &own[i];
         ck_assert(a->degree >= 1 && a->degree <= 3);
@@ -266,10 +282,12 @@ START_TEST(test_auto_is_the_jet)
         nd[a->degree]++;
         /* step 6 */
         double n[3], kk[2];
-        if (!mixed(&c, own, nbi, i, n, kk)) {
+        int how = mixed(&c, own, nbi, i, n, kk);
+        if (!how) {
             ck_assert_int_eq(memcmp(&ra[i], a, sizeof *a), 0);
             continue;
         }
+        nwide += how == 2;
         double dm = fabs(dot3(n, ra[i].normal)), ds = fabs(dot3(a->normal, ra[i].normal));
         ck_assert_msg(dm > 1.0 - 2e-8, "point %zu: step 6's normal off by %.3g rad", i, acos(dm));
         moved += ds < 1.0 - 1e-8;
@@ -284,6 +302,9 @@ START_TEST(test_auto_is_the_jet)
     ck_assert_uint_gt(nd[2], 0); /* both degrees met */
     ck_assert_uint_gt(nd[3], 0);
     ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
+    /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID */
+    ck_assert_msg(nwide > c.s.n / 10 && nwide < c.s.n - c.s.n / 10, "weighted mean at %zu of %zu",
+                  nwide, c.s.n);
     for (int d = 1; d <= 3; d++) jf_fitter_free(fit[d]);
     free(own);
     free(nbi);
