@@ -6,7 +6,8 @@ applied to auto's rows as written: since step 6 shipped, on top of it;
 the build before it gave the figures of that section's table).
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
-       [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...] [--n N]
+       [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...]
+       [--weights W,...] [--mixgate T,... [--border B,...]] [--n N]
        [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
@@ -26,7 +27,16 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   LO:HI:KMIN only where auto's K >= KMIN, LO:HI:KMIN:1 only quadric rows
   (each cloud's 10/50/90% of s on stderr);
   with --sheet TAU, indiv and mid again over only the j whose height off
-  q's own osculating quadric is at most TAU x q's sigma (q's sheet).
+  q's own osculating quadric is at most TAU x q's sigma (q's sheet);
+  indiv3  indiv with the cubic's slope too (b0..b3 of the degree-3 rows);
+  with --weights, weighted means: kern a biweight in q's distance, ivar
+  1 / the variance of j's slope, K_j r_Kj^2 / sigma_j^2 (r_Kj read at q),
+  ivarkern both;
+  with --mixgate T (f = 1/8): mid with ivar weights where s = sigma / r_K
+  > T, plain indiv elsewhere (step 6 since 28 Nov 2026, T = 0.03); with
+  --border B also where q's offset from its m nearest, |mean (q - j)| /
+  rms |q - j|, exceeds B (each cloud's percentiles of s and the offset
+  on stderr).
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
@@ -52,8 +62,8 @@ KS = (18, 32, 64, 128, 256)
 KMAX = 256  # auto's largest candidate
 
 
-def run(jetfit, cloud, nb, out):
-    subprocess.run([jetfit, "estimate", cloud, "-o", out, "--neighbors", nb, "--quiet"], check=True)
+def run(jetfit, cloud, nb, out, extra=()):
+    subprocess.run([jetfit, "estimate", cloud, "-o", out, "--neighbors", nb, "--quiet"] + list(extra), check=True)
     with open(out) as fh:
         names = fh.readline().lstrip("#").split()
     rows = np.loadtxt(out, comments="#")
@@ -71,7 +81,7 @@ def neighbours(Y, Q, m):
     return nb
 
 
-def aggregate(rows, col, I, nb, mq, sheet=None):
+def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
     """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i],
     and (key "snaps") indiv's running sums and counts at m = 1, 2, 4, ...;
     with sheet = TAU only the j whose height off q's own osculating
@@ -90,6 +100,8 @@ def aggregate(rows, col, I, nb, mq, sheet=None):
     snaps = {}
     cnt = np.zeros(n)
     mean_n, cen, ind = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    ind3 = np.zeros((n, 3))
+    B = np.nan_to_num(R[:, col["b0"]:col["b0"] + 4]) if "b0" in col else np.zeros((len(R), 4))
     W = np.zeros((n, 3, 3))
     if sheet is not None:
         Wq = k1[I][:, None, None] * D1[I][:, :, None] * D1[I][:, None, :] + \
@@ -105,6 +117,8 @@ def aggregate(rows, col, I, nb, mq, sheet=None):
         on = on.astype(float)
         if not on.any():
             break
+        if weight is not None:
+            on = on * weight(t, j)
         s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
         nj = N[j] * s[:, None]
         a1, a2 = k1[j] * s, k2[j] * s
@@ -116,6 +130,13 @@ def aggregate(rows, col, I, nb, mq, sheet=None):
         cen += P[j] * on[:, None]
         W += Wj * on[:, None, None]
         ind += (nj - np.einsum("nij,nj->ni", Wj, d)) * on[:, None]
+        # the cubic's slope too (Monge form, CGAL's b: z = (k1 u^2 + k2 v^2) / 2
+        # + (b0 u^3 + 3 b1 u^2 v + 3 b2 u v^2 + b3 v^3) / 6)
+        u, v = (d * D1[j]).sum(1), (d * D2[j]).sum(1)
+        b = B[j] * s[:, None]
+        fu = a1 * u + 0.5 * (b[:, 0] * u * u + 2 * b[:, 1] * u * v + b[:, 2] * v * v)
+        fv = a2 * v + 0.5 * (b[:, 1] * u * u + 2 * b[:, 2] * u * v + b[:, 3] * v * v)
+        ind3 += (nj - fu[:, None] * D1[j] - fv[:, None] * D2[j]) * on[:, None]
         if not t & (t + 1):  # t + 1 a power of two
             snaps[t + 1] = (ind.copy(), cnt.copy())
     cnt = np.maximum(cnt, 1.0)
@@ -123,10 +144,11 @@ def aggregate(rows, col, I, nb, mq, sheet=None):
     mean_n /= cnt[:, None]
     cen /= cnt[:, None]
     ind /= cnt[:, None]
+    ind3 /= cnt[:, None]
     # sum of n_j - W (q - j) over the m, divided by m: mean_n - W (q - cen)
     wbar = mean_n - np.einsum("nij,nj->ni", W, PI - cen)
     out = {"snaps": snaps}
-    for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0)):
+    for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0), ("indiv3", ind3)):
         nn = v / np.linalg.norm(v, axis=1)[:, None]
         Pm = np.eye(3)[None] - nn[:, :, None] * nn[:, None, :]
         ev, evec = np.linalg.eigh(Pm @ W @ Pm)
@@ -148,27 +170,36 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=()):
+def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights=(), mixgates=(), borders=(9.0,), lowweights=()):
+    T_ = T
     """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
     fixed = {}
     for k in KS:
         rows, col = run(jetfit, cloud, "knn:%d" % (k + 1), os.path.join(work, "f.xyz"))
         fixed[k] = errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2)
     best = [min((fixed[k][c], k) for k in KS) for c in range(len(fixed[KS[0]]))]
-    rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"))
+    rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"), ["--degree", "3", "--monge-degree", "3"])
     K = rows[I, col["neighbors"]]
     res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
     nb = neighbours(rows[:, 0:3], rows[I, 0:3],
-                    max(int(max(fs + ([0.5] if gates else [])) * K.max()) + 1, KMAX if taus else 0))
+                    max(int(max(fs + ([0.5] if gates else [])) * K.max()) + 1, KMAX + 1 if (taus or weights or mixgates) else 0))
+    dq = np.linalg.norm(rows[nb, 0:3] - rows[I, 0:3][:, None, :], axis=2)
+    Kall = rows[:, col["neighbors"]].astype(int)
+    sig = rows[:, col["sigma"]]
     for f in fs:
         mq = np.maximum(1, np.round(f * K)).astype(int)
         ag = aggregate(rows, col, I, nb, mq)
-        for name in ("indiv", "mid"):
+        for name in ("indiv", "mid", "indiv3"):
             res.append(("%s f=%g" % (name, f), errors(*ag[name], T, t1, t2)))
         # only where auto's K reached its largest candidate (variance-bound)
         ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
         res.append(("indiv f=%g, K=%d only" % (f, KMAX), errors(*ag["indiv"], T, t1, t2)))
         res.append(("mid f=%g, K=%d only" % (f, KMAX), errors(*ag["mid"], T, t1, t2)))
+        for wname in weights:
+            wfun = weigher(wname, dq, Kall, sig, I, mq)
+            ag = aggregate(rows, col, I, nb, mq, weight=wfun)
+            for name in ("indiv", "mid"):
+                res.append(("%s f=%g, weights %s" % (name, f, wname), errors(*ag[name], T, t1, t2)))
         for tau in sheets:
             ag = aggregate(rows, col, I, nb, mq, sheet=tau)
             for name in ("indiv", "mid"):
@@ -176,6 +207,33 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=()):
         for tau in taus:
             res.append(("indiv, Lepski tau=%g, m <= %g K" % (tau, f),
                         errors(lepski(rows, col, I, nb, K, mq, tau), None, None, T)))
+    if mixgates:
+        kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+        s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+        print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
+              file=sys.stderr, flush=True)
+        mq = np.maximum(1, np.round(K / 8.0)).astype(int)
+        flat = aggregate(rows, col, I, nb, mq)
+        iv = aggregate(rows, col, I, nb, mq, weight=weigher("ivar", dq, Kall, sig, I, mq))
+        # the offset of q from its m nearest: |mean (q - j)| / rms |q - j| (a border)
+        L = min(int(mq.max()), nb.shape[1])
+        e = rows[nb[:, :L], 0:3] - rows[I, 0:3][:, None, :]
+        on = (np.arange(L)[None, :] < mq[:, None]).astype(float)
+        cnt = on.sum(1)
+        off = np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / cnt / np.sqrt(((e * e).sum(2) * on).sum(1) / cnt)
+        print("offset 10/50/90/99%%: %.3f %.3f %.3f %.3f" % tuple(np.nanpercentile(off, [10, 50, 90, 99])),
+              file=sys.stderr, flush=True)
+        lows = {"": flat}
+        for lw in lowweights:
+            lows[lw] = aggregate(rows, col, I, nb, mq, weight=weigher(lw, dq, Kall, sig, I, mq))
+            res.append(("indiv weights %s" % lw, errors(*lows[lw]["indiv"], T_, t1, t2)))
+        for T in mixgates:
+            for B in borders:
+                for lw, lo in lows.items():
+                    hi = ((s > T) | (off > B))[:, None]
+                    pick = np.where(hi, iv["mid"][0], lo["indiv"][0])
+                    res.append(("mixgate %g border %g low %s (%.0f%% mid)" % (T, B, lw or "plain", 100 * hi.mean()),
+                                errors(pick, flat["indiv"][1], flat["indiv"][2], T_, t1, t2)))
     if gates:
         kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
         s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
@@ -192,6 +250,31 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=()):
                             np.where((ok & (s > lo))[:, None], wide["indiv"][0], small))
             res.append(("gate sigma/r_K %s" % ":".join("%g" % v for v in g), errors(pick, None, None, T)))
     return best, res
+
+
+def weigher(wname, dq, Kall, sig, I, mq):
+    """a neighbour's weight at step t (j = nb[:, t]): "kern", a biweight in
+    q's distance, zero at the (m+1)-th; "ivar", 1 / sd^2 of j's slope,
+    K_j r_Kj^2 / sigma_j^2 (r_Kj read at q), relative to q's own"""
+    at = np.arange(len(I))
+
+    def wfun(t, j):
+        w = np.ones(len(I))
+        if "kern" in wname:
+            u = dq[:, t] / np.maximum(dq[at, np.minimum(mq, dq.shape[1] - 1)], 1e-300)
+            w = w * np.clip(1.0 - u * u, 0.0, 1.0) ** 2
+        if wname == "kw":  # the fit's size alone
+            w = w * Kall[j] / np.maximum(Kall[I], 1)
+        if wname == "ivfl":  # ivar with sigma floored at 0.03 r_K (the gate's s)
+            kj, k0 = np.clip(Kall[j], 1, dq.shape[1]), np.clip(Kall[I], 1, dq.shape[1])
+            r, r0 = dq[at, kj - 1], dq[at, k0 - 1]
+            w = w * (kj / np.maximum(sig[j], 0.03 * r) ** 2 * r * r) / (k0 / np.maximum(sig[I], 0.03 * r0) ** 2 * r0 * r0)
+        if "ivar" in wname:
+            kj, k0 = np.clip(Kall[j], 1, dq.shape[1]), np.clip(Kall[I], 1, dq.shape[1])
+            r, r0 = dq[at, kj - 1], dq[at, k0 - 1]
+            w = w * (kj * r * r / np.maximum(sig[j], 1e-12) ** 2) / (k0 * r0 * r0 / np.maximum(sig[I], 1e-12) ** 2)
+        return np.where(np.isfinite(w), w, 0.0)
+    return wfun
 
 
 def lepski(rows, col, I, nb, K, cap, tau):
@@ -236,6 +319,10 @@ def main():
     ap.add_argument("--lepski", default="", help="taus of a per-point m rule (e.g. 1,2,4)")
     ap.add_argument("--gate", default="", help="LO:HI[:KMIN[:1]] bounds of sigma / r_K (e.g. 0.01:0.02)")
     ap.add_argument("--sheet", default="", help="TAUs of the same-sheet test (e.g. 2,3,4)")
+    ap.add_argument("--weights", default="", help="weighted means: kern, ivar, ivarkern")
+    ap.add_argument("--mixgate", default="", help="sigma / r_K above which mid with ivar weights, f = 1/8")
+    ap.add_argument("--border", default="9", help="with --mixgate: mid also where q's offset from its m nearest exceeds B")
+    ap.add_argument("--lowweight", default="", help="with --mixgate: weights of indiv below the gate (kw, ivfl)")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -246,6 +333,10 @@ def main():
     taus = [float(v) for v in a.lepski.split(",") if v]
     gates = [tuple(float(x) for x in v.split(":")) for v in a.gate.split(",") if v]
     sheets = [float(v) for v in a.sheet.split(",") if v]
+    weights = [v for v in a.weights.split(",") if v]
+    mixgates = [float(v) for v in a.mixgate.split(",") if v]
+    borders = [float(v) for v in a.border.split(",") if v]
+    lowweights = [v for v in a.lowweight.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in ("ellipsoid", "torus", "exp"):
@@ -257,7 +348,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -272,7 +363,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
