@@ -151,7 +151,8 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     /* the weighted sums (JF_NJ_MID): carried normals, normals, q - j, W */
     const double sq = r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2]));
     const int wide = sq > JF_NJ_MID;
-    double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0}, Ww[6] = {0, 0, 0, 0, 0, 0};
+    double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
+    double Ww[6] = {0, 0, 0, 0, 0, 0};
     for (size_t t = 0; t < mc; t++) {
         const size_t j = head[t];
         double own[JF_NJ_DEC];

@@ -1,9 +1,9 @@
 /* neigh_jets.h -- auto's last step: a point's normal and curvatures from
  * the jets of its nearest points (docs/robustness.md, "Neighbourhood
  * auto", step 6).  The estimate keeps one 20-byte record per point (its
- * fit's normal, shape operator and slope's weight), written by whichever thread fits the
- * point first: each fit depends only on its own neighbourhood, so every
- * writer writes the same bytes. */
+ * fit's normal, shape operator and slope's weight), written by whichever
+ * thread fits the point first: each fit depends only on its own
+ * neighbourhood, so every writer writes the same bytes. */
 #ifndef JF_NEIGH_JETS_H
 #define JF_NEIGH_JETS_H
 #include <stddef.h>
@@ -67,8 +67,8 @@ int jf__nj_state(const jf__njs *s, size_t i);
 void jf__nj_put(const jf__njs *s, size_t i, const jf_result *r);
 
 /* Record j decoded: its normal (3), shape operator in 3-D (xx xy xz
- * yy yz zz) and weight iv to out; 0 if it holds no fit.  Waits out a JF_NJ_BUSY
- * record (its writer is mid-copy); j must not be JF_NJ_EMPTY. */
+ * yy yz zz) and weight iv to out; 0 if it holds no fit.  Waits out a
+ * JF_NJ_BUSY record (its writer is mid-copy); j must not be JF_NJ_EMPTY. */
 #define JF_NJ_DEC 10
 int jf__nj_decode(const jf__njs *s, size_t j, double out[JF_NJ_DEC]);
 
@@ -89,8 +89,8 @@ typedef struct {
  * JF_NJ_MID, the mean of that and the normals carried by the mean
  * shape operator, weighted by the slopes' inverse variances), the
  * curvatures and directions those of the mean shape operator in the
- * plane normal to it.  Rows not fitted at degree >= 2
- * are left as they are. */
+ * plane normal to it.  Rows not fitted at degree >= 2 are left as they
+ * are. */
 void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, const double p[3],
                 const uint32_t *head, size_t m, jf_result *r);
 #endif
