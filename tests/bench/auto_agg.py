@@ -170,7 +170,7 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights=(), mixgates=(), borders=(9.0,), lowweights=()):
+def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights=(), mixgates=(), borders=(9.0,), lowweights=(), borderk=False):
     T_ = T
     """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
     fixed = {}
@@ -221,6 +221,12 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights
         on = (np.arange(L)[None, :] < mq[:, None]).astype(float)
         cnt = on.sum(1)
         off = np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / cnt / np.sqrt(((e * e).sum(2) * on).sum(1) / cnt)
+        if borderk:  # the same over q's own K nearest (its fit's points)
+            L = min(int(K.max()), nb.shape[1])
+            e = rows[nb[:, :L], 0:3] - rows[I, 0:3][:, None, :]
+            on = (np.arange(L)[None, :] < K[:, None]).astype(float)
+            cnt = on.sum(1)
+            off = np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / cnt / np.sqrt(((e * e).sum(2) * on).sum(1) / cnt)
         print("offset 10/50/90/99%%: %.3f %.3f %.3f %.3f" % tuple(np.nanpercentile(off, [10, 50, 90, 99])),
               file=sys.stderr, flush=True)
         lows = {"": flat}
@@ -323,6 +329,7 @@ def main():
     ap.add_argument("--mixgate", default="", help="sigma / r_K above which mid with ivar weights, f = 1/8")
     ap.add_argument("--border", default="9", help="with --mixgate: mid also where q's offset from its m nearest exceeds B")
     ap.add_argument("--lowweight", default="", help="with --mixgate: weights of indiv below the gate (kw, ivfl)")
+    ap.add_argument("--borderk", action="store_true", help="--border's offset over q's K nearest, not its m")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -348,7 +355,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights, a.borderk)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -363,7 +370,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights)
+                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights, a.borderk)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
