@@ -231,7 +231,8 @@ jf_status jf__nb_point(const nbctx *x, jf_natural_ws *ws, jf__knn_share *sh, siz
         break;
     default: /* sh: auto's 256 nearest, shared along the walk (knn_share.c) */
         if (sh)
-            st = jf__knn_share_query(sh, x->ix, p, idx, pos, d2, xyz, found);
+            /* input indices for the graph only; nobody reads d2 */
+            st = jf__knn_share_query(sh, x->ix, p, x->graph ? idx : NULL, pos, NULL, xyz, found);
         else if (x->nb->kind == JF_NB_KNN && hint && x->nb->k && hint_n == x->nb->k &&
                  hint_n <= x->cap)
             st = knn_hinted(x, p, hint, hint_n, idx, d2, xyz, found);

@@ -200,7 +200,7 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
             st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && jf__nj_on(p, x->nb)) /* auto's search, shared along the walk */
-        st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, &w->share);
+        st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, JF_NJ_HEAD, &w->share);
     if (st != JF_OK) worker_free(w);
     return st;
 }

@@ -30,9 +30,11 @@ jf_status jf__index_query(const jf_index *ix, const double q[3], size_t k, doubl
 
 /* knn_share.c: jf__index_query's k nearest (bound INFINITY) of a run of
  * nearby query points from one search per few points (neighbors auto).
- * The same lists, bit for bit; a jf__knn_share is one thread's. */
+ * The same lists, bit for bit; a jf__knn_share is one thread's.  A query
+ * writes what is not NULL of idx, d2, xyz (k each) and pos (only the
+ * first npos: step 6 reads q's nearest 32). */
 typedef struct jf__knn_share jf__knn_share;
-jf_status jf__knn_share_create(size_t k, jf__knn_share **out);
+jf_status jf__knn_share_create(size_t k, size_t npos, jf__knn_share **out);
 void jf__knn_share_free(jf__knn_share *s);
 /* The walk's next n points, xyz[0..2] the next query's (a hint for where
  * to search: any hint gives the same lists). */

@@ -31,6 +31,7 @@
 
 #include "avx_path.h" /* JF_CLONES */
 #include "index_internal.h"
+#include "simd.h"
 
 #define SH_AHEAD 16 /* walk points looked at for a search's centre */
 #define KSHARE 4 /* candidates: KSHARE x k (up to 1024: the tree's buffer mode) */
@@ -52,6 +53,7 @@ typedef struct {
 
 struct jf__knn_share {
     size_t k, kc;  /* asked, candidates searched                       */
+    size_t npos;   /* positions written per query (the first npos)     */
     sh_set set[SH_SETS];
     int cur;       /* the set that served last (or was searched last)  */
     double *d2;    /* per query: candidates' d2                          */
@@ -90,13 +92,14 @@ void jf__knn_share_free(jf__knn_share *s)
     free(s);
 }
 
-jf_status jf__knn_share_create(size_t k, jf__knn_share **out)
+jf_status jf__knn_share_create(size_t k, size_t npos, jf__knn_share **out)
 {
     *out = NULL;
     if (!k) return JF_ERR_INVALID;
     jf__knn_share *s = calloc(1, sizeof *s);
     if (!s) return JF_ERR_NOMEM;
     s->k = k;
+    s->npos = npos < k ? npos : k;
     s->kc = KSHARE * k;
     int ok = 1;
     for (int i = 0; i < SH_SETS; i++) {
@@ -174,8 +177,8 @@ static jf_status rebuild(jf__knn_share *s, const jf_index *ix, const double q[3]
     }
     s->expo = f == s->kc && cs->cd2[f / 2 - 1] > 0.0 ? log2(cs->cd2[f - 1] / cs->cd2[f / 2 - 1]) : 0.0;
     size_t m = f < s->k ? f : s->k;
-    memcpy(idx, cs->cid, m * sizeof *idx);
-    if (pos) memcpy(pos, cs->cpos, m * sizeof *pos);
+    if (idx) memcpy(idx, cs->cid, m * sizeof *idx);
+    if (pos) memcpy(pos, cs->cpos, (m < s->npos ? m : s->npos) * sizeof *pos);
     if (d2) memcpy(d2, cs->cd2, m * sizeof *d2);
     if (xyz) memcpy(xyz, cs->cxyz, 3 * m * sizeof *xyz);
     *found = m;
@@ -315,6 +318,14 @@ again:;
     }
     const size_t end = start[bl];
     for (size_t i = 1; i < end; i++) {
+        /* four at once while each is above the one before (most buckets
+         * hold one point: most of the list is in order already) */
+        for (v4d a, b; i + 4 <= end; i += 4) {
+            memcpy(&a, td + i, sizeof a);
+            memcpy(&b, td + i - 1, sizeof b);
+            if (!all4((v4l)(a > b))) break;
+        }
+        if (i >= end) break;
         double d = td[i];
         if (!SH_LESS(d, cid[tp[i]], td[i - 1], cid[tp[i - 1]])) continue;
         uint32_t p = tp[i], pid = cid[p];
@@ -333,9 +344,10 @@ again:;
     if (!((sqrt(td[k - 1]) + delta) * (1.0 + 1e-9) < cs->R))
         return 0;
     const double *cxyz = cs->cxyz;
-    for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
+    if (idx)
+        for (size_t i = 0; i < k; i++) idx[i] = cid[tp[i]];
     if (pos)
-        for (size_t i = 0; i < k; i++) pos[i] = cs->cpos[tp[i]];
+        for (size_t i = 0; i < s->npos; i++) pos[i] = cs->cpos[tp[i]];
     if (d2) memcpy(d2, td, k * sizeof *d2);
     if (xyz)
         for (size_t i = 0; i < k; i++) /* one 16- and one 8-byte move */

@@ -6,7 +6,9 @@
  * ties), duplicates, clouds of fewer than 2k points, and coordinates
  * whose squared distances are subnormal or near 1e10; every other query
  * with the default build's selection (jf__no_avx), the rest with the
- * machine's (AVX-512's compress where it has it). */
+ * machine's (AVX-512's compress where it has it); the first SH_NPOS
+ * tree positions of each list (step 6's nearest) name the same points,
+ * and nothing past them is written; every third query without indices. */
 #include <check.h>
 #include <math.h>
 #include <stdint.h>
@@ -17,6 +19,8 @@
 #include "index_internal.h"
 #include "jetfit.h"
 #include "jf_test.h"
+
+#define SH_NPOS 7 /* positions asked of each query */
 
 /* Every point of xyz[n] queried in the order ord (NULL: the tree's walk,
  * with its next points as the hint) through one jf__knn_share of k,
@@ -38,7 +42,7 @@ static size_t mismatches(const double *xyz, size_t n, size_t k, int shuffled)
         ord[j] = t;
     }
     jf__knn_share *sh = NULL;
-    ck_assert_int_eq(jf__knn_share_create(k, &sh), JF_OK);
+    ck_assert_int_eq(jf__knn_share_create(k, SH_NPOS, &sh), JF_OK);
     uint32_t *ia = malloc(k * sizeof *ia), *ib = malloc(k * sizeof *ib);
     double *da = malloc(k * sizeof *da), *db = malloc(k * sizeof *db);
     double *xa = malloc(3 * k * sizeof *xa), *xb = malloc(3 * k * sizeof *xb);
@@ -49,10 +53,15 @@ static size_t mismatches(const double *xyz, size_t n, size_t k, int shuffled)
         size_t fa = 0, fb = 0;
         ck_assert_int_eq(jf__index_query(ix, q, k, INFINITY, ia, da, xa, &fa), JF_OK);
         jf__no_avx = (int)(w % 2);
-        ck_assert_int_eq(jf__knn_share_query(sh, ix, q, ib, NULL, db, xb, &fb), JF_OK);
+        uint32_t pb[SH_NPOS + 1];
+        pb[SH_NPOS] = UINT32_MAX; /* must stay */
+        uint32_t *ibq = w % 3 == 2 ? NULL : ib;
+        ck_assert_int_eq(jf__knn_share_query(sh, ix, q, ibq, pb, db, xb, &fb), JF_OK);
         jf__no_avx = 0;
-        if (fa != fb || memcmp(ia, ib, fa * sizeof *ia) || memcmp(da, db, fa * sizeof *da) ||
-            memcmp(xa, xb, 3 * fa * sizeof *xa))
+        int pos_ok = pb[SH_NPOS] == UINT32_MAX;
+        for (size_t i = 0; i < SH_NPOS && i < fb && pos_ok; i++) pos_ok = id[pb[i]] == ia[i];
+        if (fa != fb || (ibq && memcmp(ia, ib, fa * sizeof *ia)) || memcmp(da, db, fa * sizeof *da) ||
+            memcmp(xa, xb, 3 * fa * sizeof *xa) || !pos_ok)
             bad++;
     }
     jf__knn_share_free(sh);
