@@ -7,8 +7,8 @@ the build before it gave the figures of that section's table).
 
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
        [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...]
-       [--weights W,...] [--mixgate T,... [--border B,...]] [--n N]
-       [--seed S]
+       [--weights W,...] [--mixgate T,... [--border B,...]]
+       [--biweight C,...] [--bulk] [--n N] [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -29,6 +29,8 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   with --sheet TAU, indiv and mid again over only the j whose height off
   q's own osculating quadric is at most TAU x q's sigma (q's sheet);
   indiv3  indiv with the cubic's slope too (b0..b3 of the degree-3 rows);
+  midq   mean of n_j - (W_j + W_q)/2 (q - j): the trapezoid with q's own
+         shape operator W_q instead of the mean W;
   with --weights, weighted means: kern a biweight in q's distance, ivar
   1 / the variance of j's slope, K_j r_Kj^2 / sigma_j^2 (r_Kj read at q),
   ivarkern both;
@@ -36,7 +38,14 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   > T, plain indiv elsewhere (step 6 since 28 Nov 2026, T = 0.03); with
   --border B also where q's offset from its m nearest, |mean (q - j)| /
   rms |q - j|, exceeds B (each cloud's percentiles of s and the offset
-  on stderr).
+  on stderr);
+  with --biweight C, indiv and mid as Tukey biweighted means of the m
+  carries (scale C x 1.4826 x their median deviation from the mean; mid's
+  W the biweighted mean W_j): a robust mean, which a wild neighbour's fit
+  does not move;
+  with --bulk, on stderr, indiv's RMS normal at m = 1, 2, 4, ..., 64 over
+  the rows whose K is 256 and degree 2 (the bulk) and over the others,
+  from every neighbour and from the bulk's only.
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
@@ -103,9 +112,10 @@ def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
     ind3 = np.zeros((n, 3))
     B = np.nan_to_num(R[:, col["b0"]:col["b0"] + 4]) if "b0" in col else np.zeros((len(R), 4))
     W = np.zeros((n, 3, 3))
+    indq = np.zeros((n, 3))
+    Wq = k1[I][:, None, None] * D1[I][:, :, None] * D1[I][:, None, :] + \
+        k2[I][:, None, None] * D2[I][:, :, None] * D2[I][:, None, :]
     if sheet is not None:
-        Wq = k1[I][:, None, None] * D1[I][:, :, None] * D1[I][:, None, :] + \
-            k2[I][:, None, None] * D2[I][:, :, None] * D2[I][:, None, :]
         lim = sheet * R[I, col["sigma"]]
     for t in range(nb.shape[1]):
         j = nb[:, t]
@@ -130,6 +140,7 @@ def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
         cen += P[j] * on[:, None]
         W += Wj * on[:, None, None]
         ind += (nj - np.einsum("nij,nj->ni", Wj, d)) * on[:, None]
+        indq += (nj - 0.5 * np.einsum("nij,nj->ni", Wj + Wq, d)) * on[:, None]
         # the cubic's slope too (Monge form, CGAL's b: z = (k1 u^2 + k2 v^2) / 2
         # + (b0 u^3 + 3 b1 u^2 v + 3 b2 u v^2 + b3 v^3) / 6)
         u, v = (d * D1[j]).sum(1), (d * D2[j]).sum(1)
@@ -145,10 +156,11 @@ def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
     cen /= cnt[:, None]
     ind /= cnt[:, None]
     ind3 /= cnt[:, None]
+    indq /= cnt[:, None]
     # sum of n_j - W (q - j) over the m, divided by m: mean_n - W (q - cen)
     wbar = mean_n - np.einsum("nij,nj->ni", W, PI - cen)
     out = {"snaps": snaps}
-    for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0), ("indiv3", ind3)):
+    for name, v in (("indiv", ind), ("mid", (ind + wbar) / 2.0), ("indiv3", ind3), ("midq", indq)):
         nn = v / np.linalg.norm(v, axis=1)[:, None]
         Pm = np.eye(3)[None] - nn[:, :, None] * nn[:, None, :]
         ev, evec = np.linalg.eigh(Pm @ W @ Pm)
@@ -170,9 +182,10 @@ def errors(nrm, c1, c2, T, t1=None, t2=None):
     return ang, np.nanmedian(np.abs(e1 - t1)), np.nanmedian(np.abs(e2 - t2))
 
 
-def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights=(), mixgates=(), borders=(9.0,), lowweights=(), borderk=False):
-    T_ = T
-    """one cloud: best fixed k, auto, auto aggregated per f (list of rows)"""
+def study(jetfit, cloud, I, T, t1, t2, o, work):
+    """one cloud: best fixed k, auto, auto aggregated per f (list of rows);
+    o: the parsed options (main)"""
+    fs, taus, gates, sheets, weights = o.fs, o.taus, o.gates, o.sheets, o.weights
     fixed = {}
     for k in KS:
         rows, col = run(jetfit, cloud, "knn:%d" % (k + 1), os.path.join(work, "f.xyz"))
@@ -182,14 +195,15 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights
     K = rows[I, col["neighbors"]]
     res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
     nb = neighbours(rows[:, 0:3], rows[I, 0:3],
-                    max(int(max(fs + ([0.5] if gates else [])) * K.max()) + 1, KMAX + 1 if (taus or weights or mixgates) else 0))
+                    max(int(max(fs + ([0.5] if gates else [])) * K.max()) + 1,
+                        KMAX + 1 if (taus or weights or o.mixgates) else 0, 65 if o.bulk else 0))
     dq = np.linalg.norm(rows[nb, 0:3] - rows[I, 0:3][:, None, :], axis=2)
     Kall = rows[:, col["neighbors"]].astype(int)
     sig = rows[:, col["sigma"]]
     for f in fs:
         mq = np.maximum(1, np.round(f * K)).astype(int)
         ag = aggregate(rows, col, I, nb, mq)
-        for name in ("indiv", "mid", "indiv3"):
+        for name in ("indiv", "mid", "indiv3", "midq"):
             res.append(("%s f=%g" % (name, f), errors(*ag[name], T, t1, t2)))
         # only where auto's K reached its largest candidate (variance-bound)
         ag = aggregate(rows, col, I, nb, np.where(K >= KMAX, mq, 1))
@@ -207,44 +221,34 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights
         for tau in taus:
             res.append(("indiv, Lepski tau=%g, m <= %g K" % (tau, f),
                         errors(lepski(rows, col, I, nb, K, mq, tau), None, None, T)))
-    if mixgates:
-        kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
-        s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
-        print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
-              file=sys.stderr, flush=True)
+        for c in o.biweights:
+            for name, v in zip(("indiv", "mid"), biweight_means(rows, col, I, nb, mq, c)):
+                res.append(("%s f=%g, biweight %g" % (name, f, c), errors(v, None, None, T)))
+    if o.bulk:
+        bulk_rms(rows, col, I, nb, T)
+    if o.mixgates:
+        s = noise_ratio(rows, col, I, nb, K)
         mq = np.maximum(1, np.round(K / 8.0)).astype(int)
         flat = aggregate(rows, col, I, nb, mq)
         iv = aggregate(rows, col, I, nb, mq, weight=weigher("ivar", dq, Kall, sig, I, mq))
         # the offset of q from its m nearest: |mean (q - j)| / rms |q - j| (a border)
-        L = min(int(mq.max()), nb.shape[1])
-        e = rows[nb[:, :L], 0:3] - rows[I, 0:3][:, None, :]
-        on = (np.arange(L)[None, :] < mq[:, None]).astype(float)
-        cnt = on.sum(1)
-        off = np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / cnt / np.sqrt(((e * e).sum(2) * on).sum(1) / cnt)
-        if borderk:  # the same over q's own K nearest (its fit's points)
-            L = min(int(K.max()), nb.shape[1])
-            e = rows[nb[:, :L], 0:3] - rows[I, 0:3][:, None, :]
-            on = (np.arange(L)[None, :] < K[:, None]).astype(float)
-            cnt = on.sum(1)
-            off = np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / cnt / np.sqrt(((e * e).sum(2) * on).sum(1) / cnt)
+        # borderk: the same over q's own K nearest (its fit's points)
+        off = offset(rows, I, nb, K if o.borderk else mq)
         print("offset 10/50/90/99%%: %.3f %.3f %.3f %.3f" % tuple(np.nanpercentile(off, [10, 50, 90, 99])),
               file=sys.stderr, flush=True)
         lows = {"": flat}
-        for lw in lowweights:
+        for lw in o.lowweights:
             lows[lw] = aggregate(rows, col, I, nb, mq, weight=weigher(lw, dq, Kall, sig, I, mq))
-            res.append(("indiv weights %s" % lw, errors(*lows[lw]["indiv"], T_, t1, t2)))
-        for T in mixgates:
-            for B in borders:
+            res.append(("indiv weights %s" % lw, errors(*lows[lw]["indiv"], T, t1, t2)))
+        for G in o.mixgates:
+            for B in o.borders:
                 for lw, lo in lows.items():
-                    hi = ((s > T) | (off > B))[:, None]
+                    hi = ((s > G) | (off > B))[:, None]
                     pick = np.where(hi, iv["mid"][0], lo["indiv"][0])
-                    res.append(("mixgate %g border %g low %s (%.0f%% mid)" % (T, B, lw or "plain", 100 * hi.mean()),
-                                errors(pick, flat["indiv"][1], flat["indiv"][2], T_, t1, t2)))
+                    res.append(("mixgate %g border %g low %s (%.0f%% mid)" % (G, B, lw or "plain", 100 * hi.mean()),
+                                errors(pick, flat["indiv"][1], flat["indiv"][2], T, t1, t2)))
     if gates:
-        kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
-        s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
-        print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
-              file=sys.stderr, flush=True)
+        s = noise_ratio(rows, col, I, nb, K)
         small = aggregate(rows, col, I, nb, np.maximum(1, np.round(K / 16.0)).astype(int))["indiv"][0]
         wide = aggregate(rows, col, I, nb, np.maximum(1, np.round(K / 2.0)).astype(int))
         for g in gates:
@@ -256,6 +260,84 @@ def study(jetfit, cloud, I, T, t1, t2, fs, taus, gates, work, sheets=(), weights
                             np.where((ok & (s > lo))[:, None], wide["indiv"][0], small))
             res.append(("gate sigma/r_K %s" % ":".join("%g" % v for v in g), errors(pick, None, None, T)))
     return best, res
+
+
+def carries(rows, col, I, nb, mq):
+    """each of q's mq nearest j (q first): its normal (signs on q's side),
+    its shape operator W_j, q - j, and 1 where it counts (n x L x ...)"""
+    good = np.isfinite(rows[:, 0:col["d2x"] + 3]).all(1)
+    R = np.where(good[:, None], rows, 0.0)
+    N, D1, D2 = R[:, col["nx"]:col["nx"] + 3], R[:, col["d1x"]:col["d1x"] + 3], R[:, col["d2x"]:col["d2x"] + 3]
+    NI, L, n = rows[I, col["nx"]:col["nx"] + 3], int(mq.max()), len(I)
+    Nn, W, d, on = np.zeros((n, L, 3)), np.zeros((n, L, 3, 3)), np.zeros((n, L, 3)), np.zeros((n, L))
+    for t in range(L):
+        j = nb[:, t]
+        s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
+        Nn[:, t], d[:, t] = N[j] * s[:, None], rows[I, 0:3] - R[j, 0:3]
+        W[:, t] = (R[j, col["k1"]] * s)[:, None, None] * D1[j][:, :, None] * D1[j][:, None, :] + \
+            (R[j, col["k2"]] * s)[:, None, None] * D2[j][:, :, None] * D2[j][:, None, :]
+        on[:, t] = (t < mq) & good[j]
+    return Nn, W, d, on
+
+
+def biweight(C, on, c):
+    """Tukey's biweights of the vectors C (n x L x 3) about their weighted
+    mean, scale c x 1.4826 x the median deviation (twice)"""
+    w = on.copy()
+    U = C / np.linalg.norm(C, axis=2)[:, :, None]
+    for _ in range(2):
+        mu = (C * w[:, :, None]).sum(1)
+        mu /= np.linalg.norm(mu, axis=1)[:, None]
+        dev = np.linalg.norm(U - mu[:, None, :], axis=2)
+        sc = 1.4826 * np.nanmedian(np.where(on > 0, dev, np.nan), axis=1)
+        u = dev / np.maximum(c * sc, 1e-12)[:, None]
+        w = on * np.clip(1.0 - u * u, 0.0, 1.0) ** 2
+    return w
+
+
+def biweight_means(rows, col, I, nb, mq, c):
+    """indiv and mid (W: the biweighted mean W_j) as biweighted means"""
+    Nn, W, d, on = carries(rows, col, I, nb, mq)
+    ind = Nn - np.einsum("ntij,ntj->nti", W, d)
+    w = biweight(ind, on, c)
+    Wb = (W * w[:, :, None, None]).sum(1) / np.maximum(w.sum(1), 1e-300)[:, None, None]
+    mid = Nn - 0.5 * np.einsum("ntij,ntj->nti", W + Wb[:, None], d)
+    return (ind * w[:, :, None]).sum(1), (mid * biweight(mid, on, c)[:, :, None]).sum(1)
+
+
+def bulk_rms(rows, col, I, nb, T):
+    """indiv's RMS normal angle at m = 1, 2, 4, ..., 64 over the rows of
+    K = KMAX and degree 2 (the bulk) and the others, from every neighbour
+    and from the bulk's only (stderr)"""
+    bulk = (rows[:, col["neighbors"]] == KMAX) & (rows[:, col["degree"]] == 2)
+    for m in (1, 2, 4, 8, 16, 32, 64):
+        Nn, W, d, on = carries(rows, col, I, nb, np.full(len(I), m))
+        ind = Nn - np.einsum("ntij,ntj->nti", W, d)
+        onb = on * bulk[nb[:, :m]]
+        onb[:, 0] = on[:, 0]
+        e = [errors((ind * w[:, :, None]).sum(1)[sel], None, None, T[sel])[0]
+             for w in (on, onb) for sel in (bulk[I], ~bulk[I])]
+        print("m=%2d: bulk (%d rows) %.4f, the rest %.4f; from bulk rows only %.4f, %.4f" %
+              ((m, bulk[I].sum()) + tuple(e)), file=sys.stderr, flush=True)
+
+
+def noise_ratio(rows, col, I, nb, K):
+    """s = sigma / r_K at each row of I (r_K: the K-th distance), its
+    10/50/90% on stderr"""
+    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+    s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+    print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
+          file=sys.stderr, flush=True)
+    return s
+
+
+def offset(rows, I, nb, cnt):
+    """q's offset from its cnt[i] nearest, |mean (q - j)| / rms |q - j| (a border)"""
+    L = min(int(cnt.max()), nb.shape[1])
+    e = rows[nb[:, :L], 0:3] - rows[I, 0:3][:, None, :]
+    on = (np.arange(L)[None, :] < cnt[:, None]).astype(float)
+    c = on.sum(1)
+    return np.linalg.norm((e * on[:, :, None]).sum(1), axis=1) / c / np.sqrt(((e * e).sum(2) * on).sum(1) / c)
 
 
 def weigher(wname, dq, Kall, sig, I, mq):
@@ -271,14 +353,12 @@ def weigher(wname, dq, Kall, sig, I, mq):
             w = w * np.clip(1.0 - u * u, 0.0, 1.0) ** 2
         if wname == "kw":  # the fit's size alone
             w = w * Kall[j] / np.maximum(Kall[I], 1)
-        if wname == "ivfl":  # ivar with sigma floored at 0.03 r_K (the gate's s)
+        if "ivar" in wname or wname == "ivfl":  # ivfl: sigma floored at 0.03 r_K (the gate's s)
+            fl = 0.03 if wname == "ivfl" else 0.0
             kj, k0 = np.clip(Kall[j], 1, dq.shape[1]), np.clip(Kall[I], 1, dq.shape[1])
             r, r0 = dq[at, kj - 1], dq[at, k0 - 1]
-            w = w * (kj / np.maximum(sig[j], 0.03 * r) ** 2 * r * r) / (k0 / np.maximum(sig[I], 0.03 * r0) ** 2 * r0 * r0)
-        if "ivar" in wname:
-            kj, k0 = np.clip(Kall[j], 1, dq.shape[1]), np.clip(Kall[I], 1, dq.shape[1])
-            r, r0 = dq[at, kj - 1], dq[at, k0 - 1]
-            w = w * (kj * r * r / np.maximum(sig[j], 1e-12) ** 2) / (k0 * r0 * r0 / np.maximum(sig[I], 1e-12) ** 2)
+            sj, s0 = np.maximum(np.maximum(sig[j], fl * r), 1e-12), np.maximum(np.maximum(sig[I], fl * r0), 1e-12)
+            w = w * (kj * r * r / sj ** 2) / (k0 * r0 * r0 / s0 ** 2)
         return np.where(np.isfinite(w), w, 0.0)
     return wfun
 
@@ -330,20 +410,23 @@ def main():
     ap.add_argument("--border", default="9", help="with --mixgate: mid also where q's offset from its m nearest exceeds B")
     ap.add_argument("--lowweight", default="", help="with --mixgate: weights of indiv below the gate (kw, ivfl)")
     ap.add_argument("--borderk", action="store_true", help="--border's offset over q's K nearest, not its m")
+    ap.add_argument("--biweight", default="", help="Cs of the biweight mean of the carries (e.g. 3)")
+    ap.add_argument("--bulk", action="store_true", help="indiv's RMS at m = 1..64 on the K = 256 quadric rows")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
     jetfit = os.path.join(a.build, "jetfit")
     if not os.access(jetfit, os.X_OK):
         sys.exit("auto_agg: %s not built" % jetfit)
-    fs = [float(v) for v in a.f.split(",")]
-    taus = [float(v) for v in a.lepski.split(",") if v]
-    gates = [tuple(float(x) for x in v.split(":")) for v in a.gate.split(",") if v]
-    sheets = [float(v) for v in a.sheet.split(",") if v]
-    weights = [v for v in a.weights.split(",") if v]
-    mixgates = [float(v) for v in a.mixgate.split(",") if v]
-    borders = [float(v) for v in a.border.split(",") if v]
-    lowweights = [v for v in a.lowweight.split(",") if v]
+    a.fs = [float(v) for v in a.f.split(",")]
+    a.taus = [float(v) for v in a.lepski.split(",") if v]
+    a.gates = [tuple(float(x) for x in v.split(":")) for v in a.gate.split(",") if v]
+    a.sheets = [float(v) for v in a.sheet.split(",") if v]
+    a.weights = [v for v in a.weights.split(",") if v]
+    a.mixgates = [float(v) for v in a.mixgate.split(",") if v]
+    a.borders = [float(v) for v in a.border.split(",") if v]
+    a.lowweights = [v for v in a.lowweight.split(",") if v]
+    a.biweights = [float(v) for v in a.biweight.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in ("ellipsoid", "torus", "exp"):
@@ -355,7 +438,7 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights, a.borderk)
+                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], a, work)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
         table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
@@ -370,7 +453,7 @@ def main():
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
-                best, res = study(jetfit, cloud, I, T[I], None, None, fs, taus, gates, work, sheets, weights, mixgates, borders, lowweights, a.borderk)
+                best, res = study(jetfit, cloud, I, T[I], None, None, a, work)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)
