@@ -33,7 +33,7 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
          shape operator W_q instead of the mean W;
   with --weights, weighted means: kern a biweight in q's distance, ivar
   1 / the variance of j's slope, K_j r_Kj^2 / sigma_j^2 (r_Kj read at q),
-  ivarkern both;
+  ivarkern both, kw K_j, kge 1 where K_j >= K_q (else 0);
   with --mixgate T (f = 1/8): mid with ivar weights where s = sigma / r_K
   > T, plain indiv elsewhere (step 6 since 28 Nov 2026, T = 0.03); with
   --border B also where q's offset from its m nearest, |mean (q - j)| /
@@ -45,7 +45,8 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   does not move;
   with --bulk, on stderr, indiv's RMS normal at m = 1, 2, 4, ..., 64 over
   the rows whose K is 256 and degree 2 (the bulk) and over the others,
-  from every neighbour and from the bulk's only.
+  from every neighbour and from the bulk's only;
+  with --no-generated, the PCPNet clouds only.
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
@@ -353,6 +354,8 @@ def weigher(wname, dq, Kall, sig, I, mq):
             w = w * np.clip(1.0 - u * u, 0.0, 1.0) ** 2
         if wname == "kw":  # the fit's size alone
             w = w * Kall[j] / np.maximum(Kall[I], 1)
+        if wname == "kge":  # only fits on at least q's own K points
+            w = w * (Kall[j] >= Kall[I])
         if "ivar" in wname or wname == "ivfl":  # ivfl: sigma floored at 0.03 r_K (the gate's s)
             fl = 0.03 if wname == "ivfl" else 0.0
             kj, k0 = np.clip(Kall[j], 1, dq.shape[1]), np.clip(Kall[I], 1, dq.shape[1])
@@ -405,13 +408,14 @@ def main():
     ap.add_argument("--lepski", default="", help="taus of a per-point m rule (e.g. 1,2,4)")
     ap.add_argument("--gate", default="", help="LO:HI[:KMIN[:1]] bounds of sigma / r_K (e.g. 0.01:0.02)")
     ap.add_argument("--sheet", default="", help="TAUs of the same-sheet test (e.g. 2,3,4)")
-    ap.add_argument("--weights", default="", help="weighted means: kern, ivar, ivarkern")
+    ap.add_argument("--weights", default="", help="weighted means: kern, ivar, ivarkern, kw, kge")
     ap.add_argument("--mixgate", default="", help="sigma / r_K above which mid with ivar weights, f = 1/8")
     ap.add_argument("--border", default="9", help="with --mixgate: mid also where q's offset from its m nearest exceeds B")
     ap.add_argument("--lowweight", default="", help="with --mixgate: weights of indiv below the gate (kw, ivfl)")
     ap.add_argument("--borderk", action="store_true", help="--border's offset over q's K nearest, not its m")
     ap.add_argument("--biweight", default="", help="Cs of the biweight mean of the carries (e.g. 3)")
     ap.add_argument("--bulk", action="store_true", help="indiv's RMS at m = 1..64 on the K = 256 quadric rows")
+    ap.add_argument("--no-generated", action="store_true", help="the PCPNet clouds only")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -429,7 +433,7 @@ def main():
     a.biweights = [float(v) for v in a.biweight.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
-        for surf in ("ellipsoid", "torus", "exp"):
+        for surf in () if a.no_generated else ("ellipsoid", "torus", "exp"):
             for lev in ("0.001", "0.003", "0.01"):
                 cloud, truth = os.path.join(work, "c.ply"), os.path.join(work, "t.csv")
                 extra = ["--density", "gradient"] if surf == "torus" else []
@@ -441,7 +445,8 @@ def main():
                 best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], a, work)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
-        table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
+        if cells:
+            table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
         if a.pcpnet:
             d = a.pcpnet
             X = np.loadtxt(os.path.join(d, "armadillo100k.xyz"))
