@@ -8,7 +8,8 @@ the build before it gave the figures of that section's table).
 usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
        [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...]
        [--weights W,...] [--mixgate T,... [--border B,...]]
-       [--biweight C,...] [--bulk] [--n N] [--seed S]
+       [--biweight C,...] [--bulk] [--bulkgate B,...] [--no-generated]
+       [--n N] [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -46,6 +47,10 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   with --bulk, on stderr, indiv's RMS normal at m = 1, 2, 4, ..., 64 over
   the rows whose K is 256 and degree 2 (the bulk) and over the others,
   from every neighbour and from the bulk's only;
+  with --bulkgate B (and --mixgate T), weighted mid also on the rows
+  whose K is 256 and degree 2 where beta < B (B = 0: all of them), beta
+  = |b| r_K^2 / 10 over the slope's sd, b from the plain cubic on 257
+  points (the slope bias a cubic term leaves in the quadric);
   with --no-generated, the PCPNet clouds only.
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
@@ -248,6 +253,14 @@ def study(jetfit, cloud, I, T, t1, t2, o, work):
                     pick = np.where(hi, iv["mid"][0], lo["indiv"][0])
                     res.append(("mixgate %g border %g low %s (%.0f%% mid)" % (G, B, lw or "plain", 100 * hi.mean()),
                                 errors(pick, flat["indiv"][1], flat["indiv"][2], T, t1, t2)))
+            if o.bulkgates:  # mid also on the K = 256 quadric rows, where beta < BETA
+                beta = cubic_bias(jetfit, cloud, work, I, nb, K, rows[I, col["sigma"]])
+                bulk = (K == KMAX) & (rows[I, col["degree"]] == 2)
+                for bt in o.bulkgates:
+                    hi = ((s > G) | (bulk & ((beta < bt) if bt > 0 else True)))[:, None]
+                    pick = np.where(hi, iv["mid"][0], flat["indiv"][0])
+                    res.append(("mixgate %g or bulk%s (%.0f%% mid)" % (G, ", beta < %g" % bt if bt > 0 else "", 100 * hi.mean()),
+                                errors(pick, None, None, T)))
     if gates:
         s = noise_ratio(rows, col, I, nb, K)
         small = aggregate(rows, col, I, nb, np.maximum(1, np.round(K / 16.0)).astype(int))["indiv"][0]
@@ -320,6 +333,20 @@ def bulk_rms(rows, col, I, nb, T):
              for w in (on, onb) for sel in (bulk[I], ~bulk[I])]
         print("m=%2d: bulk (%d rows) %.4f, the rest %.4f; from bulk rows only %.4f, %.4f" %
               ((m, bulk[I].sum()) + tuple(e)), file=sys.stderr, flush=True)
+
+
+def cubic_bias(jetfit, cloud, work, I, nb, K, sigma):
+    """beta = |b| r_K^2 / 10 over the slope's sd 2 sqrt 2 sigma / (r_K sqrt K):
+    the slope bias a cubic term b leaves in a quadric on a disk of radius
+    r_K, against its noise; b from the plain cubic on 257 points"""
+    rows, col = run(jetfit, cloud, "knn:%d" % (KMAX + 1), os.path.join(work, "cub.xyz"),
+                    ["--degree", "3", "--monge-degree", "3"])
+    b = np.linalg.norm(rows[I, col["b0"]:col["b0"] + 4], axis=1)
+    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+    rk = np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+    beta = b * rk * rk / 10.0 / np.maximum(2.0 * np.sqrt(2.0) * sigma / (rk * np.sqrt(K)), 1e-300)
+    print("beta 10/50/90%%: %.2f %.2f %.2f" % tuple(np.nanpercentile(beta, [10, 50, 90])), file=sys.stderr, flush=True)
+    return beta
 
 
 def noise_ratio(rows, col, I, nb, K):
@@ -415,6 +442,7 @@ def main():
     ap.add_argument("--borderk", action="store_true", help="--border's offset over q's K nearest, not its m")
     ap.add_argument("--biweight", default="", help="Cs of the biweight mean of the carries (e.g. 3)")
     ap.add_argument("--bulk", action="store_true", help="indiv's RMS at m = 1..64 on the K = 256 quadric rows")
+    ap.add_argument("--bulkgate", default="", help="with --mixgate: mid also on K = 256 quadric rows, beta < B (0: all)")
     ap.add_argument("--no-generated", action="store_true", help="the PCPNet clouds only")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
@@ -431,6 +459,7 @@ def main():
     a.borders = [float(v) for v in a.border.split(",") if v]
     a.lowweights = [v for v in a.lowweight.split(",") if v]
     a.biweights = [float(v) for v in a.biweight.split(",") if v]
+    a.bulkgates = [float(v) for v in a.bulkgate.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
         for surf in () if a.no_generated else ("ellipsoid", "torus", "exp"):
