@@ -96,6 +96,17 @@ def neighbours(Y, Q, m):
     return nb
 
 
+def shape_ops(a1, a2, D1, D2):
+    """W = a1 d1 d1^T + a2 d2 d2^T per row (n x 3 x 3)"""
+    return a1[:, None, None] * D1[:, :, None] * D1[:, None, :] + a2[:, None, None] * D2[:, :, None] * D2[:, None, :]
+
+
+def kth_dist(rows, I, nb, K):
+    """|q - its K-th nearest| at each row of I"""
+    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
+    return np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+
+
 def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
     """(normal, k1, k2) per variant at rows I from the mq[i] first of nb[i],
     and (key "snaps") indiv's running sums and counts at m = 1, 2, 4, ...;
@@ -119,8 +130,7 @@ def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
     B = np.nan_to_num(R[:, col["b0"]:col["b0"] + 4]) if "b0" in col else np.zeros((len(R), 4))
     W = np.zeros((n, 3, 3))
     indq = np.zeros((n, 3))
-    Wq = k1[I][:, None, None] * D1[I][:, :, None] * D1[I][:, None, :] + \
-        k2[I][:, None, None] * D2[I][:, :, None] * D2[I][:, None, :]
+    Wq = shape_ops(k1[I], k2[I], D1[I], D2[I])
     if sheet is not None:
         lim = sheet * R[I, col["sigma"]]
     for t in range(nb.shape[1]):
@@ -138,8 +148,7 @@ def aggregate(rows, col, I, nb, mq, sheet=None, weight=None):
         s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
         nj = N[j] * s[:, None]
         a1, a2 = k1[j] * s, k2[j] * s
-        Wj = a1[:, None, None] * D1[j][:, :, None] * D1[j][:, None, :] + \
-            a2[:, None, None] * D2[j][:, :, None] * D2[j][:, None, :]
+        Wj = shape_ops(a1, a2, D1[j], D2[j])
         d = PI - P[j]
         cnt += on
         mean_n += nj * on[:, None]
@@ -278,7 +287,8 @@ def study(jetfit, cloud, I, T, t1, t2, o, work):
 
 def carries(rows, col, I, nb, mq):
     """each of q's mq nearest j (q first): its normal (signs on q's side),
-    its shape operator W_j, q - j, and 1 where it counts (n x L x ...)"""
+    its shape operator W_j, q - j, 1 where it counts, and its normal
+    carried to q, n_j - W_j (q - j) (n x L x ...)"""
     good = np.isfinite(rows[:, 0:col["d2x"] + 3]).all(1)
     R = np.where(good[:, None], rows, 0.0)
     N, D1, D2 = R[:, col["nx"]:col["nx"] + 3], R[:, col["d1x"]:col["d1x"] + 3], R[:, col["d2x"]:col["d2x"] + 3]
@@ -288,10 +298,9 @@ def carries(rows, col, I, nb, mq):
         j = nb[:, t]
         s = np.where((N[j] * NI).sum(1) < 0, -1.0, 1.0)
         Nn[:, t], d[:, t] = N[j] * s[:, None], rows[I, 0:3] - R[j, 0:3]
-        W[:, t] = (R[j, col["k1"]] * s)[:, None, None] * D1[j][:, :, None] * D1[j][:, None, :] + \
-            (R[j, col["k2"]] * s)[:, None, None] * D2[j][:, :, None] * D2[j][:, None, :]
+        W[:, t] = shape_ops(R[j, col["k1"]] * s, R[j, col["k2"]] * s, D1[j], D2[j])
         on[:, t] = (t < mq) & good[j]
-    return Nn, W, d, on
+    return Nn, W, d, on, Nn - np.einsum("ntij,ntj->nti", W, d)
 
 
 def biweight(C, on, c):
@@ -311,8 +320,7 @@ def biweight(C, on, c):
 
 def biweight_means(rows, col, I, nb, mq, c):
     """indiv and mid (W: the biweighted mean W_j) as biweighted means"""
-    Nn, W, d, on = carries(rows, col, I, nb, mq)
-    ind = Nn - np.einsum("ntij,ntj->nti", W, d)
+    Nn, W, d, on, ind = carries(rows, col, I, nb, mq)
     w = biweight(ind, on, c)
     Wb = (W * w[:, :, None, None]).sum(1) / np.maximum(w.sum(1), 1e-300)[:, None, None]
     mid = Nn - 0.5 * np.einsum("ntij,ntj->nti", W + Wb[:, None], d)
@@ -325,8 +333,7 @@ def bulk_rms(rows, col, I, nb, T):
     and from the bulk's only (stderr)"""
     bulk = (rows[:, col["neighbors"]] == KMAX) & (rows[:, col["degree"]] == 2)
     for m in (1, 2, 4, 8, 16, 32, 64):
-        Nn, W, d, on = carries(rows, col, I, nb, np.full(len(I), m))
-        ind = Nn - np.einsum("ntij,ntj->nti", W, d)
+        on, ind = carries(rows, col, I, nb, np.full(len(I), m))[3:]
         onb = on * bulk[nb[:, :m]]
         onb[:, 0] = on[:, 0]
         e = [errors((ind * w[:, :, None]).sum(1)[sel], None, None, T[sel])[0]
@@ -342,8 +349,7 @@ def cubic_bias(jetfit, cloud, work, I, nb, K, sigma):
     rows, col = run(jetfit, cloud, "knn:%d" % (KMAX + 1), os.path.join(work, "cub.xyz"),
                     ["--degree", "3", "--monge-degree", "3"])
     b = np.linalg.norm(rows[I, col["b0"]:col["b0"] + 4], axis=1)
-    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
-    rk = np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+    rk = kth_dist(rows, I, nb, K)
     beta = b * rk * rk / 10.0 / np.maximum(2.0 * np.sqrt(2.0) * sigma / (rk * np.sqrt(K)), 1e-300)
     print("beta 10/50/90%%: %.2f %.2f %.2f" % tuple(np.nanpercentile(beta, [10, 50, 90])), file=sys.stderr, flush=True)
     return beta
@@ -352,8 +358,7 @@ def cubic_bias(jetfit, cloud, work, I, nb, K, sigma):
 def noise_ratio(rows, col, I, nb, K):
     """s = sigma / r_K at each row of I (r_K: the K-th distance), its
     10/50/90% on stderr"""
-    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
-    s = rows[I, col["sigma"]] / np.linalg.norm(rows[kth, 0:3] - rows[I, 0:3], axis=1)
+    s = rows[I, col["sigma"]] / kth_dist(rows, I, nb, K)
     print("sigma/r_K 10/50/90%%: %.4f %.4f %.4f" % tuple(np.nanpercentile(s, [10, 50, 90])),
           file=sys.stderr, flush=True)
     return s
@@ -399,9 +404,8 @@ def lepski(rows, col, I, nb, K, cap, tau):
     sd = 2 sqrt 2 sigma / (r_K sqrt K), the slope sd of a plane on K
     points spread over a disk of radius r_K (the K-th distance)"""
     snaps = aggregate(rows, col, I, nb, cap)["snaps"]
-    P, n0 = rows[:, 0:3], rows[I, col["nx"]:col["nx"] + 3]
-    kth = nb[np.arange(len(I)), np.clip(K, 1, nb.shape[1]).astype(int) - 1]
-    rk = np.linalg.norm(P[kth] - P[I], axis=1)
+    n0 = rows[I, col["nx"]:col["nx"] + 3]
+    rk = kth_dist(rows, I, nb, K)
     sd = 2.0 * np.sqrt(2.0) * rows[I, col["sigma"]] / (rk * np.sqrt(K))
     best, alive, m = snaps[1][0].copy(), np.ones(len(I), bool), 2
     while m in snaps:
