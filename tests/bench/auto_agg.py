@@ -9,7 +9,7 @@ usage: python3 tests/bench/auto_agg.py BUILD [--pcpnet DIR] [--f F,...]
        [--lepski TAU,...] [--gate LO:HI,...] [--sheet TAU,...]
        [--weights W,...] [--mixgate T,... [--border B,...]]
        [--biweight C,...] [--bulk] [--bulkgate B,...] [--no-generated]
-       [--n N] [--seed S]
+       [--rows NB] [--levels L,...] [--n N] [--seed S]
 
 At each point q, the jets of its m nearest points j (q itself first),
 m = f x the K auto chose at q, each j's fit the row jetfit wrote:
@@ -51,7 +51,10 @@ m = f x the K auto chose at q, each j's fit the row jetfit wrote:
   whose K is 256 and degree 2 where beta < B (B = 0: all of them), beta
   = |b| r_K^2 / 10 over the slope's sd, b from the plain cubic on 257
   points (the slope bias a cubic term leaves in the quadric);
-  with --no-generated, the PCPNet clouds only.
+  with --no-generated, the PCPNet clouds only; with --levels, only those
+  armadillo noise levels;
+  with --rows knn:K, the same means over a fixed K's rows instead of
+  auto's (m = f x K; no sigma, so ivar weights and gates do not apply).
 The rows of a build configured with -DCMAKE_C_FLAGS=-DJF_STEP6_OFF are
 steps 1-5's, on which "indiv, f = 1/16" is step 6 itself.
 Printed against auto's own rows and the plain degree-2 jet on k + 1
@@ -206,7 +209,8 @@ def study(jetfit, cloud, I, T, t1, t2, o, work):
         rows, col = run(jetfit, cloud, "knn:%d" % (k + 1), os.path.join(work, "f.xyz"))
         fixed[k] = errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2)
     best = [min((fixed[k][c], k) for k in KS) for c in range(len(fixed[KS[0]]))]
-    rows, col = run(jetfit, cloud, "auto", os.path.join(work, "a.xyz"), ["--degree", "3", "--monge-degree", "3"])
+    rows, col = run(jetfit, cloud, o.rows, os.path.join(work, "a.xyz"),
+                    ["--degree", "3", "--monge-degree", "3"] if o.rows == "auto" else [])
     K = rows[I, col["neighbors"]]
     res = [("auto", errors(rows[I, col["nx"]:col["nx"] + 3], rows[I, col["k1"]], rows[I, col["k2"]], T, t1, t2))]
     nb = neighbours(rows[:, 0:3], rows[I, 0:3],
@@ -214,7 +218,7 @@ def study(jetfit, cloud, I, T, t1, t2, o, work):
                         KMAX + 1 if (taus or weights or o.mixgates) else 0, 65 if o.bulk else 0))
     dq = np.linalg.norm(rows[nb, 0:3] - rows[I, 0:3][:, None, :], axis=2)
     Kall = rows[:, col["neighbors"]].astype(int)
-    sig = rows[:, col["sigma"]]
+    sig = rows[:, col["sigma"]] if "sigma" in col else np.ones(len(rows))  # --rows knn:K: no sigma
     for f in fs:
         mq = np.maximum(1, np.round(f * K)).astype(int)
         ag = aggregate(rows, col, I, nb, mq)
@@ -448,6 +452,8 @@ def main():
     ap.add_argument("--bulk", action="store_true", help="indiv's RMS at m = 1..64 on the K = 256 quadric rows")
     ap.add_argument("--bulkgate", default="", help="with --mixgate: mid also on K = 256 quadric rows, beta < B (0: all)")
     ap.add_argument("--no-generated", action="store_true", help="the PCPNet clouds only")
+    ap.add_argument("--rows", default="auto", help="the rows aggregated: auto, or a fixed knn:K (its own fits)")
+    ap.add_argument("--levels", default="0,0.00125,0.006,0.012", help="the armadillo's noise levels (x diag)")
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=27)
     a = ap.parse_args()
@@ -475,6 +481,8 @@ def main():
                                stdout=subprocess.DEVNULL)
                 tr = np.loadtxt(truth, delimiter=",", skiprows=1)
                 I = np.arange(len(tr))
+                if a.bulk:  # its lines on stderr, under the cloud's name
+                    print("%s %s:" % (surf, lev), file=sys.stderr, flush=True)
                 best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], a, work)
                 cells.append(("%s %s" % (surf, lev), best, res))
                 print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
@@ -487,10 +495,12 @@ def main():
             I = np.loadtxt(os.path.join(d, "armadillo100k.pidx"), dtype=int)
             diag = np.linalg.norm(X.max(0) - X.min(0))
             cells = []
-            for lev in (0.0, 0.00125, 0.006, 0.012):
+            for lev in [float(v) for v in a.levels.split(",")]:
                 Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
+                if a.bulk:
+                    print("armadillo %g:" % lev, file=sys.stderr, flush=True)
                 best, res = study(jetfit, cloud, I, T[I], None, None, a, work)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
