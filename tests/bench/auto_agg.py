@@ -435,6 +435,31 @@ def table(title, cells, curv):
             print("| | %s | %s | %s |" % (est, " | ".join(cells_), ratio))
 
 
+def generated(jetfit, work, n, seed, fname):
+    """study_auto.sh's clouds: jetfit generate's ellipsoid, torus (density
+    gradient) and exp at noise 0.1%, 0.3%, 1% into work/fname; yields
+    (name, cloud path, truth rows: x y z, normal, k1 k2, d1, d2)"""
+    for surf in ("ellipsoid", "torus", "exp"):
+        for lev in ("0.001", "0.003", "0.01"):
+            cloud, truth = os.path.join(work, fname), os.path.join(work, "t.csv")
+            extra = ["--density", "gradient"] if surf == "torus" else []
+            subprocess.run([jetfit, "generate", surf, "-o", cloud, "--n", str(n), "--noise", lev,
+                            "--seed", str(seed), "--truth", truth] + extra, check=True, stdout=subprocess.DEVNULL)
+            yield "%s %s" % (surf, lev), cloud, np.loadtxt(truth, delimiter=",", skiprows=1)
+
+
+def armadillo(d, levels):
+    """PCPNet's armadillo100k (folder d) with Gaussian noise lev x its
+    bounding-box diagonal (numpy's draw, seed 7); yields (lev, points,
+    the .pidx indices, their truth normals)"""
+    X = np.loadtxt(os.path.join(d, "armadillo100k.xyz"))
+    T = np.loadtxt(os.path.join(d, "armadillo100k.normals"))
+    I = np.loadtxt(os.path.join(d, "armadillo100k.pidx"), dtype=int)
+    diag = np.linalg.norm(X.max(0) - X.min(0))
+    for lev in levels:
+        yield lev, X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X, I, T[I]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("build")
@@ -472,36 +497,23 @@ def main():
     a.bulkgates = [float(v) for v in a.bulkgate.split(",") if v]
     with tempfile.TemporaryDirectory() as work:
         cells = []
-        for surf in () if a.no_generated else ("ellipsoid", "torus", "exp"):
-            for lev in ("0.001", "0.003", "0.01"):
-                cloud, truth = os.path.join(work, "c.ply"), os.path.join(work, "t.csv")
-                extra = ["--density", "gradient"] if surf == "torus" else []
-                subprocess.run([jetfit, "generate", surf, "-o", cloud, "--n", str(a.n), "--noise", lev,
-                                "--seed", str(a.seed), "--truth", truth] + extra, check=True,
-                               stdout=subprocess.DEVNULL)
-                tr = np.loadtxt(truth, delimiter=",", skiprows=1)
-                I = np.arange(len(tr))
-                if a.bulk:  # its lines on stderr, under the cloud's name
-                    print("%s %s:" % (surf, lev), file=sys.stderr, flush=True)
-                best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], a, work)
-                cells.append(("%s %s" % (surf, lev), best, res))
-                print("done %s %s" % (surf, lev), file=sys.stderr, flush=True)
+        for name, cloud, tr in () if a.no_generated else generated(jetfit, work, a.n, a.seed, "c.ply"):
+            I = np.arange(len(tr))
+            if a.bulk:  # its lines on stderr, under the cloud's name
+                print("%s:" % name, file=sys.stderr, flush=True)
+            best, res = study(jetfit, cloud, I, tr[:, 3:6], tr[:, 6], tr[:, 7], a, work)
+            cells.append((name, best, res))
+            print("done %s" % name, file=sys.stderr, flush=True)
         if cells:
             table("jetfit generate, %d points, seed %d" % (a.n, a.seed), cells, True)
         if a.pcpnet:
-            d = a.pcpnet
-            X = np.loadtxt(os.path.join(d, "armadillo100k.xyz"))
-            T = np.loadtxt(os.path.join(d, "armadillo100k.normals"))
-            I = np.loadtxt(os.path.join(d, "armadillo100k.pidx"), dtype=int)
-            diag = np.linalg.norm(X.max(0) - X.min(0))
             cells = []
-            for lev in [float(v) for v in a.levels.split(",")]:
-                Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
+            for lev, Y, I, T in armadillo(a.pcpnet, [float(v) for v in a.levels.split(",")]):
                 cloud = os.path.join(work, "a_in.xyz")
                 np.savetxt(cloud, Y)
                 if a.bulk:
                     print("armadillo %g:" % lev, file=sys.stderr, flush=True)
-                best, res = study(jetfit, cloud, I, T[I], None, None, a, work)
+                best, res = study(jetfit, cloud, I, T, None, None, a, work)
                 cells.append(("armadillo %g" % lev, best, res))
                 print("done armadillo %g" % lev, file=sys.stderr, flush=True)
             table("PCPNet armadillo100k, 5000 .pidx points (numpy noise, seed 7)", cells, False)

@@ -41,7 +41,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from auto_agg import neighbours  # noqa: E402
+from auto_agg import armadillo, generated, neighbours  # noqa: E402
 
 KS = [16, 24, 32, 48, 64, 96, 128, 160, 200, 256]
 
@@ -120,29 +120,14 @@ def main():
     if a.cyl and a.frame == "own":
         sys.exit("auto_cv: --cyl needs one frame for every K (--frame fixed or k32)")
     with tempfile.TemporaryDirectory() as work:
-        for surf in () if a.no_generated else ("ellipsoid", "torus", "exp"):
-            for lev in ("0.001", "0.003", "0.01"):
-                cloud, truth = os.path.join(work, "c.xyz"), os.path.join(work, "t.csv")
-                extra = ["--density", "gradient"] if surf == "torus" else []
-                subprocess.run([jetfit, "generate", surf, "-o", cloud, "--n", "20000", "--noise", lev,
-                                "--seed", "27", "--truth", truth] + extra, check=True, stdout=subprocess.DEVNULL)
-                Y = np.loadtxt(cloud)
-                I = np.arange(0, len(Y), 4)
-                T = np.loadtxt(truth, delimiter=",", skiprows=1)[I, 3:6]
-                study(Y, I, T, "%s %s" % (surf, lev), a.frame, a.cyl,
-                      lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
-        if a.pcpnet:
-            d = a.pcpnet
-            X = np.loadtxt(os.path.join(d, "armadillo100k.xyz"))
-            T = np.loadtxt(os.path.join(d, "armadillo100k.normals"))
-            I = np.loadtxt(os.path.join(d, "armadillo100k.pidx"), dtype=int)
-            diag = np.linalg.norm(X.max(0) - X.min(0))
-            for lev in (0.0, 0.00125, 0.006, 0.012):
-                Y = X + np.random.default_rng(7).normal(0.0, lev * diag, X.shape) if lev > 0 else X
-                cloud = os.path.join(work, "a.xyz")
-                np.savetxt(cloud, Y)
-                study(Y, I, T[I], "armadillo %g" % lev, a.frame, a.cyl,
-                      lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
+        for name, cloud, tr in () if a.no_generated else generated(jetfit, work, 20000, 27, "c.xyz"):
+            Y = np.loadtxt(cloud)
+            I = np.arange(0, len(Y), 4)
+            study(Y, I, tr[I, 3:6], name, a.frame, a.cyl, lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
+        for lev, Y, I, T in armadillo(a.pcpnet, (0.0, 0.00125, 0.006, 0.012)) if a.pcpnet else ():
+            cloud = os.path.join(work, "a.xyz")
+            np.savetxt(cloud, Y)
+            study(Y, I, T, "armadillo %g" % lev, a.frame, a.cyl, lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
 
 
 if __name__ == "__main__":
