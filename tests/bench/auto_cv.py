@@ -34,14 +34,13 @@ for the generated clouds and 8 for the armadillo on one core.
 """
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from auto_agg import armadillo, generated, neighbours  # noqa: E402
+from auto_agg import armadillo, generated, kth_dist, neighbours, run  # noqa: E402
 
 KS = [16, 24, 32, 48, 64, 96, 128, 160, 200, 256]
 
@@ -60,21 +59,14 @@ def monomials(x, y, d):
     return np.stack(c, -1)
 
 
-def thickness(jetfit, cloud, work, I, Y, nb):
-    """median over the evaluated points of auto's sigma over the 16th
-    nearest distance (the noise against the spacing)"""
-    out = os.path.join(work, "auto.xyz")
-    subprocess.run([jetfit, "estimate", cloud, "-o", out, "--neighbors", "auto", "--quiet"], check=True)
-    with open(out) as fh:
-        col = fh.readline().lstrip("#").split().index("sigma")
-    sigma = np.loadtxt(out, comments="#", usecols=col)[I]
-    return np.nanmedian(sigma / np.linalg.norm(Y[nb[:, 16]] - Y[I], axis=1))
-
-
-def study(Y, I, T, name, frame, cyl, thick):
+def study(jetfit, cloud, work, I, T, name, frame, cyl):
+    Y = np.loadtxt(cloud, comments="#")
     Q = Y[I]
     nb = neighbours(Y, Q, KS[-1] + 1)
-    th = thick(I, Y, nb)
+    # the noise against the spacing: auto's sigma over the 16th nearest
+    # distance (nb[:, 16]: p is nb[:, 0]), its median over the points
+    rows, col = run(jetfit, cloud, "auto", os.path.join(work, "auto.xyz"))
+    th = np.nanmedian(rows[I, col["sigma"]] / kth_dist(rows, I, nb, np.full(len(I), 17)))
     VF = pca_frames(Y[nb[:, :32]] if frame == "k32" else Y[nb])
     if cyl:  # the same 257 points, ordered by planar distance in VF
         L = np.einsum("nki,nij->nkj", Y[nb] - Q[:, None, :], VF)
@@ -121,14 +113,12 @@ def main():
         sys.exit("auto_cv: --cyl needs one frame for every K (--frame fixed or k32)")
     with tempfile.TemporaryDirectory() as work:
         for name, cloud, tr in () if a.no_generated else generated(jetfit, work, 20000, 27, "c.xyz"):
-            Y = np.loadtxt(cloud)
-            I = np.arange(0, len(Y), 4)
-            study(Y, I, tr[I, 3:6], name, a.frame, a.cyl, lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
+            I = np.arange(0, len(tr), 4)
+            study(jetfit, cloud, work, I, tr[I, 3:6], name, a.frame, a.cyl)
         for lev, Y, I, T in armadillo(a.pcpnet, (0.0, 0.00125, 0.006, 0.012)) if a.pcpnet else ():
             cloud = os.path.join(work, "a.xyz")
             np.savetxt(cloud, Y)
-            study(Y, I, T, "armadillo %g" % lev, a.frame, a.cyl, lambda I, Y, nb: thickness(jetfit, cloud, work, I, Y, nb))
-
+            study(jetfit, cloud, work, I, T, "armadillo %g" % lev, a.frame, a.cyl)
 
 if __name__ == "__main__":
     main()
