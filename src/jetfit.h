@@ -112,9 +112,14 @@ enum {
     JF_PT_NORMAL_PCA = 1u << 16,   /* natural: tangent plane from the PCA
                                       of the 16 nearest points (clean
                                       cloud, or --normal pca)           */
-    JF_PT_AUTO = 1u << 17          /* neighbourhood auto: K (n_used) and
+    JF_PT_AUTO = 1u << 17,         /* neighbourhood auto: K (n_used) and
                                       degree were chosen per point
                                       (params.auto_select)              */
+    JF_PT_AUTO_CAPPED = 1u << 18   /* auto: K at most params.auto_select
+                                      (jf_estimate: the cloud's cross-
+                                      validation, docs/robustness.md
+                                      step 0), below the largest
+                                      candidate the list held           */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf
@@ -170,7 +175,10 @@ typedef struct {
                                 each row's normal and curvatures from
                                 its nearest points' fits (docs/
                                 robustness.md, step 6).  0 = off
-                                (default)                                */
+                                (default); 16..JF_NB_AUTO_KMAX: the same,
+                                K at most that (jf_estimate sets it from
+                                the cloud's cross-validation, step 0,
+                                where it is 1)                            */
 } jf_params;
 
 /* Fills defaults.  Never fails. */

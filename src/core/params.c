@@ -69,6 +69,8 @@ jf_status jf_params_validate(const jf_params *p, const char **bad_field)
     if (p->degree_select < 0 || p->degree_select > p->degree)
         return bad(bad_field, "degree_select");
     if (!(p->dist_weight >= 0.0) || !isfinite(p->dist_weight)) return bad(bad_field, "dist_weight");
-    if (p->auto_select != 0 && p->auto_select != 1) return bad(bad_field, "auto_select");
+    if (p->auto_select < 0 || p->auto_select > JF_NB_AUTO_KMAX ||
+        (p->auto_select > 1 && p->auto_select < 16))
+        return bad(bad_field, "auto_select");
     return JF_OK;
 }

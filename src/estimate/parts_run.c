@@ -49,6 +49,7 @@
 
 #include <omp.h>
 
+#include "auto_cloud.h"
 #include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
@@ -341,7 +342,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     double *sxyz = NULL, *snrm = NULL;
     uint32_t *sscan = NULL;
     uint8_t *mask = NULL;
-    size_t *ccnt = NULL;
+    size_t *ccnt = NULL, ncv = 0;
+    jf__cvrec *cvr = NULL; /* auto's step 0: the sample's records */
     occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, 1};
     reader rd;
     double gb[6];
@@ -369,6 +371,10 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     }
     jf_estimate_opts po = *o;
     po.progress = NULL; /* per part: the totals would restart */
+    /* auto's step 0 (auto_cloud.c): a first sweep over the parts fits
+     * only the sample, whose records decide the cap every part is given */
+    const int cv = o->params.auto_select == 1 && q.nb.kind == JF_NB_KNN && q.nb.k >= JF_NB_AUTO_KMAX;
+    for (int sweep = cv ? 0 : 1; sweep < 2 && st == JF_OK; sweep++) {
     for (int a = 0; a < P && st == JF_OK; a++) {
         if (!count[a]) continue;
         if (o->cancel && o->cancel(o->cancel_user)) {
@@ -446,8 +452,24 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         sc.scan = sscan;
         sc.scanner = c->scanner;
         sc.nscans = c->nscans;
-        relay rl = {sid, sink, user};
-        st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
+        if (sweep == 0) {
+            jf__cvrec *r = NULL, *g;
+            size_t nr = 0;
+            st = jf__auto_cv_sample(sxyz, ms, mask, sid, n, NULL, &o->params, nt, &r, &nr);
+            if (st == JF_OK && nr) {
+                if ((g = realloc(cvr, (ncv + nr) * sizeof *g))) {
+                    cvr = g;
+                    memcpy(cvr + ncv, r, nr * sizeof *r);
+                    ncv += nr;
+                } else {
+                    st = JF_ERR_NOMEM;
+                }
+            }
+            free(r);
+        } else {
+            relay rl = {sid, sink, user};
+            st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
+        }
         free(sid);
         free(snrm);
         free(sscan);
@@ -456,6 +478,8 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         sscan = NULL;
         mask = NULL;
         if (st != JF_OK) goto out;
+    }
+    if (sweep == 0 && st == JF_OK) po.params.auto_select = jf__auto_cv_decide(cvr, ncv, NULL);
     }
     if (st == JF_OK && o->progress) o->progress(o->progress_user, n, n);
 out:
@@ -472,6 +496,7 @@ out:
     free(sscan);
     free(mask);
     free(ccnt);
+    free(cvr);
     free(occ.own);
     return st;
 }

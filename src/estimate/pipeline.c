@@ -31,6 +31,7 @@
 
 #include <stdint.h>
 
+#include "auto_cloud.h"
 #include "core/claim.h"
 #include "fitter_internal.h"
 #include "index_internal.h"
@@ -547,7 +548,7 @@ static void nj_move(const njrows *a, size_t k, const njrows *b, size_t t)
 /* How many of row r's nearest (h of them kept) step 6 reads. */
 static size_t nj_count(const jf_result *r, size_t h)
 {
-    size_t m = jf__nj_head(r->n_used);
+    size_t m = jf__nj_head(r);
     return m < h ? m : h;
 }
 
@@ -767,7 +768,7 @@ void jf__nb_auto_opts(jf_estimate_opts *o)
     if (o->nb.kind != JF_NB_AUTO) return;
     o->nb.kind = JF_NB_KNN;
     o->nb.k = JF_NB_AUTO_KMAX;
-    o->params.auto_select = 1;
+    if (o->params.auto_select < 1) o->params.auto_select = 1; /* a cap given stays */
     if (o->params.max_neighbors < JF_NB_AUTO_KMAX) o->params.max_neighbors = JF_NB_AUTO_KMAX;
 }
 
@@ -853,6 +854,23 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             jf__set_err(err, "out of memory (auto's neighbour fits)");
             goto out;
         }
+    }
+    /* auto's step 0: the cloud's cap on K, from a sample (auto_cloud.c);
+     * a part's or a rank's estimate is given the whole cloud's */
+    if (p->auto_select == 1 && nb.kind == JF_NB_KNN && nb.k >= JF_NB_AUTO_KMAX && need_index) {
+        if (fit) {
+            st = JF_ERR_INVALID;
+            jf__set_err(err, "neighbors auto: a part's estimate needs the cloud's cap on K");
+            goto out;
+        }
+        jf__cvrec *cv = NULL;
+        size_t ncv = 0;
+        if ((st = jf__auto_cv_sample(c->xyz, n, NULL, NULL, n, ix, p, nt, &cv, &ncv)) != JF_OK) {
+            jf__set_err(err, st == JF_ERR_NOMEM ? "out of memory (auto's sample)" : jf_strerror(st));
+            goto out;
+        }
+        use.params.auto_select = jf__auto_cv_decide(cv, ncv, NULL);
+        free(cv);
     }
     if (cancelled(o)) {
         st = cancel_status(err);

@@ -16,6 +16,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -26,6 +27,7 @@
 
 #include <omp.h>
 
+#include "auto_cloud.h"
 #include "io_internal.h"
 #include "mpi_internal.h"
 #include "opts.h"
@@ -309,6 +311,52 @@ static int nothing_fitted(jf_mpi *m, const char *in, const jf_mpi_cloud *c, cons
     return 0;
 }
 
+/* neighbors auto's step 0 (auto_cloud.c): each rank fits the sample
+ * points it owns, every rank gets every record and decides the same cap
+ * (the records sorted by input index: the whole cloud's sums).  0, or 1
+ * on a failure every rank knows of. */
+static int auto_cap(jf_mpi *m, const char *in, const jf_mpi_cloud *c, jf_estimate_opts *o,
+                    uint64_t total)
+{
+    jf_estimate_opts r = *o;
+    jf__nb_auto_opts(&r);
+    jf__cvrec *mine = NULL, *all = NULL;
+    size_t nm = 0;
+    int nt = o->threads > 0 ? o->threads : jf_default_threads(NULL);
+    jf_status st = jf__auto_cv_sample(c->xyz, c->n, c->own, c->gid, (size_t)total, NULL, &r.params,
+                                      nt, &mine, &nm);
+    if (st != JF_OK) jf_mpi_fail(m, "%s: neighbors auto's sample: %s", in, jf_strerror(st));
+    if (nm > (size_t)INT_MAX / sizeof *mine) jf_mpi_fail(m, "%s: neighbors auto's sample too large", in);
+    int bad = jf_mpi_check(m);
+    int *cnt = bad ? NULL : malloc((size_t)m->size * 2 * sizeof *cnt);
+    if (!bad && !cnt) jf_mpi_fail(m, "out of memory");
+    if (bad || jf_mpi_check(m)) {
+        free(mine);
+        free(cnt);
+        return 1;
+    }
+    int *dsp = cnt + m->size, mb = (int)(nm * sizeof *mine);
+    MPI_Allgather(&mb, 1, MPI_INT, cnt, 1, MPI_INT, m->comm);
+    size_t tot = 0;
+    for (int k = 0; k < m->size; k++) {
+        dsp[k] = (int)tot;
+        tot += (size_t)cnt[k];
+    }
+    if (tot > (size_t)INT_MAX || !(all = malloc(tot ? tot : 1))) jf_mpi_fail(m, "out of memory");
+    if (jf_mpi_check(m)) {
+        free(mine);
+        free(all);
+        free(cnt);
+        return 1;
+    }
+    MPI_Allgatherv(mine, mb, MPI_BYTE, all, cnt, dsp, MPI_BYTE, m->comm);
+    o->params.auto_select = jf__auto_cv_decide(all, tot / sizeof *all, NULL);
+    free(mine);
+    free(all);
+    free(cnt);
+    return 0;
+}
+
 static int refuse(jf_mpi *m, const char *fmt, const char *what)
 {
     if (m->rank == 0) {
@@ -412,6 +460,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         o.phase_user = &pg;
     }
     jf_result *res = NULL;
+    if (!failed && o.nb.kind == JF_NB_AUTO) failed = auto_cap(m, in, &c, &o, lay.count);
     if (!failed) {
         res = malloc((c.n ? c.n : 1) * sizeof *res);
         jf_cloud lc = {0};

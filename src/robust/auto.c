@@ -3,6 +3,9 @@
  * alone, and the noise the choice assumed (jf_result.sigma).
  *
  * design:
+ *  0. (auto_cloud.c, the estimate's) The cloud's cap on K from its
+ *     cross-validation, params.auto_select > 1: no candidate above it
+ *     (jf__auto_cv_point gives a sampled point's values).
  *  1. One frame per point: the PCA of its 32 nearest (§5.2).  In it every
  *     neighbour, nearest first, adds its power sums x^i y^j (i + j <= 6)
  *     and x^i y^j z (i + j <= 3), two at a time (SIMD lanes): the Gram
@@ -655,11 +658,24 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
     return JF_OK;
 }
 
-jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
-                       size_t n, jf_result *out)
+/* Steps 1-2 of one point: what the rule and the reported fit read. */
+typedef struct {
+    size_t nmax;
+    double fr[9], H, s2, sigma;
+    size_t ks[NCAND];
+    int nc;
+    cand_fit cf[2][NCAND];
+    mom mo[NCAND];
+    double hks[NCAND];
+} stage;
+
+/* Steps 1 and 2 into g; 0 when no candidate can be weighed (too few
+ * points, no radius, no noise estimate: final_fit on the whole list). */
+static int steps12(const jf__knobs *kn, const jf_params *pr, const double p[3], const double *nbr,
+                   size_t n, stage *g)
 {
-    size_t nmax = n < JF_NB_AUTO_KMAX ? n : JF_NB_AUTO_KMAX;
-    const jf__knobs *kn = jf__knobs_of(f);
+    const size_t nmax = g->nmax = n < JF_NB_AUTO_KMAX ? n : JF_NB_AUTO_KMAX;
+    g->sigma = NAN;
     /* step 1: the frame, PCA of the FRAME_K nearest finite points */
     double mean[3] = {0, 0, 0}, cov[9] = {0};
     size_t kf = 0;
@@ -669,7 +685,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         for (int k = 0; k < 3; k++) mean[k] += q[k] - p[k];
         kf++;
     }
-    if (kf < 16) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out); /* too few to choose */
+    if (kf < 16) return 0; /* too few to choose */
     for (int k = 0; k < 3; k++) mean[k] /= (double)kf;
     size_t seen = 0;
     for (size_t i = 0; i < nmax && seen < kf; i++) {
@@ -680,13 +696,13 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             for (int b = 0; b < 3; b++) cov[3 * a + b] += v[a] * v[b];
         seen++;
     }
-    double ev[3], evec[9], fr[9];
+    double ev[3], evec[9];
     /* the candidates' fits do not depend on the tangent axes (a rotation
      * about the normal maps the polynomials of degree d onto themselves) */
     if (!jf__normal3(cov, evec)) jf__eig3_in(cov, NULL, ev, evec);
     /* rows t1 (largest variance), t2 = nf x t1, nf (smallest), as the
      * jet's own frame (or the world axis nearest nf: params.frame) */
-    jf__frame_axes(evec, pr->frame, fr);
+    jf__frame_axes(evec, pr->frame, g->fr);
 
     /* H: a scale for the power sums, the distance of the last finite
      * neighbour (the farthest, nearest first), so that |x| / H, |y| / H
@@ -701,23 +717,22 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             break;
         }
     }
-    double H = sqrt(H2), iH = 1.0 / H;
-    if (!(H > 0.0) || !isfinite(iH)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
+    const double H = g->H = sqrt(H2), iH = 1.0 / H;
+    if (!(H > 0.0) || !isfinite(iH)) return 0;
 
     /* the candidates (the last one: the whole list when it is shorter) */
-    size_t ks[NCAND];
+    size_t *ks = g->ks;
     int nc = 0;
     for (int c = 0; c < NCAND && cand[c] <= nmax; c++) ks[nc++] = cand[c];
     if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
+    g->nc = nc;
 
     /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
      * and x^i y^j z (i + j <= 3, with z'z), four neighbours at a time */
-    cand_fit cf[2][NCAND];
-    memset(cf, 0, sizeof cf);
-    mom mo[NCAND];
-    double hks[NCAND];
-    first_pass(p, nbr, nmax, fr, H, ks, nc, mo, hks);
-    solve_all(mo, hks, nc, H, fr, cf);
+    cand_fit(*cf)[NCAND] = g->cf;
+    memset(g->cf, 0, sizeof g->cf);
+    first_pass(p, nbr, nmax, g->fr, H, ks, nc, g->mo, g->hks);
+    solve_all(g->mo, g->hks, nc, H, g->fr, cf);
 
     /* step 2: the noise, from the cubic at NOISE_K (else the nearest K) */
     double s2 = NAN;
@@ -727,7 +742,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
             s2 = cf[1][i].s2;
             if (ks[i] >= NOISE_K && s2 <= hb * hb) break;
         }
-    if (!isfinite(s2)) return final_fit(f, pr, 2, p, nbr, nmax, NAN, out);
+    if (!isfinite(s2)) return 0;
     /* On 22 dof the estimate at K = 32 falls, at a few points in a
      * thousand, to a third of the noise's variance, and Lepski then stops
      * on wild small-K normals.  Where the cubic's residual variance stays
@@ -738,7 +753,21 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     if (kn->auto_flat > 0.0 && FLAT_I < b && cf[1][FLAT_I].ok && cf[1][b].ok && cf[1][b].s2 > s2 &&
         cf[1][b].s2 <= cf[1][FLAT_I].s2 * (1.0 + kn->auto_flat * sqrt(2.0 / (FLAT_K - NMON))))
         s2 = cf[1][b].s2;
-    double sigma = sqrt(s2);
+    g->s2 = s2;
+    g->sigma = sqrt(s2);
+    return 1;
+}
+
+jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                       size_t n, jf_result *out)
+{
+    const jf__knobs *kn = jf__knobs_of(f);
+    stage g;
+    if (!steps12(kn, pr, p, nbr, n, &g)) return final_fit(f, pr, 2, p, nbr, g.nmax, g.sigma, out);
+    const size_t nmax = g.nmax, *ks = g.ks;
+    const int nc = g.nc;
+    const double s2 = g.s2, sigma = g.sigma;
+    cand_fit(*cf)[NCAND] = g.cf;
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small
      * cubic is the least biased choice) */
@@ -746,13 +775,19 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         double hc = kn->auto_clean * cf[1][i].h;
         if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= hc * hc)) cf[1][i].ok = 0;
     }
+    /* step 0's cap (the cloud's cross-validation, jf__auto_cv_point):
+     * no candidate above it */
+    int capped = 0;
+    if (pr->auto_select > 1)
+        for (int i = 0; i < nc; i++)
+            if (ks[i] > (size_t)pr->auto_select) cf[0][i].ok = cf[1][i].ok = 0, capped = 1;
 
     /* steps 3-4 (auto_rule.c): the candidate and the degree */
     jf__auto_cands C;
     C.nc = nc;
     C.s2 = s2;
-    memcpy(C.ks, ks, sizeof ks);
-    memcpy(C.cf, cf, sizeof cf);
+    memcpy(C.ks, ks, sizeof g.ks);
+    memcpy(C.cf, cf, sizeof g.cf);
     int d = 2, ci = jf__auto_rule(kn, &C, &d);
     if (kn->auto_diag) { /* bench-only: every candidate's own fit */
         jf__auto_diag *dg = kn->auto_diag;
@@ -761,11 +796,68 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         dg->d = d;
         for (int i = 0; i < nc; i++)
             for (int e = 0; e < 2; e++)
-                if (direct_fit(f, pr, p, nbr, ks[i], &mo[i], H, fr, e + 2, sigma, &dg->res[e][i]) != JF_OK)
+                if (direct_fit(f, pr, p, nbr, ks[i], &g.mo[i], g.H, g.fr, e + 2, sigma, &dg->res[e][i]) != JF_OK)
                     dg->res[e][i].status = JF_PT_FAILED;
     }
-    if (ci < 0) return final_fit(f, pr, 2, p, nbr, nmax, sigma, out);
-    if (kn->auto_dw > 0.0) /* bench-only knob, off: a distance-weighted row */
-        return fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
-    return direct_fit(f, pr, p, nbr, ks[ci], &mo[ci], H, fr, d, sigma, out);
+    jf_status st;
+    if (ci < 0) /* no candidate: the plain quadric on the list (up to the cap) */
+        st = final_fit(f, pr, 2, p, nbr, capped ? (size_t)pr->auto_select : nmax, sigma, out);
+    else if (kn->auto_dw > 0.0) /* bench-only knob, off: a distance-weighted row */
+        st = fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
+    else st = direct_fit(f, pr, p, nbr, ks[ci], &g.mo[ci], g.H, g.fr, d, sigma, out);
+    if (st == JF_OK && capped && (out->status & JF_PT_AUTO)) out->status |= JF_PT_AUTO_CAPPED;
+    return st;
+}
+
+/* The squared leave-one-out residual at p of the quadric on one
+ * candidate's points (p among them, at the origin): a0 / (1 - h00), a0
+ * the jet's height at p and h00 = (M^T M)^-1 [0, 0] the hat matrix's
+ * diagonal there, u0 = L^-1 e0 giving both (a0 = u0 . y, h00 = |u0|^2;
+ * the monomials' scale D leaves the constant's row alone). */
+static double loo2(const mom *mo, double H, double hK)
+{
+    if (mo->m < 10 || !(hK > 0.0)) return NAN;
+    const double s = H / hK, sp[3] = {1.0, s, s * s};
+    double L[36], y[6], u[6];
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j <= i; j++) L[i * 6 + j] = mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
+    for (int j = 0; j < 6; j++) {
+        double sum = L[j * 6 + j];
+        for (int k = 0; k < j; k++) sum -= L[j * 6 + k] * L[j * 6 + k];
+        if (!(sum > 1e-12 * mo->S[0])) return NAN;
+        L[j * 6 + j] = sqrt(sum);
+        for (int i = j + 1; i < 6; i++) {
+            double t = L[i * 6 + j];
+            for (int k = 0; k < j; k++) t -= L[i * 6 + k] * L[j * 6 + k];
+            L[i * 6 + j] = t / L[j * 6 + j];
+        }
+    }
+    double a0 = 0.0, h = 0.0;
+    for (int i = 0; i < 6; i++) {
+        double t = mo->T[PIDX(mex[i], mey[i])] * sp[mdeg[i]], v = i == 0 ? 1.0 : 0.0;
+        for (int k = 0; k < i; k++) t -= L[i * 6 + k] * y[k], v -= L[i * 6 + k] * u[k];
+        y[i] = t / L[i * 6 + i];
+        u[i] = v / L[i * 6 + i];
+        a0 += u[i] * y[i];
+        h += u[i] * u[i];
+    }
+    if (!(h < 1.0)) return NAN;
+    const double r = a0 / (1.0 - h);
+    return r * r;
+}
+
+void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                       size_t n, double out[JF_AUTO_CV_N])
+{
+    for (int c = 0; c < JF_AUTO_CV_N; c++) out[c] = NAN;
+    stage g;
+    if (!steps12(jf__knobs_of(f), pr, p, nbr, n, &g)) return;
+    for (int c = 0; c < g.nc; c++)
+        if (g.ks[c] == cand[c]) out[c] = loo2(&g.mo[c], g.H, g.hks[c]);
+    if (g.nmax > 16) {
+        const double *q = nbr + 3 * 16;
+        const double r = sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                              (q[2] - p[2]) * (q[2] - p[2]));
+        out[NCAND] = g.sigma / r;
+    }
 }

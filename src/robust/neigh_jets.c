@@ -20,9 +20,11 @@
 
 #include "neigh_jets.h"
 
-size_t jf__nj_head(int k)
+size_t jf__nj_head(const jf_result *r)
 {
-    double m = nearbyint(k / 8.0); /* half to even, as the offline study */
+    /* half to even, as the offline study; a capped K leaves more noise
+     * for the mean to take (step 0) */
+    double m = nearbyint(r->n_used / ((r->status & JF_PT_AUTO_CAPPED) ? 4.0 : 8.0));
     return m < 1 ? 1 : m > JF_NJ_HEAD ? JF_NJ_HEAD : (size_t)m;
 }
 
@@ -144,13 +146,15 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     if (r->degree < 2 || (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) || !isfinite(r->k1) ||
         !isfinite(r->k2))
         return;
-    size_t mc = jf__nj_head(r->n_used);
+    size_t mc = jf__nj_head(r);
     if (mc > m) mc = m;
     double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
     size_t cc = 0;
     /* the weighted sums (JF_NJ_MID): carried normals, normals, q - j, W */
     const double sq = r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2]));
-    const int wide = sq > JF_NJ_MID;
+    /* a capped cloud (step 0) has detail at its small K, which the mean
+     * shape operator would smooth: the plain carry there */
+    const int wide = sq > JF_NJ_MID && !(r->status & JF_PT_AUTO_CAPPED);
     double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
     double Ww[6] = {0, 0, 0, 0, 0, 0};
     for (size_t t = 0; t < mc; t++) {

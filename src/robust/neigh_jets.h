@@ -55,9 +55,10 @@ static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
 #endif
 }
 
-/* How many of a point's nearest its row reads: the normal and the
- * curvatures from round(K / 8) (at least 1, at most JF_NJ_HEAD). */
-size_t jf__nj_head(int k);
+/* How many of a point's nearest its row r reads: the normal and the
+ * curvatures from round(K / 8), K / 4 where K was capped (step 0); at
+ * least 1, at most JF_NJ_HEAD. */
+size_t jf__nj_head(const jf_result *r);
 
 /* The state of point i's record (JF_NJ_*). */
 int jf__nj_state(const jf__njs *s, size_t i);

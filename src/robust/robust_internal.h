@@ -97,6 +97,17 @@ typedef struct {
  * its degree (*d, 2 or 3). */
 int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
 
+/* Step 0 (the cloud's cross-validation) at one point p, its list nbr
+ * nearest first (p itself first): out[c] the squared leave-one-out
+ * residual at p of the quadric on the first cand[c] points, in step 1's
+ * frame (NaN where that candidate is not there or not fitted), and
+ * out[JF_AUTO_NCAND] step 2's sigma over the 16th neighbour's distance
+ * (|nbr[16] - p|); all NaN where steps 1-2 fail.  The decision from a
+ * sample of these: auto_cloud.c. */
+#define JF_AUTO_CV_N (JF_AUTO_NCAND + 1)
+void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                       size_t n, double out[JF_AUTO_CV_N]);
+
 /* Bench-only (tests/bench/bench_auto_diag.cpp): with jf__auto_diag_attach,
  * every auto fit of f also fills *dg: the candidates, the choice, and each
  * candidate's reported fit (res[degree - 2][i], as knn:K --degree d). */

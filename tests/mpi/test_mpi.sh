@@ -97,6 +97,15 @@ equal-more)
   same "2" lattice.ply xyz --neighbors knn:16 --monge-degree 3 --degree 3
   same "3" clusters.ply ply --ascii --neighbors knn:16
   same "2 3" clusters.ply csv --neighbors auto  # issue 27: per-point K and degree, sigma column
+  # auto's step 0: a clean cloud is capped (K <= 24, status bit 18) by its
+  # cross-validation, decided from every rank's share of the sample
+  "$jetfit" generate ellipsoid -o "$d/clean.ply" --n 3000 --seed 27 >/dev/null ||
+    bad "jetfit generate ellipsoid"
+  same "2 3" clean.ply csv --neighbors auto
+  capped=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "status") s = i; next }
+                    int($s / 262144) % 2 { c++ } END { print c + 0 }' "$d/ref.csv")
+  [ "$capped" -eq 3000 ] && echo "ok   auto capped: $capped of 3000 rows" ||
+    bad "auto on a clean cloud: $capped of 3000 rows capped (want all)"
   # auto's halo balls overlap: each point is sent to a rank once (kept == fetched)
   mpi 3 estimate "$d/clusters.ply" -o "$d/got.csv" --neighbors auto 2>"$d/stderr" >/dev/null
   h=$(sed -n 's/^ *halo: \([0-9]*\) points kept, \([0-9]*\) fetched.*/\1 \2/p' "$d/stderr")

@@ -7,13 +7,17 @@
  * row is step 6's mean of its nearest's fits (recomputed here in double
  * precision from those fits), exact on a sphere, its noise estimate is
  * near the noise drawn, and it is the same bits for 1 and 2 threads and
- * in parts (jf_estimate_parts) as on the whole cloud. */
+ * in parts (jf_estimate_parts) as on the whole cloud.  Step 0: the
+ * leave-one-out residual from the power sums is a refit without the
+ * point, the cap follows the cloud's CV, and a capped cloud is the same
+ * bits in parts and on two threads. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "auto_cloud.h" /* step 0 */
 #include "jetfit.h"
 #include "robust/neigh_jets.h" /* JF_NJ_MID */
 #include "synth/surfaces.h"
@@ -136,14 +140,14 @@ END_TEST
 /* Each point's own fit (steps 1-5): jf_fit_point_full with auto on its
  * k <= JF_NB_AUTO_KMAX nearest (*nbi[i * KMAX ...], the tree's order), as
  * the estimate's walk makes it. */
-static jf_result *own_fits(const surf *c, size_t k, uint32_t **nbi)
+static jf_result *own_fits(const surf *c, size_t k, uint32_t **nbi, int sel)
 {
     jf_index *ix;
     ck_assert_int_eq(jf_index_build(c->s.xyz, c->s.n, &ix), JF_OK);
     uint32_t *idx = *nbi = malloc(c->s.n * JF_NB_AUTO_KMAX * sizeof *idx);
     jf_params p;
     jf_params_init(&p);
-    p.auto_select = 1;
+    p.auto_select = sel;
     p.max_neighbors = JF_NB_AUTO_KMAX;
     jf_fitter *f;
     ck_assert_int_eq(jf_fitter_create(&p, &f), JF_OK);
@@ -172,15 +176,17 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
  * and n_j - W (q - j), W the mean W_j, all means weighted by K_j (l1 +
  * l2)_j / sigma_j^2 -- the curvatures the eigenvalues of the plain mean
  * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
- * q's, 2 where the weighted mean was taken. */
+ * q's, 2 where the weighted mean was taken.  A capped row (step 0):
+ * round(K/4) nearest, never the weighted mean. */
 static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, double n[3],
                  double k[2])
 {
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
-    double fc = nearbyint(a->n_used / 8.0);
+    const int capped = (a->status & JF_PT_AUTO_CAPPED) != 0;
+    double fc = nearbyint(a->n_used / (capped ? 4.0 : 8.0));
     size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
-    const int wide = a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID;
+    const int wide = a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID && !capped;
     double W[9] = {0}, v[3] = {0}, sw = 0, Ww[9] = {0}, vw[3] = {0}, nw[3] = {0}, dw[3] = {0};
     for (size_t t = 0; t < mc; t++) {
         const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
@@ -239,12 +245,28 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
  * cond) -- up to rounding, on every point (the fit comes from power sums,
  * auto.c's direct_fit).  Step 6: the row is the mean of the nearest's
  * fits (mixed() above, no quantization: to the records' 16 bits). */
-START_TEST(test_auto_is_the_jet)
+/* the cap step 0 gives c (auto_cloud.c) */
+static int cloud_cap(const surf *c)
 {
-    surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
-    jf_result *ra = run(&c, "auto", 2);
+    jf_params p;
+    jf_params_init(&p);
+    p.auto_select = 1;
+    p.max_neighbors = JF_NB_AUTO_KMAX;
+    jf__cvrec *r;
+    size_t nr;
+    ck_assert_int_eq(jf__auto_cv_sample(c->s.xyz, c->s.n, NULL, NULL, c->s.n, NULL, &p, 2, &r, &nr), JF_OK);
+    int cap = jf__auto_cv_decide(r, nr, NULL);
+    free(r);
+    return cap;
+}
+
+/* sel: params.auto_select (256: no cap; 1: the cloud's, step 0) */
+static void is_the_jet(surf c, int sel)
+{
+    jf_result *ra = run_sel(&c, "auto", 2, sel);
     uint32_t *nbi;
-    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi);
+    const int cap = sel == 1 ? cloud_cap(&c) : sel;
+    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi, cap);
     jf_fitter *fit[4] = {NULL, NULL, NULL, NULL};
     for (int d = 1; d <= 3; d++) {
         jf_params p;
@@ -302,14 +324,34 @@ START_TEST(test_auto_is_the_jet)
     ck_assert_uint_gt(nd[2], 0); /* both degrees met */
     ck_assert_uint_gt(nd[3], 0);
     ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
-    /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID */
-    ck_assert_msg(nwide > c.s.n / 10 && nwide < c.s.n - c.s.n / 10, "weighted mean at %zu of %zu",
-                  nwide, c.s.n);
+    /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID;
+     * capped, the plain carry only */
+    if (cap < JF_NB_AUTO_KMAX)
+        ck_assert_uint_eq(nwide, 0);
+    else
+        ck_assert_msg(nwide > c.s.n / 10 && nwide < c.s.n - c.s.n / 10,
+                      "weighted mean at %zu of %zu", nwide, c.s.n);
     for (int d = 1; d <= 3; d++) jf_fitter_free(fit[d]);
     free(own);
     free(nbi);
     free(ra);
     jf_sample_free(&c.s);
+}
+
+/* The numbers of steps 1-6 without a cap (this 4,000-point torus is
+ * capped at 96 by its CV: at so few points its curvature is large
+ * against the spacing) and with the cloud's. */
+START_TEST(test_auto_is_the_jet)
+{
+    is_the_jet(make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT), JF_NB_AUTO_KMAX);
+}
+END_TEST
+
+START_TEST(test_auto_is_the_jet_capped)
+{
+    surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
+    ck_assert_int_lt(cloud_cap(&c), JF_NB_AUTO_KMAX);
+    is_the_jet(c, 1);
 }
 END_TEST
 
@@ -324,7 +366,7 @@ START_TEST(test_auto_sphere)
     surf c = make(JF_SURF_SPHERE, 4000, 0.0, JF_DENSITY_UNIFORM);
     jf_result *ra = run(&c, "auto", 2);
     uint32_t *nbi;
-    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi);
+    jf_result *own = own_fits(&c, JF_NB_AUTO_KMAX, &nbi, cloud_cap(&c)); /* capped: clean */
     double worst[2] = {0, 0}, kw[2] = {0, 0}, rms[2] = {0, 0};
     for (size_t i = 0; i < c.s.n; i++)
         for (int w = 0; w < 2; w++) {
@@ -336,9 +378,9 @@ START_TEST(test_auto_sphere)
             kw[w] = e > kw[w] ? e : kw[w];
         }
     for (int w = 0; w < 2; w++) rms[w] = sqrt(rms[w] / (double)c.s.n);
-    /* measured: normals 1.9e-4 rad RMS, 9.5e-4 worst (own fits 1.5e-4,
-     * 5.9e-4): the carry's third-order error, |q - j|^3 / 2; curvatures
-     * 0.023 worst (own fits 0.044) */
+    /* clean: step 0 caps K at 24.  Measured: normals 8.2e-5 rad RMS,
+     * 3.9e-4 worst (own fits 9.9e-5, 4.5e-4); curvatures 0.0078 worst
+     * (own fits 0.0113); uncapped they were 1.9e-4, 9.5e-4 and 0.023 */
     ck_assert_msg(rms[0] < 1.5 * rms[1] && rms[0] < 3e-4 && worst[0] < 2e-3,
                   "normal rms %.3g rad (own fits %.3g), worst %.3g (%.3g)", rms[0], rms[1], worst[0],
                   worst[1]);
@@ -357,7 +399,7 @@ START_TEST(test_auto_select_knn)
     surf c = make(JF_SURF_TORUS, 1500, 0.003, JF_DENSITY_GRADIENT);
     jf_result *r = run_sel(&c, "knn:64", 2, 1);
     uint32_t *nbi;
-    jf_result *own = own_fits(&c, 64, &nbi);
+    jf_result *own = own_fits(&c, 64, &nbi, 1);
     for (size_t i = 0; i < c.s.n; i += 7) {
         ck_assert_int_eq(memcmp(own[i].normal, r[i].normal, sizeof r[i].normal), 0);
         ck_assert(own[i].k1 == r[i].k1 && own[i].n_used == r[i].n_used);
@@ -461,6 +503,159 @@ START_TEST(test_auto_parts_halo)
 }
 END_TEST
 
+/* x (n x 6 normal equations, in place) solved by Gaussian elimination
+ * with partial pivoting; the solution into b */
+static void solve6(double A[36], double b[6])
+{
+    for (int c = 0; c < 6; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 6; r++)
+            if (fabs(A[r * 6 + c]) > fabs(A[piv * 6 + c])) piv = r;
+        for (int k = 0; k < 6; k++) {
+            double t = A[c * 6 + k];
+            A[c * 6 + k] = A[piv * 6 + k];
+            A[piv * 6 + k] = t;
+        }
+        double t = b[c];
+        b[c] = b[piv];
+        b[piv] = t;
+        for (int r = c + 1; r < 6; r++) {
+            double f = A[r * 6 + c] / A[c * 6 + c];
+            for (int k = c; k < 6; k++) A[r * 6 + k] -= f * A[c * 6 + k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int c = 5; c >= 0; c--) {
+        for (int k = c + 1; k < 6; k++) b[c] -= A[c * 6 + k] * b[k];
+        b[c] /= A[c * 6 + c];
+    }
+}
+
+/* Step 0's value at p is the quadric's leave-one-out residual: the height
+ * at p of the least-squares quadric on the other K - 1 points, refitted
+ * here in the same (world) frame, squared. */
+START_TEST(test_auto_cv_loo)
+{
+    enum { N = JF_NB_AUTO_KMAX };
+    static const size_t ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
+    double *nb = malloc(3 * N * sizeof *nb), d2[N];
+    jf_rng rng;
+    jf_rng_seed(&rng, 5);
+    nb[0] = nb[1] = nb[2] = 0.0; /* p, its own nearest */
+    d2[0] = 0.0;
+    for (int i = 1; i < N; i++) {
+        double x = 2 * jf_rng_uniform(&rng) - 1, y = 2 * jf_rng_uniform(&rng) - 1;
+        double z = 0.3 * x * x - 0.2 * x * y + 0.5 * y * y + 0.1 * x * x * x + 0.01 * jf_rng_gauss(&rng);
+        nb[3 * i] = x, nb[3 * i + 1] = y, nb[3 * i + 2] = z;
+        d2[i] = x * x + y * y + z * z;
+    }
+    for (int i = 2; i < N; i++) /* nearest first */
+        for (int j = i; j > 1 && d2[j] < d2[j - 1]; j--) {
+            double t = d2[j];
+            d2[j] = d2[j - 1];
+            d2[j - 1] = t;
+            for (int k = 0; k < 3; k++) {
+                t = nb[3 * j + k];
+                nb[3 * j + k] = nb[3 * (j - 1) + k];
+                nb[3 * (j - 1) + k] = t;
+            }
+        }
+    jf_params pr;
+    jf_params_init(&pr);
+    pr.frame = JF_FRAME_AXIS; /* step 1's frame: the world's axes */
+    pr.max_neighbors = N;
+    pr.auto_select = 1;
+    jf_fitter *f;
+    ck_assert_int_eq(jf_fitter_create(&pr, &f), JF_OK);
+    double out[JF_AUTO_CV_N];
+    jf__auto_cv_point(f, &pr, nb, nb, N, out);
+    for (int c = 0; c < JF_AUTO_NCAND; c++) {
+        double A[36] = {0}, b[6] = {0};
+        for (size_t i = 1; i < ks[c]; i++) {
+            const double x = nb[3 * i], y = nb[3 * i + 1], m[6] = {1, x, y, x * x, x * y, y * y};
+            for (int r = 0; r < 6; r++) {
+                for (int k = 0; k < 6; k++) A[r * 6 + k] += m[r] * m[k];
+                b[r] += m[r] * nb[3 * i + 2];
+            }
+        }
+        solve6(A, b);
+        const double want = b[0] * b[0];
+        ck_assert_msg(fabs(out[c] - want) <= 1e-8 * want + 1e-30, "K %zu: %.17g, refit %.17g", ks[c],
+                      out[c], want);
+    }
+    const double r16 = sqrt(d2[16]);
+    ck_assert_msg(out[JF_AUTO_NCAND] > 0.005 / r16 && out[JF_AUTO_NCAND] < 0.02 / r16,
+                  "sigma / r16 %g (noise 0.01, r16 %g)", out[JF_AUTO_NCAND], r16);
+    jf_fitter_free(f);
+    free(nb);
+}
+END_TEST
+
+/* The decision: the K of least summed CV, a cap one candidate above it
+ * where the noise is thin and that K at most 64; none otherwise; the
+ * records' order does not matter. */
+START_TEST(test_auto_cv_decide)
+{
+    enum { M = 200 };
+    jf__cvrec r[M], q[M];
+    jf__auto_cv_why w;
+    for (int pick = 0; pick < JF_AUTO_NCAND; pick++)
+        for (int thick = 0; thick < 2; thick++) {
+            for (int s = 0; s < M; s++) {
+                r[s].gid = (uint32_t)(7 * s % M) * 3u;
+                for (int c = 0; c < JF_AUTO_NCAND; c++)
+                    r[s].v[c] = 1.0 + (c - pick) * (c - pick) + 0.5 * (s % 3); /* least at pick */
+                r[s].v[JF_AUTO_NCAND] = (thick ? 0.5 : 0.1) + 0.001 * s;
+            }
+            memcpy(q, r, sizeof r);
+            int cap = jf__auto_cv_decide(r, M, &w);
+            static const int ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
+            ck_assert_int_eq(w.pick, ks[pick]);
+            ck_assert_uint_eq(w.used, M);
+            ck_assert_int_eq(cap, !thick && ks[pick] <= 64 ? ks[pick + 1] : JF_NB_AUTO_KMAX);
+            for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
+            ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
+        }
+    for (int s = 0; s < M; s++) r[s].v[3] = NAN; /* no usable record: no cap */
+    ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
+    ck_assert_uint_eq(w.used, 0);
+}
+END_TEST
+
+/* On clean data CV is least at the smallest K (bias only): the cloud is
+ * capped at 24, every row says so and keeps K <= 24 (the cap given by
+ * hand, auto_select = 24, gives the same bytes); noisy data thicker than
+ * the spacing is not capped; a capped cloud is the same bits on two
+ * threads and in parts. */
+START_TEST(test_auto_cap)
+{
+    surf c = make(JF_SURF_ELLIPSOID, 3000, 0.0, JF_DENSITY_UNIFORM);
+    c.s.xyz[3 * 17] = NAN; /* a non-finite row (same_in_parts) */
+    jf_result *r1 = run(&c, "auto", 1), *r2 = run(&c, "auto", 2), *rh = run_sel(&c, "auto", 1, 24);
+    for (size_t i = 0; i < c.s.n; i++) {
+        if (i == 17) continue;
+        ck_assert_uint_ne(r1[i].status & JF_PT_AUTO_CAPPED, 0);
+        ck_assert_int_le(r1[i].n_used, 24);
+    }
+    ck_assert_int_eq(memcmp(r1, r2, c.s.n * sizeof *r1), 0);
+    ck_assert_int_eq(memcmp(r1, rh, c.s.n * sizeof *r1), 0);
+    free(r1);
+    free(r2);
+    free(rh);
+    same_in_parts(&c); /* frees c */
+    surf t = make(JF_SURF_ELLIPSOID, 3000, 0.01, JF_DENSITY_UNIFORM);
+    jf_result *rt = run(&t, "auto", 2);
+    size_t big = 0;
+    for (size_t i = 0; i < t.s.n; i++) {
+        ck_assert_uint_eq(rt[i].status & JF_PT_AUTO_CAPPED, 0);
+        big += rt[i].n_used > 96;
+    }
+    ck_assert_uint_gt(big, t.s.n / 2);
+    free(rt);
+    jf_sample_free(&t.s);
+}
+END_TEST
+
 START_TEST(test_auto_spec)
 {
     jf_nb_spec s;
@@ -499,11 +694,15 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_torus_gradient);
     tcase_add_test(tc, test_auto_threads);
     tcase_add_test(tc, test_auto_is_the_jet);
+    tcase_add_test(tc, test_auto_is_the_jet_capped);
     tcase_add_test(tc, test_auto_sphere);
     tcase_add_test(tc, test_auto_select_knn);
     tcase_add_test(tc, test_auto_parts);
     tcase_add_test(tc, test_auto_parts_far);
     tcase_add_test(tc, test_auto_parts_halo);
+    tcase_add_test(tc, test_auto_cv_loo);
+    tcase_add_test(tc, test_auto_cv_decide);
+    tcase_add_test(tc, test_auto_cap);
     suite_add_tcase(s, tc);
     return s;
 }

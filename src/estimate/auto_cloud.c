@@ -1,0 +1,152 @@
+/* auto_cloud.c -- neighbors auto's step 0: one cap on K for the whole
+ * cloud, from its leave-one-out cross-validation (docs/robustness.md,
+ * "Neighbourhood auto", step 0).
+ *
+ * design:
+ *  - the sample: the finite points whose input index is a multiple of
+ *    jf__auto_cv_stride(n) (n: the whole cloud's count), so a part or a
+ *    rank finds its share of the same sample from input indices alone;
+ *  - per sampled point, jf__auto_cv_point on its JF_NB_AUTO_KMAX nearest
+ *    (the walk's list, bit for bit): the quadric's squared leave-one-out
+ *    residual at each candidate K and sigma / r16;
+ *  - the decision (jf__auto_cv_decide) sums them in input-index order,
+ *    whoever computed them: whole cloud, parts and ranks agree.
+ * Where the noise is thin against the spacing (median sigma / r16 at most
+ * JF_CV_THICK) CV(K) is the error of the height at p plus the noise, and
+ * its least K is the cloud's best K or its neighbour (item 7 of "What is
+ * not met"); where it is thick the 3-D nearest of a noisy p lie on its
+ * side and CV is least at the smallest K whatever the surface, so no cap.
+ * A pick of 128 or more caps nothing: the curvatures want the largest K
+ * (every cap below 256 loses the torus's |dk1|, item 7). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <omp.h>
+
+#include "auto_cloud.h"
+#include "index_internal.h"
+#include "robust_internal.h"
+
+#define JF_CV_SAMPLES 2048 /* about this many points (2% of 10^5)         */
+#define JF_CV_THICK 0.4    /* median sigma / r16 above: thick noise        */
+#define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
+#define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
+
+/* the candidates' K, as auto.c's */
+static const size_t cvk[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
+
+size_t jf__auto_cv_stride(size_t ntotal)
+{
+    /* a quarter at most: on a small cloud the sample is no second pass */
+    return ntotal / JF_CV_SAMPLES > 4 ? ntotal / JF_CV_SAMPLES : 4;
+}
+
+static int finite3(const double *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+jf_status jf__auto_cv_sample(const double *xyz, size_t n, const uint8_t *own, const uint32_t *gid,
+                             size_t ntotal, const jf_index *ix, const jf_params *pr, int nt,
+                             jf__cvrec **out, size_t *nout)
+{
+    *out = NULL;
+    *nout = 0;
+    const size_t stride = jf__auto_cv_stride(ntotal);
+    size_t ns = 0;
+    for (size_t i = 0; i < n; i++)
+        if ((!own || own[i]) && (gid ? gid[i] : i) % stride == 0 && finite3(xyz + 3 * i)) ns++;
+    if (!ns) return JF_OK;
+    jf__cvrec *r = malloc(ns * sizeof *r);
+    if (!r) return JF_ERR_NOMEM;
+    ns = 0;
+    for (size_t i = 0; i < n; i++)
+        if ((!own || own[i]) && (gid ? gid[i] : i) % stride == 0 && finite3(xyz + 3 * i))
+            r[ns++].gid = (uint32_t)i; /* the local index until the fits */
+    jf_index *mine = NULL;
+    jf_status st = JF_OK;
+    if (!ix && (st = jf__index_build_threads(xyz, n, nt, &mine)) != JF_OK) {
+        free(r);
+        return st;
+    }
+    const jf_index *use = ix ? ix : mine;
+    jf_params fp = *pr;
+    if (fp.max_neighbors < JF_NB_AUTO_KMAX) fp.max_neighbors = JF_NB_AUTO_KMAX;
+    fp.auto_select = 1;
+#pragma omp parallel num_threads(nt)
+    {
+        jf_fitter *f = NULL;
+        uint32_t idx[JF_NB_AUTO_KMAX];
+        double d2[JF_NB_AUTO_KMAX], *nbr = malloc(3 * JF_NB_AUTO_KMAX * sizeof *nbr);
+        jf_status ts = nbr ? jf_fitter_create(&fp, &f) : JF_ERR_NOMEM;
+#pragma omp for schedule(dynamic, 16)
+        for (size_t s = 0; s < ns; s++) {
+            if (ts != JF_OK) continue;
+            const size_t i = r[s].gid;
+            size_t found = 0;
+            ts = jf__index_query(use, xyz + 3 * i, JF_NB_AUTO_KMAX, INFINITY, idx, d2, nbr, &found);
+            if (ts == JF_OK) jf__auto_cv_point(f, &fp, xyz + 3 * i, nbr, found, r[s].v);
+        }
+        if (ts != JF_OK) {
+#pragma omp critical(jf_auto_cv)
+            st = ts;
+        }
+        jf_fitter_free(f);
+        free(nbr);
+    }
+    jf_index_free(mine);
+    if (st != JF_OK) {
+        free(r);
+        return st;
+    }
+    for (size_t s = 0; s < ns; s++) r[s].gid = gid ? gid[r[s].gid] : r[s].gid;
+    *out = r;
+    *nout = ns;
+    return JF_OK;
+}
+
+static int by_gid(const void *a, const void *b)
+{
+    const uint32_t x = ((const jf__cvrec *)a)->gid, y = ((const jf__cvrec *)b)->gid;
+    return (x > y) - (x < y);
+}
+
+static int by_value(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
+{
+    jf__auto_cv_why w;
+    memset(&w, 0, sizeof w);
+    w.cap = JF_NB_AUTO_KMAX;
+    w.median = NAN;
+    qsort(r, n, sizeof *r, by_gid); /* input order: every split sums alike */
+    double sum[JF_AUTO_NCAND] = {0}, *sr = malloc((n ? n : 1) * sizeof *sr);
+    size_t ns = 0;
+    for (size_t s = 0; s < n; s++) {
+        int all = 1;
+        for (int c = 0; c < JF_AUTO_NCAND && all; c++) all = isfinite(r[s].v[c]);
+        if (!all) continue;
+        for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += r[s].v[c];
+        if (sr && isfinite(r[s].v[JF_AUTO_NCAND])) sr[ns++] = r[s].v[JF_AUTO_NCAND];
+        w.used++;
+    }
+    if (sr && ns) {
+        qsort(sr, ns, sizeof *sr, by_value);
+        w.median = sr[ns / 2];
+    }
+    free(sr);
+    if (w.used >= JF_CV_MINREC) {
+        int b = 0;
+        for (int c = 1; c < JF_AUTO_NCAND; c++)
+            if (sum[c] < sum[b]) b = c;
+        w.pick = (int)cvk[b];
+        if (w.median <= JF_CV_THICK && cvk[b] <= JF_CV_MAXPICK) w.cap = (int)cvk[b + 1];
+    }
+    if (why) *why = w;
+    return w.cap;
+}

@@ -1,0 +1,41 @@
+/* auto_cloud.h -- neighbors auto's step 0, the cloud's cap on K
+ * (auto_cloud.c; not part of the public API).  The whole-cloud estimate,
+ * the parts and jetfit-mpi's ranks each compute their share of one
+ * sample and decide from all of it. */
+#ifndef JF_AUTO_CLOUD_H
+#define JF_AUTO_CLOUD_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jetfit.h"
+#include "robust_internal.h" /* JF_AUTO_CV_N */
+
+/* One sampled point: its input index and jf__auto_cv_point's values. */
+typedef struct {
+    uint32_t gid;
+    double v[JF_AUTO_CV_N];
+} jf__cvrec;
+
+/* What the decision saw (the summary's line). */
+typedef struct {
+    size_t used;   /* sample points with every candidate's CV         */
+    int pick;      /* the K of least CV (0: too few points)           */
+    double median; /* median sigma / r16                              */
+    int cap;       /* params.auto_select: the cap, JF_NB_AUTO_KMAX none */
+} jf__auto_cv_why;
+
+/* Every stride-th input index is sampled (n: the whole cloud's count). */
+size_t jf__auto_cv_stride(size_t ntotal);
+
+/* The sample points among the n of xyz (own: those of this part, NULL:
+ * all; gid: their input indices, NULL: the local ones; ntotal: the whole
+ * cloud's count), each on its JF_NB_AUTO_KMAX nearest from ix (NULL:
+ * built here on nt threads), into *out (malloc'd, *nout records). */
+jf_status jf__auto_cv_sample(const double *xyz, size_t n, const uint8_t *own, const uint32_t *gid,
+                             size_t ntotal, const jf_index *ix, const jf_params *pr, int nt,
+                             jf__cvrec **out, size_t *nout);
+
+/* The cap from every sample record (sorted here by input index, so any
+ * split sums in one order); *why (may be NULL) what it saw. */
+int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why);
+#endif
