@@ -37,6 +37,9 @@ typedef struct {
     size_t nj;        /* auto's step 6 (robust/neigh_jets.h): a row reads
                          the fits of its nj nearest, so the halo holds
                          their k nearest too (jf__halo_requests); 0: off */
+    const uint8_t *only; /* jf__halo_of: requests from the own points j
+                            with only[j] (NULL: every one; auto's step
+                            0 sweep: its sample's)                      */
 } jf_part_query;
 
 /* neighbors auto (src/robust/auto.c): turns o->nb = auto into knn:

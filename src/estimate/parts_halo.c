@@ -141,6 +141,7 @@ jf_status jf__halo_of(reader *rd, const int32_t *part, const double *box, int P,
                 for (size_t jj = ch * REQ_CHUNK; ok && jj < end; jj++) {
                     const size_t j = lid[jj];
                     const double *p = lp + 3 * jj;
+                    if (q->only && !q->only[j]) continue;
                     jf_halo_req r[2];
                     if (knn && last[3] < INFINITY) {
                         /* own k-th distance <= last's + |p - last|

@@ -344,6 +344,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     uint8_t *mask = NULL;
     size_t *ccnt = NULL, ncv = 0;
     jf__cvrec *cvr = NULL; /* auto's step 0: the sample's records */
+    uint8_t *only = NULL;  /* and its own points in the part          */
     occgrid occ = {{0, 0, 0}, 1, {1, 1, 1}, NULL, 0, 1};
     reader rd;
     double gb[6];
@@ -375,6 +376,11 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
      * only the sample, whose records decide the cap every part is given */
     const int cv = o->params.auto_select == 1 && q.nb.kind == JF_NB_KNN && q.nb.k >= JF_NB_AUTO_KMAX;
     for (int sweep = cv ? 0 : 1; sweep < 2 && st == JF_OK; sweep++) {
+    /* the sample's sweep reads only the sample's K nearest: no step 6
+     * ball, no request from another point */
+    jf_part_query qs = q;
+    if (sweep == 0) qs.nj = 0;
+    const size_t stride = jf__auto_cv_stride(n);
     for (int a = 0; a < P && st == JF_OK; a++) {
         if (!count[a]) continue;
         if (o->cancel && o->cancel(o->cancel_user)) {
@@ -384,23 +390,33 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         }
         /* step 2: own index, requests, halo */
         size_t m = jf__gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
+        if (sweep == 0) { /* the sample's requests only */
+            uint8_t *on = realloc(only, m ? m : 1);
+            if (!on) {
+                st = JF_ERR_NOMEM;
+                break;
+            }
+            only = on;
+            for (size_t j = 0; j < m; j++) only[j] = ids[j] % stride == 0;
+            qs.only = only;
+        }
         if ((st = jf__reader_status(&rd, err)) != JF_OK) goto out;
         int served = 0;
         /* auto's step 6 needs a wider halo than the cells' rings: requests */
-        if (q.nb.kind == JF_NB_KNN && !q.nj &&
-            (st = jf__halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, q.nb.k, hcap > m ? hcap - m : 0,
+        if (qs.nb.kind == JF_NB_KNN && !qs.nj &&
+            (st = jf__halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, qs.nb.k, hcap > m ? hcap - m : 0,
                                 jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
             break;
         if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
             jf_index *own = NULL, *wide = NULL;
             if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-            if (q.nb.kind == JF_NB_KNN) /* the balls from the cloud's distances */
-                st = jf__wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &q, nt, &halo, &nh,
+            if (qs.nb.kind == JF_NB_KNN) /* the balls from the cloud's distances */
+                st = jf__wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &qs, nt, &halo, &nh,
                                 &wide);
             if (st == JF_OK && !halo)
                 st = rd.fail ? JF_ERR_IO
                              : jf__halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, 0.0,
-                                       NULL, sxyz, m, &q, nt, &halo, &nh);
+                                       NULL, sxyz, m, &qs, nt, &halo, &nh);
             jf_index_free(wide);
             jf_index_free(own);
         }
@@ -497,6 +513,7 @@ out:
     free(mask);
     free(ccnt);
     free(cvr);
+    free(only);
     free(occ.own);
     return st;
 }
