@@ -22,3 +22,17 @@ def test_auto_sigma_flags_threads():
         assert np.array_equal(getattr(r, a), getattr(r1, a), equal_nan=True)
     k = jetfit.estimate(p, neighbors="knn:32")
     assert np.all(np.isnan(k.sigma))
+
+
+def test_auto_capped_clean_only():
+    """step 0: a clean cloud's cross-validation caps K (every row flagged
+    auto_capped, K <= 24); on the same sphere with noise CV is least at a
+    large K and nothing is capped"""
+    cap = jetfit.STATUS["auto_capped"]
+    clean = jetfit.estimate(fib_sphere(3000), neighbors="auto", threads=2)
+    assert np.all(clean.status & cap)
+    assert np.all(clean.neighbors <= 24)
+    rng = np.random.default_rng(5)
+    noisy = jetfit.estimate(fib_sphere(3000) + rng.normal(0, 0.02, (3000, 3)), neighbors="auto")
+    assert not np.any(noisy.status & cap)
+    assert np.median(noisy.neighbors) > 96
