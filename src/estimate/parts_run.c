@@ -376,126 +376,126 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
      * only the sample, whose records decide the cap every part is given */
     const int cv = o->params.auto_select == 1 && q.nb.kind == JF_NB_KNN && q.nb.k >= JF_NB_AUTO_KMAX;
     for (int sweep = cv ? 0 : 1; sweep < 2 && st == JF_OK; sweep++) {
-    /* the sample's sweep reads only the sample's K nearest: no step 6
-     * ball, no request from another point */
-    jf_part_query qs = q;
-    if (sweep == 0) qs.nj = 0;
-    const size_t stride = jf__auto_cv_stride(n);
-    for (int a = 0; a < P && st == JF_OK; a++) {
-        if (!count[a]) continue;
-        if (o->cancel && o->cancel(o->cancel_user)) {
-            st = JF_ERR_CANCELLED;
-            jf__set_err(err, "cancelled");
-            goto out;
-        }
-        /* step 2: own index, requests, halo */
-        size_t m = jf__gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
-        if (sweep == 0) { /* the sample's requests only */
-            uint8_t *on = realloc(only, m ? m : 1);
-            if (!on) {
+        /* the sample's sweep reads only the sample's K nearest: no step 6
+         * ball, no request from another point */
+        jf_part_query qs = q;
+        if (sweep == 0) qs.nj = 0;
+        const size_t stride = jf__auto_cv_stride(n);
+        for (int a = 0; a < P && st == JF_OK; a++) {
+            if (!count[a]) continue;
+            if (o->cancel && o->cancel(o->cancel_user)) {
+                st = JF_ERR_CANCELLED;
+                jf__set_err(err, "cancelled");
+                goto out;
+            }
+            /* step 2: own index, requests, halo */
+            size_t m = jf__gather(&rd, part, a, ids, sxyz, ccnt), nh = 0;
+            if (sweep == 0) { /* the sample's requests only */
+                uint8_t *on = realloc(only, m ? m : 1);
+                if (!on) {
+                    st = JF_ERR_NOMEM;
+                    break;
+                }
+                only = on;
+                for (size_t j = 0; j < m; j++) only[j] = ids[j] % stride == 0;
+                qs.only = only;
+            }
+            if ((st = jf__reader_status(&rd, err)) != JF_OK) goto out;
+            int served = 0;
+            /* auto's step 6 needs a wider halo than the cells' rings: requests */
+            if (qs.nb.kind == JF_NB_KNN && !qs.nj &&
+                (st = jf__halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, qs.nb.k, hcap > m ? hcap - m : 0,
+                                    jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
+                break;
+            if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
+                jf_index *own = NULL, *wide = NULL;
+                if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
+                if (qs.nb.kind == JF_NB_KNN) /* the balls from the cloud's distances */
+                    st = jf__wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &qs, nt, &halo, &nh,
+                                    &wide);
+                if (st == JF_OK && !halo)
+                    st = rd.fail ? JF_ERR_IO
+                                 : jf__halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, 0.0,
+                                           NULL, sxyz, m, &qs, nt, &halo, &nh);
+                jf_index_free(wide);
+                jf_index_free(own);
+            }
+            if (rd.fail) st = jf__reader_status(&rd, err);
+            if (st != JF_OK) break;
+            /* step 3: own + halo in input order, merged from the back into
+             * sxyz (the own coordinates stay ahead of the write) */
+            size_t ms = m + nh, u = m, v = nh, k = ms;
+            uint32_t *sid = malloc(ms * sizeof *sid);
+            double *nx = realloc(sxyz, 3 * (ms > cmax ? ms : cmax) * sizeof *nx);
+            mask = malloc(ms);
+            if (!sid || !nx || !mask) {
+                free(sid);
+                if (nx) sxyz = nx;
                 st = JF_ERR_NOMEM;
                 break;
             }
-            only = on;
-            for (size_t j = 0; j < m; j++) only[j] = ids[j] % stride == 0;
-            qs.only = only;
-        }
-        if ((st = jf__reader_status(&rd, err)) != JF_OK) goto out;
-        int served = 0;
-        /* auto's step 6 needs a wider halo than the cells' rings: requests */
-        if (qs.nb.kind == JF_NB_KNN && !qs.nj &&
-            (st = jf__halo_by_cells(&rd, part, box + 6 * a, a, sxyz, m, qs.nb.k, hcap > m ? hcap - m : 0,
-                                jf__parts_grid_bits(n) / 8, nt, &halo, &nh, &served)) != JF_OK)
-            break;
-        if (!served && !rd.fail) { /* the exact requests (any kind, any cloud) */
-            jf_index *own = NULL, *wide = NULL;
-            if ((st = jf__index_build_threads(sxyz, m, nt, &own)) != JF_OK) break;
-            if (qs.nb.kind == JF_NB_KNN) /* the balls from the cloud's distances */
-                st = jf__wide_index(&rd, part, box, P, &occ, a, own, sxyz, m, &qs, nt, &halo, &nh,
-                                &wide);
-            if (st == JF_OK && !halo)
-                st = rd.fail ? JF_ERR_IO
-                             : jf__halo_of(&rd, part, box, P, &occ, a, own, wide ? wide : own, 0.0,
-                                       NULL, sxyz, m, &qs, nt, &halo, &nh);
-            jf_index_free(wide);
-            jf_index_free(own);
-        }
-        if (rd.fail) st = jf__reader_status(&rd, err);
-        if (st != JF_OK) break;
-        /* step 3: own + halo in input order, merged from the back into
-         * sxyz (the own coordinates stay ahead of the write) */
-        size_t ms = m + nh, u = m, v = nh, k = ms;
-        uint32_t *sid = malloc(ms * sizeof *sid);
-        double *nx = realloc(sxyz, 3 * (ms > cmax ? ms : cmax) * sizeof *nx);
-        mask = malloc(ms);
-        if (!sid || !nx || !mask) {
-            free(sid);
-            if (nx) sxyz = nx;
-            st = JF_ERR_NOMEM;
-            break;
-        }
-        sxyz = nx;
-        while (k > 0) {
-            int own_next = v == 0 || (u > 0 && ids[u - 1] > halo[v - 1].id);
-            k--;
-            if (own_next) {
-                u--;
-                sid[k] = ids[u];
-                memmove(sxyz + 3 * k, sxyz + 3 * u, sizeof(double[3]));
-            } else {
-                v--;
-                sid[k] = halo[v].id;
-                memcpy(sxyz + 3 * k, halo[v].x, sizeof(double[3]));
-            }
-            mask[k] = (uint8_t)own_next;
-        }
-        free(halo);
-        halo = NULL;
-        jf_cloud sc = {0};
-        sc.n = ms;
-        sc.xyz = sxyz;
-        if (c->nrm && (snrm = malloc(3 * ms * sizeof *snrm)))
-            for (size_t t = 0; t < ms; t++)
-                memcpy(snrm + 3 * t, c->nrm + 3 * (size_t)sid[t], sizeof(double[3]));
-        if (c->scan && (sscan = malloc(ms * sizeof *sscan)))
-            for (size_t t = 0; t < ms; t++) sscan[t] = c->scan[sid[t]];
-        if ((c->nrm && !snrm) || (c->scan && !sscan)) {
-            free(sid);
-            st = JF_ERR_NOMEM;
-            break;
-        }
-        sc.nrm = snrm;
-        sc.scan = sscan;
-        sc.scanner = c->scanner;
-        sc.nscans = c->nscans;
-        if (sweep == 0) {
-            jf__cvrec *r = NULL, *g;
-            size_t nr = 0;
-            st = jf__auto_cv_sample(sxyz, ms, mask, sid, n, NULL, &o->params, nt, &r, &nr);
-            if (st == JF_OK && nr) {
-                if ((g = realloc(cvr, (ncv + nr) * sizeof *g))) {
-                    cvr = g;
-                    memcpy(cvr + ncv, r, nr * sizeof *r);
-                    ncv += nr;
+            sxyz = nx;
+            while (k > 0) {
+                int own_next = v == 0 || (u > 0 && ids[u - 1] > halo[v - 1].id);
+                k--;
+                if (own_next) {
+                    u--;
+                    sid[k] = ids[u];
+                    memmove(sxyz + 3 * k, sxyz + 3 * u, sizeof(double[3]));
                 } else {
-                    st = JF_ERR_NOMEM;
+                    v--;
+                    sid[k] = halo[v].id;
+                    memcpy(sxyz + 3 * k, halo[v].x, sizeof(double[3]));
                 }
+                mask[k] = (uint8_t)own_next;
             }
-            free(r);
-        } else {
-            relay rl = {sid, sink, user};
-            st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
+            free(halo);
+            halo = NULL;
+            jf_cloud sc = {0};
+            sc.n = ms;
+            sc.xyz = sxyz;
+            if (c->nrm && (snrm = malloc(3 * ms * sizeof *snrm)))
+                for (size_t t = 0; t < ms; t++)
+                    memcpy(snrm + 3 * t, c->nrm + 3 * (size_t)sid[t], sizeof(double[3]));
+            if (c->scan && (sscan = malloc(ms * sizeof *sscan)))
+                for (size_t t = 0; t < ms; t++) sscan[t] = c->scan[sid[t]];
+            if ((c->nrm && !snrm) || (c->scan && !sscan)) {
+                free(sid);
+                st = JF_ERR_NOMEM;
+                break;
+            }
+            sc.nrm = snrm;
+            sc.scan = sscan;
+            sc.scanner = c->scanner;
+            sc.nscans = c->nscans;
+            if (sweep == 0) {
+                jf__cvrec *r = NULL, *g;
+                size_t nr = 0;
+                st = jf__auto_cv_sample(sxyz, ms, mask, sid, n, NULL, &o->params, nt, &r, &nr);
+                if (st == JF_OK && nr) {
+                    if ((g = realloc(cvr, (ncv + nr) * sizeof *g))) {
+                        cvr = g;
+                        memcpy(cvr + ncv, r, nr * sizeof *r);
+                        ncv += nr;
+                    } else {
+                        st = JF_ERR_NOMEM;
+                    }
+                }
+                free(r);
+            } else {
+                relay rl = {sid, sink, user};
+                st = jf__estimate_blocks_masked_xyz(&sc, &po, mask, relay_block, &rl, err);
+            }
+            free(sid);
+            free(snrm);
+            free(sscan);
+            free(mask);
+            snrm = NULL;
+            sscan = NULL;
+            mask = NULL;
+            if (st != JF_OK) goto out;
         }
-        free(sid);
-        free(snrm);
-        free(sscan);
-        free(mask);
-        snrm = NULL;
-        sscan = NULL;
-        mask = NULL;
-        if (st != JF_OK) goto out;
-    }
-    if (sweep == 0 && st == JF_OK) po.params.auto_select = jf__auto_cv_decide(cvr, ncv, NULL);
+        if (sweep == 0 && st == JF_OK) po.params.auto_select = jf__auto_cv_decide(cvr, ncv, NULL);
     }
     if (st == JF_OK && o->progress) o->progress(o->progress_user, n, n);
 out:

@@ -796,7 +796,8 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
         dg->d = d;
         for (int i = 0; i < nc; i++)
             for (int e = 0; e < 2; e++)
-                if (direct_fit(f, pr, p, nbr, ks[i], &g.mo[i], g.H, g.fr, e + 2, sigma, &dg->res[e][i]) != JF_OK)
+                if (direct_fit(f, pr, p, nbr, ks[i], &g.mo[i], g.H, g.fr, e + 2, sigma,
+                               &dg->res[e][i]) != JF_OK)
                     dg->res[e][i].status = JF_PT_FAILED;
     }
     jf_status st;
