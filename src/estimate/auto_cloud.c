@@ -26,6 +26,7 @@
 
 #include "auto_cloud.h"
 #include "index_internal.h"
+#include "nbctx.h" /* jf__finite3 */
 #include "robust_internal.h"
 
 #define JF_CV_SAMPLES 2048 /* about this many points (2% of 10^5)         */
@@ -33,18 +34,21 @@
 #define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
 
-/* the candidates' K, as auto.c's */
-static const size_t cvk[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
-
 size_t jf__auto_cv_stride(size_t ntotal)
 {
     /* a quarter at most: on a small cloud the sample is no second pass */
     return ntotal / JF_CV_SAMPLES > 4 ? ntotal / JF_CV_SAMPLES : 4;
 }
 
-static int finite3(const double *p)
+/* local point i is sampled: own, finite, its input index a multiple of stride */
+static int sampled(const double *xyz, const uint8_t *own, const uint32_t *gid, size_t stride, size_t i)
 {
-    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+    return (!own || own[i]) && (gid ? gid[i] : i) % stride == 0 && jf__finite3(xyz + 3 * i);
+}
+
+int jf__auto_cv_wanted(const jf_params *p, const jf_nb_spec *nb)
+{
+    return p->auto_select == 1 && nb->kind == JF_NB_KNN && nb->k >= JF_NB_AUTO_KMAX;
 }
 
 jf_status jf__auto_cv_sample(const double *xyz, size_t n, const uint8_t *own, const uint32_t *gid,
@@ -55,15 +59,13 @@ jf_status jf__auto_cv_sample(const double *xyz, size_t n, const uint8_t *own, co
     *nout = 0;
     const size_t stride = jf__auto_cv_stride(ntotal);
     size_t ns = 0;
-    for (size_t i = 0; i < n; i++)
-        if ((!own || own[i]) && (gid ? gid[i] : i) % stride == 0 && finite3(xyz + 3 * i)) ns++;
+    for (size_t i = 0; i < n; i++) ns += (size_t)sampled(xyz, own, gid, stride, i);
     if (!ns) return JF_OK;
     jf__cvrec *r = malloc(ns * sizeof *r);
     if (!r) return JF_ERR_NOMEM;
     ns = 0;
     for (size_t i = 0; i < n; i++)
-        if ((!own || own[i]) && (gid ? gid[i] : i) % stride == 0 && finite3(xyz + 3 * i))
-            r[ns++].gid = (uint32_t)i; /* the local index until the fits */
+        if (sampled(xyz, own, gid, stride, i)) r[ns++].gid = (uint32_t)i; /* local until the fits */
     jf_index *mine = NULL;
     jf_status st = JF_OK;
     if (!ix && (st = jf__index_build_threads(xyz, n, nt, &mine)) != JF_OK) {
@@ -144,8 +146,8 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
         int b = 0;
         for (int c = 1; c < JF_AUTO_NCAND; c++)
             if (sum[c] < sum[b]) b = c;
-        w.pick = (int)cvk[b];
-        if (w.median <= JF_CV_THICK && cvk[b] <= JF_CV_MAXPICK) w.cap = (int)cvk[b + 1];
+        w.pick = (int)jf__auto_ks[b];
+        if (w.median <= JF_CV_THICK && jf__auto_ks[b] <= JF_CV_MAXPICK) w.cap = (int)jf__auto_ks[b + 1];
     }
     if (why) *why = w;
     return w.cap;

@@ -24,6 +24,10 @@ typedef struct {
     int cap;       /* params.auto_select: the cap, JF_NB_AUTO_KMAX none */
 } jf__auto_cv_why;
 
+/* Whether an estimate with p and nb decides the cap itself (auto, the
+ * cap not given: params.auto_select 1, knn:JF_NB_AUTO_KMAX). */
+int jf__auto_cv_wanted(const jf_params *p, const jf_nb_spec *nb);
+
 /* Every stride-th input index is sampled (n: the whole cloud's count). */
 size_t jf__auto_cv_stride(size_t ntotal);
 

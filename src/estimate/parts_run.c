@@ -374,7 +374,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
     po.progress = NULL; /* per part: the totals would restart */
     /* auto's step 0 (auto_cloud.c): a first sweep over the parts fits
      * only the sample, whose records decide the cap every part is given */
-    const int cv = o->params.auto_select == 1 && q.nb.kind == JF_NB_KNN && q.nb.k >= JF_NB_AUTO_KMAX;
+    const int cv = jf__auto_cv_wanted(&o->params, &q.nb);
     for (int sweep = cv ? 0 : 1; sweep < 2 && st == JF_OK; sweep++) {
         /* the sample's sweep reads only the sample's K nearest: no step 6
          * ball, no request from another point */

@@ -857,7 +857,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     }
     /* auto's step 0: the cloud's cap on K, from a sample (auto_cloud.c);
      * a part's or a rank's estimate is given the whole cloud's */
-    if (p->auto_select == 1 && nb.kind == JF_NB_KNN && nb.k >= JF_NB_AUTO_KMAX && need_index) {
+    if (jf__auto_cv_wanted(p, &nb) && need_index) {
         if (fit) {
             st = JF_ERR_INVALID;
             jf__set_err(err, "neighbors auto: a part's estimate needs the cloud's cap on K");

@@ -57,10 +57,10 @@ typedef long long v4l __attribute__((vector_size(32)));
 #define NCAND JF_AUTO_NCAND
 #define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
 #define FLAT_K 48      /* the flat test's first K (step 2)             */
-#define FLAT_I 3       /* its index: cand[FLAT_I] == FLAT_K            */
+#define FLAT_I 3       /* its index: jf__auto_ks[FLAT_I] == FLAT_K     */
 
 /* Candidate K (nested, nearest first); the last is JF_NB_AUTO_KMAX. */
-static const size_t cand[NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
+const size_t jf__auto_ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
 
 /* The thresholds (Lepski's tau, blob, sdmax, clean, varw, gl) are the
  * fitter's knobs: jf__knob_defaults in robust.c says what each means. */
@@ -132,6 +132,26 @@ static const unsigned char gpos[NMON][NMON] = {
     {8, 12, 13, 17, 18, 19, 23, 24, 25, 26},
     {9, 13, 14, 18, 19, 20, 24, 25, 26, 27}};
 
+/* Cholesky in place of the leading nd x nd lower triangle of L (rows
+ * NMON apart), idg its inverse diagonal; the columns factored: nd, or the
+ * first whose pivot is not above 1e-12 s0 (s0: the point count). */
+static int chol(double *L, int nd, double s0, double *idg)
+{
+    for (int j = 0; j < nd; j++) {
+        double sum = L[j * NMON + j];
+        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
+        if (!(sum > 1e-12 * s0)) return j;
+        L[j * NMON + j] = sqrt(sum);
+        double inv = idg[j] = 1.0 / L[j * NMON + j];
+        for (int i = j + 1; i < nd; i++) {
+            double t = L[i * NMON + j];
+            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
+            L[i * NMON + j] = t * inv;
+        }
+    }
+    return nd;
+}
+
 static void solve_k(const double *S, const double *T, double zz, size_t m, double H, double hK,
                     const double fr[9], cand_fit out[2])
 {
@@ -142,23 +162,9 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
     for (int i = 0; i < nd; i++)
         for (int j = 0; j <= i; j++)
             L[i * NMON + j] = S[gpos[i][j]] * D[i] * D[j];
-    /* Cholesky, lower triangle in place; nd drops to 6 if the cubic's
-     * trailing block is singular */
-    for (int j = 0; j < nd; j++) {
-        double sum = L[j * NMON + j];
-        for (int k = 0; k < j; k++) sum -= L[j * NMON + k] * L[j * NMON + k];
-        if (!(sum > 1e-12 * S[0])) {
-            nd = j >= 6 ? 6 : 0;
-            break;
-        }
-        L[j * NMON + j] = sqrt(sum);
-        double inv = idg[j] = 1.0 / L[j * NMON + j];
-        for (int i = j + 1; i < nd; i++) {
-            double t = L[i * NMON + j];
-            for (int k = 0; k < j; k++) t -= L[i * NMON + k] * L[j * NMON + k];
-            L[i * NMON + j] = t * inv;
-        }
-    }
+    /* nd drops to 6 if the cubic's trailing block is singular */
+    const int nf = chol(L, nd, S[0], idg);
+    if (nf < nd) nd = nf >= 6 ? 6 : 0;
     for (int i = 0; i < nd; i++) { /* L y = D M^T z */
         double t = T[PIDX(mex[i], mey[i])] * D[i];
         for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k];
@@ -723,8 +729,8 @@ static int steps12(const jf__knobs *kn, const jf_params *pr, const double p[3], 
     /* the candidates (the last one: the whole list when it is shorter) */
     size_t *ks = g->ks;
     int nc = 0;
-    for (int c = 0; c < NCAND && cand[c] <= nmax; c++) ks[nc++] = cand[c];
-    if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= cand[0]) ks[nc++] = nmax;
+    for (int c = 0; c < NCAND && jf__auto_ks[c] <= nmax; c++) ks[nc++] = jf__auto_ks[c];
+    if (nc < NCAND && (nc == 0 || ks[nc - 1] < nmax) && nmax >= jf__auto_ks[0]) ks[nc++] = nmax;
     g->nc = nc;
 
     /* power sums of x^i y^j (i + j <= 6: the Gram matrix of the cubic)
@@ -749,7 +755,7 @@ static int steps12(const jf__knobs *kn, const jf_params *pr, const double p[3], 
      * flat from K = 48 to the largest K there is no bias to fear (a
      * cubic's grows like h^8, Theorem 3): the largest K's, on the most
      * points, is the noise's. */
-    const int b = nc - 1; /* ks[i] == cand[i] below the last */
+    const int b = nc - 1; /* ks[i] == jf__auto_ks[i] below the last */
     if (kn->auto_flat > 0.0 && FLAT_I < b && cf[1][FLAT_I].ok && cf[1][b].ok && cf[1][b].s2 > s2 &&
         cf[1][b].s2 <= cf[1][FLAT_I].s2 * (1.0 + kn->auto_flat * sqrt(2.0 / (FLAT_K - NMON))))
         s2 = cf[1][b].s2;
@@ -819,26 +825,16 @@ static double loo2(const mom *mo, double H, double hK)
 {
     if (mo->m < 10 || !(hK > 0.0)) return NAN;
     const double s = H / hK, sp[3] = {1.0, s, s * s};
-    double L[36], y[6], u[6];
+    double L[6 * NMON], idg[6], y[6], u[6];
     for (int i = 0; i < 6; i++)
-        for (int j = 0; j <= i; j++) L[i * 6 + j] = mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
-    for (int j = 0; j < 6; j++) {
-        double sum = L[j * 6 + j];
-        for (int k = 0; k < j; k++) sum -= L[j * 6 + k] * L[j * 6 + k];
-        if (!(sum > 1e-12 * mo->S[0])) return NAN;
-        L[j * 6 + j] = sqrt(sum);
-        for (int i = j + 1; i < 6; i++) {
-            double t = L[i * 6 + j];
-            for (int k = 0; k < j; k++) t -= L[i * 6 + k] * L[j * 6 + k];
-            L[i * 6 + j] = t / L[j * 6 + j];
-        }
-    }
+        for (int j = 0; j <= i; j++) L[i * NMON + j] = mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
+    if (chol(L, 6, mo->S[0], idg) < 6) return NAN;
     double a0 = 0.0, h = 0.0;
-    for (int i = 0; i < 6; i++) {
+    for (int i = 0; i < 6; i++) { /* L y = D M^T z, L u = e0 */
         double t = mo->T[PIDX(mex[i], mey[i])] * sp[mdeg[i]], v = i == 0 ? 1.0 : 0.0;
-        for (int k = 0; k < i; k++) t -= L[i * 6 + k] * y[k], v -= L[i * 6 + k] * u[k];
-        y[i] = t / L[i * 6 + i];
-        u[i] = v / L[i * 6 + i];
+        for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k], v -= L[i * NMON + k] * u[k];
+        y[i] = t * idg[i];
+        u[i] = v * idg[i];
         a0 += u[i] * y[i];
         h += u[i] * u[i];
     }
@@ -854,7 +850,7 @@ void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], con
     stage g;
     if (!steps12(jf__knobs_of(f), pr, p, nbr, n, &g)) return;
     for (int c = 0; c < g.nc; c++)
-        if (g.ks[c] == cand[c]) out[c] = loo2(&g.mo[c], g.H, g.hks[c]);
+        if (g.ks[c] == jf__auto_ks[c]) out[c] = loo2(&g.mo[c], g.H, g.hks[c]);
     if (g.nmax > 16) {
         const double *q = nbr + 3 * 16;
         const double r = sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +

@@ -80,6 +80,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
 
 /* neighbors auto's candidates (auto.c step 1-2, read by auto_rule.c). */
 #define JF_AUTO_NCAND 10
+extern const size_t jf__auto_ks[JF_AUTO_NCAND]; /* the candidates' K, increasing */
 typedef struct {
     int ok;
     double nrm[3]; /* world normal (in step 1's frame)               */
