@@ -178,8 +178,15 @@ typedef struct {
                                 (default); 16..JF_NB_AUTO_KMAX: the same,
                                 K at most that (jf_estimate sets it from
                                 the cloud's cross-validation, step 0,
-                                where it is 1)                            */
+                                where it is 1); either may carry
+                                JF_AUTO_CUBIC_MIN48                     */
 } jf_params;
+
+/* OR'd into params.auto_select (with 1 or a cap): no cubic on fewer than
+ * 48 points, whatever the noise (jf_estimate sets it where the cloud's
+ * cross-validation finds the cubic on the 16 nearest predicts p worse
+ * than the quadric: docs/robustness.md, step 0) */
+#define JF_AUTO_CUBIC_MIN48 1024
 
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);

@@ -69,8 +69,9 @@ jf_status jf_params_validate(const jf_params *p, const char **bad_field)
     if (p->degree_select < 0 || p->degree_select > p->degree)
         return bad(bad_field, "degree_select");
     if (!(p->dist_weight >= 0.0) || !isfinite(p->dist_weight)) return bad(bad_field, "dist_weight");
-    if (p->auto_select < 0 || p->auto_select > JF_NB_AUTO_KMAX ||
-        (p->auto_select > 1 && p->auto_select < 16))
+    const int cap = p->auto_select & ~JF_AUTO_CUBIC_MIN48;
+    if (p->auto_select < 0 || cap > JF_NB_AUTO_KMAX || (cap > 1 && cap < 16) ||
+        (cap == 0 && p->auto_select))
         return bad(bad_field, "auto_select");
     return JF_OK;
 }

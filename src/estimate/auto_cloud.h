@@ -21,7 +21,11 @@ typedef struct {
     size_t used;   /* sample points with every candidate's CV         */
     int pick;      /* the K of least CV (0: too few points)           */
     double median; /* median sigma / r16                              */
-    int cap;       /* params.auto_select: the cap, JF_NB_AUTO_KMAX none */
+    int cubic_min48; /* at K = 16 the cubic's CV is not below the quadric's
+                        (each in its points' own frame): no cubic on
+                        fewer than 48 points                             */
+    int cap;         /* params.auto_select: the cap (JF_NB_AUTO_KMAX none),
+                        | JF_AUTO_CUBIC_MIN48 where cubic_min48          */
 } jf__auto_cv_why;
 
 /* Whether an estimate with p and nb decides the cap itself (auto, the

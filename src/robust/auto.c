@@ -4,8 +4,9 @@
  *
  * design:
  *  0. (auto_cloud.c, the estimate's) The cloud's cap on K from its
- *     cross-validation, params.auto_select > 1: no candidate above it
- *     (jf__auto_cv_point gives a sampled point's values).
+ *     cross-validation, params.auto_select > 1: no candidate above it;
+ *     JF_AUTO_CUBIC_MIN48 in it: no cubic below K = 48 (jf__auto_cv_point
+ *     gives a sampled point's values).
  *  1. One frame per point: the PCA of its 32 nearest (§5.2).  In it every
  *     neighbour, nearest first, adds its power sums x^i y^j (i + j <= 6)
  *     and x^i y^j z (i + j <= 3), two at a time (SIMD lanes): the Gram
@@ -31,7 +32,9 @@
  *     region grows K; curvature makes the quadric's normal drift like h^2
  *     (its bias), which stops the growth.
  *  4. Degree (cubics from K = 32, or smaller K when the noise is under 5%
- *     of their radius): the cubic's choice, unless the quadric at the largest K of
+ *     of their radius; from K = 48 where step 0 found the cubic on 16
+ *     points predicts worse than the quadric): the cubic's choice, unless
+ *     the quadric at the largest K of
  *     its chain where it agrees with the cubic at the same K (within tau
  *     sd of the cubic) has the smaller sd.
  *  5. The reported fit: the least-squares jet of the chosen degree on the
@@ -55,7 +58,8 @@ typedef long long v4l __attribute__((vector_size(32)));
 #define FRAME_K 32     /* points of the PCA frame                      */
 #define NOISE_K 32     /* K of the noise estimate                      */
 #define NCAND JF_AUTO_NCAND
-#define CUBIC_MINK 32  /* smallest K of a cubic candidate              */
+#define CUBIC_MINK 32    /* smallest K of a cubic, but on clean data     */
+#define CUBIC_MINK_CV 48 /* ... where step 0 finds the noise outweighs it */
 #define FLAT_K 48      /* the flat test's first K (step 2)             */
 #define FLAT_I 3       /* its index: jf__auto_ks[FLAT_I] == FLAT_K     */
 
@@ -552,6 +556,24 @@ JF_CLONES static void first_pass(const double p[3], const double *nbr, size_t nm
     }
 }
 
+/* The frame of the K points of step 1's sums mo0 (the jet's, §5.2): their
+ * covariance from those sums, turned from fr0's axes to the world's. */
+static void own_frame(const mom *mo0, double H, const double fr0[9], jf_frame_mode mode, double pca_ev[3],
+                      double fk[9])
+{
+    const double *S = mo0->S, *T = mo0->T, n1 = (double)mo0->m;
+    double mx = S[PIDX(1, 0)] * H / n1, my = S[PIDX(0, 1)] * H / n1, mz = T[0] / n1;
+    double c[9], evec[9];
+    c[0] = S[PIDX(2, 0)] * H * H / n1 - mx * mx;
+    c[1] = c[3] = S[PIDX(1, 1)] * H * H / n1 - mx * my;
+    c[2] = c[6] = T[PIDX(1, 0)] * H / n1 - mx * mz;
+    c[4] = S[PIDX(0, 2)] * H * H / n1 - my * my;
+    c[5] = c[7] = T[PIDX(0, 1)] * H / n1 - my * mz;
+    c[8] = mo0->zz / n1 - mz * mz;
+    jf__eig3_in(c, fr0, pca_ev, evec);
+    jf__frame_axes(evec, mode, fk);
+}
+
 /* The chosen jet straight from its power sums (mo) in the frame fr: the
  * least-squares jet of degree d on those K points, as jf_fit_point would
  * fit it but in the frame of the 32 nearest (no second fit: step 5).
@@ -567,22 +589,8 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
                             jf_result *out)
 {
     if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
-    /* the frame of the K points (the jet's, §5.2): their covariance from
-     * step 1's sums, turned from fr's axes to the world's */
     double pca_ev[3], fk[9];
-    {
-        const double *S = mo0->S, *T = mo0->T, n1 = (double)mo0->m;
-        double mx = S[PIDX(1, 0)] * H / n1, my = S[PIDX(0, 1)] * H / n1, mz = T[0] / n1;
-        double c[9], evec[9];
-        c[0] = S[PIDX(2, 0)] * H * H / n1 - mx * mx;
-        c[1] = c[3] = S[PIDX(1, 1)] * H * H / n1 - mx * my;
-        c[2] = c[6] = T[PIDX(1, 0)] * H / n1 - mx * mz;
-        c[4] = S[PIDX(0, 2)] * H * H / n1 - my * my;
-        c[5] = c[7] = T[PIDX(0, 1)] * H / n1 - my * mz;
-        c[8] = mo0->zz / n1 - mz * mz;
-        jf__eig3_in(c, fr0, pca_ev, evec);
-        jf__frame_axes(evec, pr->frame, fk);
-    }
+    own_frame(mo0, H, fr0, pr->frame, pca_ev, fk);
     const double *fr = fk;
     mom mk;
     moments(p, nbr, k, fr, H, d, &mk);
@@ -776,17 +784,22 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     cand_fit(*cf)[NCAND] = g.cf;
     /* a cubic on fewer than 32 points follows the noise, unless the noise
      * is a small fraction of its radius (clean data, where the small
-     * cubic is the least biased choice) */
+     * cubic is the least biased choice); where the cloud's cross-validation
+     * (step 0) finds the noise outweighs the smallest cubic's detail, on
+     * fewer than 48 (the range scans' cubics at 32: item 8) */
+    const int min48 = (pr->auto_select & JF_AUTO_CUBIC_MIN48) != 0;
+    const size_t cap = (size_t)(pr->auto_select & ~JF_AUTO_CUBIC_MIN48);
     for (int i = 0; i < nc; i++) {
         double hc = kn->auto_clean * cf[1][i].h;
-        if (ks[i] < CUBIC_MINK && ks[i] < nmax && !(s2 <= hc * hc)) cf[1][i].ok = 0;
+        if (ks[i] < (min48 ? CUBIC_MINK_CV : CUBIC_MINK) && ks[i] < nmax && (min48 || !(s2 <= hc * hc)))
+            cf[1][i].ok = 0;
     }
     /* step 0's cap (the cloud's cross-validation, jf__auto_cv_point):
      * no candidate above it */
     int capped = 0;
-    if (pr->auto_select > 1)
+    if (cap > 1)
         for (int i = 0; i < nc; i++)
-            if (ks[i] > (size_t)pr->auto_select) cf[0][i].ok = cf[1][i].ok = 0, capped = 1;
+            if (ks[i] > cap) cf[0][i].ok = cf[1][i].ok = 0, capped = 1;
 
     /* steps 3-4 (auto_rule.c): the candidate and the degree */
     jf__auto_cands C;
@@ -808,7 +821,7 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     }
     jf_status st;
     if (ci < 0) /* no candidate: the plain quadric on the list (up to the cap) */
-        st = final_fit(f, pr, 2, p, nbr, capped ? (size_t)pr->auto_select : nmax, sigma, out);
+        st = final_fit(f, pr, 2, p, nbr, capped ? cap : nmax, sigma, out);
     else if (kn->auto_dw > 0.0) /* bench-only knob, off: a distance-weighted row */
         st = fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
     else st = direct_fit(f, pr, p, nbr, ks[ci], &g.mo[ci], g.H, g.fr, d, sigma, out);
@@ -816,21 +829,22 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
     return st;
 }
 
-/* The squared leave-one-out residual at p of the quadric on one
- * candidate's points (p among them, at the origin): a0 / (1 - h00), a0
- * the jet's height at p and h00 = (M^T M)^-1 [0, 0] the hat matrix's
- * diagonal there, u0 = L^-1 e0 giving both (a0 = u0 . y, h00 = |u0|^2;
- * the monomials' scale D leaves the constant's row alone). */
-static double loo2(const mom *mo, double H, double hK)
+/* The squared leave-one-out residual at p of the jet of nd monomials (6:
+ * the quadric, NMON: the cubic) on one candidate's points (p among them,
+ * at the origin): a0 / (1 - h00), a0 the jet's height at p and h00 =
+ * (M^T M)^-1 [0, 0] the hat matrix's diagonal there, u0 = L^-1 e0 giving
+ * both (a0 = u0 . y, h00 = |u0|^2; the monomials' scale D leaves the
+ * constant's row alone). */
+static double loo2(const mom *mo, double H, double hK, int nd)
 {
-    if (mo->m < 10 || !(hK > 0.0)) return NAN;
-    const double s = H / hK, sp[3] = {1.0, s, s * s};
-    double L[6 * NMON], idg[6], y[6], u[6];
-    for (int i = 0; i < 6; i++)
+    if (mo->m < (size_t)nd + 4 || !(hK > 0.0)) return NAN;
+    const double s = H / hK, sp[4] = {1.0, s, s * s, s * s * s};
+    double L[NMON * NMON], idg[NMON], y[NMON], u[NMON];
+    for (int i = 0; i < nd; i++)
         for (int j = 0; j <= i; j++) L[i * NMON + j] = mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
-    if (chol(L, 6, mo->S[0], idg) < 6) return NAN;
+    if (chol(L, nd, mo->S[0], idg) < nd) return NAN;
     double a0 = 0.0, h = 0.0;
-    for (int i = 0; i < 6; i++) { /* L y = D M^T z, L u = e0 */
+    for (int i = 0; i < nd; i++) { /* L y = D M^T z, L u = e0 */
         double t = mo->T[PIDX(mex[i], mey[i])] * sp[mdeg[i]], v = i == 0 ? 1.0 : 0.0;
         for (int k = 0; k < i; k++) t -= L[i * NMON + k] * y[k], v -= L[i * NMON + k] * u[k];
         y[i] = t * idg[i];
@@ -850,7 +864,19 @@ void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], con
     stage g;
     if (!steps12(jf__knobs_of(f), pr, p, nbr, n, &g)) return;
     for (int c = 0; c < g.nc; c++)
-        if (g.ks[c] == jf__auto_ks[c]) out[c] = loo2(&g.mo[c], g.H, g.hks[c]);
+        if (g.ks[c] == jf__auto_ks[c]) out[c] = loo2(&g.mo[c], g.H, g.hks[c], 6);
+    if (g.ks[0] == jf__auto_ks[0] && g.mo[0].m > 0) {
+        /* the smallest K's quadric and cubic in their own frame (as the
+         * reported fit's): a small cubic's CV hangs on the tilt of step
+         * 1's frame (the clean armadillo's: 1.9x the quadric's there,
+         * 0.74x in its own) */
+        double ev[3], fk[9];
+        mom mk;
+        own_frame(&g.mo[0], g.H, g.fr, pr->frame, ev, fk);
+        moments(p, nbr, g.ks[0], fk, g.H, 3, &mk);
+        out[JF_AUTO_CV_SMALL] = loo2(&mk, g.H, g.hks[0], 6);
+        out[JF_AUTO_CV_SMALL + 1] = loo2(&mk, g.H, g.hks[0], NMON);
+    }
     if (g.nmax > 16) {
         const double *q = nbr + 3 * 16;
         const double r = sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +

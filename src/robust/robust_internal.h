@@ -101,11 +101,14 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
 /* Step 0 (the cloud's cross-validation) at one point p, its list nbr
  * nearest first (p itself first): out[c] the squared leave-one-out
  * residual at p of the quadric on the first cand[c] points, in step 1's
- * frame (NaN where that candidate is not there or not fitted), and
+ * frame (NaN where that candidate is not there or not fitted),
  * out[JF_AUTO_NCAND] step 2's sigma over the 16th neighbour's distance
- * (|nbr[16] - p|); all NaN where steps 1-2 fail.  The decision from a
+ * (|nbr[16] - p|), and out[JF_AUTO_CV_SMALL], out[JF_AUTO_CV_SMALL + 1]
+ * the quadric's and the cubic's on the smallest candidate, in the frame
+ * of its own points; all NaN where steps 1-2 fail.  The decision from a
  * sample of these: auto_cloud.c. */
-#define JF_AUTO_CV_N (JF_AUTO_NCAND + 1)
+#define JF_AUTO_CV_SMALL (JF_AUTO_NCAND + 1)
+#define JF_AUTO_CV_N (JF_AUTO_CV_SMALL + 2)
 void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, double out[JF_AUTO_CV_N]);
 

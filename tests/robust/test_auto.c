@@ -280,6 +280,7 @@ static void is_the_jet(surf c, int sel)
     for (size_t i = 0; i < c.s.n; i++) {
         const jf_result *a = &own[i];
         ck_assert(a->degree >= 1 && a->degree <= 3);
+        ck_assert(!(cap & JF_AUTO_CUBIC_MIN48) || a->degree < 3 || a->n_used >= 48);
         ck_assert_int_eq(ra[i].n_used, a->n_used);
         ck_assert_int_eq(ra[i].degree, a->degree);
         ck_assert(ra[i].cond == a->cond && ra[i].residual == a->residual && ra[i].sigma == a->sigma);
@@ -326,7 +327,7 @@ static void is_the_jet(surf c, int sel)
     ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
     /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID;
      * capped, the plain carry only */
-    if (cap < JF_NB_AUTO_KMAX)
+    if ((cap & ~JF_AUTO_CUBIC_MIN48) < JF_NB_AUTO_KMAX)
         ck_assert_uint_eq(nwide, 0);
     else
         ck_assert_msg(nwide > c.s.n / 10 && nwide < c.s.n - c.s.n / 10,
@@ -350,7 +351,10 @@ END_TEST
 START_TEST(test_auto_is_the_jet_capped)
 {
     surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
-    ck_assert_int_lt(cloud_cap(&c), JF_NB_AUTO_KMAX);
+    const int sel = cloud_cap(&c);
+    ck_assert_int_lt(sel & ~JF_AUTO_CUBIC_MIN48, JF_NB_AUTO_KMAX);
+    /* at 0.3% the cubic on 16 points follows the noise: cubics from 48 */
+    ck_assert_int_ne(sel & JF_AUTO_CUBIC_MIN48, 0);
     is_the_jet(c, 1);
 }
 END_TEST
@@ -503,32 +507,49 @@ START_TEST(test_auto_parts_halo)
 }
 END_TEST
 
-/* x (n x 6 normal equations, in place) solved by Gaussian elimination
+/* x (n x n normal equations, in place) solved by Gaussian elimination
  * with partial pivoting; the solution into b */
-static void solve6(double A[36], double b[6])
+static void solve_n(double *A, double *b, int n)
 {
-    for (int c = 0; c < 6; c++) {
+    for (int c = 0; c < n; c++) {
         int piv = c;
-        for (int r = c + 1; r < 6; r++)
-            if (fabs(A[r * 6 + c]) > fabs(A[piv * 6 + c])) piv = r;
-        for (int k = 0; k < 6; k++) {
-            double t = A[c * 6 + k];
-            A[c * 6 + k] = A[piv * 6 + k];
-            A[piv * 6 + k] = t;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(A[r * n + c]) > fabs(A[piv * n + c])) piv = r;
+        for (int k = 0; k < n; k++) {
+            double t = A[c * n + k];
+            A[c * n + k] = A[piv * n + k];
+            A[piv * n + k] = t;
         }
         double t = b[c];
         b[c] = b[piv];
         b[piv] = t;
-        for (int r = c + 1; r < 6; r++) {
-            double f = A[r * 6 + c] / A[c * 6 + c];
-            for (int k = c; k < 6; k++) A[r * 6 + k] -= f * A[c * 6 + k];
+        for (int r = c + 1; r < n; r++) {
+            double f = A[r * n + c] / A[c * n + c];
+            for (int k = c; k < n; k++) A[r * n + k] -= f * A[c * n + k];
             b[r] -= f * b[c];
         }
     }
-    for (int c = 5; c >= 0; c--) {
-        for (int k = c + 1; k < 6; k++) b[c] -= A[c * 6 + k] * b[k];
-        b[c] /= A[c * 6 + c];
+    for (int c = n - 1; c >= 0; c--) {
+        for (int k = c + 1; k < n; k++) b[c] -= A[c * n + k] * b[k];
+        b[c] /= A[c * n + c];
     }
+}
+
+/* The height at 0 of the least-squares jet of nd monomials (6 or 10) on
+ * points 1..k-1 of nb (p, point 0, left out), in the world's frame */
+static double refit_at_p(const double *nb, size_t k, int nd)
+{
+    double A[100] = {0}, b[10] = {0};
+    for (size_t i = 1; i < k; i++) {
+        const double x = nb[3 * i], y = nb[3 * i + 1];
+        const double m[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
+        for (int r = 0; r < nd; r++) {
+            for (int c = 0; c < nd; c++) A[r * nd + c] += m[r] * m[c];
+            b[r] += m[r] * nb[3 * i + 2];
+        }
+    }
+    solve_n(A, b, nd);
+    return b[0];
 }
 
 /* Step 0's value at p is the quadric's leave-one-out residual: the height
@@ -569,20 +590,16 @@ START_TEST(test_auto_cv_loo)
     ck_assert_int_eq(jf_fitter_create(&pr, &f), JF_OK);
     double out[JF_AUTO_CV_N];
     jf__auto_cv_point(f, &pr, nb, nb, N, out);
-    for (int c = 0; c < JF_AUTO_NCAND; c++) {
-        double A[36] = {0}, b[6] = {0};
-        for (size_t i = 1; i < ks[c]; i++) {
-            const double x = nb[3 * i], y = nb[3 * i + 1], m[6] = {1, x, y, x * x, x * y, y * y};
-            for (int r = 0; r < 6; r++) {
-                for (int k = 0; k < 6; k++) A[r * 6 + k] += m[r] * m[k];
-                b[r] += m[r] * nb[3 * i + 2];
-            }
-        }
-        solve6(A, b);
-        const double want = b[0] * b[0];
-        ck_assert_msg(fabs(out[c] - want) <= 1e-8 * want + 1e-30, "K %zu: %.17g, refit %.17g", ks[c],
-                      out[c], want);
+    for (int c = 0; c < JF_AUTO_NCAND + 2; c++) {
+        /* the candidates' quadrics, then the smallest K's quadric and cubic
+         * in their own frame (here the world's: JF_FRAME_AXIS) */
+        const int small = c >= JF_AUTO_NCAND, at = small ? JF_AUTO_CV_SMALL + c - JF_AUTO_NCAND : c;
+        const double a0 = refit_at_p(nb, ks[small ? 0 : c], c == JF_AUTO_NCAND + 1 ? 10 : 6);
+        const double want = a0 * a0;
+        ck_assert_msg(fabs(out[at] - want) <= 1e-8 * want + 1e-30, "K %zu (%d): %.17g, refit %.17g",
+                      ks[small ? 0 : c], at, out[at], want);
     }
+    ck_assert_double_ne(out[JF_AUTO_CV_SMALL], out[JF_AUTO_CV_SMALL + 1]);
     const double r16 = sqrt(d2[16]);
     ck_assert_msg(out[JF_AUTO_NCAND] > 0.005 / r16 && out[JF_AUTO_NCAND] < 0.02 / r16,
                   "sigma / r16 %g (noise 0.01, r16 %g)", out[JF_AUTO_NCAND], r16);
@@ -592,30 +609,43 @@ START_TEST(test_auto_cv_loo)
 END_TEST
 
 /* The decision: the K of least summed CV, a cap one candidate above it
- * where the noise is thin and that K at most 64; none otherwise; the
- * records' order does not matter. */
+ * where the noise is thin and that K at most 64; none otherwise; cubics
+ * from 48 points where the summed CV of the cubic on 16 points is not
+ * below the quadric's; the records' order does not matter. */
 START_TEST(test_auto_cv_decide)
 {
     enum { M = 200 };
     jf__cvrec r[M], q[M];
     jf__auto_cv_why w;
     for (int pick = 0; pick < JF_AUTO_NCAND; pick++)
-        for (int thick = 0; thick < 2; thick++) {
-            for (int s = 0; s < M; s++) {
-                r[s].gid = (uint32_t)(7 * s % M) * 3u;
-                for (int c = 0; c < JF_AUTO_NCAND; c++)
-                    r[s].v[c] = 1.0 + (c - pick) * (c - pick) + 0.5 * (s % 3); /* least at pick */
-                r[s].v[JF_AUTO_NCAND] = (thick ? 0.5 : 0.1) + 0.001 * s;
+        for (int thick = 0; thick < 2; thick++)
+            for (int noisy = 0; noisy < 2; noisy++) {
+                for (int s = 0; s < M; s++) {
+                    r[s].gid = (uint32_t)(7 * s % M) * 3u;
+                    for (int c = 0; c < JF_AUTO_NCAND; c++)
+                        r[s].v[c] = 1.0 + (c - pick) * (c - pick) + 0.5 * (s % 3); /* least at pick */
+                    r[s].v[JF_AUTO_NCAND] = (thick ? 0.5 : 0.1) + 0.001 * s;
+                    /* the cubic below the quadric at most points, its sum
+                     * above where noisy (one wild point) */
+                    r[s].v[JF_AUTO_CV_SMALL] = 1.0;
+                    r[s].v[JF_AUTO_CV_SMALL + 1] = s == 5 && noisy ? 1.0 + M : 0.99;
+                }
+                memcpy(q, r, sizeof r);
+                int cap = jf__auto_cv_decide(r, M, &w);
+                static const int ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
+                ck_assert_int_eq(w.pick, ks[pick]);
+                ck_assert_uint_eq(w.used, M);
+                ck_assert_int_eq(w.cubic_min48, noisy);
+                ck_assert_int_eq(cap, (!thick && ks[pick] <= 64 ? ks[pick + 1] : JF_NB_AUTO_KMAX) |
+                                          (noisy ? JF_AUTO_CUBIC_MIN48 : 0));
+                for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
+                ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
             }
-            memcpy(q, r, sizeof r);
-            int cap = jf__auto_cv_decide(r, M, &w);
-            static const int ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
-            ck_assert_int_eq(w.pick, ks[pick]);
-            ck_assert_uint_eq(w.used, M);
-            ck_assert_int_eq(cap, !thick && ks[pick] <= 64 ? ks[pick + 1] : JF_NB_AUTO_KMAX);
-            for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
-            ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
-        }
+    /* a record without the small fits still counts for the cap */
+    for (int s = 0; s < M; s++) r[s].v[JF_AUTO_CV_SMALL + (s & 1)] = NAN;
+    ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
+    ck_assert_int_eq(w.cubic_min48, 0);
+    ck_assert_uint_eq(w.used, M);
     for (int s = 0; s < M; s++) r[s].v[3] = NAN; /* no usable record: no cap */
     ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
     ck_assert_uint_eq(w.used, 0);
