@@ -184,8 +184,9 @@ typedef struct {
 
 /* OR'd into params.auto_select (with 1 or a cap): no cubic on fewer than
  * 48 points, whatever the noise (jf_estimate sets it where the cloud's
- * cross-validation finds the cubic on the 16 nearest predicts p worse
- * than the quadric: docs/robustness.md, step 0) */
+ * cross-validation finds the cubic on the 16 nearest predicts p better
+ * than the quadric at no more than half its sample: docs/robustness.md,
+ * step 0) */
 #define JF_AUTO_CUBIC_MIN48 1024
 
 /* Fills defaults.  Never fails. */

@@ -21,9 +21,10 @@ typedef struct {
     size_t used;   /* sample points with every candidate's CV         */
     int pick;      /* the K of least CV (0: too few points)           */
     double median; /* median sigma / r16                              */
-    int cubic_min48; /* at K = 16 the cubic's CV is not below the quadric's
-                        (each in its points' own frame): no cubic on
-                        fewer than 48 points                             */
+    int cubic_min48; /* at K = 16 the cubic's leave-one-out residual is
+                        below the quadric's (each in its points' own
+                        frame) at no more than half the sample: no cubic
+                        on fewer than 48 points                          */
     int cap;         /* params.auto_select: the cap (JF_NB_AUTO_KMAX none),
                         | JF_AUTO_CUBIC_MIN48 where cubic_min48          */
 } jf__auto_cv_why;

@@ -610,8 +610,9 @@ END_TEST
 
 /* The decision: the K of least summed CV, a cap one candidate above it
  * where the noise is thin and that K at most 64; none otherwise; cubics
- * from 48 points where the summed CV of the cubic on 16 points is not
- * below the quadric's; the records' order does not matter. */
+ * from 48 points where the cubic on 16 points is nearer p than the
+ * quadric at no more than half the points; the records' order does not
+ * matter. */
 START_TEST(test_auto_cv_decide)
 {
     enum { M = 200 };
@@ -625,10 +626,11 @@ START_TEST(test_auto_cv_decide)
                     for (int c = 0; c < JF_AUTO_NCAND; c++)
                         r[s].v[c] = 1.0 + (c - pick) * (c - pick) + 0.5 * (s % 3); /* least at pick */
                     r[s].v[JF_AUTO_NCAND] = (thick ? 0.5 : 0.1) + 0.001 * s;
-                    /* the cubic below the quadric at most points, its sum
-                     * above where noisy (one wild point) */
+                    /* noisy: the cubic nearer at half the points (a vote:
+                     * clean, one more), its sum below the quadric's
+                     * either way */
                     r[s].v[JF_AUTO_CV_SMALL] = 1.0;
-                    r[s].v[JF_AUTO_CV_SMALL + 1] = s == 5 && noisy ? 1.0 + M : 0.99;
+                    r[s].v[JF_AUTO_CV_SMALL + 1] = 2 * s < M + (noisy ? 0 : 2) ? 0.01 : 1.01;
                 }
                 memcpy(q, r, sizeof r);
                 int cap = jf__auto_cv_decide(r, M, &w);
