@@ -32,6 +32,7 @@
 #include <omp.h>
 
 #include "auto_cloud.h"
+#include "core/order_stat.h"
 #include "index_internal.h"
 #include "nbctx.h" /* jf__finite3 */
 #include "robust_internal.h"
@@ -122,12 +123,6 @@ static int by_gid(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static int by_value(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
 {
     jf__auto_cv_why w;
@@ -148,7 +143,7 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
         w.used++;
     }
     if (sr && ns) {
-        qsort(sr, ns, sizeof *sr, by_value);
+        jf__select_kth(sr, ns, ns / 2);
         w.median = sr[ns / 2];
     }
     free(sr);
@@ -166,4 +161,9 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
     if (w.cubic_min48) w.cap |= JF_AUTO_CUBIC_MIN48;
     if (why) *why = w;
     return w.cap;
+}
+
+int jf__auto_cv_select(const jf_params *p, jf__cvrec *r, size_t n)
+{
+    return jf__auto_cv_decide(r, n, NULL) | (p->auto_select & JF_AUTO_CUBIC_MIN48);
 }

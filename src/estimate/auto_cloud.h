@@ -16,7 +16,7 @@ typedef struct {
     double v[JF_AUTO_CV_N];
 } jf__cvrec;
 
-/* What the decision saw (the summary's line). */
+/* What the decision saw (for tests). */
 typedef struct {
     size_t used;   /* sample points with every candidate's CV         */
     int pick;      /* the K of least CV (0: too few points)           */
@@ -47,4 +47,8 @@ jf_status jf__auto_cv_sample(const double *xyz, size_t n, const uint8_t *own, co
 /* The cap from every sample record (sorted here by input index, so any
  * split sums in one order); *why (may be NULL) what it saw. */
 int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why);
+
+/* params.auto_select for the fits of an estimate with p: the decision,
+ * with JF_AUTO_CUBIC_MIN48 also where p gave it. */
+int jf__auto_cv_select(const jf_params *p, jf__cvrec *r, size_t n);
 #endif

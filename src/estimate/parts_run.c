@@ -495,9 +495,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
             mask = NULL;
             if (st != JF_OK) goto out;
         }
-        if (sweep == 0 && st == JF_OK)
-            po.params.auto_select = jf__auto_cv_decide(cvr, ncv, NULL) |
-                                    (po.params.auto_select & JF_AUTO_CUBIC_MIN48);
+        if (sweep == 0 && st == JF_OK) po.params.auto_select = jf__auto_cv_select(&o->params, cvr, ncv);
     }
     if (st == JF_OK && o->progress) o->progress(o->progress_user, n, n);
 out:

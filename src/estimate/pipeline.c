@@ -869,8 +869,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             jf__set_err(err, st == JF_ERR_NOMEM ? "out of memory (auto's sample)" : jf_strerror(st));
             goto out;
         }
-        use.params.auto_select = jf__auto_cv_decide(cv, ncv, NULL) |
-                                 (use.params.auto_select & JF_AUTO_CUBIC_MIN48);
+        use.params.auto_select = jf__auto_cv_select(p, cv, ncv);
         free(cv);
     }
     if (cancelled(o)) {

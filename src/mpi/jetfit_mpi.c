@@ -350,8 +350,7 @@ static int auto_cap(jf_mpi *m, const char *in, const jf_mpi_cloud *c, jf_estimat
         return 1;
     }
     MPI_Allgatherv(mine, mb, MPI_BYTE, all, cnt, dsp, MPI_BYTE, m->comm);
-    o->params.auto_select = jf__auto_cv_decide(all, tot / sizeof *all, NULL) |
-                            (o->params.auto_select & JF_AUTO_CUBIC_MIN48);
+    o->params.auto_select = jf__auto_cv_select(&o->params, all, tot / sizeof *all);
     free(mine);
     free(all);
     free(cnt);
