@@ -90,6 +90,11 @@ void jf__eig3_in(const double a[9], const double rot[9], double eval[3], double 
  * 0 (evec untouched) when l1 is not clearly apart from l2 or a is not
  * finite: jf__eig3 decides there. */
 int jf__normal3(const double a[9], double evec[9]);
+/* jf__eig3_in's results (to rounding; their tangent axes may differ
+ * where two eigenvalues nearly meet) from jf__normal3's least eigenvector
+ * and the 2 x 2 block of a in the plane normal to it; jf__eig3_in where
+ * normal3 finds no clear normal. */
+void jf__eig3_near(const double a[9], const double rot[9], double eval[3], double evec[9]);
 
 /* Fitting frame (§5.2) of the local points q[3*i] (already translated to
  * p) with weights w[i] (> 0 used): two-pass weighted centred covariance,
@@ -177,6 +182,10 @@ int jf__sym_eigvals(double *a, size_t n, double *d, double *e);
 /* jf__gram_extremes (gram_eig.c): the largest and least eigenvalues of
  * the symmetric cols x cols g (2 <= cols <= 10), as jf__eigvals; 1 ok. */
 int jf__gram_extremes(const double *g, size_t cols, double *hi, double *lo);
+/* the same of four matrices g[0..3] (may repeat), ok[L] 1 where found:
+ * each lane's bits are jf__gram_extremes' */
+void jf__gram_extremes_x4(const double *const g[4], size_t cols, double hi[4], double lo[4],
+                          int ok[4]);
 int jf__solve_after_eig(jf_fitter *f, size_t rows, size_t cols, int have_eig, double *cond);
 
 /* jet.c */

@@ -182,6 +182,48 @@ int jf__normal3(const double a[9], double evec[9])
     return 1;
 }
 
+void jf__eig3_near(const double a[9], const double rot[9], double eval[3], double evec[9])
+{
+    double e[9];
+    if (!jf__normal3(a, e)) {
+        jf__eig3_in(a, rot, eval, evec);
+        return;
+    }
+    /* the other two from the 2 x 2 block of a in the plane normal to n
+     * (t, u: normal3's axes there) */
+    const double *n = e, *u = e + 3, *t = e + 6;
+    double an[3], at[3], au[3];
+    for (int i = 0; i < 3; i++) {
+        an[i] = a[3 * i] * n[0] + a[3 * i + 1] * n[1] + a[3 * i + 2] * n[2];
+        at[i] = a[3 * i] * t[0] + a[3 * i + 1] * t[1] + a[3 * i + 2] * t[2];
+        au[i] = a[3 * i] * u[0] + a[3 * i + 1] * u[1] + a[3 * i + 2] * u[2];
+    }
+    const double tt = t[0] * at[0] + t[1] * at[1] + t[2] * at[2];
+    const double uu = u[0] * au[0] + u[1] * au[1] + u[2] * au[2];
+    const double tu = t[0] * au[0] + t[1] * au[1] + t[2] * au[2];
+    const double mid = 0.5 * (tt + uu), rad = hypot(0.5 * (tt - uu), tu), l3 = mid + rad;
+    eval[0] = n[0] * an[0] + n[1] * an[1] + n[2] * an[2];
+    eval[1] = mid - rad;
+    eval[2] = l3;
+    /* the largest's eigenvector (tu, l3 - tt) or (l3 - uu, tu) in (t, u),
+     * whichever is longer (one vanishes where t or u is it already) */
+    const double e0 = tu, e1 = l3 - tt, f0 = l3 - uu, f1 = tu;
+    const int ef = e0 * e0 + e1 * e1 >= f0 * f0 + f1 * f1;
+    double g0 = ef ? e0 : f0, g1 = ef ? e1 : f1, gl = sqrt(g0 * g0 + g1 * g1);
+    if (!(gl > 0.0)) g0 = 1.0, g1 = 0.0, gl = 1.0; /* a multiple of I there: any */
+    g0 /= gl, g1 /= gl;
+    const double v[3][3] = {{n[0], n[1], n[2]},
+                            {g1 * t[0] - g0 * u[0], g1 * t[1] - g0 * u[1], g1 * t[2] - g0 * u[2]},
+                            {g0 * t[0] + g1 * u[0], g0 * t[1] + g1 * u[1], g0 * t[2] + g1 * u[2]}};
+    static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double *R = rot ? rot : id;
+    for (int r = 0; r < 3; r++) { /* to the world's axes, pinned as jf__eig3's */
+        for (int k = 0; k < 3; k++)
+            evec[3 * r + k] = v[r][0] * R[k] + v[r][1] * R[3 + k] + v[r][2] * R[6 + k];
+        pin_sign(evec + 3 * r);
+    }
+}
+
 int jf__frame_cov(const double *q, const double *w, size_t n, double cov[9])
 {
     /* pass 1: weighted centroid */

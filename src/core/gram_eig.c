@@ -153,3 +153,19 @@ int jf__gram_extremes(const double *g, size_t cols, double *hi, double *lo)
     *lo = l[0];
     return rc[0] == 0;
 }
+
+void jf__gram_extremes_x4(const double *const g[4], size_t cols, double hi[4], double lo[4],
+                          int ok[4])
+{
+    if (cols > GE_MAX || cols < 2) {
+        for (int L = 0; L < 4; L++) ok[L] = 0;
+        return;
+    }
+    int rc[4];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) gram_extremes_x4_avx(g, cols, hi, lo, rc);
+    else
+#endif
+        gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_sse);
+    for (int L = 0; L < 4; L++) ok[L] = rc[L] == 0;
+}

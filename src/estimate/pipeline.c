@@ -39,6 +39,7 @@
 #include "orient_internal.h"
 #include "parts.h"
 #include "planes_internal.h"
+#include "robust_internal.h"
 #include "nbctx.h"
 #include "neigh_jets.h"
 
@@ -508,6 +509,41 @@ static jf_status fit_pass(const runctx *R, const uint32_t *walk, const double *w
     return failed;
 }
 
+/* Auto's points i[0..L-1] (rows kq[] of the unit; left[]: the walk's
+ * points from each on, for the shared search): their queries one by one,
+ * each one's nearest positions kept for step 6, then their fits side by
+ * side (jf__fit_auto_lanes: the bits of one by one). */
+static jf_status auto_lanes(worker *w, const nbctx *x, int L, const size_t i[], const double *const p[],
+                            const size_t kq[], const size_t left[])
+{
+    jf_result r[LANES];
+    size_t n[LANES] = {0};
+    unsigned fl[LANES] = {0};
+    int fit[LANES] = {0}, nf = 0;
+    const double *pf[LANES], *cf[LANES];
+    size_t nff[LANES];
+    jf_result *of[LANES];
+    for (int k = 0; k < L; k++) {
+        if (w->share && left) jf__knn_share_ahead(w->share, p[k], left[k]);
+        w->hint_n = 0;
+        jf_status st = prepare(w, x, i[k], p[k], w->coords[k], &r[k], &n[k], &fl[k], &fit[k]);
+        if (st != JF_OK) return st;
+        /* prepare's query left the neighbourhood in w->pos */
+        const size_t h = w->hint_n < JF_NJ_HEAD ? w->hint_n : JF_NJ_HEAD;
+        memcpy(w->head + kq[k] * JF_NJ_HEAD, w->pos, h * sizeof *w->head);
+        w->headn[kq[k]] = (uint8_t)h;
+        if (fit[k]) pf[nf] = p[k], cf[nf] = w->coords[k], nff[nf] = n[k], of[nf++] = &r[k];
+    }
+    const jf_params *pr = jf_fitter_params(w->fit[0]);
+    jf_status st = nf ? jf__fit_auto_lanes(w->fit[0], pr, nf, pf, cf, nff, of) : JF_OK;
+    if (st != JF_OK) return st;
+    for (int k = 0; k < L; k++) {
+        if (fit[k]) r[k].status |= fl[k];
+        store_row(&w->blk[kq[k]], &r[k]);
+    }
+    return JF_OK;
+}
+
 /* Auto's step 6: the record of the point at tree position j, fitted here
  * because its own unit is not done: the same neighbourhood (knn_share.c
  * gives one search's lists) and fit as its own walk step makes, so the
@@ -618,27 +654,25 @@ static jf_status fit_pass_nj(const runctx *R, const uint32_t *walk, const double
             if (stop_seen(wst, &failed)) continue;
             const size_t beg = u * unit, nu = beg + unit < nwalk ? unit : nwalk - beg;
             size_t m = 0; /* the unit's points to fit (a part's halo: not) */
-            for (size_t kk = 0; kk < nu && wst == JF_OK; kk++) {
-                const size_t i = walk[beg + kk], k = m;
-                const double *pt = walk_xyz ? walk_xyz + 3 * (beg + kk) : R->c->xyz + 3 * i;
-                if (R->fit && !R->fit[i]) {
-                    if (R->out) nan_result(&R->out[i], JF_PT_NONFINITE);
-                    continue;
+            for (size_t kk = 0; kk < nu && wst == JF_OK;) {
+                /* up to LANES points to fit, fitted side by side (auto_lanes) */
+                int L = 0;
+                size_t iq[LANES], kq[LANES], left[LANES];
+                const double *pq[LANES];
+                for (; kk < nu && L < LANES; kk++) {
+                    const size_t i = walk[beg + kk], k = m;
+                    const double *pt = walk_xyz ? walk_xyz + 3 * (beg + kk) : R->c->xyz + 3 * i;
+                    if (R->fit && !R->fit[i]) {
+                        if (R->out) nan_result(&R->out[i], JF_PT_NONFINITE);
+                        continue;
+                    }
+                    m++;
+                    w.bidx[k] = (uint32_t)i;
+                    memcpy(w.bxyz + 3 * k, pt, 3 * sizeof *pt);
+                    w.bpos[k] = (uint32_t)(beg + kk);
+                    iq[L] = i, pq[L] = pt, kq[L] = k, left[L++] = nu - kk;
                 }
-                m++;
-                w.bidx[k] = (uint32_t)i;
-                memcpy(w.bxyz + 3 * k, pt, 3 * sizeof *pt);
-                size_t iq[LANES] = {i};
-                const double *pq[LANES] = {pt};
-                jf_result *oq[LANES] = {&w.blk[k]};
-                if (w.share && walk_xyz) jf__knn_share_ahead(w.share, pt, nu - kk);
-                w.hint_n = 0;
-                if ((wst = fit_lanes(&w, x, 1, iq, pq, oq)) != JF_OK) break;
-                /* prepare's query left the neighbourhood in w.idx */
-                const size_t h = w.hint_n < JF_NJ_HEAD ? w.hint_n : JF_NJ_HEAD;
-                memcpy(w.head + k * JF_NJ_HEAD, w.pos, h * sizeof *w.head);
-                w.headn[k] = (uint8_t)h;
-                w.bpos[k] = (uint32_t)(beg + kk);
+                if (L) wst = auto_lanes(&w, x, L, iq, pq, kq, walk_xyz ? left : NULL);
             }
             /* the records after the fits: a locked store right after a fit
              * waits for its stores to drain */

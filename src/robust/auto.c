@@ -570,7 +570,7 @@ static void own_frame(const mom *mo0, double H, const double fr0[9], jf_frame_mo
     c[4] = S[PIDX(0, 2)] * H * H / n1 - my * my;
     c[5] = c[7] = T[PIDX(0, 1)] * H / n1 - my * mz;
     c[8] = mo0->zz / n1 - mz * mz;
-    jf__eig3_in(c, fr0, pca_ev, evec);
+    jf__eig3_near(c, fr0, pca_ev, evec);
     jf__frame_axes(evec, mode, fk);
 }
 
@@ -583,37 +583,82 @@ static void own_frame(const mom *mo0, double H, const double fr0[9], jf_frame_mo
  * lowered while G' is singular or too ill-conditioned (params.max_cond,
  * flags LOWERED_RANK / LOWERED_COND), A_ij = Y_ij / h^(i+j), then the
  * quantities (monge.c).  Interpolation, or no degree left: jf_fit_point
- * on the same points (final_fit). */
-static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr, size_t k,
-                            const mom *mo0, double H, const double fr0[9], int d, double sigma,
-                            jf_result *out)
+ * on the same points (final_fit).  In two halves (direct_begin, then
+ * direct_end), so that up to four points' first G' have their extremes
+ * side by side (jf__gram_extremes_x4: the bits of one at a time). */
+typedef struct {
+    mom mk;             /* the K points' sums in their own frame       */
+    double fk[9], pca_ev[3], sp[4], sigma;
+    double E[NMON * NMON]; /* G' of degree deg (nd x nd), row-major    */
+    int d, deg, nd;     /* asked, first tried (its G' in E), its size  */
+    unsigned flags;     /* the degrees lowered before deg              */
+} dfit;
+
+/* G' of degree deg from the sums: nd x nd into E (and L's rows, when L) */
+static int gram_of(const dfit *D, int deg, double *E, double *L)
 {
-    if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
-    double pca_ev[3], fk[9];
-    own_frame(mo0, H, fr0, pr->frame, pca_ev, fk);
-    const double *fr = fk;
-    mom mk;
-    moments(p, nbr, k, fr, H, d, &mk);
-    const mom *mo = &mk;
-    if (!(mo->hmean > 0.0)) return final_fit(f, pr, d, p, nbr, k, sigma, out);
-    const double h = mo->hmean, sc = H / h, sp[4] = {1.0, sc, sc * sc, sc * sc * sc};
-    const size_t m = mo->m;
-    unsigned flags = 0;
-    double L[NMON * NMON], Y[NMON], cond = NAN, rss = mo->zz;
+    const int nd = (deg + 1) * (deg + 2) / 2;
+    for (int i = 0; i < nd; i++)
+        for (int j = 0; j < nd; j++) {
+            const double g = D->mk.S[gpos[i][j]] * D->sp[mdeg[i]] * D->sp[mdeg[j]];
+            E[i * nd + j] = g;
+            if (L) L[i * NMON + j] = g;
+        }
+    return nd;
+}
+
+/* Up to the first G' to weigh: 1 with it in D->E, 0 when the jet is to
+ * be fitted by final_fit (its call made, its status in *st). */
+static int direct_begin(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                        size_t k, const mom *mo0, double H, const double fr0[9], int d, double sigma,
+                        dfit *D, jf_result *out, jf_status *st)
+{
+    if (pr->fit != JF_FIT_APPROX || !(mo0->m > 0)) {
+        *st = final_fit(f, pr, d, p, nbr, k, sigma, out);
+        return 0;
+    }
+    own_frame(mo0, H, fr0, pr->frame, D->pca_ev, D->fk);
+    moments(p, nbr, k, D->fk, H, d, &D->mk);
+    if (!(D->mk.hmean > 0.0)) {
+        *st = final_fit(f, pr, d, p, nbr, k, sigma, out);
+        return 0;
+    }
+    const double sc = H / D->mk.hmean;
+    D->sp[0] = 1.0, D->sp[1] = sc, D->sp[2] = sc * sc, D->sp[3] = sc * sc * sc;
+    D->sigma = sigma;
+    D->d = d;
+    D->flags = 0;
     int deg = d;
+    while (deg >= 1 && D->mk.m < (size_t)((deg + 1) * (deg + 2) / 2)) {
+        D->flags |= JF_PT_LOWERED_FEW;
+        deg--;
+    }
+    D->deg = deg;
+    D->nd = deg >= 1 ? gram_of(D, deg, D->E, NULL) : 0;
+    return 1;
+}
+
+/* The rest of direct_fit: with the extremes of D->E (hi0, lo0; ok0 0:
+ * singular) for the first degree, lower ones by jf__gram_extremes. */
+static jf_status direct_end(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                            size_t k, const dfit *D, double hi0, double lo0, int ok0, jf_result *out)
+{
+    const mom *mo = &D->mk;
+    const double h = mo->hmean, *sp = D->sp;
+    const size_t m = mo->m;
+    unsigned flags = D->flags;
+    double L[NMON * NMON], Y[NMON], cond = NAN, rss = mo->zz;
+    int deg = D->deg;
     for (; deg >= 1; deg--) {
-        int nd = (deg + 1) * (deg + 2) / 2;
+        const int nd = (deg + 1) * (deg + 2) / 2;
         if (m < (size_t)nd) {
             flags |= JF_PT_LOWERED_FEW;
             continue;
         }
-        double E[NMON * NMON], lo = 0.0, hi = 0.0;
-        for (int i = 0; i < nd; i++)
-            for (int j = 0; j < nd; j++)
-                E[i * nd + j] = L[i * NMON + j] =
-                    mo->S[gpos[i][j]] * sp[mdeg[i]] * sp[mdeg[j]];
+        double E[NMON * NMON], lo = lo0, hi = hi0;
+        gram_of(D, deg, E, L);
         /* the extremes only, as the jet's own (gram_eig.c) */
-        if (!jf__gram_extremes(E, (size_t)nd, &hi, &lo)) {
+        if (deg == D->deg ? !ok0 : !jf__gram_extremes(E, (size_t)nd, &hi, &lo)) {
             flags |= JF_PT_LOWERED_RANK;
             continue;
         }
@@ -656,20 +701,32 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
         }
         break;
     }
-    if (deg < 1) return final_fit(f, pr, d, p, nbr, k, sigma, out);
+    if (deg < 1) return final_fit(f, pr, D->d, p, nbr, k, D->sigma, out);
     memset(out, 0, sizeof *out);
     out->status = flags | JF_PT_AUTO;
     out->degree = deg;
     out->n_used = (int)m;
     out->cond = cond;
     out->residual = sqrt((rss > 0.0 ? rss : 0.0) / (double)m);
-    out->sigma = sigma;
-    memcpy(out->pca_eval, pca_ev, sizeof pca_ev);
+    out->sigma = D->sigma;
+    memcpy(out->pca_eval, D->pca_ev, sizeof D->pca_ev);
     double A[NMON], hk = 1.0;
     for (int t = 0, j = 0; t <= deg; t++, hk *= h)
         for (int q = 0; q <= t; q++, j++) A[j] = Y[j] / hk;
-    jf__quantities(A, deg, pr->monge_degree, fr, h, out);
+    jf__quantities(A, deg, pr->monge_degree, D->fk, h, out);
     return JF_OK;
+}
+
+static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr, size_t k,
+                            const mom *mo0, double H, const double fr0[9], int d, double sigma,
+                            jf_result *out)
+{
+    dfit D;
+    jf_status st = JF_OK;
+    if (!direct_begin(f, pr, p, nbr, k, mo0, H, fr0, d, sigma, &D, out, &st)) return st;
+    double hi = 0.0, lo = 0.0;
+    const int ok = D.nd > 0 && jf__gram_extremes(D.E, (size_t)D.nd, &hi, &lo);
+    return direct_end(f, pr, p, nbr, k, &D, hi, lo, ok, out);
 }
 
 /* Steps 1-2 of one point: what the rule and the reported fit read. */
@@ -772,12 +829,24 @@ static int steps12(const jf__knobs *kn, const jf_params *pr, const double p[3], 
     return 1;
 }
 
-jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
-                       size_t n, jf_result *out)
+/* A point's direct fit waiting for its first G's extremes (direct_end). */
+typedef struct {
+    dfit D;
+    size_t k;   /* its K                       */
+    int capped; /* step 0's cap left candidates out */
+} pend;
+
+/* jf__fit_auto up to the direct fit's first G' (then 1, *P to finish),
+ * or the whole fit (0, its status in *st). */
+static int auto_begin(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr, size_t n,
+                      pend *P, jf_result *out, jf_status *st)
 {
     const jf__knobs *kn = jf__knobs_of(f);
     stage g;
-    if (!steps12(kn, pr, p, nbr, n, &g)) return final_fit(f, pr, 2, p, nbr, g.nmax, g.sigma, out);
+    if (!steps12(kn, pr, p, nbr, n, &g)) {
+        *st = final_fit(f, pr, 2, p, nbr, g.nmax, g.sigma, out);
+        return 0;
+    }
     const size_t nmax = g.nmax, *ks = g.ks;
     const int nc = g.nc;
     const double s2 = g.s2, sigma = g.sigma;
@@ -819,13 +888,70 @@ jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], con
                                &dg->res[e][i]) != JF_OK)
                     dg->res[e][i].status = JF_PT_FAILED;
     }
-    jf_status st;
-    if (ci < 0) /* no candidate: the plain quadric on the list (up to the cap) */
-        st = final_fit(f, pr, 2, p, nbr, capped ? cap : nmax, sigma, out);
-    else if (kn->auto_dw > 0.0) /* bench-only knob, off: a distance-weighted row */
-        st = fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
-    else st = direct_fit(f, pr, p, nbr, ks[ci], &g.mo[ci], g.H, g.fr, d, sigma, out);
-    if (st == JF_OK && capped && (out->status & JF_PT_AUTO)) out->status |= JF_PT_AUTO_CAPPED;
+    if (ci >= 0 && !(kn->auto_dw > 0.0)) {
+        P->k = ks[ci];
+        P->capped = capped;
+        if (direct_begin(f, pr, p, nbr, ks[ci], &g.mo[ci], g.H, g.fr, d, sigma, &P->D, out, st)) return 1;
+    } else if (ci < 0) /* no candidate: the plain quadric on the list (up to the cap) */
+        *st = final_fit(f, pr, 2, p, nbr, capped ? cap : nmax, sigma, out);
+    else /* bench-only knob, off: a distance-weighted row */
+        *st = fit_by_fitter(f, pr, d, p, nbr, ks[ci], sigma, kn->auto_dw, out);
+    if (*st == JF_OK && capped && (out->status & JF_PT_AUTO)) out->status |= JF_PT_AUTO_CAPPED;
+    return 0;
+}
+
+/* The direct fit of P, its first G's extremes given (hi, lo, ok). */
+static jf_status auto_end(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                          const pend *P, double hi, double lo, int ok, jf_result *out)
+{
+    jf_status st = direct_end(f, pr, p, nbr, P->k, &P->D, hi, lo, ok, out);
+    if (st == JF_OK && P->capped && (out->status & JF_PT_AUTO)) out->status |= JF_PT_AUTO_CAPPED;
+    return st;
+}
+
+jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
+                       size_t n, jf_result *out)
+{
+    pend P;
+    jf_status st = JF_OK;
+    if (!auto_begin(f, pr, p, nbr, n, &P, out, &st)) return st;
+    double hi = 0.0, lo = 0.0;
+    const int ok = P.D.nd > 0 && jf__gram_extremes(P.D.E, (size_t)P.D.nd, &hi, &lo);
+    return auto_end(f, pr, p, nbr, &P, hi, lo, ok, out);
+}
+
+jf_status jf__fit_auto_lanes(jf_fitter *f, const jf_params *pr, int L, const double *const p[],
+                             const double *const nbr[], const size_t n[], jf_result *const out[])
+{
+    pend P[4];
+    int wait[4] = {0};
+    jf_status st = JF_OK;
+    for (int l = 0; l < L && l < 4 && st == JF_OK; l++) {
+        wait[l] = auto_begin(f, pr, p[l], nbr[l], n[l], &P[l], out[l], &st);
+    }
+    if (st != JF_OK) return st;
+    /* the waiting lanes' first G' side by side, those of one size together
+     * (a lane's extremes do not depend on the others': the same bits) */
+    double hi[4] = {0}, lo[4] = {0};
+    int ok[4] = {0}, done[4] = {0};
+    for (int l = 0; l < L && l < 4; l++) {
+        if (!wait[l] || done[l]) continue;
+        const int nd = P[l].D.nd;
+        const double *g[4];
+        int lane[4], c = 0;
+        for (int e = l; e < L && e < 4; e++)
+            if (wait[e] && !done[e] && P[e].D.nd == nd) lane[c] = e, g[c++] = P[e].D.E, done[e] = 1;
+        if (c > 1 && nd > 0) {
+            double h4[4], l4[4];
+            int o4[4];
+            for (int e = c; e < 4; e++) g[e] = g[0];
+            jf__gram_extremes_x4(g, (size_t)nd, h4, l4, o4);
+            for (int e = 0; e < c; e++) hi[lane[e]] = h4[e], lo[lane[e]] = l4[e], ok[lane[e]] = o4[e];
+        } else
+            ok[l] = nd > 0 && jf__gram_extremes(P[l].D.E, (size_t)nd, &hi[l], &lo[l]);
+    }
+    for (int l = 0; l < L && l < 4 && st == JF_OK; l++)
+        if (wait[l]) st = auto_end(f, pr, p[l], nbr[l], &P[l], hi[l], lo[l], ok[l], out[l]);
     return st;
 }
 

@@ -77,6 +77,10 @@ jf_status jf__fit_select(jf_fitter *f, const jf_params *pr, const double p[3],
  * (nearest first) and the degree; fills out->sigma. */
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out);
+/* jf__fit_auto of L <= 4 points (p[l], its nbr[l] of n[l]) into out[l],
+ * their fits' eigen-steps side by side: the bits of one by one. */
+jf_status jf__fit_auto_lanes(jf_fitter *f, const jf_params *pr, int L, const double *const p[],
+                             const double *const nbr[], const size_t n[], jf_result *const out[]);
 
 /* neighbors auto's candidates (auto.c step 1-2, read by auto_rule.c). */
 #define JF_AUTO_NCAND 10

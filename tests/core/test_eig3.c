@@ -1,9 +1,11 @@
 /* test_eig3.c -- the faster eigen-solvers neighbors auto uses for its
  * frames, against matrices of known spectrum A = R diag(l) R^T (R a
  * random rotation): jf__normal3 (closed form: the least eigenvector, a
- * tangent frame around it) and jf__eig3_in (Jacobi to rounding in given
- * axes), within what rounding allows (eps x l3 / gap), and agreeing with
- * jf__eig3; both refuse or fall back where the normal is not unique. */
+ * tangent frame around it), jf__eig3_in (Jacobi to rounding in given
+ * axes) and jf__eig3_near (normal3's normal, the rest from the 2 x 2
+ * block around it), within what rounding allows (eps x l3 / gap), and
+ * agreeing with jf__eig3; they refuse or fall back where the normal is
+ * not unique. */
 #include <check.h>
 #include <float.h>
 #include <math.h>
@@ -146,19 +148,28 @@ START_TEST(test_eig3_in_known)
                     for (int q = 0; q < 3; q++) s += ax[3 * i + p] * a[3 * p + q] * ax[3 * j + q];
                 in[3 * i + j] = s;
             }
-        if (mode == 2)
-            jf__eig3_in(a, NULL, ev, e);
-        else
-            jf__eig3_in(in, ax, ev, e);
         jf__eig3(a, ev1, e1);
-        for (int k = 0; k < 3; k++) {
-            ck_assert_msg(fabs(ev[k] - l[k]) <= 64 * DBL_EPSILON * l[2], "case %d: eigenvalue %d", t, k);
-            ck_assert_msg(fabs(ev[k] - ev1[k]) <= 64 * DBL_EPSILON * l[2], "case %d: vs jf__eig3", t);
-            double gap = k == 0 ? l[1] - l[0] : k == 2 ? l[2] - l[1] : fmin(l[1] - l[0], l[2] - l[1]);
-            double tol = 64 * DBL_EPSILON * l[2] / gap + 1e-15;
-            ck_assert_msg(axis_angle(e + 3 * k, r + 3 * k) <= tol, "case %d: vector %d %.3g off", t, k,
-                          axis_angle(e + 3 * k, r + 3 * k));
-            ck_assert_msg(axis_angle(e + 3 * k, e1 + 3 * k) <= 2 * tol, "case %d: vs jf__eig3", t);
+        for (int near = 0; near < 2; near++) {
+            if (near)
+                jf__eig3_near(mode == 2 ? a : in, mode == 2 ? NULL : ax, ev, e);
+            else if (mode == 2)
+                jf__eig3_in(a, NULL, ev, e);
+            else
+                jf__eig3_in(in, ax, ev, e);
+            for (int k = 0; k < 3; k++) {
+                ck_assert_msg(fabs(ev[k] - l[k]) <= 64 * DBL_EPSILON * l[2], "case %d: eigenvalue %d", t, k);
+                ck_assert_msg(fabs(ev[k] - ev1[k]) <= 64 * DBL_EPSILON * l[2], "case %d: vs jf__eig3", t);
+                double gap = k == 0 ? l[1] - l[0] : k == 2 ? l[2] - l[1] : fmin(l[1] - l[0], l[2] - l[1]);
+                double tol = 64 * DBL_EPSILON * l[2] / gap + 1e-15;
+                ck_assert_msg(axis_angle(e + 3 * k, r + 3 * k) <= tol, "case %d: vector %d %.3g off", t, k,
+                              axis_angle(e + 3 * k, r + 3 * k));
+                ck_assert_msg(axis_angle(e + 3 * k, e1 + 3 * k) <= 2 * tol, "case %d: vs jf__eig3", t);
+                /* the sign pinned as jf__eig3's: the largest component positive */
+                int m = 0;
+                for (int i = 1; i < 3; i++)
+                    if (fabs(e[3 * k + i]) > fabs(e[3 * k + m])) m = i;
+                ck_assert_msg(e[3 * k + m] > 0, "case %d (near %d): vector %d's sign", t, near, k);
+            }
         }
     }
 }

@@ -450,8 +450,8 @@ END_TEST
  * <= 2.2e-13; the QL of all eigenvalues it replaced was off by up to
  * 2.2e-9 there); against that QL (solve.c) on these and on matrices
  * with (nearly) multiple eigenvalues, where Laguerre converges slowest:
- * both extremes to 8 cols eps lambda_max; and two at once
- * (jf__eigvals_x2) bit for bit as one at a time. */
+ * both extremes to 8 cols eps lambda_max; and two or four at once
+ * (jf__eigvals_x2, jf__gram_extremes_x4) bit for bit as one at a time. */
 START_TEST(test_gram_extremes)
 {
     jf_params p;
@@ -512,6 +512,22 @@ START_TEST(test_gram_extremes)
         jf__eigvals_x2(f, g, cols, ok);
         ck_assert(ok[0] && ok[1]);
         ck_assert(f->s[0] == s0 && f->s[1] == s1 && g->s[0] == s0 && g->s[1] == s1);
+        /* four matrices (auto's lanes), this G in lane t % 4 beside others:
+         * its lane as alone, AVX and default builds */
+        double hi = 0, lo = 0, h4[4], l4[4];
+        ck_assert_int_eq(jf__gram_extremes(gx, cols, &hi, &lo), 1);
+        ck_assert(hi == s0 && lo == s1);
+        double other[100];
+        for (size_t j = 0; j < cols * cols; j++) other[j] = gx[j] * (1.0 + (j % (cols + 1) == 0));
+        const double *g4[4] = {other, other, other, other};
+        g4[t % 4] = gx;
+        for (int avx = 0; avx < 2; avx++) {
+            jf__no_avx = !avx;
+            int o4[4];
+            jf__gram_extremes_x4(g4, cols, h4, l4, o4);
+            ck_assert(o4[t % 4] && h4[t % 4] == s0 && l4[t % 4] == s1);
+        }
+        jf__no_avx = 0;
     }
     ck_assert_int_eq(graded, 200);
     jf_fitter_free(f);
