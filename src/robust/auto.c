@@ -41,7 +41,8 @@
  *     chosen K points in their own PCA frame (the jet's, §5.2), from a
  *     second pass of power sums (direct_fit) -- the numbers of knn:K
  *     --degree d up to rounding (test_auto), without a second fit;
- *     flagged JF_PT_AUTO.
+ *     flagged JF_PT_AUTO.  The walk's points come four at a time
+ *     (jf__fit_auto_lanes): their Gram extremes side by side.
  */
 #include <emmintrin.h>
 #include <math.h>
