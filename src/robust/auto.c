@@ -212,6 +212,36 @@ static inline __attribute__((always_inline)) void sqrt4(v4d *r, const v4d *x)
     *r = (v4d){lo[0], lo[1], hi[0], hi[1]};
 }
 
+/* put_fit of the four lanes of a quad at once (lane e: candidate l0 + e,
+ * used where use_e), each lane with put_fit's operations in its order,
+ * so its bits. */
+static inline __attribute__((always_inline)) void put_fit4(v4d a1, v4d a2, v4d var, v4d rss,
+                                                           const v4d hK, const v4d dof, const int use[4],
+                                                           const double fr[9], cand_fit *out)
+{
+    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    const v4d gx = a1 / hK, gy = a2 / hK, g2 = one + gx * gx + gy * gy;
+    v4d v[3];
+    for (int k = 0; k < 3; k++) v[k] = fr[6 + k] - gx * fr[k] - gy * fr[3 + k];
+    const v4d n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    v4d nv;
+    sqrt4(&nv, &n2);
+    v4d nrm[3];
+    for (int k = 0; k < 3; k++) nrm[k] = v[k] / nv;
+    const v4d tr = var / (hK * hK) / (g2 * g2);
+    const v4d rp = (v4d)((v4l)rss & (v4l)(rss > zero));
+    const v4d s2 = rp / dof;
+    for (int e = 0; e < 4; e++) {
+        if (!use[e] || !(nv[e] > 0.0) || !isfinite(nv[e])) continue;
+        cand_fit *o = &out[e];
+        for (int k = 0; k < 3; k++) o->nrm[k] = nrm[k][e];
+        o->tr = tr[e];
+        o->s2 = s2[e];
+        o->h = hK[e];
+        o->ok = isfinite(o->tr) && isfinite(o->s2);
+    }
+}
+
 JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
                                 cand_fit cf[2][NCAND])
 {
@@ -285,24 +315,24 @@ JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double 
                 }
             }
         for (int g = 0; g < NQUAD; g++) {
-            v4d a1 = zero, a2 = zero, var = zero, rss = zz[g];
+            v4d a1 = zero, a2 = zero, var = zero, rss = zz[g], hK, m, dof[2];
+            int ug[4];
+            for (int e = 0; e < 4; e++) {
+                const int l = 4 * g + e;
+                ug[e] = use[l] && !bad[g][e];
+                hK[e] = hk[src[l]];
+                m[e] = (double)mo[src[l]].m;
+            }
+            dof[0] = m - 6.0; /* (double)(m - nd): exact, m < 2^53 */
+            dof[1] = m - (double)NMON;
             for (int i = 0; i < NMON; i++) {
                 a1 += u[0][i][g] * y[i][g];
                 a2 += u[1][i][g] * y[i][g];
                 var += u[0][i][g] * u[0][i][g] + u[1][i][g] * u[1][i][g];
                 rss -= y[i][g] * y[i][g];
-                if (i == 5)
-                    for (int e = 0; e < 4; e++) {
-                        const int l = 4 * g + e;
-                        if (use[l] && !bad[g][e])
-                            put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, 6, hk[l], fr, &cf[0][l]);
-                    }
+                if (i == 5) put_fit4(a1, a2, var, rss, hK, dof[0], ug, fr, &cf[0][4 * g]);
             }
-            for (int e = 0; e < 4; e++) {
-                const int l = 4 * g + e;
-                if (use[l] && !bad[g][e])
-                    put_fit(a1[e], a2[e], var[e], rss[e], mo[l].m, NMON, hk[l], fr, &cf[1][l]);
-            }
+            put_fit4(a1, a2, var, rss, hK, dof[1], ug, fr, &cf[1][4 * g]);
         }
     }
     for (int l = 0; l < nc; l++)
