@@ -106,6 +106,22 @@ JF_AVX_FN static void gram_extremes_x4_avx(const double *const g[4], size_t cols
 }
 #endif
 
+void jf__gram_extremes_x4(const double *const g[4], size_t cols, double hi[4], double lo[4],
+                          int ok[4])
+{
+    if (cols > GE_MAX || cols < 2) {
+        for (int L = 0; L < 4; L++) ok[L] = 0;
+        return;
+    }
+    int rc[4];
+#if JF_AVX_PATH
+    if (JF_HAVE_AVX()) gram_extremes_x4_avx(g, cols, hi, lo, rc);
+    else
+#endif
+        gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_sse);
+    for (int L = 0; L < 4; L++) ok[L] = rc[L] == 0;
+}
+
 /* f[L] may repeat (a lane whose result is not wanted): its lanes compute
  * the same values. */
 void jf__eigvals_x4(jf_fitter *const f[4], size_t cols, int ok[4])
@@ -120,16 +136,8 @@ void jf__eigvals_x4(jf_fitter *const f[4], size_t cols, int ok[4])
     }
     const double *g[4] = {f[0]->x, f[1]->x, f[2]->x, f[3]->x};
     double hi[4], lo[4];
-    int rc[4];
-#if JF_AVX_PATH
-    if (JF_HAVE_AVX()) gram_extremes_x4_avx(g, cols, hi, lo, rc);
-    else
-#endif
-        gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_sse);
-    for (int L = 0; L < 4; L++) {
-        put(f[L], cols, hi[L], lo[L]);
-        ok[L] = rc[L] == 0;
-    }
+    jf__gram_extremes_x4(g, cols, hi, lo, ok);
+    for (int L = 0; L < 4; L++) put(f[L], cols, hi[L], lo[L]);
 }
 
 int jf__eigvals(jf_fitter *f, size_t cols)
@@ -152,20 +160,4 @@ int jf__gram_extremes(const double *g, size_t cols, double *hi, double *lo)
     *hi = h[0];
     *lo = l[0];
     return rc[0] == 0;
-}
-
-void jf__gram_extremes_x4(const double *const g[4], size_t cols, double hi[4], double lo[4],
-                          int ok[4])
-{
-    if (cols > GE_MAX || cols < 2) {
-        for (int L = 0; L < 4; L++) ok[L] = 0;
-        return;
-    }
-    int rc[4];
-#if JF_AVX_PATH
-    if (JF_HAVE_AVX()) gram_extremes_x4_avx(g, cols, hi, lo, rc);
-    else
-#endif
-        gram_extremes_x4(g, cols, hi, lo, rc, sqrt4_sse);
-    for (int L = 0; L < 4; L++) ok[L] = rc[L] == 0;
 }
