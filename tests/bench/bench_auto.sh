@@ -14,25 +14,30 @@
 # that time, points/s and peak RSS, then the ratios auto / knn:32 (goal:
 # time <= 3, memory <= 1.5).  EXTRA: more --neighbors settings timed in
 # the same rounds, each with its ratio to knn:32 (the plain fits at the
-# K the accuracy target would need, docs/robustness.md).  Needs GNU time
-# (/usr/bin/time).
+# K the accuracy target would need, docs/robustness.md).  Needs python3
+# (resource.getrusage of the run: CPU to the microsecond).
 set -eu
 B=${1:-build}
 N=${2:-100000}
 R=${3:-5}
 J=$B/jetfit
 [ -x "$J" ] || { echo "bench_auto: $J not built" >&2; exit 1; }
-[ -x /usr/bin/time ] || { echo "bench_auto: needs GNU time (/usr/bin/time)" >&2; exit 1; }
+# the system's python3 first: a wrapper's (pyenv's) adds to its child's CPU time
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=$(command -v python3) || { echo "bench_auto: needs python3 (the rusage of each run)" >&2; exit 1; }
 W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT INT TERM
 
 "$J" generate torus -o "$W/in.ply" --n "$N" --noise 0.003 --density gradient --seed 27 >/dev/null
 echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); $N points, $R rounds, 1 thread"
 
-one() { # one NB -> "cpu_seconds peak_kb"
-    /usr/bin/time -f "%U %S %M" -o "$W/t" "$J" estimate "$W/in.ply" -o "$W/out.ply" \
-        --neighbors "$1" --threads 1 --quiet
-    awk '{ printf "%.3f %d\n", $1 + $2, $3 }' "$W/t"
+one() { # one NB -> "cpu_seconds peak_kb" (the child's rusage, to the microsecond:
+    # GNU time prints 10 ms steps, 4% of knn:32 at 10^5)
+    "$PY" -c 'import resource, subprocess, sys
+subprocess.run(sys.argv[1:], check=True)
+r = resource.getrusage(resource.RUSAGE_CHILDREN)
+print("%.4f %d" % (r.ru_utime + r.ru_stime, r.ru_maxrss))' \
+        "$J" estimate "$W/in.ply" -o "$W/out.ply" --neighbors "$1" --threads 1 --quiet
 }
 
 : >"$W/runs"
