@@ -92,24 +92,54 @@ static const int mey[NMON] = {0, 0, 1, 0, 1, 2, 0, 1, 2, 3};
 _Static_assert(NPOW % 4 == 0 && NMON >= 8, "first_pass sums four power sums a step");
 #define PIDX(i, j) (((i) + (j)) * ((i) + (j) + 1) / 2 + (j))
 
-/* The normal of a jet whose slope, in units of x / hK, is (a1, a2), and
- * the sd^2 of its angle per unit noise variance from the slope's variance
- * var (same units). */
-static int put_fit(double a1, double a2, double var, double rss, size_t m, int nd, double hK,
-                   const double fr[9], cand_fit *out)
+/* *r = sqrt(x) lane by lane, IEEE: correctly rounded (by pointer: a v4d
+ * return value's ABI differs with and without AVX) */
+static inline __attribute__((always_inline)) void sqrt4(v4d *r, const v4d *x)
 {
-    double gx = a1 / hK, gy = a2 / hK, g2 = 1.0 + gx * gx + gy * gy;
-    double v[3];
+    const __m128d lo = _mm_sqrt_pd((__m128d){(*x)[0], (*x)[1]}), hi = _mm_sqrt_pd((__m128d){(*x)[2], (*x)[3]});
+    *r = (v4d){lo[0], lo[1], hi[0], hi[1]};
+}
+
+/* The normals of four jets (lane e where use[e]) whose slopes, in units
+ * of x / hK, are (a1, a2), and the sd^2 of their angles per unit noise
+ * variance from the slopes' variances var (same units), into out[e]
+ * (left as it is where the normal is not finite); each lane's operations
+ * those of one jet alone (put_fit), so its bits. */
+static inline __attribute__((always_inline)) void put_fit4(v4d a1, v4d a2, v4d var, v4d rss,
+                                                           const v4d hK, const v4d dof, const int use[4],
+                                                           const double fr[9], cand_fit *out)
+{
+    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    const v4d gx = a1 / hK, gy = a2 / hK, g2 = one + gx * gx + gy * gy;
+    v4d v[3];
     for (int k = 0; k < 3; k++) v[k] = fr[6 + k] - gx * fr[k] - gy * fr[3 + k];
-    double nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (!(nv > 0.0) || !isfinite(nv)) return 0;
-    for (int k = 0; k < 3; k++) out->nrm[k] = v[k] / nv;
-    /* d(angle) = d|grad| / (1 + |grad|^2) */
-    out->tr = var / (hK * hK) / (g2 * g2);
-    out->s2 = (rss > 0.0 ? rss : 0.0) / (double)(m - (size_t)nd);
-    out->h = hK;
-    out->ok = isfinite(out->tr) && isfinite(out->s2);
-    return out->ok;
+    const v4d n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    v4d nv;
+    sqrt4(&nv, &n2);
+    v4d nrm[3];
+    for (int k = 0; k < 3; k++) nrm[k] = v[k] / nv;
+    const v4d tr = var / (hK * hK) / (g2 * g2);
+    const v4d rp = (v4d)((v4l)rss & (v4l)(rss > zero));
+    const v4d s2 = rp / dof;
+    for (int e = 0; e < 4; e++) {
+        if (!use[e] || !(nv[e] > 0.0) || !isfinite(nv[e])) continue;
+        cand_fit *o = &out[e];
+        for (int k = 0; k < 3; k++) o->nrm[k] = nrm[k][e];
+        o->tr = tr[e];
+        o->s2 = s2[e];
+        o->h = hK[e];
+        o->ok = isfinite(o->tr) && isfinite(o->s2);
+    }
+}
+
+/* put_fit4 of one jet of nd monomials on m points (lane 0). */
+static void put_fit(double a1, double a2, double var, double rss, size_t m, int nd, double hK,
+                    const double fr[9], cand_fit *out)
+{
+    const int use[4] = {1, 0, 0, 0};
+    const double dof = (double)(m - (size_t)nd);
+    put_fit4((v4d){a1, a1, a1, a1}, (v4d){a2, a2, a2, a2}, (v4d){var, var, var, var},
+             (v4d){rss, rss, rss, rss}, (v4d){hK, hK, hK, hK}, (v4d){dof, dof, dof, dof}, use, fr, out);
 }
 
 /* The quadric (out[0]) and the cubic (out[1]) least-squares jets at one
@@ -204,44 +234,6 @@ static void solve_k(const double *S, const double *T, double zz, size_t m, doubl
  * points, a singular block: solve_k lowers the degree) runs solve_k on
  * its own; a candidate with no radius (hk <= 0) is left out (ok = 0). */
 #define NQUAD ((NCAND + 3) / 4)
-/* *r = sqrt(x) lane by lane, IEEE: correctly rounded (by pointer: a v4d
- * return value's ABI differs with and without AVX) */
-static inline __attribute__((always_inline)) void sqrt4(v4d *r, const v4d *x)
-{
-    const __m128d lo = _mm_sqrt_pd((__m128d){(*x)[0], (*x)[1]}), hi = _mm_sqrt_pd((__m128d){(*x)[2], (*x)[3]});
-    *r = (v4d){lo[0], lo[1], hi[0], hi[1]};
-}
-
-/* put_fit of the four lanes of a quad at once (lane e: candidate l0 + e,
- * used where use_e), each lane with put_fit's operations in its order,
- * so its bits. */
-static inline __attribute__((always_inline)) void put_fit4(v4d a1, v4d a2, v4d var, v4d rss,
-                                                           const v4d hK, const v4d dof, const int use[4],
-                                                           const double fr[9], cand_fit *out)
-{
-    const v4d one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
-    const v4d gx = a1 / hK, gy = a2 / hK, g2 = one + gx * gx + gy * gy;
-    v4d v[3];
-    for (int k = 0; k < 3; k++) v[k] = fr[6 + k] - gx * fr[k] - gy * fr[3 + k];
-    const v4d n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    v4d nv;
-    sqrt4(&nv, &n2);
-    v4d nrm[3];
-    for (int k = 0; k < 3; k++) nrm[k] = v[k] / nv;
-    const v4d tr = var / (hK * hK) / (g2 * g2);
-    const v4d rp = (v4d)((v4l)rss & (v4l)(rss > zero));
-    const v4d s2 = rp / dof;
-    for (int e = 0; e < 4; e++) {
-        if (!use[e] || !(nv[e] > 0.0) || !isfinite(nv[e])) continue;
-        cand_fit *o = &out[e];
-        for (int k = 0; k < 3; k++) o->nrm[k] = nrm[k][e];
-        o->tr = tr[e];
-        o->s2 = s2[e];
-        o->h = hK[e];
-        o->ok = isfinite(o->tr) && isfinite(o->s2);
-    }
-}
-
 JF_CLONES static void solve_all(const mom *mo, const double *hk, int nc, double H, const double fr[9],
                                 cand_fit cf[2][NCAND])
 {
@@ -625,17 +617,19 @@ typedef struct {
     unsigned flags;     /* the degrees lowered before deg              */
 } dfit;
 
-/* G' of degree deg from the sums: nd x nd into E (and L's rows, when L) */
-static int gram_of(const dfit *D, int deg, double *E, double *L)
+/* G' of degree deg from the sums: nd x nd into E */
+static int gram_of(const dfit *D, int deg, double *E)
 {
     const int nd = (deg + 1) * (deg + 2) / 2;
     for (int i = 0; i < nd; i++)
-        for (int j = 0; j < nd; j++) {
-            const double g = D->mk.S[gpos[i][j]] * D->sp[mdeg[i]] * D->sp[mdeg[j]];
-            E[i * nd + j] = g;
-            if (L) L[i * NMON + j] = g;
-        }
+        for (int j = 0; j < nd; j++) E[i * nd + j] = D->mk.S[gpos[i][j]] * D->sp[mdeg[i]] * D->sp[mdeg[j]];
     return nd;
+}
+
+/* The extremes of the first G' (direct_begin's) alone: 1 where found. */
+static int gram_first(const dfit *D, double *hi, double *lo)
+{
+    return D->nd > 0 && jf__gram_extremes(D->E, (size_t)D->nd, hi, lo);
 }
 
 /* Up to the first G' to weigh: 1 with it in D->E, 0 when the jet is to
@@ -665,7 +659,7 @@ static int direct_begin(jf_fitter *f, const jf_params *pr, const double p[3], co
         deg--;
     }
     D->deg = deg;
-    D->nd = deg >= 1 ? gram_of(D, deg, D->E, NULL) : 0;
+    D->nd = deg >= 1 ? gram_of(D, deg, D->E) : 0;
     return 1;
 }
 
@@ -687,7 +681,10 @@ static jf_status direct_end(jf_fitter *f, const jf_params *pr, const double p[3]
             continue;
         }
         double E[NMON * NMON], lo = lo0, hi = hi0;
-        gram_of(D, deg, E, L);
+        const double *G = deg == D->deg ? D->E : E; /* the first's: direct_begin's */
+        if (deg != D->deg) gram_of(D, deg, E);
+        for (int i = 0; i < nd; i++)
+            for (int j = 0; j < nd; j++) L[i * NMON + j] = G[i * nd + j];
         /* the extremes only, as the jet's own (gram_eig.c) */
         if (deg == D->deg ? !ok0 : !jf__gram_extremes(E, (size_t)nd, &hi, &lo)) {
             flags |= JF_PT_LOWERED_RANK;
@@ -756,7 +753,7 @@ static jf_status direct_fit(jf_fitter *f, const jf_params *pr, const double p[3]
     jf_status st = JF_OK;
     if (!direct_begin(f, pr, p, nbr, k, mo0, H, fr0, d, sigma, &D, out, &st)) return st;
     double hi = 0.0, lo = 0.0;
-    const int ok = D.nd > 0 && jf__gram_extremes(D.E, (size_t)D.nd, &hi, &lo);
+    const int ok = gram_first(&D, &hi, &lo);
     return direct_end(f, pr, p, nbr, k, &D, hi, lo, ok, out);
 }
 
@@ -943,34 +940,31 @@ static jf_status auto_end(jf_fitter *f, const jf_params *pr, const double p[3], 
 jf_status jf__fit_auto(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, jf_result *out)
 {
-    pend P;
-    jf_status st = JF_OK;
-    if (!auto_begin(f, pr, p, nbr, n, &P, out, &st)) return st;
-    double hi = 0.0, lo = 0.0;
-    const int ok = P.D.nd > 0 && jf__gram_extremes(P.D.E, (size_t)P.D.nd, &hi, &lo);
-    return auto_end(f, pr, p, nbr, &P, hi, lo, ok, out);
+    const double *const pp[1] = {p}, *const nn[1] = {nbr};
+    jf_result *const oo[1] = {out};
+    return jf__fit_auto_lanes(f, pr, 1, pp, nn, &n, oo);
 }
 
 jf_status jf__fit_auto_lanes(jf_fitter *f, const jf_params *pr, int L, const double *const p[],
                              const double *const nbr[], const size_t n[], jf_result *const out[])
 {
+    if (L < 1 || L > 4) return JF_ERR_INVALID;
     pend P[4];
     int wait[4] = {0};
     jf_status st = JF_OK;
-    for (int l = 0; l < L && l < 4 && st == JF_OK; l++) {
+    for (int l = 0; l < L && st == JF_OK; l++)
         wait[l] = auto_begin(f, pr, p[l], nbr[l], n[l], &P[l], out[l], &st);
-    }
     if (st != JF_OK) return st;
     /* the waiting lanes' first G' side by side, those of one size together
      * (a lane's extremes do not depend on the others': the same bits) */
     double hi[4] = {0}, lo[4] = {0};
     int ok[4] = {0}, done[4] = {0};
-    for (int l = 0; l < L && l < 4; l++) {
+    for (int l = 0; l < L; l++) {
         if (!wait[l] || done[l]) continue;
         const int nd = P[l].D.nd;
         const double *g[4];
         int lane[4], c = 0;
-        for (int e = l; e < L && e < 4; e++)
+        for (int e = l; e < L; e++)
             if (wait[e] && !done[e] && P[e].D.nd == nd) lane[c] = e, g[c++] = P[e].D.E, done[e] = 1;
         if (c > 1 && nd > 0) {
             double h4[4], l4[4];
@@ -979,9 +973,9 @@ jf_status jf__fit_auto_lanes(jf_fitter *f, const jf_params *pr, int L, const dou
             jf__gram_extremes_x4(g, (size_t)nd, h4, l4, o4);
             for (int e = 0; e < c; e++) hi[lane[e]] = h4[e], lo[lane[e]] = l4[e], ok[lane[e]] = o4[e];
         } else
-            ok[l] = nd > 0 && jf__gram_extremes(P[l].D.E, (size_t)nd, &hi[l], &lo[l]);
+            ok[l] = gram_first(&P[l].D, &hi[l], &lo[l]);
     }
-    for (int l = 0; l < L && l < 4 && st == JF_OK; l++)
+    for (int l = 0; l < L && st == JF_OK; l++)
         if (wait[l]) st = auto_end(f, pr, p[l], nbr[l], &P[l], hi[l], lo[l], ok[l], out[l]);
     return st;
 }
