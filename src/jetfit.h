@@ -179,7 +179,7 @@ typedef struct {
                                 K at most that (jf_estimate sets it from
                                 the cloud's cross-validation, step 0,
                                 where it is 1); either may carry
-                                JF_AUTO_CUBIC_MIN48                     */
+                                JF_AUTO_FLAGS                           */
 } jf_params;
 
 /* OR'd into params.auto_select (with 1 or a cap): no cubic on fewer than
@@ -188,6 +188,15 @@ typedef struct {
  * than the quadric at no more than half its sample: docs/robustness.md,
  * step 0) */
 #define JF_AUTO_CUBIC_MIN48 1024
+/* OR'd into params.auto_select (with 1 or a cap): step 6 takes the normal
+ * of every row not capped from its neighbours' fits weighted by their
+ * slopes' precision, carried by their own and the mean shape operator,
+ * however small the noise (jf_estimate sets it where no row is capped and
+ * the quadric's normal on 256 points is as near the cubic's as the noise
+ * alone would put it: docs/robustness.md, step 0) */
+#define JF_AUTO_WEIGHTED_MEAN 2048
+/* both flags */
+#define JF_AUTO_FLAGS (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN)
 
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);

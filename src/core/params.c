@@ -69,7 +69,7 @@ jf_status jf_params_validate(const jf_params *p, const char **bad_field)
     if (p->degree_select < 0 || p->degree_select > p->degree)
         return bad(bad_field, "degree_select");
     if (!(p->dist_weight >= 0.0) || !isfinite(p->dist_weight)) return bad(bad_field, "dist_weight");
-    const int cap = p->auto_select & ~JF_AUTO_CUBIC_MIN48;
+    const int cap = p->auto_select & ~JF_AUTO_FLAGS;
     if (p->auto_select < 0 || cap > JF_NB_AUTO_KMAX || (cap > 1 && cap < 16) ||
         (cap == 0 && p->auto_select))
         return bad(bad_field, "auto_select");

@@ -24,7 +24,13 @@
  * not met"); where it is thick the 3-D nearest of a noisy p lie on its
  * side and CV is least at the smallest K whatever the surface, so no cap.
  * A pick of 128 or more caps nothing: the curvatures want the largest K
- * (every cap below 256 loses the torus's |dk1|, item 7). */
+ * (every cap below 256 loses the torus's |dk1|, item 7).
+ * Where nothing is capped and the quadric's normal on the 256 nearest is
+ * as near the cubic's as noise alone would put it (the median of
+ * JF_AUTO_CV_BIAS at most 1; about ln 2 without bias), the quadric's slope
+ * bias is small against its noise: step 6 takes its weighted trapezoid
+ * mean on every row (JF_AUTO_WEIGHTED_MEAN; the `exp` patch at 0.1% reads
+ * 0.65, the ellipsoid and the torus 1.9 and 1.5, item 6). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +47,7 @@
 #define JF_CV_THICK 0.4    /* median sigma / r16 above: thick noise        */
 #define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
+#define JF_CV_NOBIAS 1.0   /* median bias statistic at most: noise-bound   */
 
 size_t jf__auto_cv_stride(size_t ntotal)
 {
@@ -56,7 +63,7 @@ static int sampled(const double *xyz, const uint8_t *own, const uint32_t *gid, s
 
 int jf__auto_cv_wanted(const jf_params *p, const jf_nb_spec *nb)
 {
-    return (p->auto_select & ~JF_AUTO_CUBIC_MIN48) == 1 && nb->kind == JF_NB_KNN &&
+    return (p->auto_select & ~JF_AUTO_FLAGS) == 1 && nb->kind == JF_NB_KNN &&
            nb->k >= JF_NB_AUTO_KMAX;
 }
 
@@ -130,12 +137,14 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
     w.cap = JF_NB_AUTO_KMAX;
     w.median = NAN;
     qsort(r, n, sizeof *r, by_gid); /* input order: every split sums alike */
-    double sum[JF_AUTO_NCAND] = {0}, *sr = malloc((n ? n : 1) * sizeof *sr);
-    size_t ns = 0, nsmall = 0, cubic = 0; /* the smallest K's: both fitted, the cubic nearer */
+    double sum[JF_AUTO_NCAND] = {0}, *sr = malloc((n ? n : 1) * sizeof *sr),
+           *sb = malloc((n ? n : 1) * sizeof *sb);
+    size_t ns = 0, nb = 0, nsmall = 0, cubic = 0; /* the smallest K's: both fitted, the cubic nearer */
     for (size_t s = 0; s < n; s++) {
         int all = 1;
         const double *v2 = r[s].v + JF_AUTO_CV_SMALL;
         if (isfinite(v2[0]) && isfinite(v2[1])) cubic += v2[1] < v2[0], nsmall++;
+        if (sb && isfinite(r[s].v[JF_AUTO_CV_BIAS])) sb[nb++] = r[s].v[JF_AUTO_CV_BIAS];
         for (int c = 0; c < JF_AUTO_NCAND && all; c++) all = isfinite(r[s].v[c]);
         if (!all) continue;
         for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += r[s].v[c];
@@ -147,6 +156,12 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
         w.median = sr[ns / 2];
     }
     free(sr);
+    w.bias = NAN;
+    if (sb && nb) {
+        jf__select_kth(sb, nb, nb / 2);
+        w.bias = sb[nb / 2];
+    }
+    free(sb);
     if (w.used >= JF_CV_MINREC) {
         int b = 0;
         for (int c = 1; c < JF_AUTO_NCAND; c++)
@@ -159,11 +174,18 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
      * cubic would add (a vote, not the sums: a few wild points move them) */
     if (nsmall >= JF_CV_MINREC) w.cubic_min48 = 2 * cubic <= nsmall;
     if (w.cubic_min48) w.cap |= JF_AUTO_CUBIC_MIN48;
+    /* no cap, and the quadric's normal on the most points is as near the
+     * cubic's as the noise alone puts it at most of the sample: the noise,
+     * not the bias, bounds the fits, and the weighted trapezoid mean,
+     * which averages the neighbours' slopes and keeps their bias, is the
+     * better of step 6's two means on every row (the `exp` patch at 0.1%) */
+    if ((w.cap & ~JF_AUTO_FLAGS) == JF_NB_AUTO_KMAX && nb >= JF_CV_MINREC && w.bias <= JF_CV_NOBIAS)
+        w.cap |= JF_AUTO_WEIGHTED_MEAN;
     if (why) *why = w;
     return w.cap;
 }
 
 int jf__auto_cv_select(const jf_params *p, jf__cvrec *r, size_t n)
 {
-    return jf__auto_cv_decide(r, n, NULL) | (p->auto_select & JF_AUTO_CUBIC_MIN48);
+    return jf__auto_cv_decide(r, n, NULL) | (p->auto_select & JF_AUTO_FLAGS);
 }

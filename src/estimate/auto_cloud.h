@@ -25,8 +25,12 @@ typedef struct {
                         below the quadric's (each in its points' own
                         frame) at no more than half the sample: no cubic
                         on fewer than 48 points                          */
+    double bias;     /* median of the sample's JF_AUTO_CV_BIAS (about
+                        ln 2 where the noise alone parts the two normals) */
     int cap;         /* params.auto_select: the cap (JF_NB_AUTO_KMAX none),
-                        | JF_AUTO_CUBIC_MIN48 where cubic_min48          */
+                        | JF_AUTO_CUBIC_MIN48 where cubic_min48,
+                        | JF_AUTO_WEIGHTED_MEAN where no cap and bias is
+                        at most 1                                        */
 } jf__auto_cv_why;
 
 /* Whether an estimate with p and nb decides the cap itself (auto, the

@@ -880,7 +880,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     x.ix = ix;
     /* auto's step 6 (neigh_jets.h); a part's halo holds what it reads
      * (parts.c, jf__halo_requests) */
-    jf__njs njs = {NULL, NULL};
+    jf__njs njs = {NULL, NULL, 0};
     if (jf__nj_on(p, &nb) && need_index) {
         x.nj = &njs;
         if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
@@ -906,6 +906,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         use.params.auto_select = jf__auto_cv_select(p, cv, ncv);
         free(cv);
     }
+    njs.weighted = (use.params.auto_select & JF_AUTO_WEIGHTED_MEAN) != 0;
     if (cancelled(o)) {
         st = cancel_status(err);
         goto out;

@@ -885,7 +885,7 @@ static int auto_begin(jf_fitter *f, const jf_params *pr, const double p[3], cons
      * (step 0) finds the noise outweighs the smallest cubic's detail, on
      * fewer than 48 (the range scans' cubics at 32: item 8) */
     const int min48 = (pr->auto_select & JF_AUTO_CUBIC_MIN48) != 0;
-    const size_t cap = (size_t)(pr->auto_select & ~JF_AUTO_CUBIC_MIN48);
+    const size_t cap = (size_t)(pr->auto_select & ~JF_AUTO_FLAGS);
     for (int i = 0; i < nc; i++) {
         double hc = kn->auto_clean * cf[1][i].h;
         if (ks[i] < (min48 ? CUBIC_MINK_CV : CUBIC_MINK) && ks[i] < nmax && (min48 || !(s2 <= hc * hc)))
@@ -1027,6 +1027,15 @@ void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], con
         moments(p, nbr, g.ks[0], fk, g.H, 3, &mk);
         out[JF_AUTO_CV_SMALL] = loo2(&mk, g.H, g.hks[0], 6);
         out[JF_AUTO_CV_SMALL + 1] = loo2(&mk, g.H, g.hks[0], NMON);
+    }
+    const cand_fit *q2 = &g.cf[0][g.nc - 1], *q3 = &g.cf[1][g.nc - 1];
+    if (g.ks[g.nc - 1] == JF_NB_AUTO_KMAX && q2->ok && q3->ok && q3->tr > q2->tr) {
+        /* the quadric's slope bias on the most points against the noise
+         * (the cubic's slope is unbiased where the 4th-order terms are
+         * small, §3; the two differ by noise of variance tr3 - tr2) */
+        double d2 = 0.0;
+        for (int k = 0; k < 3; k++) d2 += (q3->nrm[k] - q2->nrm[k]) * (q3->nrm[k] - q2->nrm[k]);
+        out[JF_AUTO_CV_BIAS] = d2 / ((q3->tr - q2->tr) * q3->s2);
     }
     if (g.nmax > 16) {
         const double *q = nbr + 3 * 16;

@@ -61,6 +61,7 @@ jf_status jf__njs_alloc(jf__njs *s, size_t n)
 {
     s->v = malloc((n ? n : 1) * sizeof *s->v);
     s->state = calloc(n ? n : 1, 1);
+    s->weighted = 0;
     if (s->v && s->state) return JF_OK;
     jf__njs_free(s);
     return JF_ERR_NOMEM;
@@ -154,7 +155,7 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     const double sq = r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2]));
     /* a capped cloud (step 0) has detail at its small K, which the mean
      * shape operator would smooth: the plain carry there */
-    const int wide = sq > JF_NJ_MID && !(r->status & JF_PT_AUTO_CAPPED);
+    const int wide = (sq > JF_NJ_MID || s->weighted) && !(r->status & JF_PT_AUTO_CAPPED);
     double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
     double Ww[6] = {0, 0, 0, 0, 0, 0};
     for (size_t t = 0; t < mc; t++) {

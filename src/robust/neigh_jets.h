@@ -25,6 +25,8 @@ typedef struct {
 typedef struct {
     jf__njet *v;
     uint8_t *state; /* JF_NJ_*: read and written atomically */
+    int weighted;   /* JF_AUTO_WEIGHTED_MEAN: the weighted mean on every
+                       row not capped, whatever its noise                  */
 } jf__njs;
 
 enum { JF_NJ_EMPTY = 0, JF_NJ_BUSY = 1, JF_NJ_FIT = 2, JF_NJ_NONE = 3 };

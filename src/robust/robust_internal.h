@@ -109,10 +109,15 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
  * out[JF_AUTO_NCAND] step 2's sigma over the 16th neighbour's distance
  * (|nbr[16] - p|), and out[JF_AUTO_CV_SMALL], out[JF_AUTO_CV_SMALL + 1]
  * the quadric's and the cubic's on the smallest candidate, in the frame
- * of its own points; all NaN where steps 1-2 fail.  The decision from a
- * sample of these: auto_cloud.c. */
+ * of its own points, and out[JF_AUTO_CV_BIAS] the squared angle between
+ * the quadric's and the cubic's normals on the largest candidate (in step
+ * 1's frame) over the variance the noise alone gives it (sigma^2 times
+ * the cubic's angle variance less the quadric's: nested least squares);
+ * all NaN where steps 1-2 fail.  The decision from a sample of these:
+ * auto_cloud.c. */
 #define JF_AUTO_CV_SMALL (JF_AUTO_NCAND + 1)
-#define JF_AUTO_CV_N (JF_AUTO_CV_SMALL + 2)
+#define JF_AUTO_CV_BIAS (JF_AUTO_CV_SMALL + 2)
+#define JF_AUTO_CV_N (JF_AUTO_CV_BIAS + 1)
 void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, double out[JF_AUTO_CV_N]);
 

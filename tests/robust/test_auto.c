@@ -178,15 +178,16 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
  * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
  * q's, 2 where the weighted mean was taken.  A capped row (step 0):
  * round(K/4) nearest, never the weighted mean. */
-static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, double n[3],
-                 double k[2])
+static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, int weighted,
+                 double n[3], double k[2])
 {
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
     const int capped = (a->status & JF_PT_AUTO_CAPPED) != 0;
     double fc = nearbyint(a->n_used / (capped ? 4.0 : 8.0));
     size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
-    const int wide = a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID && !capped;
+    const int wide =
+        (weighted || a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID) && !capped;
     double W[9] = {0}, v[3] = {0}, sw = 0, Ww[9] = {0}, vw[3] = {0}, nw[3] = {0}, dw[3] = {0};
     for (size_t t = 0; t < mc; t++) {
         const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
@@ -276,7 +277,7 @@ static void is_the_jet(surf c, int sel)
         ck_assert_int_eq(jf_fitter_create(&p, &fit[d]), JF_OK);
     }
     double nb[3 * JF_NB_AUTO_KMAX];
-    size_t nd[4] = {0}, moved = 0, nwide = 0;
+    size_t nd[4] = {0}, moved = 0, nwide = 0, nmix = 0;
     for (size_t i = 0; i < c.s.n; i++) {
         const jf_result *a = &own[i];
         ck_assert(a->degree >= 1 && a->degree <= 3);
@@ -305,12 +306,13 @@ static void is_the_jet(surf c, int sel)
         nd[a->degree]++;
         /* step 6 */
         double n[3], kk[2];
-        int how = mixed(&c, own, nbi, i, n, kk);
+        int how = mixed(&c, own, nbi, i, (cap & JF_AUTO_WEIGHTED_MEAN) != 0, n, kk);
         if (!how) {
             ck_assert_int_eq(memcmp(&ra[i], a, sizeof *a), 0);
             continue;
         }
         nwide += how == 2;
+        nmix++;
         double dm = fabs(dot3(n, ra[i].normal)), ds = fabs(dot3(a->normal, ra[i].normal));
         ck_assert_msg(dm > 1.0 - 2e-8, "point %zu: step 6's normal off by %.3g rad", i, acos(dm));
         moved += ds < 1.0 - 1e-8;
@@ -326,9 +328,11 @@ static void is_the_jet(surf c, int sel)
     ck_assert_uint_gt(nd[3], 0);
     ck_assert_uint_gt(moved, c.s.n / 2); /* step 6 moved most normals */
     /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID;
-     * capped, the plain carry only */
-    if ((cap & ~JF_AUTO_CUBIC_MIN48) < JF_NB_AUTO_KMAX)
+     * capped, the plain carry only; JF_AUTO_WEIGHTED_MEAN, the weighted */
+    if ((cap & ~JF_AUTO_FLAGS) < JF_NB_AUTO_KMAX)
         ck_assert_uint_eq(nwide, 0);
+    else if (cap & JF_AUTO_WEIGHTED_MEAN)
+        ck_assert_uint_eq(nwide, nmix);
     else
         ck_assert_msg(nwide > c.s.n / 10 && nwide < c.s.n - c.s.n / 10,
                       "weighted mean at %zu of %zu", nwide, c.s.n);
@@ -348,11 +352,20 @@ START_TEST(test_auto_is_the_jet)
 }
 END_TEST
 
+/* The same with the weighted mean on every row (JF_AUTO_WEIGHTED_MEAN,
+ * given by hand: step 0 finds this torus biased) */
+START_TEST(test_auto_is_the_jet_weighted)
+{
+    is_the_jet(make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT),
+               JF_NB_AUTO_KMAX | JF_AUTO_WEIGHTED_MEAN);
+}
+END_TEST
+
 START_TEST(test_auto_is_the_jet_capped)
 {
     surf c = make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT);
     const int sel = cloud_cap(&c);
-    ck_assert_int_lt(sel & ~JF_AUTO_CUBIC_MIN48, JF_NB_AUTO_KMAX);
+    ck_assert_int_lt(sel & ~JF_AUTO_FLAGS, JF_NB_AUTO_KMAX);
     /* at 0.3% the cubic on 16 points follows the noise: cubics from 48 */
     ck_assert_int_ne(sel & JF_AUTO_CUBIC_MIN48, 0);
     is_the_jet(c, 1);
@@ -552,6 +565,40 @@ static double refit_at_p(const double *nb, size_t k, int nd)
     return b[0];
 }
 
+/* The quadric (nd 6) or cubic (10) on all k points of nb, p among them,
+ * in the world's frame: its normal n, the variance of n's angle per unit
+ * noise variance, ((M'M)^-1_11 + (M'M)^-1_22) / (1 + |grad|^2)^2 (as
+ * auto.c states it), and its residual sum of squares. */
+static void plain_fit(const double *nb, size_t k, int nd, double n[3], double *tr, double *rss)
+{
+    double A[100] = {0}, b[10] = {0}, m[10][10], a[10], c[2][10];
+    for (size_t i = 0; i < k; i++) {
+        const double x = nb[3 * i], y = nb[3 * i + 1];
+        const double v[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
+        for (int r = 0; r < nd; r++) {
+            for (int q = 0; q < nd; q++) A[r * nd + q] += v[r] * v[q];
+            b[r] += v[r] * nb[3 * i + 2];
+        }
+    }
+    for (int e = 0; e < 3; e++) {
+        memcpy(m, A, sizeof A);
+        double *x = e == 0 ? a : c[e - 1];
+        for (int r = 0; r < nd; r++) x[r] = e == 0 ? b[r] : r == e;
+        solve_n(&m[0][0], x, nd);
+    }
+    *rss = 0;
+    for (size_t i = 0; i < k; i++) {
+        const double x = nb[3 * i], y = nb[3 * i + 1];
+        const double v[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
+        double z = nb[3 * i + 2];
+        for (int r = 0; r < nd; r++) z -= a[r] * v[r];
+        *rss += z * z;
+    }
+    const double g2 = 1 + a[1] * a[1] + a[2] * a[2], l = sqrt(g2);
+    n[0] = -a[1] / l, n[1] = -a[2] / l, n[2] = 1 / l;
+    *tr = (c[0][1] + c[1][2]) / (g2 * g2);
+}
+
 /* Step 0's value at p is the quadric's leave-one-out residual: the height
  * at p of the least-squares quadric on the other K - 1 points, refitted
  * here in the same (world) frame, squared. */
@@ -600,6 +647,18 @@ START_TEST(test_auto_cv_loo)
                       ks[small ? 0 : c], at, out[at], want);
     }
     ck_assert_double_ne(out[JF_AUTO_CV_SMALL], out[JF_AUTO_CV_SMALL + 1]);
+    /* the bias statistic: the squared angle between the quadric's and the
+     * cubic's normals on all N points over (tr3 - tr2) sigma^2, sigma^2
+     * the cubic's residual variance -- refitted here (the x^3 term gives
+     * the quadric a slope bias of a few noise sd) */
+    double n2[3], n3[3], tr2, tr3, rss2, rss3;
+    plain_fit(nb, N, 6, n2, &tr2, &rss2);
+    plain_fit(nb, N, 10, n3, &tr3, &rss3);
+    const double dn[3] = {n3[0] - n2[0], n3[1] - n2[1], n3[2] - n2[2]};
+    const double zb = (dn[0] * dn[0] + dn[1] * dn[1] + dn[2] * dn[2]) / ((tr3 - tr2) * rss3 / (N - 10));
+    ck_assert_msg(fabs(out[JF_AUTO_CV_BIAS] - zb) <= 1e-8 * zb, "bias %.17g, refit %.17g",
+                  out[JF_AUTO_CV_BIAS], zb);
+    ck_assert_msg(zb > 4, "bias statistic %g: the x^3 term should show", zb);
     const double r16 = sqrt(d2[16]);
     ck_assert_msg(out[JF_AUTO_NCAND] > 0.005 / r16 && out[JF_AUTO_NCAND] < 0.02 / r16,
                   "sigma / r16 %g (noise 0.01, r16 %g)", out[JF_AUTO_NCAND], r16);
@@ -620,7 +679,9 @@ START_TEST(test_auto_cv_decide)
     jf__auto_cv_why w;
     for (int pick = 0; pick < JF_AUTO_NCAND; pick++)
         for (int thick = 0; thick < 2; thick++)
-            for (int noisy = 0; noisy < 2; noisy++) {
+            for (int noisy = 0; noisy < 4; noisy++) {
+                /* noisy & 2: the bias statistic's median just above 1 */
+                const int biased = noisy >> 1;
                 for (int s = 0; s < M; s++) {
                     r[s].gid = (uint32_t)(7 * s % M) * 3u;
                     for (int c = 0; c < JF_AUTO_NCAND; c++)
@@ -630,22 +691,33 @@ START_TEST(test_auto_cv_decide)
                      * clean, one more), its sum below the quadric's
                      * either way */
                     r[s].v[JF_AUTO_CV_SMALL] = 1.0;
-                    r[s].v[JF_AUTO_CV_SMALL + 1] = 2 * s < M + (noisy ? 0 : 2) ? 0.01 : 1.01;
+                    r[s].v[JF_AUTO_CV_SMALL + 1] = 2 * s < M + (noisy & 1 ? 0 : 2) ? 0.01 : 1.01;
+                    /* its sum below M either way: the median decides */
+                    r[s].v[JF_AUTO_CV_BIAS] = 2 * s < M + (biased ? -2 : 2) ? 0.1 : 1.001;
                 }
                 memcpy(q, r, sizeof r);
                 int cap = jf__auto_cv_decide(r, M, &w);
                 static const int ks[JF_AUTO_NCAND] = {16, 24, 32, 48, 64, 96, 128, 160, 200, 256};
                 ck_assert_int_eq(w.pick, ks[pick]);
                 ck_assert_uint_eq(w.used, M);
-                ck_assert_int_eq(w.cubic_min48, noisy);
-                ck_assert_int_eq(cap, (!thick && ks[pick] <= 64 ? ks[pick + 1] : JF_NB_AUTO_KMAX) |
-                                          (noisy ? JF_AUTO_CUBIC_MIN48 : 0));
+                ck_assert_int_eq(w.cubic_min48, noisy & 1);
+                ck_assert_double_eq(w.bias, biased ? 1.001 : 0.1);
+                const int capped = !thick && ks[pick] <= 64;
+                /* no cap and no bias the noise does not explain: the
+                 * weighted mean everywhere */
+                ck_assert_int_eq(cap, (capped ? ks[pick + 1] : JF_NB_AUTO_KMAX) |
+                                          (noisy & 1 ? JF_AUTO_CUBIC_MIN48 : 0) |
+                                          (!capped && !biased ? JF_AUTO_WEIGHTED_MEAN : 0));
                 for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
                 ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
             }
-    /* a record without the small fits still counts for the cap */
+    /* a record without the small fits still counts for the cap; without
+     * the bias statistic, it does not count for the weighted mean (too
+     * few left: none) */
     for (int s = 0; s < M; s++) r[s].v[JF_AUTO_CV_SMALL + (s & 1)] = NAN;
+    for (int s = 0; s < M; s++) r[s].v[JF_AUTO_CV_BIAS] = s < 31 ? 0.1 : NAN;
     ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
+    ck_assert_double_eq(w.bias, 0.1);
     ck_assert_int_eq(w.cubic_min48, 0);
     ck_assert_uint_eq(w.used, M);
     for (int s = 0; s < M; s++) r[s].v[3] = NAN; /* no usable record: no cap */
@@ -688,6 +760,55 @@ START_TEST(test_auto_cap)
 }
 END_TEST
 
+/* Step 0's bias statistic on noise alone: on a noisy plane no slope is
+ * biased, the squared angle between the quadric's and the cubic's normals
+ * over its variance is about chi^2_2 / 2 (median ln 2): the cloud reads
+ * as noise-bound, and the rows of step 0's decision are those of the
+ * same flags given by hand, the whole cloud's bytes in parts too, and not
+ * those without the weighted mean.  A curved noisy ellipsoid reads far
+ * above 1: no flag. */
+START_TEST(test_auto_cv_bias)
+{
+    surf c = make(JF_SURF_ELLIPSOID, 4000, 0.0, JF_DENSITY_UNIFORM);
+    jf_rng rng;
+    jf_rng_seed(&rng, 9);
+    for (size_t i = 0; i < c.s.n; i++) {
+        c.s.xyz[3 * i] = jf_rng_uniform(&rng), c.s.xyz[3 * i + 1] = jf_rng_uniform(&rng);
+        c.s.xyz[3 * i + 2] = 0.003 * jf_rng_gauss(&rng);
+    }
+    jf_params p;
+    jf_params_init(&p);
+    p.auto_select = 1;
+    p.max_neighbors = JF_NB_AUTO_KMAX;
+    jf__cvrec *r;
+    size_t nr;
+    jf__auto_cv_why w;
+    ck_assert_int_eq(jf__auto_cv_sample(c.s.xyz, c.s.n, NULL, NULL, c.s.n, NULL, &p, 2, &r, &nr), JF_OK);
+    const int sel = jf__auto_cv_decide(r, nr, &w);
+    free(r);
+    ck_assert_msg(w.bias > 0.5 && w.bias < 0.9, "plane: median %g (ln 2 = 0.693)", w.bias);
+    ck_assert_int_eq(sel & ~JF_AUTO_FLAGS, JF_NB_AUTO_KMAX);
+    ck_assert_int_ne(sel & JF_AUTO_WEIGHTED_MEAN, 0);
+    jf_result *ra = run(&c, "auto", 2), *rh = run_sel(&c, "auto", 1, sel),
+              *rn = run_sel(&c, "auto", 1, sel & ~JF_AUTO_WEIGHTED_MEAN);
+    ck_assert_int_eq(memcmp(ra, rh, c.s.n * sizeof *ra), 0);
+    size_t differ = 0;
+    for (size_t i = 0; i < c.s.n; i++) differ += memcmp(ra[i].normal, rn[i].normal, sizeof ra[i].normal) != 0;
+    ck_assert_uint_gt(differ, c.s.n / 2);
+    free(ra);
+    free(rh);
+    free(rn);
+    c.s.xyz[3 * 17] = NAN;
+    same_in_parts(&c); /* frees c */
+    surf e = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
+    ck_assert_int_eq(jf__auto_cv_sample(e.s.xyz, e.s.n, NULL, NULL, e.s.n, NULL, &p, 2, &r, &nr), JF_OK);
+    ck_assert_int_eq(jf__auto_cv_decide(r, nr, &w) & JF_AUTO_WEIGHTED_MEAN, 0);
+    ck_assert_msg(w.bias > 4, "ellipsoid: median %g", w.bias);
+    free(r);
+    jf_sample_free(&e.s);
+}
+END_TEST
+
 START_TEST(test_auto_spec)
 {
     jf_nb_spec s;
@@ -726,7 +847,9 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_torus_gradient);
     tcase_add_test(tc, test_auto_threads);
     tcase_add_test(tc, test_auto_is_the_jet);
+    tcase_add_test(tc, test_auto_is_the_jet_weighted);
     tcase_add_test(tc, test_auto_is_the_jet_capped);
+    tcase_add_test(tc, test_auto_cv_bias);
     tcase_add_test(tc, test_auto_sphere);
     tcase_add_test(tc, test_auto_select_knn);
     tcase_add_test(tc, test_auto_parts);
