@@ -115,11 +115,18 @@ enum {
     JF_PT_AUTO = 1u << 17,         /* neighbourhood auto: K (n_used) and
                                       degree were chosen per point
                                       (params.auto_select)              */
-    JF_PT_AUTO_CAPPED = 1u << 18   /* auto: K at most params.auto_select
+    JF_PT_AUTO_CAPPED = 1u << 18,  /* auto: K at most params.auto_select
                                       (jf_estimate: the cloud's cross-
                                       validation, docs/robustness.md
                                       step 0), below the largest
                                       candidate the list held           */
+    JF_PT_AUTO_WEIGHTED = 1u << 19 /* auto, jf_estimate: the normal is
+                                      the neighbours' fits' weighted
+                                      trapezoid mean over K/8 of them
+                                      (the noise large against the fit's
+                                      spread, or the cloud's fits bound
+                                      by the noise: step 6), not their
+                                      plain carry (K/2; K/4 if capped)  */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf

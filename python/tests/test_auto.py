@@ -36,3 +36,17 @@ def test_auto_capped_clean_only():
     noisy = jetfit.estimate(fib_sphere(3000) + rng.normal(0, 0.02, (3000, 3)), neighbors="auto")
     assert not np.any(noisy.status & cap)
     assert np.median(noisy.neighbors) > 96
+
+
+def test_auto_weighted_where_noise_bound():
+    """step 0's bias test: on a noisy plane no fit is biased, every row
+    takes step 6's weighted mean (flag auto_weighted); on a clean sphere
+    (capped) none does"""
+    w = jetfit.STATUS["auto_weighted"]
+    rng = np.random.default_rng(9)
+    p = np.column_stack([rng.random(4000), rng.random(4000), rng.normal(0, 0.003, 4000)])
+    plane = jetfit.estimate(p, neighbors="auto", threads=2)
+    assert np.all(plane.status & w)
+    assert not np.any(plane.status & jetfit.STATUS["auto_capped"])
+    clean = jetfit.estimate(fib_sphere(3000), neighbors="auto")
+    assert not np.any(clean.status & w)

@@ -28,7 +28,7 @@ static const char *const flag_names[] = {
     "failed", "nonfinite", "few_neighbors", "normal_poles",
     "normal_mincirc", "normal_fallback", "robust_noconv", "orient_unknown",
     "normal_input", "scale_selected", "mesh_nonmanifold", "normal_jet",
-    "normal_pca", "auto", "auto_capped",
+    "normal_pca", "auto", "auto_capped", "auto_weighted",
 };
 
 char *jf_point_status_str(unsigned status, char *buf, size_t len)

@@ -67,7 +67,7 @@ jf_status jf__part_query_init(const jf_estimate_opts *o, jf_part_query *q)
     if (q->cap > p->max_neighbors) return JF_ERR_INVALID;
     if (q->nb.kind != JF_NB_KNN && !(q->nb.r >= 0 && isfinite(q->nb.r))) return JF_ERR_INVALID;
     if (q->nb.kind != JF_NB_RADIUS && !q->nb.k) return JF_ERR_INVALID;
-    q->nj = jf__nj_on(p, &q->nb) ? JF_NJ_HEAD : 0;
+    q->nj = jf__nj_on(p, &q->nb) ? jf__nj_reach(p) : 0;
     return JF_OK;
 }
 

@@ -53,6 +53,7 @@
 #include "fitter_internal.h"
 #include "index_internal.h"
 #include "jetfit.h"
+#include "neigh_jets.h" /* jf__nj_reach */
 #include "parts.h"
 #include "parts_run.h"
 #include "set_err.h"
@@ -495,7 +496,12 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
             mask = NULL;
             if (st != JF_OK) goto out;
         }
-        if (sweep == 0 && st == JF_OK) po.params.auto_select = jf__auto_cv_select(&o->params, cvr, ncv);
+        if (sweep == 0 && st == JF_OK) {
+            po.params.auto_select = jf__auto_cv_select(&o->params, cvr, ncv);
+            /* step 6's ball from the decision: 32 nearest where every mean
+             * is weighted, up to JF_NJ_REACH otherwise */
+            if (q.nj) q.nj = jf__nj_reach(&po.params);
+        }
     }
     if (st == JF_OK && o->progress) o->progress(o->progress_user, n, n);
 out:

@@ -109,7 +109,9 @@ typedef struct {
     size_t hint_n;        /* coords[k]) and their count, for knn_hinted  */
     uint32_t *pos;        /* auto's step 6: the query's tree positions   */
     uint32_t *head;       /* and each unit point's nearest (positions)   */
-    uint8_t *headn;       /* (JF_NJ_HEAD a point) and their count        */
+    uint8_t *headn;       /* (JF_NJ_HEAD a point, those step 6 reads) and
+                             their count                                 */
+    uint32_t *lpos;       /* a lane's nearest positions until its fit    */
     uint32_t *bpos;       /* the unit's rows' tree positions             */
     jf_result *pblk;      /* rows held back to the thread's next unit    */
     uint32_t *pidx, *phead; /* (a record they read not yet fitted), as    */
@@ -139,6 +141,7 @@ static void worker_free(worker *w)
     free(w->pos);
     free(w->head);
     free(w->headn);
+    free(w->lpos);
     free(w->bpos);
     free(w->pblk);
     free(w->pidx);
@@ -182,6 +185,7 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
     if (st == JF_OK && x->nj) {
         w->pos = malloc(x->cap * sizeof *w->pos);
         w->head = malloc(unit * JF_NJ_HEAD * sizeof *w->head);
+        w->lpos = malloc(LANES * JF_NJ_REACH * sizeof *w->lpos);
         w->headn = malloc(unit);
         w->bpos = malloc(unit * sizeof *w->bpos);
         w->pcap = unit; /* rows wait for the units around theirs */
@@ -196,13 +200,13 @@ static jf_status worker_init(worker *w, const jf_params *p, const nbctx *x, int 
         w->oidx = malloc(x->cap * sizeof *w->oidx);
         w->od2 = malloc(x->cap * sizeof *w->od2);
         w->oxyz = malloc(3 * x->cap * sizeof *w->oxyz);
-        if (!w->pos || !w->head || !w->headn || !w->bpos || !w->pblk || !w->pidx || !w->phead ||
+        if (!w->pos || !w->head || !w->lpos || !w->headn || !w->bpos || !w->pblk || !w->pidx || !w->phead ||
             !w->pxyz || !w->pheadn || !w->rdy || !w->dec || !w->decok || !w->oidx ||
             !w->od2 || !w->oxyz)
             st = JF_ERR_NOMEM;
     }
     if (st == JF_OK && jf__nj_on(p, x->nb)) /* auto's search, shared along the walk */
-        st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, JF_NJ_HEAD, &w->share);
+        st = jf__knn_share_create(x->nb->k < x->cap ? x->nb->k : x->cap, x->nj->reach, &w->share);
     if (st != JF_OK) worker_free(w);
     return st;
 }
@@ -517,7 +521,7 @@ static jf_status auto_lanes(worker *w, const nbctx *x, int L, const size_t i[], 
                             const size_t kq[], const size_t left[])
 {
     jf_result r[LANES];
-    size_t n[LANES] = {0};
+    size_t n[LANES] = {0}, ln[LANES] = {0};
     unsigned fl[LANES] = {0};
     int fit[LANES] = {0}, nf = 0;
     const double *pf[LANES], *cf[LANES];
@@ -528,10 +532,10 @@ static jf_status auto_lanes(worker *w, const nbctx *x, int L, const size_t i[], 
         w->hint_n = 0;
         jf_status st = prepare(w, x, i[k], p[k], w->coords[k], &r[k], &n[k], &fl[k], &fit[k]);
         if (st != JF_OK) return st;
-        /* prepare's query left the neighbourhood in w->pos */
-        const size_t h = w->hint_n < JF_NJ_HEAD ? w->hint_n : JF_NJ_HEAD;
-        memcpy(w->head + kq[k] * JF_NJ_HEAD, w->pos, h * sizeof *w->head);
-        w->headn[kq[k]] = (uint8_t)h;
+        /* prepare's query left the neighbourhood in w->pos: which of it
+         * step 6 reads depends on the fit (jf__nj_head) */
+        ln[k] = w->hint_n < x->nj->reach ? w->hint_n : x->nj->reach;
+        memcpy(w->lpos + k * JF_NJ_REACH, w->pos, ln[k] * sizeof *w->lpos);
         if (fit[k]) pf[nf] = p[k], cf[nf] = w->coords[k], nff[nf] = n[k], of[nf++] = &r[k];
     }
     const jf_params *pr = jf_fitter_params(w->fit[0]);
@@ -539,6 +543,10 @@ static jf_status auto_lanes(worker *w, const nbctx *x, int L, const size_t i[], 
     if (st != JF_OK) return st;
     for (int k = 0; k < L; k++) {
         if (fit[k]) r[k].status |= fl[k];
+        size_t step, c = jf__nj_head(&r[k], jf__nj_weighted(x->nj, &r[k]), &step), h = 0;
+        uint32_t *hd = w->head + kq[k] * JF_NJ_HEAD;
+        for (size_t t = 0; h < c && t < ln[k]; t += step) hd[h++] = w->lpos[k * JF_NJ_REACH + t];
+        w->headn[kq[k]] = (uint8_t)h;
         store_row(&w->blk[kq[k]], &r[k]);
     }
     return JF_OK;
@@ -566,9 +574,9 @@ static jf_status nj_fit_other(worker *w, const nbctx *x, uint32_t j)
  * headn, bxyz) or those held back (pblk, ...). */
 typedef struct {
     jf_result *blk;
-    uint32_t *idx, *head; /* inputs; nearest positions, JF_NJ_HEAD a row */
+    uint32_t *idx, *head; /* inputs; the positions step 6 reads, JF_NJ_HEAD a row */
     double *xyz;
-    uint8_t *headn;       /* nearest kept */
+    uint8_t *headn;       /* how many */
 } njrows;
 
 static void nj_move(const njrows *a, size_t k, const njrows *b, size_t t)
@@ -581,18 +589,11 @@ static void nj_move(const njrows *a, size_t k, const njrows *b, size_t t)
     b->headn[t] = a->headn[k];
 }
 
-/* How many of row r's nearest (h of them kept) step 6 reads. */
-static size_t nj_count(const jf_result *r, size_t h)
-{
-    size_t m = jf__nj_head(r);
-    return m < h ? m : h;
-}
-
 /* Whether every record row k reads is fitted. */
 static int nj_ready(const nbctx *x, const njrows *r, size_t k)
 {
     const uint32_t *hd = r->head + k * JF_NJ_HEAD;
-    const size_t h = nj_count(&r->blk[k], r->headn[k]);
+    const size_t h = r->headn[k];
     for (size_t t = 0; t < h; t++)
         if (jf__nj_state(x->nj, hd[t]) == JF_NJ_EMPTY) return 0;
     return 1;
@@ -610,7 +611,7 @@ static jf_status nj_finish(const runctx *R, worker *w, const jf__nj_cache *c, co
     jf_status st = JF_OK;
     for (size_t k = 0; k < m && st == JF_OK; k++) {
         const uint32_t *hd = r->head + k * JF_NJ_HEAD;
-        const size_t h = nj_count(&blk[k], r->headn[k]);
+        const size_t h = r->headn[k];
         for (size_t t = 0; t < h && st == JF_OK; t++)
             if (jf__nj_state(x->nj, hd[t]) == JF_NJ_EMPTY) st = nj_fit_other(w, x, hd[t]);
         if (st == JF_OK) jf__nj_mix(x->nj, c, x->pts, bxyz + 3 * k, hd, h, &blk[k]);
@@ -880,7 +881,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     x.ix = ix;
     /* auto's step 6 (neigh_jets.h); a part's halo holds what it reads
      * (parts.c, jf__halo_requests) */
-    jf__njs njs = {NULL, NULL, 0};
+    jf__njs njs = {NULL, NULL, 0, JF_NJ_REACH};
     if (jf__nj_on(p, &nb) && need_index) {
         x.nj = &njs;
         if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
@@ -907,6 +908,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         free(cv);
     }
     njs.weighted = (use.params.auto_select & JF_AUTO_WEIGHTED_MEAN) != 0;
+    njs.reach = jf__nj_reach(&use.params);
     if (cancelled(o)) {
         st = cancel_status(err);
         goto out;

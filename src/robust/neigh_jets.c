@@ -20,12 +20,42 @@
 
 #include "neigh_jets.h"
 
-size_t jf__nj_head(const jf_result *r)
+int jf__nj_weighted(const jf__njs *s, const jf_result *r)
+{
+    /* a capped cloud (step 0) has detail at its small K, which the mean
+     * shape operator would smooth: the plain carry there */
+    if (r->status & JF_PT_AUTO_CAPPED) return 0;
+    return s->weighted || r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2])) > JF_NJ_MID;
+}
+
+size_t jf__nj_head(const jf_result *r, int weighted, size_t *step)
 {
     /* half to even, as the offline study; a capped K leaves more noise
-     * for the mean to take (step 0) */
-    double m = nearbyint(r->n_used / ((r->status & JF_PT_AUTO_CAPPED) ? 4.0 : 8.0));
+     * for the mean to take (step 0).  A quadric fitted on a disk of radius
+     * R to the cubic term b x^3 / 6 is off in slope by b R^2 / 12 at its
+     * centre, carried to d from it by b (R^2 / 12 - d^2 / 2) along d:
+     * over the nearest m of its K points (E d^2 = m R^2 / 2K, half of it
+     * along x) the mean error is b R^2 (1/12 - m / 8K), a quarter of the
+     * centre's at m = K/2 (nil at 2K/3, where the curvatures' noise has
+     * grown: measured within 3%).  The spread cancels it, not the count:
+     * every 4th of the K/2 nearest keeps most of the gain at the cost of
+     * K/8 (docs/robustness.md, step 6) */
+    const int capped = (r->status & JF_PT_AUTO_CAPPED) != 0;
+    const double f = capped ? 4.0 : weighted ? 8.0 : 2.0;
+    *step = capped || weighted ? 1 : JF_NJ_STEP;
+    double m = nearbyint(r->n_used / f);
+    m = ceil(m / (double)*step); /* the point itself and every step-th after */
     return m < 1 ? 1 : m > JF_NJ_HEAD ? JF_NJ_HEAD : (size_t)m;
+}
+
+size_t jf__nj_reach(const jf_params *p)
+{
+    int cap = p->auto_select & ~JF_AUTO_FLAGS;
+    if (cap <= 1 || cap > JF_NB_AUTO_KMAX) cap = JF_NB_AUTO_KMAX;
+    /* jf__nj_head's divisors: capped rows K/4, weighted K/8, plain K/2 */
+    const double f = (p->auto_select & JF_AUTO_WEIGHTED_MEAN) ? (cap < JF_NB_AUTO_KMAX ? 4.0 : 8.0) : 2.0;
+    const size_t m = (size_t)ceil(cap / f);
+    return m < 1 ? 1 : m > JF_NJ_REACH ? JF_NJ_REACH : m;
 }
 
 
@@ -62,6 +92,7 @@ jf_status jf__njs_alloc(jf__njs *s, size_t n)
     s->v = malloc((n ? n : 1) * sizeof *s->v);
     s->state = calloc(n ? n : 1, 1);
     s->weighted = 0;
+    s->reach = JF_NJ_REACH;
     if (s->v && s->state) return JF_OK;
     jf__njs_free(s);
     return JF_ERR_NOMEM;
@@ -147,15 +178,12 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     if (r->degree < 2 || (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) || !isfinite(r->k1) ||
         !isfinite(r->k2))
         return;
-    size_t mc = jf__nj_head(r);
+    const int wide = jf__nj_weighted(s, r);
+    size_t step, mc = jf__nj_head(r, wide, &step);
     if (mc > m) mc = m;
     double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
     size_t cc = 0;
-    /* the weighted sums (JF_NJ_MID): carried normals, normals, q - j, W */
-    const double sq = r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2]));
-    /* a capped cloud (step 0) has detail at its small K, which the mean
-     * shape operator would smooth: the plain carry there */
-    const int wide = (sq > JF_NJ_MID || s->weighted) && !(r->status & JF_PT_AUTO_CAPPED);
+    /* the weighted sums: carried normals, normals, q - j, W */
     double sw = 0, iw[3] = {0, 0, 0}, nw[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
     double Ww[6] = {0, 0, 0, 0, 0, 0};
     for (size_t t = 0; t < mc; t++) {
@@ -224,6 +252,7 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     const double h = sqrt((p[0] - pf[0]) * (p[0] - pf[0]) + (p[1] - pf[1]) * (p[1] - pf[1]) +
                           (p[2] - pf[2]) * (p[2] - pf[2]));
     const double big = fmax(fmax(fabs(r->k1), fabs(r->k2)), h > 0 ? 1.0 / h : 0.0);
-    r->status &= ~(unsigned)JF_PT_UMBILIC;
+    r->status &= ~(unsigned)(JF_PT_UMBILIC | JF_PT_AUTO_WEIGHTED);
+    if (wide && sw > 0 && isfinite(sw)) r->status |= JF_PT_AUTO_WEIGHTED;
     if (2.0 * rad <= 1e-10 * big) r->status |= JF_PT_UMBILIC;
 }

@@ -27,6 +27,8 @@ typedef struct {
     uint8_t *state; /* JF_NJ_*: read and written atomically */
     int weighted;   /* JF_AUTO_WEIGHTED_MEAN: the weighted mean on every
                        row not capped, whatever its noise                  */
+    size_t reach;   /* the farthest of a point's nearest a row reads
+                       (jf__nj_reach)                                      */
 } jf__njs;
 
 enum { JF_NJ_EMPTY = 0, JF_NJ_BUSY = 1, JF_NJ_FIT = 2, JF_NJ_NONE = 3 };
@@ -40,8 +42,18 @@ void jf__njs_free(jf__njs *s);
  * (jf__nj_mix; docs/robustness.md, step 6) */
 #define JF_NJ_MID 0.03
 
-/* The most nearest points a row reads (f = 1/8 of K <= 256). */
+/* The most records a row reads (K/8 of K <= 256, or every JF_NJ_STEP-th
+ * of the nearest K/2), and the farthest of its nearest among them. */
 #define JF_NJ_HEAD 32
+#define JF_NJ_STEP 4
+#define JF_NJ_REACH (JF_NJ_HEAD * JF_NJ_STEP)
+
+/* The farthest of its nearest points a row of an estimate with p reads
+ * (1-based): 32 where every row's mean is weighted
+ * (JF_AUTO_WEIGHTED_MEAN), up to JF_NJ_REACH where a row may take the
+ * plain carry, less under a cap (params.auto_select 1, not yet decided:
+ * JF_NJ_REACH). */
+size_t jf__nj_reach(const jf_params *p);
 
 /* Whether an estimate runs step 6: auto on a k-NN of at least
  * JF_NJ_KMIN (JF_NB_AUTO's knn:JF_NB_AUTO_KMAX), whose shared search
@@ -57,10 +69,19 @@ static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
 #endif
 }
 
-/* How many of a point's nearest its row r reads: the normal and the
- * curvatures from round(K / 8), K / 4 where K was capped (step 0); at
- * least 1, at most JF_NJ_HEAD. */
-size_t jf__nj_head(const jf_result *r);
+/* Whether row r takes the weighted trapezoid mean: not capped, and its
+ * noise large against its fit's spread (JF_NJ_MID) or the cloud's fits
+ * bound by the noise (s->weighted). */
+int jf__nj_weighted(const jf__njs *s, const jf_result *r);
+
+/* Which of a point's nearest its row r reads, the normal and the
+ * curvatures from: the nearest round(K / 4) where K was capped (step 0),
+ * round(K / 8) where the mean is weighted, every JF_NJ_STEP-th of the
+ * nearest round(K / 2) for the plain carry (bias-bound fits: a mean over
+ * that spread cancels most of the quadric's slope bias).  Returns how
+ * many (at least 1, at most JF_NJ_HEAD), *step the stride (1 or
+ * JF_NJ_STEP) from the point itself. */
+size_t jf__nj_head(const jf_result *r, int weighted, size_t *step);
 
 /* The state of point i's record (JF_NJ_*). */
 int jf__nj_state(const jf__njs *s, size_t i);
@@ -84,8 +105,8 @@ typedef struct {
     size_t beg, n;
 } jf__nj_cache;
 
-/* Row r of point q (at p) from the records of its nearest head[0..m-1]
- * (q's own among them; none JF_NJ_EMPTY), through the cache c where it
+/* Row r of point q (at p) from the records head[0..m-1] of its nearest
+ * that jf__nj_head names (q's own first; none JF_NJ_EMPTY), through the cache c where it
  * holds them (may be NULL), at coordinates xyz (3 per record): the
  * normal the mean of each neighbour's normal carried to p by its shape
  * operator (where the noise is small against the fit's spread; above

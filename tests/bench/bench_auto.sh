@@ -4,10 +4,13 @@
 #
 #   sh tests/bench/bench_auto.sh [BUILD] [N] [ROUNDS]
 #   EXTRA="knn:256 knn:512" sh tests/bench/bench_auto.sh ...
+#   SURF=ellipsoid NOISE=0.001 sh tests/bench/bench_auto.sh ...
 #
 # BUILD (default: build) holds the jetfit command; N (default 100000) is
 # the point count of a `jetfit generate torus --density gradient --noise
-# 0.003` cloud (binary PLY); ROUNDS (default 5) rounds each run knn:32 then
+# 0.003` cloud (binary PLY; SURF and NOISE: another surface of `jetfit
+# generate`, uniform, or noise; step 6 reads 32 records a row on the torus,
+# up to 128 where the cloud's fits are bias-bound); ROUNDS (default 5) rounds each run knn:32 then
 # auto, one thread, binary PLY out.  The machine may be shared: each
 # setting's time is its least CPU time (user + system) over the rounds,
 # the two alternating so that both see the same load.  Prints per setting
@@ -28,8 +31,11 @@ PY=/usr/bin/python3
 W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT INT TERM
 
-"$J" generate torus -o "$W/in.ply" --n "$N" --noise 0.003 --density gradient --seed 27 >/dev/null
-echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); $N points, $R rounds, 1 thread"
+S=${SURF:-torus}
+D=uniform
+[ "$S" = torus ] && D=gradient
+"$J" generate "$S" -o "$W/in.ply" --n "$N" --noise "${NOISE:-0.003}" --density "$D" --seed 27 >/dev/null
+echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); $S, noise ${NOISE:-0.003}, $D; $N points, $R rounds, 1 thread"
 
 one() { # one NB -> "cpu_seconds peak_kb" (the child's rusage, to the microsecond:
     # GNU time prints 10 ms steps, 4% of knn:32 at 10^5)

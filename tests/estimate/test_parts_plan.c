@@ -102,7 +102,7 @@ START_TEST(plan_is_monotone)
     jf_plan_nb au, rec;
     jf__plan_nb(&o, &au);
     ck_assert_uint_eq(au.fit_pt, JF_PLAN_NJ_PT);
-    ck_assert(fabs(au.ball - pow(16 + 2 * sqrt(32), 2)) < 1e-9); /* r_256 + 2 r_32 */
+    ck_assert(fabs(au.ball - pow(16 + 2 * sqrt(128), 2)) < 1e-9); /* r_256 + 2 r_128 */
     rec = au;
     rec.ball = 0; /* the records alone */
     size_t whole6 = 0, least6 = 0, leastr = 0;

@@ -170,7 +170,9 @@ static jf_result *own_fits(const surf *c, size_t k, uint32_t **nbi, int sel)
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Step 6 as docs/robustness.md states it, in double precision from the
- * own fits, over q's round(K/8) <= 32 nearest j: the normal the mean of
+ * own fits, over q's round(K/8) <= 32 nearest j where the mean is
+ * weighted, q and every 4th after it among its round(K/2) nearest for
+ * the plain carry: the normal the mean of
  * n_j - W_j (q - j), W_j = k1 d1 d1' + k2 d2 d2' (signs on q's side) --
  * where q's sigma / sqrt(2 (l1 + l2)) exceeds JF_NJ_MID, the mean of that
  * and n_j - W (q - j), W the mean W_j, all means weighted by K_j (l1 +
@@ -184,14 +186,18 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
     const int capped = (a->status & JF_PT_AUTO_CAPPED) != 0;
-    double fc = nearbyint(a->n_used / (capped ? 4.0 : 8.0));
-    size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
     const int wide =
         (weighted || a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID) && !capped;
+    /* capped: the K/4 nearest; weighted: the K/8 nearest; else q and
+     * every 4th after it among the K/2 nearest */
+    double fc = nearbyint(a->n_used / (capped ? 4.0 : wide ? 8.0 : 2.0));
+    const size_t step = capped || wide ? 1 : 4;
+    fc = ceil(fc / (double)step);
+    size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
     double W[9] = {0}, v[3] = {0}, sw = 0, Ww[9] = {0}, vw[3] = {0}, nw[3] = {0}, dw[3] = {0};
     for (size_t t = 0; t < mc; t++) {
-        const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t]];
-        const double *pj = c->s.xyz + 3 * (size_t)idx[q * JF_NB_AUTO_KMAX + t];
+        const jf_result *b = &own[idx[q * JF_NB_AUTO_KMAX + t * step]];
+        const double *pj = c->s.xyz + 3 * (size_t)idx[q * JF_NB_AUTO_KMAX + t * step];
         if (b->degree < 2) continue;
         double sg = dot3(b->normal, a->normal) < 0 ? -1 : 1, Wj[9];
         for (int r = 0; r < 3; r++)
@@ -234,7 +240,7 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
             m22 += t2[r] * W[3 * r + s2] * t2[s2];
         }
     double cnt = 0;
-    for (size_t t = 0; t < mc; t++) cnt += own[idx[q * JF_NB_AUTO_KMAX + t]].degree >= 2;
+    for (size_t t = 0; t < mc; t++) cnt += own[idx[q * JF_NB_AUTO_KMAX + t * step]].degree >= 2;
     double mid = (m11 + m22) / 2, rad = hypot((m11 - m22) / 2, m12);
     k[0] = (mid + rad) / cnt, k[1] = (mid - rad) / cnt;
     return wide ? 2 : 1;
