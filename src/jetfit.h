@@ -202,8 +202,15 @@ typedef struct {
  * the quadric's normal on 256 points is as near the cubic's as the noise
  * alone would put it: docs/robustness.md, step 0) */
 #define JF_AUTO_WEIGHTED_MEAN 2048
-/* both flags */
-#define JF_AUTO_FLAGS (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN)
+/* OR'd into params.auto_select (with 1 or a cap): step 6's plain carry
+ * reads the point and every 4th of its K/2 nearest, not its K/8 nearest,
+ * which averages out the slope bias a cubic term leaves in the quadric
+ * (jf_estimate sets it where no row is capped and the quadric's normal on
+ * 256 points is off the cubic's by a little more than the noise explains,
+ * the sample's median statistic in (1, 4]: docs/robustness.md, step 0) */
+#define JF_AUTO_SPREAD_CARRY 4096
+/* the three flags */
+#define JF_AUTO_FLAGS (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY)
 
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);

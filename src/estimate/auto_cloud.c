@@ -48,6 +48,7 @@
 #define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
 #define JF_CV_NOBIAS 1.0   /* median bias statistic at most: noise-bound   */
+#define JF_CV_MILDBIAS 4.0 /* at most: a cubic term's bias, spread carry   */
 
 size_t jf__auto_cv_stride(size_t ntotal)
 {
@@ -179,8 +180,14 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
      * not the bias, bounds the fits, and the weighted trapezoid mean,
      * which averages the neighbours' slopes and keeps their bias, is the
      * better of step 6's two means on every row (the `exp` patch at 0.1%) */
-    if ((w.cap & ~JF_AUTO_FLAGS) == JF_NB_AUTO_KMAX && nb >= JF_CV_MINREC && w.bias <= JF_CV_NOBIAS)
-        w.cap |= JF_AUTO_WEIGHTED_MEAN;
+    if ((w.cap & ~JF_AUTO_FLAGS) == JF_NB_AUTO_KMAX && nb >= JF_CV_MINREC)
+        w.cap |= w.bias <= JF_CV_NOBIAS ? JF_AUTO_WEIGHTED_MEAN
+                 /* a mild bias, a cubic term's: the plain carry over a
+                  * spread that averages it out (neigh_jets.c); a larger
+                  * one is detail or thin parts the spread would cross
+                  * (the uncapped range scan ear_back reads 45) */
+                 : w.bias <= JF_CV_MILDBIAS ? JF_AUTO_SPREAD_CARRY
+                                            : 0;
     if (why) *why = w;
     return w.cap;
 }

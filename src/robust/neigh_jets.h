@@ -27,6 +27,8 @@ typedef struct {
     uint8_t *state; /* JF_NJ_*: read and written atomically */
     int weighted;   /* JF_AUTO_WEIGHTED_MEAN: the weighted mean on every
                        row not capped, whatever its noise                  */
+    int spread;     /* JF_AUTO_SPREAD_CARRY: the plain carry over every
+                       JF_NJ_STEP-th of the K/2 nearest                    */
     size_t reach;   /* the farthest of a point's nearest a row reads
                        (jf__nj_reach)                                      */
 } jf__njs;
@@ -49,10 +51,9 @@ void jf__njs_free(jf__njs *s);
 #define JF_NJ_REACH (JF_NJ_HEAD * JF_NJ_STEP)
 
 /* The farthest of its nearest points a row of an estimate with p reads
- * (1-based): 32 where every row's mean is weighted
- * (JF_AUTO_WEIGHTED_MEAN), up to JF_NJ_REACH where a row may take the
- * plain carry, less under a cap (params.auto_select 1, not yet decided:
- * JF_NJ_REACH). */
+ * (1-based): up to JF_NJ_REACH where a row may take the spread carry
+ * (JF_AUTO_SPREAD_CARRY, or params.auto_select 1: not yet decided), else
+ * 32, less under a cap. */
 size_t jf__nj_reach(const jf_params *p);
 
 /* Whether an estimate runs step 6: auto on a k-NN of at least
@@ -76,12 +77,13 @@ int jf__nj_weighted(const jf__njs *s, const jf_result *r);
 
 /* Which of a point's nearest its row r reads, the normal and the
  * curvatures from: the nearest round(K / 4) where K was capped (step 0),
- * round(K / 8) where the mean is weighted, every JF_NJ_STEP-th of the
- * nearest round(K / 2) for the plain carry (bias-bound fits: a mean over
- * that spread cancels most of the quadric's slope bias).  Returns how
- * many (at least 1, at most JF_NJ_HEAD), *step the stride (1 or
- * JF_NJ_STEP) from the point itself. */
-size_t jf__nj_head(const jf_result *r, int weighted, size_t *step);
+ * round(K / 8) where the mean is weighted or the carry not spread, every
+ * JF_NJ_STEP-th of the nearest round(K / 2) for the spread carry (s->
+ * spread: a mean over that spread cancels most of the slope bias a cubic
+ * term leaves in the quadric).  Returns how many (at least 1, at most
+ * JF_NJ_HEAD), *step the stride (1 or JF_NJ_STEP) from the point
+ * itself. */
+size_t jf__nj_head(const jf__njs *s, const jf_result *r, size_t *step);
 
 /* The state of point i's record (JF_NJ_*). */
 int jf__nj_state(const jf__njs *s, size_t i);

@@ -180,18 +180,20 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
  * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
  * q's, 2 where the weighted mean was taken.  A capped row (step 0):
  * round(K/4) nearest, never the weighted mean. */
-static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, int weighted,
+static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, int flags,
                  double n[3], double k[2])
 {
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
     const int capped = (a->status & JF_PT_AUTO_CAPPED) != 0;
-    const int wide =
-        (weighted || a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID) && !capped;
-    /* capped: the K/4 nearest; weighted: the K/8 nearest; else q and
-     * every 4th after it among the K/2 nearest */
-    double fc = nearbyint(a->n_used / (capped ? 4.0 : wide ? 8.0 : 2.0));
-    const size_t step = capped || wide ? 1 : 4;
+    const int wide = ((flags & JF_AUTO_WEIGHTED_MEAN) ||
+                      a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID) &&
+                     !capped;
+    /* capped: the K/4 nearest; weighted or not spread: the K/8 nearest;
+     * spread: q and every 4th after it among the K/2 nearest */
+    const int spread = !capped && !wide && (flags & JF_AUTO_SPREAD_CARRY);
+    double fc = nearbyint(a->n_used / (capped ? 4.0 : spread ? 2.0 : 8.0));
+    const size_t step = spread ? 4 : 1;
     fc = ceil(fc / (double)step);
     size_t mc = fc < 1 ? 1 : fc > 32 ? 32 : (size_t)fc;
     double W[9] = {0}, v[3] = {0}, sw = 0, Ww[9] = {0}, vw[3] = {0}, nw[3] = {0}, dw[3] = {0};
@@ -312,7 +314,7 @@ static void is_the_jet(surf c, int sel)
         nd[a->degree]++;
         /* step 6 */
         double n[3], kk[2];
-        int how = mixed(&c, own, nbi, i, (cap & JF_AUTO_WEIGHTED_MEAN) != 0, n, kk);
+        int how = mixed(&c, own, nbi, i, cap, n, kk);
         if (!how) {
             ck_assert_int_eq(memcmp(&ra[i], a, sizeof *a), 0);
             continue;
@@ -358,12 +360,39 @@ START_TEST(test_auto_is_the_jet)
 }
 END_TEST
 
-/* The same with the weighted mean on every row (JF_AUTO_WEIGHTED_MEAN,
- * given by hand: step 0 finds this torus biased) */
+/* The same with the weighted mean on every row (JF_AUTO_WEIGHTED_MEAN),
+ * and with the plain carry over every 4th of the K/2 nearest
+ * (JF_AUTO_SPREAD_CARRY), given by hand: step 0 finds this small torus
+ * too biased for either */
 START_TEST(test_auto_is_the_jet_weighted)
 {
     is_the_jet(make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT),
                JF_NB_AUTO_KMAX | JF_AUTO_WEIGHTED_MEAN);
+}
+END_TEST
+
+START_TEST(test_auto_is_the_jet_spread)
+{
+    is_the_jet(make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT),
+               JF_NB_AUTO_KMAX | JF_AUTO_SPREAD_CARRY);
+}
+END_TEST
+
+static void same_in_parts(surf *c);
+
+/* A torus with a density gradient at 0.3%, 6,000 points: step 0 reads a
+ * mild bias (median between 1 and 4) and spreads the plain carry; the
+ * rows are steps 1-6 as stated, and the whole cloud's bytes in parts */
+START_TEST(test_auto_spread_decided)
+{
+    surf c = make(JF_SURF_TORUS, 6000, 0.003, JF_DENSITY_GRADIENT);
+    const int sel = cloud_cap(&c);
+    ck_assert_int_eq(sel & ~JF_AUTO_FLAGS, JF_NB_AUTO_KMAX);
+    ck_assert_int_eq(sel & (JF_AUTO_SPREAD_CARRY | JF_AUTO_WEIGHTED_MEAN), JF_AUTO_SPREAD_CARRY);
+    is_the_jet(c, 1);
+    surf d = make(JF_SURF_TORUS, 6000, 0.003, JF_DENSITY_GRADIENT);
+    d.s.xyz[3 * 17] = NAN;
+    same_in_parts(&d);
 }
 END_TEST
 
@@ -685,9 +714,11 @@ START_TEST(test_auto_cv_decide)
     jf__auto_cv_why w;
     for (int pick = 0; pick < JF_AUTO_NCAND; pick++)
         for (int thick = 0; thick < 2; thick++)
-            for (int noisy = 0; noisy < 4; noisy++) {
-                /* noisy & 2: the bias statistic's median just above 1 */
+            for (int noisy = 0; noisy < 6; noisy++) {
+                /* noisy >> 1: the bias statistic's median at most 1, just
+                 * above 4, just above 1 (at most 4) */
                 const int biased = noisy >> 1;
+                static const double lo[3] = {0.1, 0.1, 1.001}, hi[3] = {1.001, 4.001, 4.001};
                 for (int s = 0; s < M; s++) {
                     r[s].gid = (uint32_t)(7 * s % M) * 3u;
                     for (int c = 0; c < JF_AUTO_NCAND; c++)
@@ -698,8 +729,8 @@ START_TEST(test_auto_cv_decide)
                      * either way */
                     r[s].v[JF_AUTO_CV_SMALL] = 1.0;
                     r[s].v[JF_AUTO_CV_SMALL + 1] = 2 * s < M + (noisy & 1 ? 0 : 2) ? 0.01 : 1.01;
-                    /* its sum below M either way: the median decides */
-                    r[s].v[JF_AUTO_CV_BIAS] = 2 * s < M + (biased ? -2 : 2) ? 0.1 : 1.001;
+                    /* the median decides, not the mean */
+                    r[s].v[JF_AUTO_CV_BIAS] = 2 * s < M + (biased == 1 ? -2 : 2) ? lo[biased] : hi[biased];
                 }
                 memcpy(q, r, sizeof r);
                 int cap = jf__auto_cv_decide(r, M, &w);
@@ -707,13 +738,15 @@ START_TEST(test_auto_cv_decide)
                 ck_assert_int_eq(w.pick, ks[pick]);
                 ck_assert_uint_eq(w.used, M);
                 ck_assert_int_eq(w.cubic_min48, noisy & 1);
-                ck_assert_double_eq(w.bias, biased ? 1.001 : 0.1);
+                static const double med[3] = {0.1, 4.001, 1.001};
+                ck_assert_double_eq(w.bias, med[biased]);
                 const int capped = !thick && ks[pick] <= 64;
-                /* no cap and no bias the noise does not explain: the
-                 * weighted mean everywhere */
+                /* no cap: no bias the noise does not explain, the
+                 * weighted mean everywhere; a mild one, the spread carry */
+                static const int fl[3] = {JF_AUTO_WEIGHTED_MEAN, 0, JF_AUTO_SPREAD_CARRY};
                 ck_assert_int_eq(cap, (capped ? ks[pick + 1] : JF_NB_AUTO_KMAX) |
                                           (noisy & 1 ? JF_AUTO_CUBIC_MIN48 : 0) |
-                                          (!capped && !biased ? JF_AUTO_WEIGHTED_MEAN : 0));
+                                          (capped ? 0 : fl[biased]));
                 for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
                 ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
             }
@@ -808,7 +841,7 @@ START_TEST(test_auto_cv_bias)
     same_in_parts(&c); /* frees c */
     surf e = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
     ck_assert_int_eq(jf__auto_cv_sample(e.s.xyz, e.s.n, NULL, NULL, e.s.n, NULL, &p, 2, &r, &nr), JF_OK);
-    ck_assert_int_eq(jf__auto_cv_decide(r, nr, &w) & JF_AUTO_WEIGHTED_MEAN, 0);
+    ck_assert_int_eq(jf__auto_cv_decide(r, nr, &w) & (JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY), 0);
     ck_assert_msg(w.bias > 4, "ellipsoid: median %g", w.bias);
     free(r);
     jf_sample_free(&e.s);
@@ -854,6 +887,8 @@ static Suite *suite(void)
     tcase_add_test(tc, test_auto_threads);
     tcase_add_test(tc, test_auto_is_the_jet);
     tcase_add_test(tc, test_auto_is_the_jet_weighted);
+    tcase_add_test(tc, test_auto_is_the_jet_spread);
+    tcase_add_test(tc, test_auto_spread_decided);
     tcase_add_test(tc, test_auto_is_the_jet_capped);
     tcase_add_test(tc, test_auto_cv_bias);
     tcase_add_test(tc, test_auto_sphere);

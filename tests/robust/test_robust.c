@@ -430,7 +430,7 @@ START_TEST(new_params_validated)
     static const int good[] = {0, 1, 16, 24, 256, 1 | JF_AUTO_CUBIC_MIN48, 48 | JF_AUTO_CUBIC_MIN48,
                                1 | JF_AUTO_WEIGHTED_MEAN, 24 | JF_AUTO_FLAGS};
     static const int wrong[] = {-1, 2, 15, 257, JF_AUTO_CUBIC_MIN48, 8 | JF_AUTO_CUBIC_MIN48,
-                                JF_AUTO_WEIGHTED_MEAN, JF_AUTO_FLAGS, 4096 | 24};
+                                JF_AUTO_WEIGHTED_MEAN, JF_AUTO_FLAGS, 8192 | 24};
     for (size_t i = 0; i < sizeof good / sizeof *good; i++) {
         p.auto_select = good[i];
         ck_assert_int_eq(jf_params_validate(&p, &bad), JF_OK);
