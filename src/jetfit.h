@@ -120,13 +120,18 @@ enum {
                                       validation, docs/robustness.md
                                       step 0), below the largest
                                       candidate the list held           */
-    JF_PT_AUTO_WEIGHTED = 1u << 19 /* auto, jf_estimate: the normal is
+    JF_PT_AUTO_WEIGHTED = 1u << 19,/* auto, jf_estimate: the normal is
                                       the neighbours' fits' weighted
                                       trapezoid mean over K/8 of them
                                       (the noise large against the fit's
                                       spread, or the cloud's fits bound
                                       by the noise: step 6), not their
-                                      plain carry (K/2; K/4 if capped)  */
+                                      plain carry                       */
+    JF_PT_AUTO_SPREAD = 1u << 20   /* auto, jf_estimate: the plain carry
+                                      over every 4th of the K/2 nearest
+                                      (the cloud's fits hold a cubic
+                                      term's bias: step 6), not over the
+                                      K/8 nearest (K/4 if capped)       */
 };
 
 /* Writes a '|'-separated list of flag names of `status` into buf

@@ -16,7 +16,7 @@ int jf_cmd_view(int argc, char **argv);        /* cmd_view.c        */
  * umbilic): a point with no other flag counts as ok in estimate's summary
  * and in study's cells (with jetfit.h) */
 #define JF_CLI_HOW_FLAGS                                                                   \
-    (JF_PT_AUTO | JF_PT_AUTO_CAPPED | JF_PT_AUTO_WEIGHTED | JF_PT_SCALE_SELECTED |         \
-     JF_PT_NORMAL_POLES | JF_PT_NORMAL_MINCIRC | JF_PT_NORMAL_INPUT | JF_PT_NORMAL_JET |   \
-     JF_PT_NORMAL_PCA | JF_PT_UMBILIC)
+    (JF_PT_AUTO | JF_PT_AUTO_CAPPED | JF_PT_AUTO_WEIGHTED | JF_PT_AUTO_SPREAD |           \
+     JF_PT_SCALE_SELECTED | JF_PT_NORMAL_POLES | JF_PT_NORMAL_MINCIRC | JF_PT_NORMAL_INPUT | \
+     JF_PT_NORMAL_JET | JF_PT_NORMAL_PCA | JF_PT_UMBILIC)
 #endif

@@ -29,6 +29,7 @@ static const char *const flag_names[] = {
     "normal_mincirc", "normal_fallback", "robust_noconv", "orient_unknown",
     "normal_input", "scale_selected", "mesh_nonmanifold", "normal_jet",
     "normal_pca", "auto", "auto_capped", "auto_weighted",
+    "auto_spread",
 };
 
 char *jf_point_status_str(unsigned status, char *buf, size_t len)

@@ -255,7 +255,8 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
     const double h = sqrt((p[0] - pf[0]) * (p[0] - pf[0]) + (p[1] - pf[1]) * (p[1] - pf[1]) +
                           (p[2] - pf[2]) * (p[2] - pf[2]));
     const double big = fmax(fmax(fabs(r->k1), fabs(r->k2)), h > 0 ? 1.0 / h : 0.0);
-    r->status &= ~(unsigned)(JF_PT_UMBILIC | JF_PT_AUTO_WEIGHTED);
+    r->status &= ~(unsigned)(JF_PT_UMBILIC | JF_PT_AUTO_WEIGHTED | JF_PT_AUTO_SPREAD);
     if (wide && sw > 0 && isfinite(sw)) r->status |= JF_PT_AUTO_WEIGHTED;
+    if (step > 1) r->status |= JF_PT_AUTO_SPREAD;
     if (2.0 * rad <= 1e-10 * big) r->status |= JF_PT_UMBILIC;
 }

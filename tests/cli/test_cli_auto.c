@@ -57,7 +57,8 @@ START_TEST(auto_columns_and_summary)
     for (size_t i = 0; i < t.nrows; i++) {
         unsigned st = (unsigned)cli_val(&t, i, "status");
         ck_assert_uint_ne(st & JF_PT_AUTO, 0);
-        nok += !(st & ~(unsigned)(JF_PT_AUTO | JF_PT_AUTO_CAPPED | JF_PT_AUTO_WEIGHTED));
+        nok += !(st & ~(unsigned)(JF_PT_AUTO | JF_PT_AUTO_CAPPED | JF_PT_AUTO_WEIGHTED |
+                                  JF_PT_AUTO_SPREAD));
         double k = cli_val(&t, i, "neighbors"), d = cli_val(&t, i, "degree");
         ck_assert(k >= 16 && k <= JF_NB_AUTO_KMAX);
         ck_assert(d == 2 || d == 3);

@@ -178,7 +178,7 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
  * and n_j - W (q - j), W the mean W_j, all means weighted by K_j (l1 +
  * l2)_j / sigma_j^2 -- the curvatures the eigenvalues of the plain mean
  * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
- * q's, 2 where the weighted mean was taken.  A capped row (step 0):
+ * q's, 2 where the weighted mean was taken, 3 the spread carry, else 1.  A capped row (step 0):
  * round(K/4) nearest, never the weighted mean. */
 static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, int flags,
                  double n[3], double k[2])
@@ -245,7 +245,7 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
     for (size_t t = 0; t < mc; t++) cnt += own[idx[q * JF_NB_AUTO_KMAX + t * step]].degree >= 2;
     double mid = (m11 + m22) / 2, rad = hypot((m11 - m22) / 2, m12);
     k[0] = (mid + rad) / cnt, k[1] = (mid - rad) / cnt;
-    return wide ? 2 : 1;
+    return wide ? 2 : spread ? 3 : 1;
 }
 
 /* Steps 1-5: each point's own fit is the least-squares jet of its degree
@@ -321,6 +321,9 @@ static void is_the_jet(surf c, int sel)
         }
         nwide += how == 2;
         nmix++;
+        /* the row says which mean */
+        ck_assert_int_eq((ra[i].status & JF_PT_AUTO_WEIGHTED) != 0, how == 2);
+        ck_assert_int_eq((ra[i].status & JF_PT_AUTO_SPREAD) != 0, how == 3);
         double dm = fabs(dot3(n, ra[i].normal)), ds = fabs(dot3(a->normal, ra[i].normal));
         ck_assert_msg(dm > 1.0 - 2e-8, "point %zu: step 6's normal off by %.3g rad", i, acos(dm));
         moved += ds < 1.0 - 1e-8;
