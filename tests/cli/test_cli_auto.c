@@ -81,27 +81,59 @@ START_TEST(auto_columns_and_summary)
 }
 END_TEST
 
-START_TEST(auto_parts_threads)
+/* in: auto's rows on 2 threads, in --memory parts (the least plan that
+ * works) and on one thread are the same bytes; returns how many rows
+ * carry flag */
+static size_t parts_threads(const char *in, unsigned flag)
 {
-    write_noisy(cli_path("in.xyz"));
-    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("w.ply"), "--neighbors",
-                             "auto", "--threads", "2", "--quiet", NULL),
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("w.csv"), "--neighbors", "auto",
+                             "--threads", "2", "--quiet", NULL),
                      0);
     /* --memory 16K is refused with the least that works: that runs in parts */
-    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
-                             "auto", "--threads", "2", "--memory", "16K", "--quiet", NULL),
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("p.csv"), "--neighbors", "auto",
+                             "--threads", "2", "--memory", "16K", "--quiet", NULL),
                      1);
     const char *lw = strstr(cli_err, "the least that works is --memory ");
     char mem[32] = "";
     ck_assert_msg(lw && sscanf(lw + 33, "%31s", mem) == 1, "%s", cli_err);
-    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("p.ply"), "--neighbors",
-                             "auto", "--threads", "2", "--memory", mem, "--quiet", NULL),
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("p.csv"), "--neighbors", "auto",
+                             "--threads", "2", "--memory", mem, "--quiet", NULL),
                      0);
-    jf_test_assert_same_files("auto, in parts", cli_path("w.ply"), cli_path("p.ply"));
-    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("t.ply"), "--neighbors",
-                             "auto", "--threads", "1", "--quiet", NULL),
+    jf_test_assert_same_files("auto, in parts", cli_path("w.csv"), cli_path("p.csv"));
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("t.csv"), "--neighbors", "auto",
+                             "--threads", "1", "--quiet", NULL),
                      0);
-    jf_test_assert_same_files("auto, one thread", cli_path("w.ply"), cli_path("t.ply"));
+    jf_test_assert_same_files("auto, one thread", cli_path("w.csv"), cli_path("t.csv"));
+    jf_eval_table t;
+    cli_read(cli_path("w.csv"), &t);
+    size_t c = 0;
+    for (size_t i = 0; i < t.nrows; i++) c += ((unsigned)cli_val(&t, i, "status") & flag) != 0;
+    jf_eval_table_free(&t);
+    return c;
+}
+
+START_TEST(auto_parts_threads)
+{
+    write_noisy(cli_path("in.xyz"));
+    parts_threads(cli_path("in.xyz"), 0);
+}
+END_TEST
+
+/* Step 0's bias test: a torus with a density gradient at 0.3% reads a
+ * mild bias (its rows whose noise is small against their fit's spread,
+ * 1,355 here, take the spread carry, whose halo reaches the 128th
+ * nearest; the others the weighted mean), an `exp` patch at 0.05% none
+ * (every row weighted) */
+START_TEST(auto_parts_step0_flags)
+{
+    ck_assert_int_eq(cli_run("generate", "torus", "-o", cli_path("torus.ply"), "--n", "6000", "--noise",
+                             "0.003", "--density", "gradient", "--seed", "27", NULL),
+                     0);
+    ck_assert_uint_gt(parts_threads(cli_path("torus.ply"), JF_PT_AUTO_SPREAD), 600);
+    ck_assert_int_eq(cli_run("generate", "exp", "-o", cli_path("exp.ply"), "--n", "4000", "--noise",
+                             "0.0005", "--seed", "27", NULL),
+                     0);
+    ck_assert_uint_eq(parts_threads(cli_path("exp.ply"), JF_PT_AUTO_WEIGHTED), 4000);
 }
 END_TEST
 
@@ -113,6 +145,7 @@ int main(void)
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, auto_columns_and_summary);
     tcase_add_test(tc, auto_parts_threads);
+    tcase_add_test(tc, auto_parts_step0_flags);
     suite_add_tcase(s, tc);
     return jf_test_run(s);
 }

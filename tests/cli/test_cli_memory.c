@@ -129,7 +129,7 @@ static void write_sheet(const char *path, size_t n, uint64_t seed)
 START_TEST(coordinates_on_disk_same_bytes)
 {
     write_sheet(cli_path("in.ply"), 30000, 5);
-    /* auto's halo ring (r_256 + 2 r_32, jf__plan_part_points) is wider
+    /* auto's halo ring (r_256 + 2 r_128, jf__plan_part_points) is wider
      * than a part of 30,000 / 32 points: parts pay below ~3e5 points, and
      * the least plan for the small sheet is the whole cloud in memory */
     write_sheet(cli_path("big.ply"), 300000, 5);

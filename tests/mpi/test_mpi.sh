@@ -106,6 +106,21 @@ equal-more)
                     int($s / 262144) % 2 { c++ } END { print c + 0 }' "$d/ref.csv")
   [ "$capped" -eq 3000 ] && echo "ok   auto capped: $capped of 3000 rows" ||
     bad "auto on a clean cloud: $capped of 3000 rows capped (want all)"
+  # auto's step 0 bias test, decided from every rank's share of the sample:
+  # a torus at 0.3% spreads the plain carry (bit 20) on part of its rows, an
+  # exp patch at 0.05% weights every row's mean (bit 19)
+  "$jetfit" generate torus -o "$d/spread.ply" --n 6000 --noise 0.003 --density gradient --seed 27 \
+    >/dev/null || bad "jetfit generate torus"
+  "$jetfit" generate exp -o "$d/weighted.ply" --n 4000 --noise 0.0005 --seed 27 >/dev/null ||
+    bad "jetfit generate exp"
+  for c in spread:1048576:600 weighted:524288:3999; do
+    name=${c%%:*} rest=${c#*:} bit=${rest%%:*} least=${rest#*:}
+    same "2 3" "$name.ply" csv --neighbors auto
+    got=$(awk -F, -v b="$bit" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "status") s = i; next }
+                              int($s / b) % 2 { c++ } END { print c + 0 }' "$d/ref.csv")
+    [ "$got" -gt "$least" ] && echo "ok   auto $name: $got rows flagged $bit" ||
+      bad "auto on $name.ply: $got rows flagged $bit (want more than $least)"
+  done
   # auto's halo balls overlap: each point is sent to a rank once (kept == fetched)
   mpi 3 estimate "$d/clusters.ply" -o "$d/got.csv" --neighbors auto 2>"$d/stderr" >/dev/null
   h=$(sed -n 's/^ *halo: \([0-9]*\) points kept, \([0-9]*\) fetched.*/\1 \2/p' "$d/stderr")
