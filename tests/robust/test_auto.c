@@ -254,8 +254,9 @@ static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_
  * cond) -- up to rounding, on every point (the fit comes from power sums,
  * auto.c's direct_fit).  Step 6: the row is the mean of the nearest's
  * fits (mixed() above, no quantization: to the records' 16 bits). */
-/* the cap step 0 gives c (auto_cloud.c) */
-static int cloud_cap(const surf *c)
+/* the cap and flags step 0 gives c (auto_cloud.c), what it saw to *w
+ * (may be NULL) */
+static int cloud_decide(const surf *c, jf__auto_cv_why *w)
 {
     jf_params p;
     jf_params_init(&p);
@@ -264,10 +265,12 @@ static int cloud_cap(const surf *c)
     jf__cvrec *r;
     size_t nr;
     ck_assert_int_eq(jf__auto_cv_sample(c->s.xyz, c->s.n, NULL, NULL, c->s.n, NULL, &p, 2, &r, &nr), JF_OK);
-    int cap = jf__auto_cv_decide(r, nr, NULL);
+    int cap = jf__auto_cv_decide(r, nr, w);
     free(r);
     return cap;
 }
+
+static int cloud_cap(const surf *c) { return cloud_decide(c, NULL); }
 
 /* sel: params.auto_select (256: no cap; 1: the cloud's, step 0) */
 static void is_the_jet(surf c, int sel)
@@ -586,19 +589,35 @@ static void solve_n(double *A, double *b, int n)
     }
 }
 
+/* The monomials of degree <= 3 at (x, y), by degree */
+static void monomials(double x, double y, double v[10])
+{
+    const double m[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
+    memcpy(v, m, sizeof m);
+}
+
+/* The normal equations A a = b of the jet of nd monomials on points
+ * from..k-1 of nb, in the world's frame */
+static void normal_eq(const double *nb, size_t from, size_t k, int nd, double A[100], double b[10])
+{
+    memset(A, 0, 100 * sizeof *A);
+    memset(b, 0, 10 * sizeof *b);
+    for (size_t i = from; i < k; i++) {
+        double v[10];
+        monomials(nb[3 * i], nb[3 * i + 1], v);
+        for (int r = 0; r < nd; r++) {
+            for (int c = 0; c < nd; c++) A[r * nd + c] += v[r] * v[c];
+            b[r] += v[r] * nb[3 * i + 2];
+        }
+    }
+}
+
 /* The height at 0 of the least-squares jet of nd monomials (6 or 10) on
  * points 1..k-1 of nb (p, point 0, left out), in the world's frame */
 static double refit_at_p(const double *nb, size_t k, int nd)
 {
-    double A[100] = {0}, b[10] = {0};
-    for (size_t i = 1; i < k; i++) {
-        const double x = nb[3 * i], y = nb[3 * i + 1];
-        const double m[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
-        for (int r = 0; r < nd; r++) {
-            for (int c = 0; c < nd; c++) A[r * nd + c] += m[r] * m[c];
-            b[r] += m[r] * nb[3 * i + 2];
-        }
-    }
+    double A[100], b[10];
+    normal_eq(nb, 1, k, nd, A, b);
     solve_n(A, b, nd);
     return b[0];
 }
@@ -609,26 +628,18 @@ static double refit_at_p(const double *nb, size_t k, int nd)
  * auto.c states it), and its residual sum of squares. */
 static void plain_fit(const double *nb, size_t k, int nd, double n[3], double *tr, double *rss)
 {
-    double A[100] = {0}, b[10] = {0}, m[10][10], a[10], c[2][10];
-    for (size_t i = 0; i < k; i++) {
-        const double x = nb[3 * i], y = nb[3 * i + 1];
-        const double v[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
-        for (int r = 0; r < nd; r++) {
-            for (int q = 0; q < nd; q++) A[r * nd + q] += v[r] * v[q];
-            b[r] += v[r] * nb[3 * i + 2];
-        }
-    }
+    double A[100], b[10], m[100], a[10], c[2][10];
+    normal_eq(nb, 0, k, nd, A, b);
     for (int e = 0; e < 3; e++) {
         memcpy(m, A, sizeof A);
         double *x = e == 0 ? a : c[e - 1];
         for (int r = 0; r < nd; r++) x[r] = e == 0 ? b[r] : r == e;
-        solve_n(&m[0][0], x, nd);
+        solve_n(m, x, nd);
     }
     *rss = 0;
     for (size_t i = 0; i < k; i++) {
-        const double x = nb[3 * i], y = nb[3 * i + 1];
-        const double v[10] = {1, x, y, x * x, x * y, y * y, x * x * x, x * x * y, x * y * y, y * y * y};
-        double z = nb[3 * i + 2];
+        double v[10], z = nb[3 * i + 2];
+        monomials(nb[3 * i], nb[3 * i + 1], v);
         for (int r = 0; r < nd; r++) z -= a[r] * v[r];
         *rss += z * z;
     }
@@ -818,16 +829,8 @@ START_TEST(test_auto_cv_bias)
         c.s.xyz[3 * i] = jf_rng_uniform(&rng), c.s.xyz[3 * i + 1] = jf_rng_uniform(&rng);
         c.s.xyz[3 * i + 2] = 0.003 * jf_rng_gauss(&rng);
     }
-    jf_params p;
-    jf_params_init(&p);
-    p.auto_select = 1;
-    p.max_neighbors = JF_NB_AUTO_KMAX;
-    jf__cvrec *r;
-    size_t nr;
     jf__auto_cv_why w;
-    ck_assert_int_eq(jf__auto_cv_sample(c.s.xyz, c.s.n, NULL, NULL, c.s.n, NULL, &p, 2, &r, &nr), JF_OK);
-    const int sel = jf__auto_cv_decide(r, nr, &w);
-    free(r);
+    const int sel = cloud_decide(&c, &w);
     ck_assert_msg(w.bias > 0.5 && w.bias < 0.9, "plane: median %g (ln 2 = 0.693)", w.bias);
     ck_assert_int_eq(sel & ~JF_AUTO_FLAGS, JF_NB_AUTO_KMAX);
     ck_assert_int_ne(sel & JF_AUTO_WEIGHTED_MEAN, 0);
@@ -843,10 +846,8 @@ START_TEST(test_auto_cv_bias)
     c.s.xyz[3 * 17] = NAN;
     same_in_parts(&c); /* frees c */
     surf e = make(JF_SURF_ELLIPSOID, 3000, 0.003, JF_DENSITY_UNIFORM);
-    ck_assert_int_eq(jf__auto_cv_sample(e.s.xyz, e.s.n, NULL, NULL, e.s.n, NULL, &p, 2, &r, &nr), JF_OK);
-    ck_assert_int_eq(jf__auto_cv_decide(r, nr, &w) & (JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY), 0);
+    ck_assert_int_eq(cloud_decide(&e, &w) & (JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY), 0);
     ck_assert_msg(w.bias > 4, "ellipsoid: median %g", w.bias);
-    free(r);
     jf_sample_free(&e.s);
 }
 END_TEST
