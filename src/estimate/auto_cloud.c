@@ -145,7 +145,8 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
         int all = 1;
         const double *v2 = r[s].v + JF_AUTO_CV_SMALL;
         if (isfinite(v2[0]) && isfinite(v2[1])) cubic += v2[1] < v2[0], nsmall++;
-        if (sb && isfinite(r[s].v[JF_AUTO_CV_BIAS])) sb[nb++] = r[s].v[JF_AUTO_CV_BIAS];
+        /* +inf: a bias with no noise at all, the largest */
+        if (sb && !isnan(r[s].v[JF_AUTO_CV_BIAS])) sb[nb++] = r[s].v[JF_AUTO_CV_BIAS];
         for (int c = 0; c < JF_AUTO_NCAND && all; c++) all = isfinite(r[s].v[c]);
         if (!all) continue;
         for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += r[s].v[c];

@@ -1035,7 +1035,8 @@ void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], con
          * small, §3; the two differ by noise of variance tr3 - tr2) */
         double d2 = 0.0;
         for (int k = 0; k < 3; k++) d2 += (q3->nrm[k] - q2->nrm[k]) * (q3->nrm[k] - q2->nrm[k]);
-        out[JF_AUTO_CV_BIAS] = d2 / ((q3->tr - q2->tr) * q3->s2);
+        const double den = (q3->tr - q2->tr) * q3->s2; /* 0: no noise left */
+        out[JF_AUTO_CV_BIAS] = den > 0.0 ? d2 / den : d2 > 0.0 ? INFINITY : NAN;
     }
     if (g.nmax > 16) {
         const double *q = nbr + 3 * 16;

@@ -771,6 +771,10 @@ START_TEST(test_auto_cv_decide)
     for (int s = 0; s < M; s++) r[s].v[JF_AUTO_CV_BIAS] = s < 31 ? 0.1 : NAN;
     ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
     ck_assert_double_eq(w.bias, 0.1);
+    /* +inf (no noise, some bias) counts, as the largest */
+    for (int s = 0; s < M; s++) r[s].v[JF_AUTO_CV_BIAS] = s < 99 ? 0.1 : INFINITY;
+    ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
+    ck_assert(isinf(w.bias));
     ck_assert_int_eq(w.cubic_min48, 0);
     ck_assert_uint_eq(w.used, M);
     for (int s = 0; s < M; s++) r[s].v[3] = NAN; /* no usable record: no cap */
