@@ -492,6 +492,7 @@ void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb)
     const double r = sqrt((double)q.nb.k) + 2.0 * sqrt((double)q.nj); /* step 6's ball */
     nb->ball = q.nj ? r * r : (double)q.nb.k;
     nb->fit_pt = q.nj ? JF_PLAN_NJ_PT : 0;
+    nb->fit_thread = q.nj ? JF_PLAN_NJ_THREAD : 0;
 }
 
 double jf__plan_part_points(size_t n, int P, const jf_plan_nb *nb)
@@ -525,7 +526,11 @@ static int plan_figures(size_t n, size_t held, size_t ncols, int nt, const jf_pl
     const double writer = (double)(1 << 20) + (double)nt * 256.0 * 8.0 * (double)ncols +
                           (double)nt * 4096.0 * 32.0 * (double)ncols;
     const double base = (double)held + (double)jf__spool_bytes(n, ncols) + writer;
-    *whole = base + (double)(JF_PLAN_WHOLE_PT + (nb ? nb->fit_pt : 0)) * (double)n;
+    /* auto's walk holds rows per thread (a part's run holds them too,
+     * within the parts' per-point figures: measured 20.5 MB at the least
+     * plan of a 2 * 10^5 torus, 23.8 MB planned) */
+    const double threads = nb ? (double)(nt > 0 ? nt : 1) * (double)nb->fit_thread : 0.0;
+    *whole = base + threads + (double)(JF_PLAN_WHOLE_PT + (nb ? nb->fit_pt : 0)) * (double)n;
     const double fixed = base + (double)JF_PLAN_SPLIT_PT * (double)n +
                          2.0 * (double)(jf__parts_grid_bits(n) / 8) +
                          (double)sizeof(uint64_t[2]) * (double)jf__parts_sample_size(n);

@@ -92,13 +92,14 @@ jf_status jf__parts_split_sampled(const double *xyz, size_t n, int nparts, int t
 
 /* What the memory plan needs of an estimate's neighbourhood: fit_pt,
  * bytes more per fitted point (own and halo) while fitting (auto's step
- * 6 records: JF_PLAN_NJ_PT), and ball, the points a halo request's ball
- * holds on a surface (knn: K, raised to the largest --scales entry;
- * auto: (sqrt K + 2 sqrt 32)^2, step 6's r_K + 2 r_32; 0: not known,
- * radius kinds).  jf__plan_nb fills both from the options (zeros when
- * the parts cannot take them). */
+ * 6 records: JF_PLAN_NJ_PT), fit_thread, bytes more per thread while
+ * fitting (auto's walk: JF_PLAN_NJ_THREAD), and ball, the points a halo
+ * request's ball holds on a surface (knn: K, raised to the largest
+ * --scales entry; auto: (sqrt K + 2 sqrt m)^2, step 6's r_K + 2 r_m, m
+ * jf__nj_reach's; 0: not known, radius kinds).  jf__plan_nb fills them
+ * from the options (zeros when the parts cannot take them). */
 typedef struct {
-    size_t fit_pt;
+    size_t fit_pt, fit_thread;
     double ball;
 } jf_plan_nb;
 void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
@@ -133,6 +134,10 @@ void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
                                   23 (docs/scale.md)                      */
 #define JF_PLAN_NJ_PT 17       /* auto: step 6's record and state per point
                                   (robust/neigh_jets.h): fit_pt          */
+#define JF_PLAN_NJ_THREAD (3584u << 10) /* auto: a thread's rows in hand
+                                  (a unit and as many waiting: 224-byte
+                                  rows, 32 nearest each, decoded records;
+                                  about 3.4 MiB, pipeline.c): fit_thread */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */
