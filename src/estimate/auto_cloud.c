@@ -30,7 +30,9 @@
  * JF_AUTO_CV_BIAS at most 1; about ln 2 without bias), the quadric's slope
  * bias is small against its noise: step 6 takes its weighted trapezoid
  * mean on every row (JF_AUTO_WEIGHTED_MEAN; the `exp` patch at 0.1% reads
- * 0.65, the ellipsoid and the torus 1.9 and 1.5, item 6). */
+ * 0.65); where it is above 1 and at most 4, a cubic term's bias, step 6's
+ * plain carry reads every 4th of the K/2 nearest (JF_AUTO_SPREAD_CARRY;
+ * the ellipsoid and the torus at 0.1% read 1.9 and 1.5; item 6). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

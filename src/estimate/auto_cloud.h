@@ -30,7 +30,8 @@ typedef struct {
     int cap;         /* params.auto_select: the cap (JF_NB_AUTO_KMAX none),
                         | JF_AUTO_CUBIC_MIN48 where cubic_min48,
                         | JF_AUTO_WEIGHTED_MEAN where no cap and bias is
-                        at most 1                                        */
+                        at most 1, | JF_AUTO_SPREAD_CARRY where no cap
+                        and bias is above 1, at most 4                    */
 } jf__auto_cv_why;
 
 /* Whether an estimate with p and nb decides the cap itself (auto, the

@@ -543,7 +543,7 @@ static jf_status auto_lanes(worker *w, const nbctx *x, int L, const size_t i[], 
     if (st != JF_OK) return st;
     for (int k = 0; k < L; k++) {
         if (fit[k]) r[k].status |= fl[k];
-        size_t step, c = jf__nj_head(x->nj, &r[k], &step), h = 0;
+        size_t step, c = jf__nj_head(x->nj, &r[k], jf__nj_weighted(x->nj, &r[k]), &step), h = 0;
         uint32_t *hd = w->head + kq[k] * JF_NJ_HEAD;
         for (size_t t = 0; h < c && t < ln[k]; t += step) hd[h++] = w->lpos[k * JF_NJ_REACH + t];
         w->headn[kq[k]] = (uint8_t)h;
@@ -881,7 +881,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
     x.ix = ix;
     /* auto's step 6 (neigh_jets.h); a part's halo holds what it reads
      * (parts.c, jf__halo_requests) */
-    jf__njs njs = {NULL, NULL, 0, 0, JF_NJ_REACH};
+    jf__njs njs = {0};
     if (jf__nj_on(p, &nb) && need_index) {
         x.nj = &njs;
         if (jf__njs_alloc(&njs, jf_index_size(ix)) != JF_OK) {
@@ -907,9 +907,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
         use.params.auto_select = jf__auto_cv_select(p, cv, ncv);
         free(cv);
     }
-    njs.weighted = (use.params.auto_select & JF_AUTO_WEIGHTED_MEAN) != 0;
-    njs.spread = (use.params.auto_select & JF_AUTO_SPREAD_CARRY) != 0;
-    njs.reach = jf__nj_reach(&use.params);
+    jf__njs_set(&njs, &use.params);
     if (cancelled(o)) {
         st = cancel_status(err);
         goto out;

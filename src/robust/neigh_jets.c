@@ -28,7 +28,13 @@ int jf__nj_weighted(const jf__njs *s, const jf_result *r)
     return s->weighted || r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2])) > JF_NJ_MID;
 }
 
-size_t jf__nj_head(const jf__njs *s, const jf_result *r, size_t *step)
+/* step 6's divisors of K: the nearest K/4 on capped rows, K/8 for the
+ * weighted mean, K/2 (every JF_NJ_STEP-th) for the spread carry */
+#define F_CAPPED 4.0
+#define F_WEIGHTED 8.0
+#define F_SPREAD 2.0
+
+size_t jf__nj_head(const jf__njs *s, const jf_result *r, int wide, size_t *step)
 {
     /* half to even, as the offline study; a capped K leaves more noise
      * for the mean to take (step 0).  A quadric fitted on a disk of radius
@@ -41,8 +47,8 @@ size_t jf__nj_head(const jf__njs *s, const jf_result *r, size_t *step)
      * every 4th of the K/2 nearest keeps most of the gain at the cost of
      * K/8 (docs/robustness.md, step 6) */
     const int capped = (r->status & JF_PT_AUTO_CAPPED) != 0;
-    const int spread = !capped && s->spread && !jf__nj_weighted(s, r);
-    const double f = capped ? 4.0 : spread ? 2.0 : 8.0;
+    const int spread = !capped && s->spread && !wide;
+    const double f = capped ? F_CAPPED : spread ? F_SPREAD : F_WEIGHTED;
     *step = spread ? JF_NJ_STEP : 1;
     double m = nearbyint(r->n_used / f);
     m = ceil(m / (double)*step); /* the point itself and every step-th after */
@@ -53,11 +59,17 @@ size_t jf__nj_reach(const jf_params *p)
 {
     int cap = p->auto_select & ~JF_AUTO_FLAGS;
     if (cap <= 1 || cap > JF_NB_AUTO_KMAX) cap = JF_NB_AUTO_KMAX;
-    /* jf__nj_head's divisors: capped rows K/4, weighted K/8, plain K/2 */
     const int spread = (p->auto_select & ~JF_AUTO_FLAGS) == 1 || (p->auto_select & JF_AUTO_SPREAD_CARRY);
-    const double f = spread ? 2.0 : cap < JF_NB_AUTO_KMAX ? 4.0 : 8.0;
+    const double f = spread ? F_SPREAD : cap < JF_NB_AUTO_KMAX ? F_CAPPED : F_WEIGHTED;
     const size_t m = (size_t)ceil(cap / f);
     return m < 1 ? 1 : m > JF_NJ_REACH ? JF_NJ_REACH : m;
+}
+
+void jf__njs_set(jf__njs *s, const jf_params *p)
+{
+    s->weighted = (p->auto_select & JF_AUTO_WEIGHTED_MEAN) != 0;
+    s->spread = (p->auto_select & JF_AUTO_SPREAD_CARRY) != 0;
+    s->reach = jf__nj_reach(p);
 }
 
 
@@ -93,9 +105,6 @@ jf_status jf__njs_alloc(jf__njs *s, size_t n)
 {
     s->v = malloc((n ? n : 1) * sizeof *s->v);
     s->state = calloc(n ? n : 1, 1);
-    s->weighted = 0;
-    s->spread = 0;
-    s->reach = JF_NJ_REACH;
     if (s->v && s->state) return JF_OK;
     jf__njs_free(s);
     return JF_ERR_NOMEM;
@@ -182,7 +191,7 @@ void jf__nj_mix(const jf__njs *s, const jf__nj_cache *c, const double *xyz, cons
         !isfinite(r->k2))
         return;
     const int wide = jf__nj_weighted(s, r);
-    size_t step, mc = jf__nj_head(s, r, &step);
+    size_t step, mc = jf__nj_head(s, r, wide, &step);
     if (mc > m) mc = m;
     double ind[3] = {0, 0, 0}, W[6] = {0, 0, 0, 0, 0, 0}; /* W: xx xy xz yy yz zz */
     size_t cc = 0;

@@ -35,7 +35,8 @@ typedef struct {
 
 enum { JF_NJ_EMPTY = 0, JF_NJ_BUSY = 1, JF_NJ_FIT = 2, JF_NJ_NONE = 3 };
 
-/* n records, all JF_NJ_EMPTY; JF_OK or JF_ERR_NOMEM. */
+/* n records, all JF_NJ_EMPTY (the rest of s: jf__njs_set); JF_OK or
+ * JF_ERR_NOMEM. */
 jf_status jf__njs_alloc(jf__njs *s, size_t n);
 void jf__njs_free(jf__njs *s);
 
@@ -56,6 +57,10 @@ void jf__njs_free(jf__njs *s);
  * 32, less under a cap. */
 size_t jf__nj_reach(const jf_params *p);
 
+/* s's weighted, spread and reach from an estimate's params (after step 0
+ * decided them). */
+void jf__njs_set(jf__njs *s, const jf_params *p);
+
 /* Whether an estimate runs step 6: auto on a k-NN of at least
  * JF_NJ_KMIN (JF_NB_AUTO's knn:JF_NB_AUTO_KMAX), whose shared search
  * (knn_share.c) gives the tree positions the records are keyed by. */
@@ -75,15 +80,16 @@ static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
  * bound by the noise (s->weighted). */
 int jf__nj_weighted(const jf__njs *s, const jf_result *r);
 
-/* Which of a point's nearest its row r reads, the normal and the
- * curvatures from: the nearest round(K / 4) where K was capped (step 0),
- * round(K / 8) where the mean is weighted or the carry not spread, every
+/* Which of a point's nearest its row r reads (wide: jf__nj_weighted's),
+ * the normal and the curvatures from: the nearest round(K / 4) where K
+ * was capped (step 0), round(K / 8) where the mean is weighted or the
+ * carry not spread, every
  * JF_NJ_STEP-th of the nearest round(K / 2) for the spread carry (s->
  * spread: a mean over that spread cancels most of the slope bias a cubic
  * term leaves in the quadric).  Returns how many (at least 1, at most
  * JF_NJ_HEAD), *step the stride (1 or JF_NJ_STEP) from the point
  * itself. */
-size_t jf__nj_head(const jf__njs *s, const jf_result *r, size_t *step);
+size_t jf__nj_head(const jf__njs *s, const jf_result *r, int wide, size_t *step);
 
 /* The state of point i's record (JF_NJ_*). */
 int jf__nj_state(const jf__njs *s, size_t i);

@@ -9,8 +9,9 @@
 # BUILD (default: build) holds the jetfit command; N (default 100000) is
 # the point count of a `jetfit generate torus --density gradient --noise
 # 0.003` cloud (binary PLY; SURF and NOISE: another surface of `jetfit
-# generate`, uniform, or noise; step 6 reads 32 records a row on the torus,
-# up to 128 where the cloud's fits are bias-bound); ROUNDS (default 5) rounds each run knn:32 then
+# generate`, uniform, or noise; step 6 reads 32 records a row, from the
+# 32 nearest on the torus, up to the 128th where its carry is spread);
+# ROUNDS (default 5) rounds each run knn:32 then
 # auto, one thread, binary PLY out.  The machine may be shared: each
 # setting's time is its least CPU time (user + system) over the rounds,
 # the two alternating so that both see the same load.  Prints per setting
