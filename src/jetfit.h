@@ -123,9 +123,9 @@ enum {
     JF_PT_AUTO_WEIGHTED = 1u << 19,/* auto, jf_estimate: the normal is
                                       the neighbours' fits' weighted
                                       trapezoid mean over K/8 of them
-                                      (the noise large against the fit's
-                                      spread, or the cloud's fits bound
-                                      by the noise: step 6), not their
+                                      (K/4 if capped; the noise large
+                                      against the fit's spread, or step
+                                      0's bias test: step 6), not their
                                       plain carry                       */
     JF_PT_AUTO_SPREAD = 1u << 20   /* auto, jf_estimate: the plain carry
                                       over every 4th of the K/2 nearest
@@ -214,8 +214,16 @@ typedef struct {
  * 256 points is off the cubic's by a little more than the noise explains,
  * the sample's median statistic in (1, 4]: docs/robustness.md, step 0) */
 #define JF_AUTO_SPREAD_CARRY 4096
-/* the three flags */
-#define JF_AUTO_FLAGS (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY)
+/* OR'd into params.auto_select (with a cap): step 6 takes the weighted
+ * trapezoid mean on capped rows too, not the plain carry (jf_estimate
+ * sets it, with a cap of at least 32, where the cloud is capped and the
+ * quadric's normal on 32 points is off the cubic's by a little more than
+ * the noise explains, the sample's median statistic in (1, 4]: the range
+ * scans; docs/robustness.md, step 0) */
+#define JF_AUTO_CAPPED_WEIGHTED 8192
+/* the four flags */
+#define JF_AUTO_FLAGS \
+    (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY | JF_AUTO_CAPPED_WEIGHTED)
 
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);

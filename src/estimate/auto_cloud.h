@@ -27,11 +27,14 @@ typedef struct {
                         on fewer than 48 points                          */
     double bias;     /* median of the sample's JF_AUTO_CV_BIAS (about
                         ln 2 where the noise alone parts the two normals) */
+    double bias32;   /* median of the sample's JF_AUTO_CV_BIAS32         */
     int cap;         /* params.auto_select: the cap (JF_NB_AUTO_KMAX none),
                         | JF_AUTO_CUBIC_MIN48 where cubic_min48,
                         | JF_AUTO_WEIGHTED_MEAN where no cap and bias is
                         at most 1, | JF_AUTO_SPREAD_CARRY where no cap
-                        and bias is above 1, at most 4                    */
+                        and bias is above 1, at most 4,
+                        | JF_AUTO_CAPPED_WEIGHTED and a cap of at least
+                        32 where capped and bias32 is above 1, at most 4 */
 } jf__auto_cv_why;
 
 /* Whether an estimate with p and nb decides the cap itself (auto, the

@@ -1008,6 +1008,21 @@ static double loo2(const mom *mo, double H, double hK, int nd)
     return r * r;
 }
 
+/* Candidate c's quadric normal against its cubic's: the squared angle
+ * over the variance the noise alone gives it.  The cubic's slope is
+ * unbiased where the 4th-order terms are small (§3) and the two differ by
+ * noise of variance tr3 - tr2 (nested least squares), so a quadric's
+ * slope bias adds to about chi2_2 / 2.  +inf: a bias and no noise. */
+static double bias_stat(const stage *g, int c)
+{
+    const cand_fit *q2 = &g->cf[0][c], *q3 = &g->cf[1][c];
+    if (!q2->ok || !q3->ok || !(q3->tr > q2->tr)) return NAN;
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++) d2 += (q3->nrm[k] - q2->nrm[k]) * (q3->nrm[k] - q2->nrm[k]);
+    const double den = (q3->tr - q2->tr) * q3->s2; /* 0: no noise left */
+    return den > 0.0 ? d2 / den : d2 > 0.0 ? INFINITY : NAN;
+}
+
 void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, double out[JF_AUTO_CV_N])
 {
@@ -1028,16 +1043,9 @@ void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], con
         out[JF_AUTO_CV_SMALL] = loo2(&mk, g.H, g.hks[0], 6);
         out[JF_AUTO_CV_SMALL + 1] = loo2(&mk, g.H, g.hks[0], NMON);
     }
-    const cand_fit *q2 = &g.cf[0][g.nc - 1], *q3 = &g.cf[1][g.nc - 1];
-    if (g.ks[g.nc - 1] == JF_NB_AUTO_KMAX && q2->ok && q3->ok && q3->tr > q2->tr) {
-        /* the quadric's slope bias on the most points against the noise
-         * (the cubic's slope is unbiased where the 4th-order terms are
-         * small, §3; the two differ by noise of variance tr3 - tr2) */
-        double d2 = 0.0;
-        for (int k = 0; k < 3; k++) d2 += (q3->nrm[k] - q2->nrm[k]) * (q3->nrm[k] - q2->nrm[k]);
-        const double den = (q3->tr - q2->tr) * q3->s2; /* 0: no noise left */
-        out[JF_AUTO_CV_BIAS] = den > 0.0 ? d2 / den : d2 > 0.0 ? INFINITY : NAN;
-    }
+    if (g.ks[g.nc - 1] == JF_NB_AUTO_KMAX) out[JF_AUTO_CV_BIAS] = bias_stat(&g, g.nc - 1);
+    if (g.nc > JF_AUTO_CV_K32 && g.ks[JF_AUTO_CV_K32] == jf__auto_ks[JF_AUTO_CV_K32])
+        out[JF_AUTO_CV_BIAS32] = bias_stat(&g, JF_AUTO_CV_K32);
     if (g.nmax > 16) {
         const double *q = nbr + 3 * 16;
         const double r = sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +

@@ -23,8 +23,9 @@
 int jf__nj_weighted(const jf__njs *s, const jf_result *r)
 {
     /* a capped cloud (step 0) has detail at its small K, which the mean
-     * shape operator would smooth: the plain carry there */
-    if (r->status & JF_PT_AUTO_CAPPED) return 0;
+     * shape operator would smooth: the plain carry there, unless step 0
+     * found its small fits mildly biased (the range scans: item 8) */
+    if (r->status & JF_PT_AUTO_CAPPED) return s->capw;
     return s->weighted || r->sigma / sqrt(2.0 * (r->pca_eval[1] + r->pca_eval[2])) > JF_NJ_MID;
 }
 
@@ -69,6 +70,7 @@ void jf__njs_set(jf__njs *s, const jf_params *p)
 {
     s->weighted = (p->auto_select & JF_AUTO_WEIGHTED_MEAN) != 0;
     s->spread = (p->auto_select & JF_AUTO_SPREAD_CARRY) != 0;
+    s->capw = (p->auto_select & JF_AUTO_CAPPED_WEIGHTED) != 0;
     s->reach = jf__nj_reach(p);
 }
 

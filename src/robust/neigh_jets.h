@@ -29,6 +29,8 @@ typedef struct {
                        row not capped, whatever its noise                  */
     int spread;     /* JF_AUTO_SPREAD_CARRY: the plain carry over every
                        JF_NJ_STEP-th of the K/2 nearest                    */
+    int capw;       /* JF_AUTO_CAPPED_WEIGHTED: the weighted mean on
+                       capped rows too                                   */
     size_t reach;   /* the farthest of a point's nearest a row reads
                        (jf__nj_reach)                                      */
 } jf__njs;
@@ -75,9 +77,10 @@ static inline int jf__nj_on(const jf_params *p, const jf_nb_spec *nb)
 #endif
 }
 
-/* Whether row r takes the weighted trapezoid mean: not capped, and its
- * noise large against its fit's spread (JF_NJ_MID) or the cloud's fits
- * bound by the noise (s->weighted). */
+/* Whether row r takes the weighted trapezoid mean: capped, where step 0
+ * says so (s->capw); else where its noise is large against its fit's
+ * spread (JF_NJ_MID) or the cloud's fits are bound by the noise
+ * (s->weighted). */
 int jf__nj_weighted(const jf__njs *s, const jf_result *r);
 
 /* Which of a point's nearest its row r reads (wide: jf__nj_weighted's),

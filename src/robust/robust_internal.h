@@ -112,12 +112,15 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
  * of its own points, and out[JF_AUTO_CV_BIAS] the squared angle between
  * the quadric's and the cubic's normals on the largest candidate (in step
  * 1's frame) over the variance the noise alone gives it (sigma^2 times
- * the cubic's angle variance less the quadric's: nested least squares);
+ * the cubic's angle variance less the quadric's: nested least squares),
+ * out[JF_AUTO_CV_BIAS32] the same on 32 points (JF_AUTO_CV_K32);
  * all NaN where steps 1-2 fail.  The decision from a sample of these:
  * auto_cloud.c. */
 #define JF_AUTO_CV_SMALL (JF_AUTO_NCAND + 1)
 #define JF_AUTO_CV_BIAS (JF_AUTO_CV_SMALL + 2)
-#define JF_AUTO_CV_N (JF_AUTO_CV_BIAS + 1)
+#define JF_AUTO_CV_BIAS32 (JF_AUTO_CV_BIAS + 1)
+#define JF_AUTO_CV_N (JF_AUTO_CV_BIAS32 + 1)
+#define JF_AUTO_CV_K32 2 /* jf__auto_ks[JF_AUTO_CV_K32] == 32 */
 void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, double out[JF_AUTO_CV_N]);
 

@@ -179,16 +179,16 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
  * l2)_j / sigma_j^2 -- the curvatures the eigenvalues of the plain mean
  * W_j in the plane normal to it; n[3], k[2] out; 0 where the row stays
  * q's, 2 where the weighted mean was taken, 3 the spread carry, else 1.  A capped row (step 0):
- * round(K/4) nearest, never the weighted mean. */
+ * round(K/4) nearest, the weighted mean only under JF_AUTO_CAPPED_WEIGHTED. */
 static int mixed(const surf *c, const jf_result *own, const uint32_t *idx, size_t q, int flags,
                  double n[3], double k[2])
 {
     const jf_result *a = &own[q];
     if (a->degree < 2) return 0;
     const int capped = (a->status & JF_PT_AUTO_CAPPED) != 0;
-    const int wide = ((flags & JF_AUTO_WEIGHTED_MEAN) ||
-                      a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID) &&
-                     !capped;
+    const int wide = capped ? (flags & JF_AUTO_CAPPED_WEIGHTED) != 0
+                            : (flags & JF_AUTO_WEIGHTED_MEAN) ||
+                                  a->sigma / sqrt(2 * (a->pca_eval[1] + a->pca_eval[2])) > JF_NJ_MID;
     /* capped: the K/4 nearest; weighted or not spread: the K/8 nearest;
      * spread: q and every 4th after it among the K/2 nearest */
     const int spread = !capped && !wide && (flags & JF_AUTO_SPREAD_CARRY);
@@ -344,7 +344,7 @@ static void is_the_jet(surf c, int sel)
     /* both means met: here sigma / sqrt(2 (l1 + l2)) straddles JF_NJ_MID;
      * capped, the plain carry only; JF_AUTO_WEIGHTED_MEAN, the weighted */
     if ((cap & ~JF_AUTO_FLAGS) < JF_NB_AUTO_KMAX)
-        ck_assert_uint_eq(nwide, 0);
+        ck_assert_uint_eq(nwide, cap & JF_AUTO_CAPPED_WEIGHTED ? nmix : 0);
     else if (cap & JF_AUTO_WEIGHTED_MEAN)
         ck_assert_uint_eq(nwide, nmix);
     else
@@ -410,6 +410,9 @@ START_TEST(test_auto_is_the_jet_capped)
     /* at 0.3% the cubic on 16 points follows the noise: cubics from 48 */
     ck_assert_int_ne(sel & JF_AUTO_CUBIC_MIN48, 0);
     is_the_jet(c, 1);
+    /* the weighted mean on the capped rows too, given by hand */
+    is_the_jet(make(JF_SURF_TORUS, 4000, 0.003, JF_DENSITY_GRADIENT),
+               (sel & ~JF_AUTO_CAPPED_WEIGHTED) | JF_AUTO_CAPPED_WEIGHTED);
 }
 END_TEST
 
@@ -731,7 +734,7 @@ START_TEST(test_auto_cv_decide)
             for (int noisy = 0; noisy < 6; noisy++) {
                 /* noisy >> 1: the bias statistic's median at most 1, just
                  * above 4, just above 1 (at most 4) */
-                const int biased = noisy >> 1;
+                const int biased = noisy >> 1, b32 = (biased + pick) % 3; /* the same, on 32 points */
                 static const double lo[3] = {0.1, 0.1, 1.001}, hi[3] = {1.001, 4.001, 4.001};
                 for (int s = 0; s < M; s++) {
                     r[s].gid = (uint32_t)(7 * s % M) * 3u;
@@ -745,6 +748,7 @@ START_TEST(test_auto_cv_decide)
                     r[s].v[JF_AUTO_CV_SMALL + 1] = 2 * s < M + (noisy & 1 ? 0 : 2) ? 0.01 : 1.01;
                     /* the median decides, not the mean */
                     r[s].v[JF_AUTO_CV_BIAS] = 2 * s < M + (biased == 1 ? -2 : 2) ? lo[biased] : hi[biased];
+                    r[s].v[JF_AUTO_CV_BIAS32] = 2 * s < M + (b32 == 1 ? -2 : 2) ? lo[b32] : hi[b32];
                 }
                 memcpy(q, r, sizeof r);
                 int cap = jf__auto_cv_decide(r, M, &w);
@@ -754,13 +758,17 @@ START_TEST(test_auto_cv_decide)
                 ck_assert_int_eq(w.cubic_min48, noisy & 1);
                 static const double med[3] = {0.1, 4.001, 1.001};
                 ck_assert_double_eq(w.bias, med[biased]);
+                ck_assert_double_eq(w.bias32, med[b32]);
                 const int capped = !thick && ks[pick] <= 64;
                 /* no cap: no bias the noise does not explain, the
-                 * weighted mean everywhere; a mild one, the spread carry */
+                 * weighted mean everywhere; a mild one, the spread carry;
+                 * capped with a mild one on 32 points: the weighted mean
+                 * on the capped rows, K up to at least 32 */
                 static const int fl[3] = {JF_AUTO_WEIGHTED_MEAN, 0, JF_AUTO_SPREAD_CARRY};
-                ck_assert_int_eq(cap, (capped ? ks[pick + 1] : JF_NB_AUTO_KMAX) |
-                                          (noisy & 1 ? JF_AUTO_CUBIC_MIN48 : 0) |
-                                          (capped ? 0 : fl[biased]));
+                const int own = capped && b32 == 2;
+                const int k = capped ? ks[pick + 1] : JF_NB_AUTO_KMAX;
+                ck_assert_int_eq(cap, (own && k < 32 ? 32 : k) | (noisy & 1 ? JF_AUTO_CUBIC_MIN48 : 0) |
+                                          (capped ? 0 : fl[biased]) | (own ? JF_AUTO_CAPPED_WEIGHTED : 0));
                 for (int s = 0; s < M; s++) q[s] = r[M - 1 - s];
                 ck_assert_int_eq(jf__auto_cv_decide(q, M, NULL), cap);
             }

@@ -428,9 +428,9 @@ START_TEST(new_params_validated)
     p.dist_weight = 0.0;
     /* auto_select: 0, 1 or a cap 16..256, either with JF_AUTO_FLAGS */
     static const int good[] = {0, 1, 16, 24, 256, 1 | JF_AUTO_CUBIC_MIN48, 48 | JF_AUTO_CUBIC_MIN48,
-                               1 | JF_AUTO_WEIGHTED_MEAN, 24 | JF_AUTO_FLAGS};
+                               1 | JF_AUTO_WEIGHTED_MEAN, 32 | JF_AUTO_CAPPED_WEIGHTED, 24 | JF_AUTO_FLAGS};
     static const int wrong[] = {-1, 2, 15, 257, JF_AUTO_CUBIC_MIN48, 8 | JF_AUTO_CUBIC_MIN48,
-                                JF_AUTO_WEIGHTED_MEAN, JF_AUTO_FLAGS, 8192 | 24};
+                                JF_AUTO_WEIGHTED_MEAN, JF_AUTO_CAPPED_WEIGHTED, JF_AUTO_FLAGS, 16384 | 24};
     for (size_t i = 0; i < sizeof good / sizeof *good; i++) {
         p.auto_select = good[i];
         ck_assert_int_eq(jf_params_validate(&p, &bad), JF_OK);
