@@ -215,8 +215,9 @@ typedef struct {
  * the sample's median statistic in (1, 4]: docs/robustness.md, step 0) */
 #define JF_AUTO_SPREAD_CARRY 4096
 /* OR'd into params.auto_select (with a cap): step 6 takes the weighted
- * trapezoid mean on capped rows too, not the plain carry (jf_estimate
- * sets it, with a cap of at least 32, where the cloud is capped and the
+ * trapezoid mean on capped rows too, not the plain carry, and no capped
+ * row's K is below 32 (jf_estimate sets it, with a cap of at least 32,
+ * where the cloud is capped and the
  * quadric's normal on 32 points is off the cubic's by a little more than
  * the noise explains, the sample's median statistic in (1, 4]: the range
  * scans; docs/robustness.md, step 0) */

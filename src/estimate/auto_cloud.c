@@ -34,8 +34,9 @@
  * plain carry reads every 4th of the K/2 nearest (JF_AUTO_SPREAD_CARRY;
  * the ellipsoid and the torus at 0.1% read 1.9 and 1.5; item 6).
  * Where K is capped and the same statistic on 32 points is above 1, at
- * most 4, the capped rows take the weighted mean, K up to at least 32
- * (JF_AUTO_CAPPED_WEIGHTED; the range scans read 1.5-2.1; item 8). */
+ * most 4, the capped rows take the weighted mean and K = 32 where the
+ * cap was below (JF_AUTO_CAPPED_WEIGHTED; the range scans read 1.5-2.1;
+ * item 8). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,7 +55,6 @@
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
 #define JF_CV_NOBIAS 1.0   /* median bias statistic at most: noise-bound   */
 #define JF_CV_MILDBIAS 4.0 /* at most: a cubic term's bias, spread carry   */
-#define JF_CV_CAPW_MIN 32  /* the least cap with JF_AUTO_CAPPED_WEIGHTED    */
 
 size_t jf__auto_cv_stride(size_t ntotal)
 {
@@ -208,13 +208,14 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
      * the clean one 13): the plain carry by each neighbour's own shape
      * operator added more noise than it took (the scans' normals agree
      * less between overlapping scans with it); the weighted trapezoid
-     * mean does not, and K up to 32 gains more than the least CV's K
-     * loses (item 8) */
+     * mean does not; and the scans' best K is 32 (as the mesh judges,
+     * the least CV's 16-24 less), which the cap and the fits keep
+     * (auto.c: no candidate below it; item 8) */
     const int cap = w.cap & ~JF_AUTO_FLAGS;
     if (cap < JF_NB_AUTO_KMAX && n32 >= JF_CV_MINREC && w.bias32 > JF_CV_NOBIAS &&
         w.bias32 <= JF_CV_MILDBIAS)
         w.cap = (w.cap & JF_AUTO_FLAGS) | JF_AUTO_CAPPED_WEIGHTED |
-                (cap < JF_CV_CAPW_MIN ? JF_CV_CAPW_MIN : cap);
+                (cap < JF_AUTO_CAPW_KMIN ? JF_AUTO_CAPW_KMIN : cap);
     if (why) *why = w;
     return w.cap;
 }

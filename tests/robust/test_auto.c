@@ -293,6 +293,9 @@ static void is_the_jet(surf c, int sel)
         const jf_result *a = &own[i];
         ck_assert(a->degree >= 1 && a->degree <= 3);
         ck_assert(!(cap & JF_AUTO_CUBIC_MIN48) || a->degree < 3 || a->n_used >= 48);
+        /* JF_AUTO_CAPPED_WEIGHTED: no capped row below 32 points */
+        ck_assert(!(cap & JF_AUTO_CAPPED_WEIGHTED) || !(a->status & JF_PT_AUTO_CAPPED) ||
+                  a->n_used >= 32);
         ck_assert_int_eq(ra[i].n_used, a->n_used);
         ck_assert_int_eq(ra[i].degree, a->degree);
         ck_assert(ra[i].cond == a->cond && ra[i].residual == a->residual && ra[i].sigma == a->sigma);
