@@ -9,7 +9,8 @@
  *  - per sampled point, jf__auto_cv_point on its JF_NB_AUTO_KMAX nearest
  *    (the walk's list, bit for bit): the quadric's squared leave-one-out
  *    residual at each candidate K and sigma / r16;
- *  - the decision (jf__auto_cv_decide) sums them in input-index order,
+ *  - the decision (jf__auto_cv_decide) sums them, each clipped at 25
+ *    times its candidate's median (cv_clip), in input-index order,
  *    whoever computed them: whole cloud, parts and ranks agree.
  * Where the cubic on the 16 nearest, in their own frame, predicts p better
  * than the quadric at no more than half the sample, the noise outweighs
@@ -53,6 +54,8 @@
 #define JF_CV_THICK 0.4    /* median sigma / r16 above: thick noise        */
 #define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
+#define JF_CV_CLIP 25.0    /* a squared residual counts at most this times
+                              its candidate's median (cv_clip)            */
 #define JF_CV_NOBIAS 1.0   /* median bias statistic at most: noise-bound   */
 #define JF_CV_MILDBIAS 4.0 /* at most: a cubic term's bias, spread carry   */
 
@@ -137,6 +140,37 @@ static int by_gid(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* every candidate's CV is there */
+static int usable(const jf__cvrec *r)
+{
+    for (int c = 0; c < JF_AUTO_NCAND; c++)
+        if (!isfinite(r->v[c])) return 0;
+    return 1;
+}
+
+/* clip[c]: JF_CV_CLIP times the median of candidate c's squared residuals
+ * over the usable records (+inf where none, or no memory: no clip).  A
+ * few wild points' residuals dominate the plain sums (the range scan
+ * ear_back's: 2 10^4 to 1, least at K = 96 where its other scans' is at
+ * 16-24); clipped, a point counts at most about (3.4 sigma)^2 for
+ * Gaussian residuals, whose median square is 0.455 sigma^2 (robust
+ * cross-validation: Leung, Ann. Stat. 2005). */
+static void cv_clip(const jf__cvrec *r, size_t n, double clip[JF_AUTO_NCAND])
+{
+    for (int c = 0; c < JF_AUTO_NCAND; c++) clip[c] = INFINITY;
+    double *t = malloc((n ? n : 1) * sizeof *t);
+    if (!t) return;
+    for (int c = 0; c < JF_AUTO_NCAND; c++) {
+        size_t m = 0;
+        for (size_t s = 0; s < n; s++)
+            if (usable(&r[s])) t[m++] = r[s].v[c];
+        if (!m) break;
+        jf__select_kth(t, m, m / 2);
+        clip[c] = JF_CV_CLIP * t[m / 2];
+    }
+    free(t);
+}
+
 int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
 {
     jf__auto_cv_why w;
@@ -144,19 +178,19 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
     w.cap = JF_NB_AUTO_KMAX;
     w.median = NAN;
     qsort(r, n, sizeof *r, by_gid); /* input order: every split sums alike */
+    double clip[JF_AUTO_NCAND];
+    cv_clip(r, n, clip);
     double sum[JF_AUTO_NCAND] = {0}, *sr = malloc((n ? n : 1) * sizeof *sr),
            *sb = malloc((n ? n : 1) * sizeof *sb), *s32 = malloc((n ? n : 1) * sizeof *s32);
     size_t ns = 0, nb = 0, n32 = 0, nsmall = 0, cubic = 0; /* the smallest K's: both fitted, the cubic nearer */
     for (size_t s = 0; s < n; s++) {
-        int all = 1;
         const double *v2 = r[s].v + JF_AUTO_CV_SMALL;
         if (isfinite(v2[0]) && isfinite(v2[1])) cubic += v2[1] < v2[0], nsmall++;
         /* +inf: a bias with no noise at all, the largest */
         if (sb && !isnan(r[s].v[JF_AUTO_CV_BIAS])) sb[nb++] = r[s].v[JF_AUTO_CV_BIAS];
         if (s32 && !isnan(r[s].v[JF_AUTO_CV_BIAS32])) s32[n32++] = r[s].v[JF_AUTO_CV_BIAS32];
-        for (int c = 0; c < JF_AUTO_NCAND && all; c++) all = isfinite(r[s].v[c]);
-        if (!all) continue;
-        for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += r[s].v[c];
+        if (!usable(&r[s])) continue;
+        for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += fmin(r[s].v[c], clip[c]);
         if (sr && isfinite(r[s].v[JF_AUTO_NCAND])) sr[ns++] = r[s].v[JF_AUTO_NCAND];
         w.used++;
     }

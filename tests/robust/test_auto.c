@@ -791,6 +791,18 @@ START_TEST(test_auto_cv_decide)
     for (int s = 0; s < M; s++) r[s].v[3] = NAN; /* no usable record: no cap */
     ck_assert_int_eq(jf__auto_cv_decide(r, M, &w), JF_NB_AUTO_KMAX);
     ck_assert_uint_eq(w.used, 0);
+    /* a few wild points do not decide: each squared residual counts at
+     * most 25 times its candidate's median (three records 10^6 times
+     * larger, least at the largest K, would move the plain sums' least
+     * from 16 to 256) */
+    for (int s = 0; s < M; s++) {
+        for (int c = 0; c < JF_AUTO_NCAND; c++)
+            r[s].v[c] = s < 3 ? 1e6 * (JF_AUTO_NCAND - c) : 1.0 + c * c;
+        r[s].v[JF_AUTO_NCAND] = 0.1;
+        r[s].v[JF_AUTO_CV_BIAS32] = 0.5;
+    }
+    ck_assert_int_eq(jf__auto_cv_decide(r, M, &w) & ~JF_AUTO_FLAGS, 24);
+    ck_assert_int_eq(w.pick, 16);
 }
 END_TEST
 
