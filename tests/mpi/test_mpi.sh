@@ -7,7 +7,7 @@
 #       duplicates straddling a cut, K above the parts' counts, an empty
 #       part, NaN rows, big-endian floats with normals), for knn, radius,
 #       knn+radius, every fit option, orientation none/input/viewpoint, and
-#       the text outputs.
+#       the text outputs; auto's step 0 regimes, a range scan's among them.
 #   full-disk: on a 2 MB tmpfs (skipped where it cannot be mounted) every
 #       np ends with exit 1, one line, the old output intact, no temporary.
 #   errors: refused options and inputs, bad files and a failing rank end
@@ -121,6 +121,16 @@ equal-more)
     [ "$got" -gt "$least" ] && echo "ok   auto $name: $got rows flagged $bit" ||
       bad "auto on $name.ply: $got rows flagged $bit (want more than $least)"
   done
+  # a raw range scan (data/bun090.ply, made binary): step 0 caps K at 32
+  # and weights every row's mean (bits 18 and 19), decided from the ranks'
+  # shares of the sample
+  "$jetfit" estimate "$here/../../data/bun090.ply" -o "$d/scan.ply" --keep none --quiet ||
+    bad "jetfit estimate bun090.ply"
+  same "2" scan.ply csv --neighbors auto --orient none
+  got=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "status") s = i; next }
+                 int($s / 262144) % 2 && int($s / 524288) % 2 { c++ } END { print c + 0 }' "$d/ref.csv")
+  [ "$got" -eq 30379 ] && echo "ok   auto scan: $got rows capped and weighted" ||
+    bad "auto on bun090: $got rows capped and weighted (want 30379)"
   # auto's halo balls overlap: each point is sent to a rank once (kept == fetched)
   mpi 3 estimate "$d/clusters.ply" -o "$d/got.csv" --neighbors auto 2>"$d/stderr" >/dev/null
   h=$(sed -n 's/^ *halo: \([0-9]*\) points kept, \([0-9]*\) fetched.*/\1 \2/p' "$d/stderr")
