@@ -216,11 +216,11 @@ typedef struct {
 #define JF_AUTO_SPREAD_CARRY 4096
 /* OR'd into params.auto_select (with a cap): step 6 takes the weighted
  * trapezoid mean on capped rows too, not the plain carry, and no capped
- * row's K is below 32 (jf_estimate sets it, with a cap of at least 32,
- * where the cloud is capped and the
- * quadric's normal on 32 points is off the cubic's by a little more than
- * the noise explains, the sample's median statistic in (1, 4]: the range
- * scans; docs/robustness.md, step 0) */
+ * row's K is below 32 or the cap, the smaller (jf_estimate sets it, with
+ * a cap of at least 32, where the cloud is capped and the quadric's
+ * normal on 32 points is off the cubic's by a little more than the noise
+ * explains, the sample's median statistic in (1, 4]: the range scans;
+ * docs/robustness.md, step 0) */
 #define JF_AUTO_CAPPED_WEIGHTED 8192
 /* the four flags */
 #define JF_AUTO_FLAGS \

@@ -121,8 +121,8 @@ int jf__auto_rule(const jf__knobs *kn, const jf__auto_cands *c, int *d);
 #define JF_AUTO_CV_BIAS32 (JF_AUTO_CV_BIAS + 1)
 #define JF_AUTO_CV_N (JF_AUTO_CV_BIAS32 + 1)
 #define JF_AUTO_CV_K32 2 /* jf__auto_ks[JF_AUTO_CV_K32] == 32 */
-/* Under JF_AUTO_CAPPED_WEIGHTED the cap is at least this, and no capped
- * row's candidate below it (step 0; docs/robustness.md, item 8). */
+/* Under JF_AUTO_CAPPED_WEIGHTED step 0's cap is at least this, and no
+ * capped row's candidate below it or the cap (docs/robustness.md, item 8). */
 #define JF_AUTO_CAPW_KMIN 32
 void jf__auto_cv_point(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                        size_t n, double out[JF_AUTO_CV_N]);
