@@ -24,25 +24,14 @@ import tempfile
 
 import numpy as np
 
-from scan_mesh import pose
+from scan_mesh import H, nearest, pose
 
 
 def pairs(P, Q, h):
-    """(i, j): P[i]'s nearest row of Q within h"""
-    cells = {}
-    for j, k in enumerate(map(tuple, np.floor(Q / h).astype(np.int64))):
-        cells.setdefault(k, []).append(j)
-    ia, ib = [], []
-    for n, k in enumerate(map(tuple, np.floor(P / h).astype(np.int64))):
-        cand = [j for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)
-                for j in cells.get((k[0] + dx, k[1] + dy, k[2] + dz), ())]
-        if cand:
-            e = ((Q[cand] - P[n]) ** 2).sum(1)
-            b = int(np.argmin(e))
-            if e[b] < h * h:
-                ia.append(n)
-                ib.append(cand[b])
-    return np.array(ia, dtype=np.int64), np.array(ib, dtype=np.int64)
+    """(i, j): P[i]'s nearest row of Q within h (h <= scan_mesh's cell)"""
+    d, at = nearest(Q, P)
+    i = np.flatnonzero(d < h)
+    return i, at[i]
 
 
 def main():
@@ -53,6 +42,8 @@ def main():
     ap.add_argument("--near", type=float, default=0.0002)
     ap.add_argument("scans", nargs="*")
     a = ap.parse_args()
+    if not 0 < a.near <= H:
+        sys.exit("scan_pairs: --near must be in (0, %g]" % H)
     jetfit = os.path.join(a.build, "jetfit")
     root = os.path.join(a.data, "scans", "stanford_bunny", "data")
     if not os.access(jetfit, os.X_OK):
