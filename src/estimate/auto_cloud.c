@@ -140,6 +140,15 @@ static int by_gid(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The median (the upper one of an even count) of a[0..m), reordered;
+ * NaN where a is NULL (no memory) or empty. */
+static double median(double *a, size_t m)
+{
+    if (!a || !m) return NAN;
+    jf__select_kth(a, m, m / 2);
+    return a[m / 2];
+}
+
 /* every candidate's CV is there */
 static int usable(const jf__cvrec *r)
 {
@@ -165,8 +174,7 @@ static void cv_clip(const jf__cvrec *r, size_t n, double clip[JF_AUTO_NCAND])
         for (size_t s = 0; s < n; s++)
             if (usable(&r[s])) t[m++] = r[s].v[c];
         if (!m) break;
-        jf__select_kth(t, m, m / 2);
-        clip[c] = JF_CV_CLIP * t[m / 2];
+        clip[c] = JF_CV_CLIP * median(t, m);
     }
     free(t);
 }
@@ -176,7 +184,6 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
     jf__auto_cv_why w;
     memset(&w, 0, sizeof w);
     w.cap = JF_NB_AUTO_KMAX;
-    w.median = NAN;
     qsort(r, n, sizeof *r, by_gid); /* input order: every split sums alike */
     double clip[JF_AUTO_NCAND];
     cv_clip(r, n, clip);
@@ -194,22 +201,11 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
         if (sr && isfinite(r[s].v[JF_AUTO_NCAND])) sr[ns++] = r[s].v[JF_AUTO_NCAND];
         w.used++;
     }
-    if (sr && ns) {
-        jf__select_kth(sr, ns, ns / 2);
-        w.median = sr[ns / 2];
-    }
+    w.median = median(sr, ns);
+    w.bias = median(sb, nb);
+    w.bias32 = median(s32, n32);
     free(sr);
-    w.bias = NAN;
-    if (sb && nb) {
-        jf__select_kth(sb, nb, nb / 2);
-        w.bias = sb[nb / 2];
-    }
     free(sb);
-    w.bias32 = NAN;
-    if (s32 && n32) {
-        jf__select_kth(s32, n32, n32 / 2);
-        w.bias32 = s32[n32 / 2];
-    }
     free(s32);
     if (w.used >= JF_CV_MINREC) {
         int b = 0;

@@ -891,19 +891,18 @@ static int auto_begin(jf_fitter *f, const jf_params *pr, const double p[3], cons
         if (ks[i] < (min48 ? CUBIC_MINK_CV : CUBIC_MINK) && ks[i] < nmax && (min48 || !(s2 <= hc * hc)))
             cf[1][i].ok = 0;
     }
-    /* step 0's cap (the cloud's cross-validation, jf__auto_cv_point):
-     * no candidate above it */
-    int capped = 0;
-    if (cap > 1)
-        for (int i = 0; i < nc; i++)
-            if (ks[i] > cap) cf[0][i].ok = cf[1][i].ok = 0, capped = 1;
-    /* where step 0 found the cloud's small fits mildly biased, none below
-     * JF_AUTO_CAPW_KMIN either, nor below a smaller cap (the range scans'
-     * rows at K = 16 and 24 were 2.6 and 1.5 times knn:32's mean error on
-     * the same points: a wild small fit stops Lepski's rule; item 8) */
-    if (capped && (pr->auto_select & JF_AUTO_CAPPED_WEIGHTED))
-        for (int i = 0; i < nc; i++)
-            if (ks[i] < JF_AUTO_CAPW_KMIN && ks[i] < cap) cf[0][i].ok = cf[1][i].ok = 0;
+    /* step 0's cap (the cloud's cross-validation, jf__auto_cv_point): no
+     * candidate above it (ks ascend); where step 0 found the cloud's small
+     * fits mildly biased, none below JF_AUTO_CAPW_KMIN either, nor below a
+     * smaller cap (the range scans' rows at K = 16 and 24 were 2.6 and 1.5
+     * times knn:32's mean error on the same points: a wild small fit stops
+     * Lepski's rule; item 8) */
+    const int capped = cap > 1 && ks[nc - 1] > cap;
+    const size_t least = capped && (pr->auto_select & JF_AUTO_CAPPED_WEIGHTED)
+                             ? (cap < JF_AUTO_CAPW_KMIN ? cap : JF_AUTO_CAPW_KMIN)
+                             : 0;
+    for (int i = 0; i < nc; i++)
+        if ((capped && ks[i] > cap) || ks[i] < least) cf[0][i].ok = cf[1][i].ok = 0;
 
     /* steps 3-4 (auto_rule.c): the candidate and the degree */
     jf__auto_cands C;
