@@ -1,6 +1,6 @@
 /* nbctx.c -- the neighbourhood of a point, whatever its kind: the
  * natural neighbourhoods' setup (cells and tangent planes, §5.1) and the
- * per-point query the estimate's walk makes (pipeline.c). */
+ * per-point query the estimate's walk makes (walk.c). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

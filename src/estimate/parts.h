@@ -137,7 +137,7 @@ void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
 #define JF_PLAN_NJ_THREAD (3584u << 10) /* auto: a thread's rows in hand
                                   (a unit and as many waiting: 224-byte
                                   rows, 32 nearest each, decoded records;
-                                  about 3.4 MiB, pipeline.c): fit_thread */
+                                  about 3.4 MiB, walk.c): fit_thread */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */

@@ -1,5 +1,5 @@
 /* orient_internal.h -- orientation pieces for the streaming pipeline
- * (pipeline.c's jf_estimate_blocks), not part of the public API. */
+ * (walk.c, for jf_estimate_blocks), not part of the public API. */
 #ifndef JF_ORIENT_INTERNAL_H
 #define JF_ORIENT_INTERNAL_H
 
