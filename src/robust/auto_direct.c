@@ -58,7 +58,6 @@ void jf__auto_own_frame(const mom *mo0, double H, const double fr0[9], jf_frame_
     jf__frame_axes(evec, mode, fk);
 }
 
-
 /* G' of degree deg from the sums: nd x nd into E */
 static int gram_of(const jf__auto_dfit *D, int deg, double *E)
 {

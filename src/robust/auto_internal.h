@@ -75,9 +75,10 @@ void jf__auto_first_pass(const double p[3], const double *nbr, size_t nmax, cons
  * lowered while G' is singular or too ill-conditioned (params.max_cond,
  * flags LOWERED_RANK / LOWERED_COND), A_ij = Y_ij / h^(i+j), then the
  * quantities (monge.c).  Interpolation, or no degree left: jf_fit_point
- * on the same points (final_fit).  In two halves (direct_begin, then
- * direct_end), so that up to four points' first G' have their extremes
- * side by side (jf__gram_extremes_x4: the bits of one at a time). */
+ * on the same points (jf__auto_final_fit).  In two halves
+ * (jf__auto_direct_begin, then jf__auto_direct_end), so that up to four
+ * points' first G' have their extremes side by side
+ * (jf__gram_extremes_x4: the bits of one at a time). */
 typedef struct {
     mom mk;             /* the K points' sums in their own frame       */
     double fk[9], pca_ev[3], sp[4], sigma;
@@ -89,7 +90,7 @@ typedef struct {
 /* auto_direct.c, step 5.  The jet of degree d on the first k points by the
  * fitter itself (dw > 0: Gaussian distance weights of width dw, the
  * bench-only knob auto_dw), flagged JF_PT_AUTO with the noise assumed;
- * final_fit: the same without weights. */
+ * jf__auto_final_fit: the same without weights. */
 jf_status jf__auto_fit_by_fitter(jf_fitter *f, const jf_params *pr, int d, const double p[3],
                                  const double *nbr, size_t k, double sigma, double dw, jf_result *out);
 jf_status jf__auto_final_fit(jf_fitter *f, const jf_params *pr, int d, const double p[3], const double *nbr,
@@ -98,8 +99,8 @@ jf_status jf__auto_final_fit(jf_fitter *f, const jf_params *pr, int d, const dou
 void jf__auto_own_frame(const mom *mo0, double H, const double fr0[9], jf_frame_mode mode, double pca_ev[3],
                         double fk[9]);
 /* The direct fit in two halves: begin up to its first G' (1; 0 when
- * final_fit did the whole fit, its status in *st), the G's extremes
- * (gram_first, or four side by side), then end. */
+ * jf__auto_final_fit did the whole fit, its status in *st), the G's
+ * extremes (jf__auto_gram_first, or four side by side), then end. */
 int jf__auto_direct_begin(jf_fitter *f, const jf_params *pr, const double p[3], const double *nbr,
                           size_t k, const mom *mo0, double H, const double fr0[9], int d, double sigma,
                           jf__auto_dfit *D, jf_result *out, jf_status *st);
