@@ -10,7 +10,7 @@
  *    (the walk's list, bit for bit): the quadric's squared leave-one-out
  *    residual at each candidate K and sigma / r16;
  *  - the decision (jf__auto_cv_decide) sums them, each clipped at 25
- *    times its candidate's median (cv_clip), in input-index order,
+ *    times its candidate's median, in input-index order,
  *    whoever computed them: whole cloud, parts and ranks agree.
  * Where the cubic on the 16 nearest, in their own frame, predicts p better
  * than the quadric at no more than half the sample, the noise outweighs
@@ -55,7 +55,7 @@
 #define JF_CV_MAXPICK 64   /* a pick above this caps nothing               */
 #define JF_CV_MINREC 32    /* fewer usable sample points: no cap           */
 #define JF_CV_CLIP 25.0    /* a squared residual counts at most this times
-                              its candidate's median (cv_clip)            */
+                              its candidate's median                      */
 #define JF_CV_NOBIAS 1.0   /* median bias statistic at most: noise-bound   */
 #define JF_CV_MILDBIAS 4.0 /* at most: a cubic term's bias, spread carry   */
 
@@ -140,15 +140,6 @@ static int by_gid(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The median (the upper one of an even count) of a[0..m), reordered;
- * NaN where a is NULL (no memory) or empty. */
-static double median(double *a, size_t m)
-{
-    if (!a || !m) return NAN;
-    jf__select_kth(a, m, m / 2);
-    return a[m / 2];
-}
-
 /* every candidate's CV is there */
 static int usable(const jf__cvrec *r)
 {
@@ -157,26 +148,21 @@ static int usable(const jf__cvrec *r)
     return 1;
 }
 
-/* clip[c]: JF_CV_CLIP times the median of candidate c's squared residuals
- * over the usable records (+inf where none, or no memory: no clip).  A
- * few wild points' residuals dominate the plain sums (the range scan
- * ear_back's: 2 10^4 to 1, least at K = 96 where its other scans' is at
- * 16-24); clipped, a point counts at most about (3.4 sigma)^2 for
- * Gaussian residuals, whose median square is 0.455 sigma^2 (robust
- * cross-validation: Leung, Ann. Stat. 2005). */
-static void cv_clip(const jf__cvrec *r, size_t n, double clip[JF_AUTO_NCAND])
+/* The median (the upper one of an even count) of value f of the records
+ * (only the usable ones' finite values where cv, else every one not NaN:
+ * +inf, a bias with no noise at all, is the largest), gathered in t (room
+ * n; NULL, no memory: none); *m (may be NULL) how many there were. */
+static double field_median(const jf__cvrec *r, size_t n, int f, int cv, double *t, size_t *m)
 {
-    for (int c = 0; c < JF_AUTO_NCAND; c++) clip[c] = INFINITY;
-    double *t = malloc((n ? n : 1) * sizeof *t);
-    if (!t) return;
-    for (int c = 0; c < JF_AUTO_NCAND; c++) {
-        size_t m = 0;
-        for (size_t s = 0; s < n; s++)
-            if (usable(&r[s])) t[m++] = r[s].v[c];
-        if (!m) break;
-        clip[c] = JF_CV_CLIP * median(t, m);
+    size_t k = 0;
+    for (size_t s = 0; s < n && t; s++) {
+        const double v = r[s].v[f];
+        if (cv ? usable(&r[s]) && isfinite(v) : !isnan(v)) t[k++] = v;
     }
-    free(t);
+    if (m) *m = k;
+    if (!k) return NAN;
+    jf__select_kth(t, k, k / 2);
+    return t[k / 2];
 }
 
 int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
@@ -185,28 +171,31 @@ int jf__auto_cv_decide(jf__cvrec *r, size_t n, jf__auto_cv_why *why)
     memset(&w, 0, sizeof w);
     w.cap = JF_NB_AUTO_KMAX;
     qsort(r, n, sizeof *r, by_gid); /* input order: every split sums alike */
-    double clip[JF_AUTO_NCAND];
-    cv_clip(r, n, clip);
-    double sum[JF_AUTO_NCAND] = {0}, *sr = malloc((n ? n : 1) * sizeof *sr),
-           *sb = malloc((n ? n : 1) * sizeof *sb), *s32 = malloc((n ? n : 1) * sizeof *s32);
-    size_t ns = 0, nb = 0, n32 = 0, nsmall = 0, cubic = 0; /* the smallest K's: both fitted, the cubic nearer */
+    double *t = malloc((n ? n : 1) * sizeof *t);
+    /* each candidate's squared residuals clipped at JF_CV_CLIP times their
+     * median over the usable records (no clip where none, or no memory).
+     * A few wild points' residuals dominate the plain sums (the range scan
+     * ear_back's: 2 10^4 to 1, least at K = 96 where its other scans' is
+     * at 16-24); clipped, a point counts at most about (3.4 sigma)^2 for
+     * Gaussian residuals, whose median square is 0.455 sigma^2 (robust
+     * cross-validation: Leung, Ann. Stat. 2005) */
+    double clip[JF_AUTO_NCAND], sum[JF_AUTO_NCAND] = {0};
+    for (int c = 0; c < JF_AUTO_NCAND; c++) {
+        const double md = field_median(r, n, c, 1, t, NULL);
+        clip[c] = isnan(md) ? INFINITY : JF_CV_CLIP * md;
+    }
+    size_t nb = 0, n32 = 0, nsmall = 0, cubic = 0; /* the smallest K's: both fitted, the cubic nearer */
     for (size_t s = 0; s < n; s++) {
         const double *v2 = r[s].v + JF_AUTO_CV_SMALL;
         if (isfinite(v2[0]) && isfinite(v2[1])) cubic += v2[1] < v2[0], nsmall++;
-        /* +inf: a bias with no noise at all, the largest */
-        if (sb && !isnan(r[s].v[JF_AUTO_CV_BIAS])) sb[nb++] = r[s].v[JF_AUTO_CV_BIAS];
-        if (s32 && !isnan(r[s].v[JF_AUTO_CV_BIAS32])) s32[n32++] = r[s].v[JF_AUTO_CV_BIAS32];
         if (!usable(&r[s])) continue;
         for (int c = 0; c < JF_AUTO_NCAND; c++) sum[c] += fmin(r[s].v[c], clip[c]);
-        if (sr && isfinite(r[s].v[JF_AUTO_NCAND])) sr[ns++] = r[s].v[JF_AUTO_NCAND];
         w.used++;
     }
-    w.median = median(sr, ns);
-    w.bias = median(sb, nb);
-    w.bias32 = median(s32, n32);
-    free(sr);
-    free(sb);
-    free(s32);
+    w.median = field_median(r, n, JF_AUTO_NCAND, 1, t, NULL);
+    w.bias = field_median(r, n, JF_AUTO_CV_BIAS, 0, t, &nb);
+    w.bias32 = field_median(r, n, JF_AUTO_CV_BIAS32, 0, t, &n32);
+    free(t);
     if (w.used >= JF_CV_MINREC) {
         int b = 0;
         for (int c = 1; c < JF_AUTO_NCAND; c++)
