@@ -134,10 +134,11 @@ void jf__plan_nb(const jf_estimate_opts *o, jf_plan_nb *nb);
                                   23 (docs/scale.md)                      */
 #define JF_PLAN_NJ_PT 17       /* auto: step 6's record and state per point
                                   (robust/neigh_jets.h): fit_pt          */
-#define JF_PLAN_NJ_THREAD (3584u << 10) /* auto: a thread's rows in hand
-                                  (a unit and as many waiting: 224-byte
-                                  rows, 32 nearest each, decoded records;
-                                  about 3.4 MiB, walk.c): fit_thread */
+#define JF_PLAN_NJ_THREAD (5120u << 10) /* auto: a thread's rows in hand
+                                  (a unit and twice as many waiting:
+                                  224-byte rows, 32 nearest each, decoded
+                                  records; about 4.8 MiB, walk.c):
+                                  fit_thread */
 #define JF_PLAN_PARTS_MAX 32   /* each part scans the cloud three times */
 #define JF_PLAN_PART_MIN 1024  /* points: a part's fixed costs (threads,
                                   workspaces, grids) stay small          */

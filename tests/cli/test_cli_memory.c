@@ -138,7 +138,7 @@ START_TEST(coordinates_on_disk_same_bytes)
                 {"knn:12,radius:0.015", "ply", "none", "in.ply"}, {"auto", "ply", "all", "big.ply"}};
     /* on 1,500 points the least plan holds the cloud (parts of it in
      * memory); on 30,000 it reads the coordinates from the file (the
-     * whole cloud's run holds auto's rows per thread, 3.5 MiB each) */
+     * whole cloud's run holds auto's rows per thread, 5 MiB each) */
     write_sheet(cli_path("tiny.ply"), 1500, 5);
     ck_assert_int_eq(cli_run("estimate", cli_path("tiny.ply"), "-o", cli_path("a.ply"), "--neighbors",
                              "auto", "--memory", "1K", NULL),
