@@ -1294,6 +1294,12 @@ typedef struct {
                                 progress counts); jf_estimate_parts:
                                 per part, with the part's counts        */
     void *phase_user;
+    int *auto_chosen;        /* may be NULL: where the estimate decides
+                                step 0 (neighbors auto, params.auto_select
+                                1 with or without flags), the decision, in
+                                params.auto_select's form (the cap on K or
+                                1 for none, | JF_AUTO_FLAGS), is written
+                                here; untouched otherwise                */
 } jf_estimate_opts;
 
 /* Fills defaults (params.monge_degree 0: from the degree, see

@@ -191,7 +191,7 @@ static void tally_add(tally *t, const jf_result *r)
 
 /* cond[i] of every point (NaN skipped); nt tallies summed. */
 static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad, double secs,
-                    const char *out)
+                    const char *out, int chosen)
 {
     tally t = {{0}, 0, {0}, {0}, 0, 0, {0}};
     size_t nauto = 0;
@@ -222,6 +222,11 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
                 fprintf(stderr, " <=%d: %zu (%.0f%%)", kbin[b], t.k[b],
                         100.0 * (double)t.k[b] / (double)nauto);
         fputc('\n', stderr);
+    }
+    if (chosen) { /* step 0: what the cloud's cross-validation decided */
+        char line[256];
+        jf_cli_auto_step0(chosen, line, sizeof line);
+        fprintf(stderr, "  %s\n", line);
     }
     size_t m = 0;
     if (cond)
@@ -619,6 +624,8 @@ static int estimate(int argc, char **argv, int *fd)
     pg.fit_total = c.n;
     o.phase = jf_cli_progress_phase;
     o.phase_user = &pg;
+    int chosen = 0; /* neighbors auto: step 0's decision, for the summary */
+    o.auto_chosen = &chosen;
     jf_writer_progress(w, jf_cli_progress_phase, &pg);
     int nparts = plan > 1 ? plan : 1;
     pg.parts = nparts > 1;
@@ -698,7 +705,7 @@ static int estimate(int argc, char **argv, int *fd)
     }
     if (!quiet) {
         char ph[160];
-        summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out);
+        summary(sk.tl, nt, sk.cond, c.n, c.nbad, now_s() - t0, out, chosen);
         if (nparts > 1) /* --memory: the cloud was fitted in parts */
             fprintf(stderr, "  parts: %d, one at a time, within --memory\n", nparts);
         jf_cli_progress_times(&pg, ph, sizeof ph);

@@ -498,6 +498,7 @@ jf_status jf__estimate_parts_src(const jf_cloud *c, const jf_xyz_src *src,
         }
         if (sweep == 0 && st == JF_OK) {
             po.params.auto_select = jf__auto_cv_select(&o->params, cvr, ncv);
+            if (o->auto_chosen) *o->auto_chosen = po.params.auto_select;
             /* step 6's ball from the decision: 32 nearest where every mean
              * is weighted, up to JF_NJ_REACH otherwise */
             if (q.nj) q.nj = jf__nj_reach(&po.params);

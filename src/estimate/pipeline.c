@@ -200,6 +200,7 @@ static jf_status estimate(const jf_cloud *c, const jf_estimate_opts *o_in, const
             goto out;
         }
         use.params.auto_select = jf__auto_cv_select(p, cv, ncv);
+        if (o->auto_chosen) *o->auto_chosen = use.params.auto_select;
         free(cv);
     }
     jf__njs_set(&njs, &use.params);

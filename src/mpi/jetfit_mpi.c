@@ -528,6 +528,11 @@ static int estimate(jf_mpi *m, int argc, char **argv)
                 (unsigned long long)hall[0], (unsigned long long)hall[1],
                 lay.count ? (double)hall[0] / (double)lay.count : 0.0,
                 lay.count ? (double)hall[1] / (double)lay.count : 0.0);
+        if (o.nb.kind == JF_NB_AUTO) { /* step 0's decision, as jetfit estimate's */
+            char line[256];
+            jf_cli_auto_step0(o.params.auto_select, line, sizeof line);
+            fprintf(stderr, "  %s\n", line);
+        }
         fprintf(stderr, "  output: %s\n", out);
     }
     jf_mpi_cloud_free(&c);

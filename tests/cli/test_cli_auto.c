@@ -1,8 +1,9 @@
 /* test_cli_auto.c -- `--neighbors auto` end to end: the extra sigma column
  * holds the noise estimate (near the noise added), the status column has
  * the auto bit on every row, neighbors/degree say what was chosen, the
- * summary line prints the distribution of K, and --memory parts and one
- * thread give the same bytes as the whole cloud on two threads. */
+ * summary line prints the distribution of K and step 0's decision, and
+ * --memory parts and one thread give the same bytes as the whole cloud on
+ * two threads. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -45,6 +46,7 @@ START_TEST(auto_columns_and_summary)
                      0);
     ck_assert_msg(strstr(cli_err, "auto K: <="), "%s", cli_err);
     ck_assert_msg(strstr(cli_err, ", auto 1600"), "%s", cli_err);
+    ck_assert_msg(strstr(cli_err, "\n  auto step 0: "), "%s", cli_err);
     /* "ok" counts the rows with no flag but auto's (which say how the
      * row was made, not that anything went wrong) */
     const char *okp = strstr(cli_err, "  status: ok ");
@@ -71,10 +73,9 @@ START_TEST(auto_columns_and_summary)
     qsort(sg, SIDE * SIDE, sizeof sg[0], cmp_d);
     double med = sg[SIDE * SIDE / 2];
     ck_assert_msg(med > 0.6 * NOISE && med < 1.5 * NOISE, "median sigma %g vs %g", med, NOISE);
-    /* knn runs have no sigma column */
-    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("k.csv"), "--quiet",
-                             NULL),
-                     0);
+    /* knn runs have no sigma column, nor step 0's line */
+    ck_assert_int_eq(cli_run("estimate", cli_path("in.xyz"), "-o", cli_path("k.csv"), NULL), 0);
+    ck_assert_msg(!strstr(cli_err, "auto step 0"), "%s", cli_err);
     cli_read(cli_path("k.csv"), &t);
     ck_assert_int_lt(jf_eval_table_col(&t, "sigma"), 0);
     jf_eval_table_free(&t);
@@ -112,6 +113,31 @@ static size_t parts_threads(const char *in, unsigned flag)
     return c;
 }
 
+/* The summary's step 0 line of `jetfit estimate in --neighbors auto`,
+ * whole cloud and in --memory parts (the least plan): the same line, into
+ * line (empty if none). */
+static void step0_line(const char *in, char *line, size_t len)
+{
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("s.csv"), "--neighbors", "auto", NULL), 0);
+    const char *a = strstr(cli_err, "\n  auto step 0: ");
+    ck_assert_msg(a, "%s", cli_err);
+    snprintf(line, len, "%.*s", (int)strcspn(a + 3, "\n"), a + 3);
+    /* not --quiet: the least counts the summary's values */
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("s.csv"), "--neighbors", "auto", "--memory",
+                             "16K", NULL),
+                     1);
+    const char *lw = strstr(cli_err, "the least that works is --memory ");
+    char mem[32] = "";
+    ck_assert_msg(lw && sscanf(lw + 33, "%31s", mem) == 1, "%s", cli_err);
+    ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("s.csv"), "--neighbors", "auto", "--memory", mem,
+                             NULL),
+                     0);
+    ck_assert_msg(strstr(cli_err, "  parts: "), "in parts: %s", cli_err);
+    const char *b = strstr(cli_err, "\n  auto step 0: ");
+    ck_assert_msg(b && !strncmp(b + 3, line, strlen(line)) && b[3 + strlen(line)] == '\n',
+                  "parts: %s\nwhole: %s", cli_err, line);
+}
+
 START_TEST(auto_parts_threads)
 {
     write_noisy(cli_path("in.xyz"));
@@ -130,10 +156,21 @@ START_TEST(auto_parts_step0_flags)
                              "0.003", "--density", "gradient", "--seed", "27", NULL),
                      0);
     ck_assert_uint_gt(parts_threads(cli_path("torus.ply"), JF_PT_AUTO_SPREAD), 600);
+    /* the summary says so: no cap, the spread carry; the exp patch below:
+     * no cap, every row's mean weighted */
+    char line[256];
+    step0_line(cli_path("torus.ply"), line, sizeof line);
+    ck_assert_msg(strstr(line, "auto step 0: no cap on K") == line && strstr(line, "; step 6: the spread carry") &&
+                      !strstr(line, "weighted"),
+                  "%s", line);
     ck_assert_int_eq(cli_run("generate", "exp", "-o", cli_path("exp.ply"), "--n", "4000", "--noise",
                              "0.0005", "--seed", "27", NULL),
                      0);
     ck_assert_uint_eq(parts_threads(cli_path("exp.ply"), JF_PT_AUTO_WEIGHTED), 4000);
+    step0_line(cli_path("exp.ply"), line, sizeof line);
+    ck_assert_msg(strstr(line, "auto step 0: no cap on K") == line &&
+                      strstr(line, "; step 6: every row's weighted mean") && !strstr(line, "spread"),
+                  "%s", line);
 }
 END_TEST
 
@@ -157,6 +194,18 @@ START_TEST(auto_scan_capped_weighted)
     jf_eval_table_free(&t);
     ck_assert_uint_eq(both, 30379);
     ck_assert_uint_eq(at32, 30379);
+    /* the summary says what the rows show: K capped at 32, capped rows
+     * weighted (and no cubic below 48: every row a quadric) */
+    char line[256];
+    step0_line(bun, line, sizeof line);
+    ck_assert_msg(strstr(line, "auto step 0: K capped at 32;") == line &&
+                      strstr(line, "; capped rows: the weighted mean, K at least 32"),
+                  "%s", line);
+    size_t deg2 = 0;
+    cli_read(cli_path("s.csv"), &t);
+    for (size_t i = 0; i < t.nrows; i++) deg2 += cli_val(&t, i, "degree") == 2;
+    jf_eval_table_free(&t);
+    if (strstr(line, "no cubic below K = 48")) ck_assert_uint_eq(deg2, 30379);
 }
 END_TEST
 
