@@ -225,6 +225,11 @@ typedef struct {
 /* the four flags */
 #define JF_AUTO_FLAGS \
     (JF_AUTO_CUBIC_MIN48 | JF_AUTO_WEIGHTED_MEAN | JF_AUTO_SPREAD_CARRY | JF_AUTO_CAPPED_WEIGHTED)
+/* A decision of step 0 (params.auto_select's form: jf_estimate_opts.
+ * auto_chosen) in words into buf: "K capped at 32; no cubic below K = 48;
+ * capped rows: the weighted mean, K at least 32", or "no cap on K" (1 or
+ * JF_NB_AUTO_KMAX) and the flags'.  Returns buf.  Thread-safe. */
+char *jf_auto_step0_str(int chosen, char *buf, size_t len);
 
 /* Fills defaults.  Never fails. */
 void jf_params_init(jf_params *p);

@@ -29,6 +29,7 @@ class Result:
     cond: npt.NDArray[np.float64]          # (N,)
     residual: npt.NDArray[np.float64]      # (N,)
     sigma: npt.NDArray[np.float64]         # (N,) neighbors="auto": noise seen; else NaN
+    auto_step0: Optional[str]              # neighbors="auto": step 0's decision; else None
     points: object
     faces: Optional[object]
     monge_degree: int

@@ -113,6 +113,8 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
     volatile int stop = 0;
     o->cancel = check_stop;
     o->cancel_user = (void *)&stop;
+    int chosen = 0; /* neighbors="auto": step 0's decision */
+    o->auto_chosen = &chosen;
     est_job j = {c, o, whole ? res : NULL, result, {{0}}, JF_OK};
     jf_py_off_thread(est_work, &j, &stop);
     jf_status st = j.st;
@@ -120,6 +122,10 @@ static PyObject *run(jf_cloud *c, jf_py_opts *po, PyObject *points, PyObject *fa
     if (st != JF_OK) {
         Py_DECREF(result);
         return jf_py_status_error(st, j.err.msg);
+    }
+    if (chosen && jf_py_result_step0(result, chosen) < 0) {
+        Py_DECREF(result);
+        return NULL;
     }
     return nothing_fitted(c, result) ? NULL : result;
 }

@@ -98,6 +98,9 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 size_t jf_py_result_columns(PyObject *result, jf_column *cols);
 int jf_py_result_monge(PyObject *result);
 int jf_py_result_sigma(PyObject *result);
+/* Sets the Result's auto_step0 to step 0's decision (jf_estimate_opts.
+ * auto_chosen) in words; 0, or -1 with a Python error. */
+int jf_py_result_step0(PyObject *result, int chosen);
 /* Rows whose status has a flag of mask. */
 size_t jf_py_result_count(PyObject *result, unsigned mask);
 

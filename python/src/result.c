@@ -14,6 +14,7 @@ typedef struct {
     PyObject *degree, *neighbors, *status, *cond, *residual;
     PyObject *sigma; /* neighbors="auto": the noise it saw; NaN otherwise */
     PyObject *points, *faces; /* as given (points converted on demand) */
+    PyObject *auto_step0; /* neighbors="auto": step 0's decision (str); None otherwise */
     Py_ssize_t n;
     int monge;
     int with_sigma; /* neighbors="auto": sigma is an output column */
@@ -38,6 +39,7 @@ static void result_dealloc(Result *r)
     Py_XDECREF(r->sigma);
     Py_XDECREF(r->points);
     Py_XDECREF(r->faces);
+    Py_XDECREF(r->auto_step0);
     Py_TYPE(r)->tp_free((PyObject *)r);
 }
 
@@ -64,6 +66,7 @@ PyObject *jf_py_result_new(size_t n, int monge, int sigma, PyObject *points, PyO
     r->sigma = (PyObject *)jf_py_empty(1, N, 0, NPY_DOUBLE);
     r->points = Py_XNewRef(points ? points : Py_None);
     r->faces = Py_XNewRef(faces ? faces : Py_None);
+    r->auto_step0 = Py_NewRef(Py_None);
     if (!r->normal || !r->k1 || !r->k2 || !r->d1 || !r->d2 || !r->b || !r->c || !r->degree ||
         !r->neighbors || !r->status || !r->cond || !r->residual || !r->sigma) {
         Py_DECREF(r);
@@ -128,6 +131,16 @@ jf_status jf_py_result_block(void *result, const uint32_t *idx, jf_result *res, 
 int jf_py_result_monge(PyObject *result) { return ((Result *)result)->monge; }
 
 int jf_py_result_sigma(PyObject *result) { return ((Result *)result)->with_sigma; }
+
+int jf_py_result_step0(PyObject *result, int chosen)
+{
+    char line[256];
+    PyObject *s = PyUnicode_FromString(jf_auto_step0_str(chosen, line, sizeof line));
+    if (!s) return -1;
+    Result *r = (Result *)result;
+    Py_SETREF(r->auto_step0, s);
+    return 0;
+}
 
 size_t jf_py_result_count(PyObject *result, unsigned mask)
 {
@@ -270,6 +283,9 @@ static PyMemberDef members[] = {
     {"residual", T_OBJECT_EX, offsetof(Result, residual), READONLY, "(N,) RMS fit residual"},
     {"sigma", T_OBJECT_EX, offsetof(Result, sigma), READONLY,
      "(N,) neighbors='auto': the noise it estimated (length units); NaN otherwise"},
+    {"auto_step0", T_OBJECT_EX, offsetof(Result, auto_step0), READONLY,
+     "neighbors='auto': step 0's decision for the cloud, as the command's summary "
+     "says it ('K capped at 32; ...' or 'no cap on K; ...'); None otherwise"},
     {"points", T_OBJECT_EX, offsetof(Result, points), READONLY, "the points, as given"},
     {"faces", T_OBJECT_EX, offsetof(Result, faces), READONLY, "the faces (meshes) or None"},
     {"monge_degree", T_INT, offsetof(Result, monge), READONLY, "Monge degree (2..4)"},

@@ -3,7 +3,7 @@ the noise it saw in Result.sigma; same bits for any thread count."""
 import numpy as np
 
 import jetfit
-from conftest import fib_sphere
+from conftest import fib_sphere, save_xyz
 
 
 def test_auto_sigma_flags_threads():
@@ -50,3 +50,25 @@ def test_auto_weighted_where_noise_bound():
     assert not np.any(plane.status & jetfit.STATUS["auto_capped"])
     clean = jetfit.estimate(fib_sphere(3000), neighbors="auto")
     assert not np.any(clean.status & w)
+
+
+def test_auto_step0_as_command(cmd, tmp_path):
+    """Result.auto_step0 says step 0's decision as the command's summary
+    line does, and matches the rows: capped (K <= 24, every row flagged)
+    on a clean sphere, no cap on a noisy one; None for knn"""
+    clean = fib_sphere(3000)
+    rng = np.random.default_rng(5)
+    noisy = fib_sphere(3000) + rng.normal(0, 0.02, (3000, 3))
+    for name, p in (("clean", clean), ("noisy", noisy)):
+        r = jetfit.estimate(p, neighbors="auto", threads=2)
+        f = save_xyz(tmp_path / (name + ".xyz"), p)
+        _, err = cmd("estimate", f, "-o", tmp_path / "o.ply", "--neighbors", "auto")
+        line = [ln for ln in err.splitlines() if ln.startswith("  auto step 0: ")]
+        assert line == ["  auto step 0: " + r.auto_step0], (err, r.auto_step0)
+        capped = np.all(r.status & jetfit.STATUS["auto_capped"])
+        if name == "clean":
+            cap = int(r.auto_step0.split(";")[0].removeprefix("K capped at "))
+            assert capped and np.all(r.neighbors <= cap)
+        else:
+            assert r.auto_step0.startswith("no cap on K") and not np.any(r.status & jetfit.STATUS["auto_capped"])
+    assert jetfit.estimate(clean, neighbors="knn:16").auto_step0 is None

@@ -225,8 +225,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
     }
     if (chosen) { /* step 0: what the cloud's cross-validation decided */
         char line[256];
-        jf_cli_auto_step0(chosen, line, sizeof line);
-        fprintf(stderr, "  %s\n", line);
+        fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(chosen, line, sizeof line));
     }
     size_t m = 0;
     if (cond)

@@ -252,25 +252,3 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
     if (jf_cli_est_finish(e, bad)) return -1;
     return 0;
 }
-
-void jf_cli_auto_step0(int chosen, char *out, size_t len)
-{
-    static const struct {
-        int flag;
-        const char *what;
-    } fl[] = {{JF_AUTO_CUBIC_MIN48, "no cubic below K = 48"},
-              {JF_AUTO_WEIGHTED_MEAN, "step 6: every row's weighted mean"},
-              {JF_AUTO_SPREAD_CARRY, "step 6: the spread carry"},
-              {JF_AUTO_CAPPED_WEIGHTED, "capped rows: the weighted mean, K at least 32"}};
-    const int cap = chosen & ~JF_AUTO_FLAGS;
-    if (!len) return;
-    /* a cap at the largest K caps nothing (auto.c: no candidate above it) */
-    int w = cap > 1 && cap < JF_NB_AUTO_KMAX ? snprintf(out, len, "auto step 0: K capped at %d", cap)
-                    : snprintf(out, len, "auto step 0: no cap on K");
-    size_t at = 0;
-    for (size_t i = 0; i < sizeof fl / sizeof *fl; i++) {
-        if (w < 0 || (size_t)w >= len - at) return; /* full: cut */
-        at += (size_t)w;
-        w = chosen & fl[i].flag ? snprintf(out + at, len - at, "; %s", fl[i].what) : 0;
-    }
-}

@@ -69,9 +69,4 @@ int jf_cli_estimate_parse(int argc, char **argv, jf_cli_estimate_cmd *cmd, jf_cl
  * trailing B).  0 if it is not one. */
 unsigned long long jf_cli_parse_size(const char *s);
 
-/* The summary's line for neighbors auto's step 0 (jf_estimate_opts.
- * auto_chosen: the cap on K and JF_AUTO_FLAGS): "auto step 0: K capped
- * at 48; no cubic below K = 48", ... into out (always terminated). */
-void jf_cli_auto_step0(int chosen, char *out, size_t len);
-
 #endif

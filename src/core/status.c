@@ -49,3 +49,26 @@ char *jf_point_status_str(unsigned status, char *buf, size_t len)
     }
     return buf;
 }
+
+char *jf_auto_step0_str(int chosen, char *buf, size_t len)
+{
+    static const struct {
+        int flag;
+        const char *what;
+    } fl[] = {{JF_AUTO_CUBIC_MIN48, "no cubic below K = 48"},
+              {JF_AUTO_WEIGHTED_MEAN, "step 6: every row's weighted mean"},
+              {JF_AUTO_SPREAD_CARRY, "step 6: the spread carry"},
+              {JF_AUTO_CAPPED_WEIGHTED, "capped rows: the weighted mean, K at least 32"}};
+    if (!buf || !len) return buf;
+    const int cap = chosen & ~JF_AUTO_FLAGS;
+    /* a cap at the largest K caps nothing (auto.c: no candidate above it) */
+    int w = cap > 1 && cap < JF_NB_AUTO_KMAX ? snprintf(buf, len, "K capped at %d", cap)
+                                             : snprintf(buf, len, "no cap on K");
+    size_t at = 0;
+    for (size_t i = 0; i < sizeof fl / sizeof *fl; i++) {
+        if (w < 0 || (size_t)w >= len - at) break; /* full: cut */
+        at += (size_t)w;
+        w = chosen & fl[i].flag ? snprintf(buf + at, len - at, "; %s", fl[i].what) : 0;
+    }
+    return buf;
+}

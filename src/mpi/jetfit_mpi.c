@@ -530,8 +530,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
                 lay.count ? (double)hall[1] / (double)lay.count : 0.0);
         if (o.nb.kind == JF_NB_AUTO) { /* step 0's decision, as jetfit estimate's */
             char line[256];
-            jf_cli_auto_step0(o.params.auto_select, line, sizeof line);
-            fprintf(stderr, "  %s\n", line);
+            fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(o.params.auto_select, line, sizeof line));
         }
         fprintf(stderr, "  output: %s\n", out);
     }

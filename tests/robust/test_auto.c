@@ -889,6 +889,17 @@ START_TEST(test_auto_spec)
     ck_assert_int_ne(jf_nb_parse("auto:5", &s, NULL), JF_OK);
     char st[64];
     ck_assert_str_eq(jf_point_status_str(JF_PT_AUTO, st, sizeof st), "auto");
+    /* step 0's decision in words: a cap at the largest K caps nothing, the
+     * flags in their order, a short buffer cut and terminated */
+    char w[160];
+    ck_assert_str_eq(jf_auto_step0_str(1, w, sizeof w), "no cap on K");
+    ck_assert_str_eq(jf_auto_step0_str(JF_NB_AUTO_KMAX | JF_AUTO_SPREAD_CARRY, w, sizeof w),
+                     "no cap on K; step 6: the spread carry");
+    ck_assert_str_eq(jf_auto_step0_str(48 | JF_AUTO_CAPPED_WEIGHTED | JF_AUTO_CUBIC_MIN48, w, sizeof w),
+                     "K capped at 48; no cubic below K = 48; capped rows: the weighted mean, K at least 32");
+    ck_assert_str_eq(jf_auto_step0_str(24 | JF_AUTO_WEIGHTED_MEAN, w, 20), "K capped at 24; ste");
+    ck_assert_str_eq(jf_auto_step0_str(24, w, 5), "K ca");
+    ck_assert_ptr_null(jf_auto_step0_str(24, NULL, 5));
     /* a fit without auto leaves sigma NaN */
     jf_params p;
     jf_params_init(&p);
