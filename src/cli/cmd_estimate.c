@@ -13,6 +13,7 @@
 
 #include <omp.h>
 
+#include "auto_k.h"
 #include "cmd.h"
 #include "core/order_stat.h" /* the percentiles without sorting 10^8 conds */
 #include "estimate/parts.h"  /* --memory: the plan (jf__parts_plan) */
@@ -164,12 +165,8 @@ static double now_s(void)
 
 /* What the summary counts, per thread (the sink runs on the fit's
  * threads), padded so that threads do not share a cache line. */
-/* neighbors auto: the summary's bins of the chosen K (upper bounds) */
-#define NKBIN 10
-static const int kbin[NKBIN] = {16, 24, 32, 48, 64, 96, 128, 160, 200, JF_NB_AUTO_KMAX};
-
 typedef struct {
-    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1], k[NKBIN];
+    size_t flags[32], ok, deg[JF_MAX_DEGREE + 1], k[JF_CLI_NKBIN]; /* k: auto's chosen K (auto_k.h) */
     size_t unfit; /* failed or nonfinite: no fit at all */
     double big;   /* coordinates on disk: the largest finite |x|, |y|, |z| */
     char pad[64];
@@ -177,11 +174,7 @@ typedef struct {
 
 static void tally_add(tally *t, const jf_result *r)
 {
-    if (r->status & JF_PT_AUTO) {
-        int b = 0;
-        while (b < NKBIN - 1 && r->n_used > kbin[b]) b++;
-        t->k[b]++;
-    }
+    if (r->status & JF_PT_AUTO) t->k[jf_cli_kbin(r->n_used)]++;
     if (!(r->status & ~JF_CLI_HOW_FLAGS)) t->ok++; /* under auto every row has a flag */
     if (r->status & (JF_PT_FAILED | JF_PT_NONFINITE)) t->unfit++;
     for (int b = 0; b < 32; b++)
@@ -194,9 +187,8 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
                     const char *out, int chosen)
 {
     tally t = {{0}, 0, {0}, {0}, 0, 0, {0}};
-    size_t nauto = 0;
     for (int k = 0; k < nt; k++) {
-        for (int b = 0; b < NKBIN; b++) t.k[b] += tl[k].k[b];
+        for (int b = 0; b < JF_CLI_NKBIN; b++) t.k[b] += tl[k].k[b];
         t.ok += tl[k].ok;
         for (int b = 0; b < 32; b++) t.flags[b] += tl[k].flags[b];
         for (int d = 0; d <= JF_MAX_DEGREE; d++) t.deg[d] += tl[k].deg[d];
@@ -214,15 +206,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
     for (int d = 0; d <= JF_MAX_DEGREE; d++)
         if (t.deg[d]) fprintf(stderr, " %d: %zu", d, t.deg[d]);
     fputc('\n', stderr);
-    for (int b = 0; b < NKBIN; b++) nauto += t.k[b];
-    if (nauto) { /* neighbors auto: what it chose */
-        fprintf(stderr, "  auto K:");
-        for (int b = 0; b < NKBIN; b++)
-            if (t.k[b])
-                fprintf(stderr, " <=%d: %zu (%.0f%%)", kbin[b], t.k[b],
-                        100.0 * (double)t.k[b] / (double)nauto);
-        fputc('\n', stderr);
-    }
+    jf_cli_kbins_print(stderr, t.k); /* neighbors auto: what it chose */
     if (chosen) { /* step 0: what the cloud's cross-validation decided */
         char line[256];
         fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(chosen, line, sizeof line));

@@ -28,6 +28,7 @@
 #include <omp.h>
 
 #include "auto_cloud.h"
+#include "auto_k.h"
 #include "io_internal.h"
 #include "mpi_internal.h"
 #include "opts.h"
@@ -460,6 +461,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         o.phase_user = &pg;
     }
     jf_result *res = NULL;
+    uint64_t kall[JF_CLI_NKBIN] = {0}; /* rank 0: auto's chosen K, every rank's rows */
     if (!failed && o.nb.kind == JF_NB_AUTO) failed = auto_cap(m, in, &c, &o, lay.count);
     if (!failed) {
         res = malloc((c.n ? c.n : 1) * sizeof *res);
@@ -479,6 +481,13 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         if (!failed) {
             nothing_fitted(m, in, &c, res, lay.count);
             failed = jf_mpi_check(m);
+        }
+        /* auto's chosen K over every rank's own rows, for the summary */
+        if (!failed && o.nb.kind == JF_NB_AUTO) {
+            uint64_t mine[JF_CLI_NKBIN] = {0};
+            for (size_t j = 0; j < c.n; j++)
+                if (c.own[j] && (res[j].status & JF_PT_AUTO)) mine[jf_cli_kbin(res[j].n_used)]++;
+            MPI_Reduce(mine, kall, JF_CLI_NKBIN, MPI_UINT64_T, MPI_SUM, 0, m->comm);
         }
     }
     double t2 = MPI_Wtime();
@@ -528,7 +537,10 @@ static int estimate(jf_mpi *m, int argc, char **argv)
                 (unsigned long long)hall[0], (unsigned long long)hall[1],
                 lay.count ? (double)hall[0] / (double)lay.count : 0.0,
                 lay.count ? (double)hall[1] / (double)lay.count : 0.0);
-        if (o.nb.kind == JF_NB_AUTO) { /* step 0's decision, as jetfit estimate's */
+        if (o.nb.kind == JF_NB_AUTO) { /* the chosen K and step 0's decision, as jetfit estimate's */
+            size_t kc[JF_CLI_NKBIN];
+            for (int b = 0; b < JF_CLI_NKBIN; b++) kc[b] = (size_t)kall[b];
+            jf_cli_kbins_print(stderr, kc);
             char line[256];
             fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(o.params.auto_select, line, sizeof line));
         }

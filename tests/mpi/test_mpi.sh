@@ -137,13 +137,16 @@ equal-more)
   set -- $h
   if [ -n "$h" ] && [ "$1" -gt 0 ] && [ "$1" = "$2" ]; then echo "ok   np 3 auto halo: $1 kept, $2 fetched"
   else bad "np 3 auto halo: '$h' (want N kept, N fetched)"; cat "$d/stderr"; fi
-  # the summary's line for step 0's decision: the ranks' as the whole cloud's
+  # the summary's lines for the chosen K and step 0's decision: the
+  # ranks' as the whole cloud's
   for c in clean spread scan; do
     "$jetfit" estimate "$d/$c.ply" -o "$d/ref.csv" --neighbors auto 2>"$d/want" >/dev/null
     mpi 2 estimate "$d/$c.ply" -o "$d/got.csv" --neighbors auto 2>"$d/stderr" >/dev/null
-    w=$(grep '^  auto step 0: ' "$d/want") g=$(grep '^  auto step 0: ' "$d/stderr")
-    if [ -n "$w" ] && [ "$w" = "$g" ]; then echo "ok   np 2 $c: the same step 0 line:$w"
-    else bad "np 2 $c: step 0 line '$g', jetfit estimate's '$w'"; fi
+    for l in 'auto K' 'auto step 0'; do
+      w=$(grep "^  $l: " "$d/want") g=$(grep "^  $l: " "$d/stderr")
+      if [ -n "$w" ] && [ "$w" = "$g" ]; then echo "ok   np 2 $c: the same line:$w"
+      else bad "np 2 $c: '$g', jetfit estimate's '$w'"; fi
+    done
   done
   ;;
 errors)
