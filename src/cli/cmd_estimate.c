@@ -206,11 +206,7 @@ static void summary(const tally *tl, int nt, double *cond, size_t n, size_t nbad
     for (int d = 0; d <= JF_MAX_DEGREE; d++)
         if (t.deg[d]) fprintf(stderr, " %d: %zu", d, t.deg[d]);
     fputc('\n', stderr);
-    jf_cli_kbins_print(stderr, t.k); /* neighbors auto: what it chose */
-    if (chosen) { /* step 0: what the cloud's cross-validation decided */
-        char line[256];
-        fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(chosen, line, sizeof line));
-    }
+    jf_cli_auto_summary(stderr, t.k, chosen); /* neighbors auto: what it chose */
     size_t m = 0;
     if (cond)
         for (size_t i = 0; i < n; i++)

@@ -540,9 +540,7 @@ static int estimate(jf_mpi *m, int argc, char **argv)
         if (o.nb.kind == JF_NB_AUTO) { /* the chosen K and step 0's decision, as jetfit estimate's */
             size_t kc[JF_CLI_NKBIN];
             for (int b = 0; b < JF_CLI_NKBIN; b++) kc[b] = (size_t)kall[b];
-            jf_cli_kbins_print(stderr, kc);
-            char line[256];
-            fprintf(stderr, "  auto step 0: %s\n", jf_auto_step0_str(o.params.auto_select, line, sizeof line));
+            jf_cli_auto_summary(stderr, kc, o.params.auto_select);
         }
         fprintf(stderr, "  output: %s\n", out);
     }

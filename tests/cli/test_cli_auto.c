@@ -113,9 +113,9 @@ static size_t parts_threads(const char *in, unsigned flag)
     return c;
 }
 
-/* The summary's step 0 line of `jetfit estimate in --neighbors auto`,
- * whole cloud and in --memory parts (the least plan): the same line, into
- * line (empty if none). */
+/* The summary's step 0 line of `jetfit estimate in --neighbors auto`
+ * into line, asserting it is there and the same in --memory parts (the
+ * least plan). */
 static void step0_line(const char *in, char *line, size_t len)
 {
     ck_assert_int_eq(cli_run("estimate", in, "-o", cli_path("s.csv"), "--neighbors", "auto", NULL), 0);
